@@ -1,0 +1,206 @@
+// Acceleration-constrained hybrid dynamics of a serial KDL::Chain (Popov-Vereshchagin algorithm).
+//
+// The solver minimises Gauss' acceleration energy of the chain subject to m <= 6 linear
+// acceleration constraints on the last segment, in O(n) sweeps plus one m x m eigen-solve:
+//
+//     min_qdd  Z(qdd)   s.t.   alfa^T Xdd_N = beta
+//
+// Units are SI throughout (m, rad, kg, kg m^2, N, N m, s).
+//
+// Frames and signs (identical to KDL 1.5.1's ChainHdSolver_Vereshchagin, so KDL users can switch):
+//  * Spatial motion vectors (twists, accelerations) are [linear; angular]; force vectors (wrenches)
+//    are [force; moment].
+//  * root_acc: the spatial acceleration of the base, in the base frame. Gravity enters as an
+//    upward base acceleration: gravity g = (0, 0, -9.81) m/s^2 is root_acc = (0, 0, +9.81, 0, 0, 0).
+//    (KDL's RNE/FD solvers take the opposite sign; the Python API takes physical gravity.)
+//  * alfa (6 x m): each column a unit constraint wrench, rows 0-2 force, rows 3-5 moment, axes of the
+//    base frame, moment about the origin of the last segment's tip frame. m may change per call.
+//  * beta (m): acceleration-energy set-points, beta = alfa^T Xdd_N, where Xdd_N is the last
+//    segment's spatial acceleration (base axes, tip origin) INCLUDING root_acc. To hold the tip still
+//    along z against gravity, beta_z = 9.81 (not 0).
+//  * f_ext (6 x n_segments, one column per segment): the wrench applied on segment i by the
+//    environment, base axes, moment about segment i's tip origin. Gravity does not go here.
+//  * ff_torques (n_joints): generalised joint forces (N m or N) added as-is (springs, friction, ...).
+//  * Segment inertias are KDL RigidBodyInertia in the segment tip frame; the joint's rotor inertia
+//    (KDL::Joint::getInertia()) adds to the joint's articulated inertia. Joint damping and stiffness
+//    are ignored, as in KDL. Fixed joints are supported anywhere in the chain.
+//
+// Outputs after a successful solve():
+//  * qdd (n_joints): joint accelerations, rad/s^2 or m/s^2.
+//  * nu (m): constraint force magnitudes; the constraint wrench acting ON the last segment is
+//    -alfa * nu (base axes, tip origin).
+//  * command torques (n_joints): tau_cmd = -J^T alfa nu, J the base-frame Jacobian of the last
+//    segment's tip. ff_torques + tau_cmd applied to the unconstrained chain (forward dynamics with
+//    the same f_ext and gravity) reproduces qdd exactly. Unlike KDL's `constraint_torques`, these
+//    are valid motor commands.
+//  * link accelerations (6 x (n_segments + 1)): column 0 is root_acc, column i the spatial
+//    acceleration of segment i's tip frame, base axes, tip origin, including root_acc (KDL's
+//    getTransformedLinkAcceleration).
+//  * constraint rank and smallest singular value of the coupling matrix K = alfa^T J H^-1 J^T alfa
+//    (m x m, symmetric positive semi-definite, units 1/kg-like: acceleration per force).
+//
+// Singular tasks: K is inverted by eigen-decomposition. Policy TruncatedPseudoInverse (default)
+// drops eigenvalues below rcond * largest eigenvalue (the rank reported counts the others);
+// DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda. Both give
+// finite outputs for any valid input.
+//
+// Affine structure: qdd and tau_cmd are affine in ff_torques. After a solve, responseColumns()
+// returns d(qdd)/d(tau_j) and d(tau_cmd)/d(tau_j) for requested joints j, O(n) per column, reusing
+// the factorisation (the columns of G = H^-1 - H^-1 A^T K^+ A H^-1, A = alfa^T J).
+//
+// Real-time use: construction allocates everything; solve(), CartToJnt() and responseColumns()
+// allocate no heap memory and do bounded work. One instance is not thread-safe; use one per thread.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <kdl/chain.hpp>
+#include <kdl/frames.hpp>
+#include <kdl/jacobian.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/solveri.hpp>
+#include <kdl/chainidsolver.hpp>  // KDL::Wrenches
+
+#include "vereshchagin/spatial.hpp"
+
+namespace vereshchagin {
+
+enum class SingularityPolicy { TruncatedPseudoInverse, DampedLeastSquares };
+
+struct SolverOptions {
+  SingularityPolicy policy = SingularityPolicy::TruncatedPseudoInverse;
+  // Truncation threshold relative to the largest eigenvalue of the coupling matrix (>= 0).
+  double rcond = 1e-12;
+  // Damping of the damped-least-squares policy, in the eigenvalues' units (> 0 for that policy).
+  double damping = 1e-6;
+};
+
+class ChainHdSolver : public KDL::SolverI {
+ public:
+  static constexpr int kMaxConstraints = 6;
+  using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+  using MatrixC = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstraints,
+                                kMaxConstraints>;
+  using VectorC = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxConstraints, 1>;
+
+  // Error codes in addition to KDL::SolverI's (E_SIZE_MISMATCH = -4, E_OUT_OF_RANGE = -6, ...).
+  enum {
+    E_NONFINITE_INPUT = -100,      // NaN or Inf in an input
+    E_INVALID_MODEL = -101,        // negative mass, non-PSD inertia, negative rotor inertia, ...
+    E_DEGENERATE_INERTIA = -102,   // a joint's articulated inertia is zero: no unique motion
+    E_TOO_MANY_CONSTRAINTS = -103, // alfa has more than 6 columns
+    E_NO_SOLUTION = -104,          // responseColumns() called before a successful solve
+    E_INVALID_OPTIONS = -105,      // rcond < 0, damping <= 0 for the damped policy, non-finite
+  };
+
+  // The chain is copied. root_acc: base acceleration (gravity as +9.81 along up), see above.
+  // Construction never throws for a bad model: the error is kept and returned by every solve
+  // (check modelError()).
+  ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc,
+                const SolverOptions& options = SolverOptions());
+
+  // KDL-compatible entry point. alfa: KDL::Jacobian (6 x m, m = 0..6); beta: m entries;
+  // f_ext: one wrench per segment; command_torques: output tau_cmd (see above), must be sized
+  // n_joints like q_dotdot. Returns 0 or an error code.
+  int CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot,
+                const KDL::Jacobian& alfa, const KDL::JntArray& beta, const KDL::Wrenches& f_ext,
+                const KDL::JntArray& ff_torques, KDL::JntArray& command_torques);
+
+  // Eigen entry point. f_ext (6 x n_segments) and ff_torques (n_joints) may be empty (zero).
+  // alfa may have 0 columns (plain forward dynamics); beta has as many entries as alfa columns.
+  int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+            const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const Matrix6X>& f_ext,
+            const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+
+  // Results of the last successful solve.
+  const Eigen::VectorXd& qdd() const { return qdd_; }
+  const Eigen::VectorXd& commandTorques() const { return tau_cmd_; }
+  Eigen::Map<const Eigen::VectorXd> nu() const { return Eigen::Map<const Eigen::VectorXd>(nu_.data(), m_); }
+  const Matrix6X& linkAccelerations() const { return link_acc_; }
+  int constraintCount() const { return m_; }
+  int constraintRank() const { return rank_; }
+  double smallestSingularValue() const { return sigma_min_; }
+
+  // KDL-style getters.
+  void getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot) const;
+  void getConstraintForceMagnitude(Eigen::VectorXd& nu) const { nu = this->nu(); }
+  void getContraintForceMagnitude(Eigen::VectorXd& nu) const { getConstraintForceMagnitude(nu); }
+
+  // Affine response to unit joint torques, after a successful solve. joints: k joint indices;
+  // dqdd, dtau_cmd: n_joints x k outputs (column c answers joint joints[c]).
+  int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                      Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
+
+  void setRootAcceleration(const KDL::Twist& root_acc);
+  int setOptions(const SolverOptions& options);
+  const SolverOptions& options() const { return options_; }
+
+  unsigned int nrOfJoints() const { return nj_; }
+  unsigned int nrOfSegments() const { return ns_; }
+  const KDL::Chain& chain() const { return chain_; }
+
+  // E_NOERROR if the model is valid, else the reason's code (message in errorMessage()).
+  int modelError() const { return model_error_; }
+  // Human-readable detail of the last error (which argument, which joint, what was expected).
+  const char* errorMessage() const { return message_.data(); }
+  const char* strError(const int error) const override;
+
+  // The chain has changed: recompute the model data (KDL::SolverI interface).
+  void updateInternalDataStructures() override;
+
+ private:
+  struct Segment {
+    Pose X;                 // pose of this tip frame in the parent tip frame (q-dependent)
+    Matrix3 R_base;         // orientation of this tip frame in the base frame
+    Vector6 S;              // joint motion axis in the tip frame (zero for fixed joints)
+    Matrix6 I;              // rigid-body inertia about the tip origin, tip frame
+    Matrix6 IA;             // articulated inertia
+    Vector6 v, c, pA;       // velocity, velocity-product acceleration, articulated bias force
+    Vector6 u;              // IA * S
+    Vector6 xdd;            // spatial acceleration (tip frame)
+    Vector6 dpA;            // workspace of responseColumns()
+    Eigen::Matrix<double, 6, kMaxConstraints> A;  // constraint wrenches felt by this segment
+    double rotor = 0.0, D = 0.0, Dinv = 0.0;
+    int joint = -1;         // joint index or -1 for a fixed joint
+  };
+
+  int fail(int code, const char* fmt, ...);
+  void buildModel();
+  int checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                  const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                  const Eigen::Ref<const Matrix6X>& f_ext,
+                  const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Matrix6X>& f_ext);
+  int inwardSweep(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void factorizeCoupling();
+  // out = K^+ rhs under the singularity policy (K = -L0).
+  void applyCouplingInverse(const VectorC& rhs, VectorC& out) const;
+  void commandFromNu(const VectorC& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
+
+  KDL::Chain chain_;
+  SolverOptions options_;
+  Vector6 root_acc_;
+  unsigned int nj_ = 0, ns_ = 0;
+  double d_tolerance_ = 0.0;
+  int model_error_ = E_NOERROR;
+  std::array<char, 512> message_{};
+
+  std::vector<Segment> segs_;
+  Eigen::VectorXd qdd_, tau_cmd_, zero_joints_;
+  Matrix6X link_acc_, f_ext_buf_, zero_f_ext_;
+  Matrix6 alfa_buf_;
+  int m_ = 0, rank_ = 0;
+  double sigma_min_ = 0.0;
+  bool solved_ = false;
+  VectorC U0_, nu_;
+  MatrixC L0_;
+  Eigen::SelfAdjointEigenSolver<MatrixC> eig_;
+  VectorC inv_eigen_;   // per-eigenvalue multiplier of the policy
+};
+
+}  // namespace vereshchagin

@@ -1,0 +1,101 @@
+// Small spatial-vector algebra on fixed-size Eigen types, used by the solver's sweeps.
+//
+// Conventions (same as KDL): a motion vector (twist, spatial acceleration) is [linear; angular],
+// a force vector (wrench) is [force; moment]; both are expressed in some frame and refer to that
+// frame's origin. A `Pose` {R, p} is the pose of a child frame in its parent frame: R has the
+// child's axes as columns (parent coordinates), p is the child's origin in parent coordinates.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace vereshchagin {
+
+using Vector3 = Eigen::Matrix<double, 3, 1>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+using Matrix3 = Eigen::Matrix<double, 3, 3>;
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+
+struct Pose {
+  Matrix3 R = Matrix3::Identity();
+  Vector3 p = Vector3::Zero();
+};
+
+inline Matrix3 skew(const Vector3& a) {
+  Matrix3 s;
+  s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return s;
+}
+
+// Motion vector given in the parent frame -> the same motion in the child frame.
+// w' = R^T w, v' = R^T (v - p x w).
+template <typename In>
+inline Vector6 motionToChild(const Pose& X, const Eigen::MatrixBase<In>& m) {
+  Vector6 out;
+  const Vector3 w = m.template tail<3>();
+  out.template tail<3>().noalias() = X.R.transpose() * w;
+  out.template head<3>().noalias() = X.R.transpose() * (m.template head<3>() - X.p.cross(w));
+  return out;
+}
+
+// Force vector given in the child frame -> the same force in the parent frame.
+// f = R f', n = R n' + p x (R f').
+template <typename In>
+inline Vector6 forceToParent(const Pose& X, const Eigen::MatrixBase<In>& f) {
+  Vector6 out;
+  out.template head<3>().noalias() = X.R * f.template head<3>();
+  out.template tail<3>().noalias() = X.R * f.template tail<3>();
+  out.template tail<3>() += X.p.cross(out.template head<3>());
+  return out;
+}
+
+// Spatial cross product for motions: m1 x m2.
+inline Vector6 crossMotion(const Vector6& a, const Vector6& b) {
+  Vector6 out;
+  const Vector3 av = a.head<3>(), aw = a.tail<3>();
+  out.head<3>() = aw.cross(b.head<3>()) + av.cross(b.tail<3>());
+  out.tail<3>() = aw.cross(b.tail<3>());
+  return out;
+}
+
+// Spatial cross product motion x* force.
+inline Vector6 crossForce(const Vector6& a, const Vector6& f) {
+  Vector6 out;
+  const Vector3 av = a.head<3>(), aw = a.tail<3>();
+  out.head<3>() = aw.cross(f.head<3>());
+  out.tail<3>() = aw.cross(f.tail<3>()) + av.cross(f.head<3>());
+  return out;
+}
+
+// A symmetric 6x6 inertia (rigid or articulated) given in the child frame, expressed in the
+// parent frame: X^* I X with X the parent-to-child motion transform. Block form with
+// I = [M H; H^T J]: rotate every block by R, then shift the reference point by p (P = [p]x):
+// M' = M, H' = H - M P, J' = J - H^T P + P H - P M P.
+inline void addInertiaToParent(const Pose& X, const Matrix6& Ic, Matrix6& Ip) {
+  const Matrix3& R = X.R;
+  const Matrix3 M = R * Ic.topLeftCorner<3, 3>() * R.transpose();
+  const Matrix3 H = R * Ic.topRightCorner<3, 3>() * R.transpose();
+  const Matrix3 J = R * Ic.bottomRightCorner<3, 3>() * R.transpose();
+  const Matrix3 P = skew(X.p);
+  const Matrix3 MP = M * P;
+  const Matrix3 H2 = H - MP;
+  const Matrix3 PH = P * H;
+  const Matrix3 J2 = J - H.transpose() * P + PH - P * MP;
+  Ip.topLeftCorner<3, 3>() += M;
+  Ip.topRightCorner<3, 3>() += H2;
+  Ip.bottomLeftCorner<3, 3>() += H2.transpose();
+  Ip.bottomRightCorner<3, 3>() += J2;
+}
+
+// Rigid-body inertia about a frame origin, from mass m, centre of mass c and rotational inertia
+// Io about the frame origin (all in that frame): [m 1, -m [c]x; m [c]x, Io].
+inline Matrix6 rigidInertia(double m, const Vector3& c, const Matrix3& Io) {
+  Matrix6 I;
+  const Matrix3 mc = m * skew(c);
+  I.topLeftCorner<3, 3>() = m * Matrix3::Identity();
+  I.topRightCorner<3, 3>() = -mc;
+  I.bottomLeftCorner<3, 3>() = mc;
+  I.bottomRightCorner<3, 3>() = Io;
+  return I;
+}
+
+}  // namespace vereshchagin

@@ -1,0 +1,505 @@
+// Popov-Vereshchagin hybrid dynamics: implementation. The math and conventions are stated in
+// chain_hd_solver.hpp. Notation in the comments: segment i has tip frame i, X_i the pose of frame
+// i in frame i-1, S_i the joint axis in frame i, IA_i / pA_i the articulated inertia / bias force,
+// A_i the 6 x m constraint wrenches felt by segment i, U (m) the acceleration energy already
+// produced by bias forces and torques, L (m x m) the one produced by unit constraint forces.
+#include "vereshchagin/chain_hd_solver.hpp"
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <limits>
+
+namespace vereshchagin {
+
+namespace {
+
+bool allFinite(const Eigen::Ref<const Eigen::MatrixXd>& m) { return m.allFinite(); }
+
+Pose toPose(const KDL::Frame& f) {
+  Pose X;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) X.R(r, c) = f.M(r, c);
+    X.p(r) = f.p(r);
+  }
+  return X;
+}
+
+}  // namespace
+
+ChainHdSolver::ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc,
+                             const SolverOptions& options)
+    : chain_(chain), options_(options) {
+  setRootAcceleration(root_acc);
+  buildModel();
+  if (model_error_ == E_NOERROR) {
+    const int rc = setOptions(options);
+    if (rc != E_NOERROR) model_error_ = rc;
+  }
+}
+
+void ChainHdSolver::updateInternalDataStructures() { buildModel(); }
+
+void ChainHdSolver::setRootAcceleration(const KDL::Twist& root_acc) {
+  for (int k = 0; k < 3; ++k) {
+    root_acc_(k) = root_acc.vel(k);
+    root_acc_(3 + k) = root_acc.rot(k);
+  }
+}
+
+int ChainHdSolver::setOptions(const SolverOptions& options) {
+  if (!std::isfinite(options.rcond) || options.rcond < 0.0 || options.rcond >= 1.0) {
+    return fail(E_INVALID_OPTIONS, "options.rcond must be finite and in [0, 1), got %g", options.rcond);
+  }
+  if (!std::isfinite(options.damping) || options.damping < 0.0 ||
+      (options.policy == SingularityPolicy::DampedLeastSquares && options.damping <= 0.0)) {
+    return fail(E_INVALID_OPTIONS,
+                "options.damping must be finite and > 0 for the damped least-squares policy, got %g",
+                options.damping);
+  }
+  options_ = options;
+  solved_ = false;
+  return E_NOERROR;
+}
+
+int ChainHdSolver::fail(int code, const char* fmt, ...) {
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(message_.data(), message_.size(), fmt, args);
+  va_end(args);
+  error = code;
+  return code;
+}
+
+const char* ChainHdSolver::strError(const int code) const {
+  switch (code) {
+    case E_NONFINITE_INPUT: return "An input contains NaN or Inf";
+    case E_INVALID_MODEL: return "The chain's physical parameters are invalid";
+    case E_DEGENERATE_INERTIA: return "A joint has zero articulated inertia";
+    case E_TOO_MANY_CONSTRAINTS: return "More than 6 constraints on one segment";
+    case E_NO_SOLUTION: return "No successful solve to take the response from";
+    case E_INVALID_OPTIONS: return "Invalid solver options";
+    default: return KDL::SolverI::strError(code);
+  }
+}
+
+void ChainHdSolver::buildModel() {
+  model_error_ = E_NOERROR;
+  message_[0] = '\0';
+  solved_ = false;
+  nj_ = chain_.getNrOfJoints();
+  ns_ = chain_.getNrOfSegments();
+  segs_.assign(ns_, Segment());
+  qdd_ = Eigen::VectorXd::Zero(nj_);
+  tau_cmd_ = Eigen::VectorXd::Zero(nj_);
+  zero_joints_ = Eigen::VectorXd::Zero(nj_);
+  link_acc_ = Matrix6X::Zero(6, ns_ + 1);
+  f_ext_buf_ = Matrix6X::Zero(6, ns_);
+  zero_f_ext_ = Matrix6X::Zero(6, ns_);
+  alfa_buf_.setZero();
+  m_ = 0;
+  rank_ = 0;
+  sigma_min_ = 0.0;
+
+  double scale = 0.0;  // typical size of a joint inertia, for the degeneracy tolerance
+  unsigned int j = 0;
+  for (unsigned int i = 0; i < ns_; ++i) {
+    const KDL::Segment& seg = chain_.getSegment(i);
+    const KDL::Joint& joint = seg.getJoint();
+    Segment& s = segs_[i];
+    const KDL::RigidBodyInertia& rbi = seg.getInertia();
+    const double mass = rbi.getMass();
+    const KDL::Vector cog = rbi.getCOG();
+    const KDL::RotationalInertia Io = rbi.getRotationalInertia();  // about the tip origin
+    Vector3 c(cog.x(), cog.y(), cog.z());
+    Matrix3 I_origin = Eigen::Map<const Matrix3>(Io.data);
+    if (!std::isfinite(mass) || !c.allFinite() || !I_origin.allFinite()) {
+      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): non-finite inertial parameters", i,
+                          seg.getName().c_str());
+      return;
+    }
+    if (mass < 0.0) {
+      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): mass must be >= 0, got %g", i,
+                          seg.getName().c_str(), mass);
+      return;
+    }
+    // Rotational inertia about the centre of mass must be symmetric positive semi-definite.
+    const Matrix3 Sc = skew(c);
+    const Matrix3 I_com = I_origin + mass * Sc * Sc;
+    const double tol = 1e-12 * std::max(1.0, I_com.cwiseAbs().maxCoeff());
+    if ((I_com - I_com.transpose()).cwiseAbs().maxCoeff() > tol) {
+      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): rotational inertia is not symmetric",
+                          i, seg.getName().c_str());
+      return;
+    }
+    Eigen::SelfAdjointEigenSolver<Matrix3> es(I_com, Eigen::EigenvaluesOnly);
+    if (es.eigenvalues().minCoeff() < -tol) {
+      model_error_ = fail(E_INVALID_MODEL,
+                          "segment %u ('%s'): rotational inertia about the centre of mass is not "
+                          "positive semi-definite (smallest eigenvalue %g)",
+                          i, seg.getName().c_str(), es.eigenvalues().minCoeff());
+      return;
+    }
+    s.I = rigidInertia(mass, c, 0.5 * (I_origin + I_origin.transpose()));
+    scale += I_com.trace() + mass * (c.squaredNorm() + seg.getFrameToTip().p.Norm() *
+                                                           seg.getFrameToTip().p.Norm());
+    if (joint.getType() == KDL::Joint::Fixed) {
+      s.joint = -1;
+      s.S.setZero();
+    } else {
+      s.joint = static_cast<int>(j++);
+      s.rotor = joint.getInertia();
+      if (!std::isfinite(s.rotor) || s.rotor < 0.0) {
+        model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): rotor inertia must be >= 0, got %g",
+                            s.joint, joint.getName().c_str(), s.rotor);
+        return;
+      }
+      scale += s.rotor;
+      // The joint axis is fixed in the child body, so in the tip frame it does not depend on q.
+      const KDL::Twist t = seg.twist(0.0, 1.0);           // root axes, tip reference point
+      const KDL::Rotation Rt = seg.pose(0.0).M.Inverse();  // root axes -> tip axes
+      const KDL::Vector v = Rt * t.vel, w = Rt * t.rot;
+      s.S << v.x(), v.y(), v.z(), w.x(), w.y(), w.z();
+      if (!s.S.allFinite() || s.S.norm() == 0.0) {
+        model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite",
+                            s.joint, joint.getName().c_str());
+        return;
+      }
+    }
+  }
+  d_tolerance_ = 1e-13 * std::max(scale, std::numeric_limits<double>::min());
+
+  // Reject chains whose joints have no inertia to move (checked at q = 0, at rest).
+  outwardSweep(zero_joints_, zero_joints_, zero_f_ext_);
+  const int rc = inwardSweep(alfa_buf_.leftCols(0), zero_joints_);
+  if (rc != E_NOERROR) model_error_ = rc;
+}
+
+int ChainHdSolver::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q,
+                               const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                               const Eigen::Ref<const Matrix6X>& alfa,
+                               const Eigen::Ref<const Eigen::VectorXd>& beta,
+                               const Eigen::Ref<const Matrix6X>& f_ext,
+                               const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  if (model_error_ != E_NOERROR) {
+    error = model_error_;
+    return model_error_;  // message_ still holds the model's problem
+  }
+  const long nj = nj_, ns = ns_;
+  if (q.size() != nj) return fail(E_SIZE_MISMATCH, "q has %ld entries, expected %ld (joints)", (long)q.size(), nj);
+  if (q_dot.size() != nj)
+    return fail(E_SIZE_MISMATCH, "q_dot has %ld entries, expected %ld (joints)", (long)q_dot.size(), nj);
+  if (ff_torques.size() != nj && ff_torques.size() != 0)
+    return fail(E_SIZE_MISMATCH, "ff_torques has %ld entries, expected %ld (joints) or 0",
+                (long)ff_torques.size(), nj);
+  if (f_ext.cols() != ns && f_ext.cols() != 0)
+    return fail(E_SIZE_MISMATCH, "f_ext has %ld wrenches, expected %ld (segments) or 0",
+                (long)f_ext.cols(), ns);
+  if (alfa.cols() > kMaxConstraints)
+    return fail(E_TOO_MANY_CONSTRAINTS, "alfa has %ld columns, at most %d constraints are supported",
+                (long)alfa.cols(), kMaxConstraints);
+  if (beta.size() != alfa.cols())
+    return fail(E_SIZE_MISMATCH, "beta has %ld entries, expected %ld (one per alfa column)",
+                (long)beta.size(), (long)alfa.cols());
+  if (!allFinite(q)) return fail(E_NONFINITE_INPUT, "q contains NaN or Inf");
+  if (!allFinite(q_dot)) return fail(E_NONFINITE_INPUT, "q_dot contains NaN or Inf");
+  if (!allFinite(ff_torques)) return fail(E_NONFINITE_INPUT, "ff_torques contains NaN or Inf");
+  if (!allFinite(f_ext)) return fail(E_NONFINITE_INPUT, "f_ext contains NaN or Inf");
+  if (!allFinite(alfa)) return fail(E_NONFINITE_INPUT, "alfa contains NaN or Inf");
+  if (!allFinite(beta)) return fail(E_NONFINITE_INPUT, "beta contains NaN or Inf");
+  if (!root_acc_.allFinite()) return fail(E_NONFINITE_INPUT, "root acceleration contains NaN or Inf");
+  return E_NOERROR;
+}
+
+// Outward sweep: poses, velocities, velocity-product accelerations, rigid bias forces.
+void ChainHdSolver::outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                 const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                                 const Eigen::Ref<const Matrix6X>& f_ext) {
+  Vector6 v_parent = Vector6::Zero();
+  Matrix3 R_parent = Matrix3::Identity();
+  const bool has_fext = f_ext.cols() != 0;
+  for (unsigned int i = 0; i < ns_; ++i) {
+    Segment& s = segs_[i];
+    const double qi = s.joint >= 0 ? q(s.joint) : 0.0;
+    s.X = toPose(chain_.getSegment(i).pose(qi));
+    s.R_base.noalias() = R_parent * s.X.R;
+    s.v = motionToChild(s.X, v_parent);
+    if (s.joint >= 0) {
+      const Vector6 vj = s.S * q_dot(s.joint);
+      s.v += vj;
+      s.c = crossMotion(s.v, vj);
+    } else {
+      s.c.setZero();
+    }
+    s.pA = crossForce(s.v, s.I * s.v);
+    if (has_fext) {
+      // f_ext: base axes, moment about this tip's origin -> tip axes.
+      s.pA.head<3>().noalias() -= s.R_base.transpose() * f_ext.col(i).head<3>();
+      s.pA.tail<3>().noalias() -= s.R_base.transpose() * f_ext.col(i).tail<3>();
+    }
+    s.IA = s.I;
+    v_parent = s.v;
+    R_parent = s.R_base;
+  }
+}
+
+// Inward sweep: articulated inertias and bias forces, constraint wrenches felt by each segment,
+// acceleration-energy contributions U and L.
+int ChainHdSolver::inwardSweep(const Eigen::Ref<const Matrix6X>& alfa,
+                               const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  const int m = static_cast<int>(alfa.cols());
+  m_ = m;
+  U0_.setZero(m);
+  L0_.setZero(m, m);
+  if (ns_ == 0) return E_NOERROR;
+  {
+    // alfa: base axes -> last tip axes (moment reference point is already the tip origin).
+    Segment& last = segs_[ns_ - 1];
+    last.A.topLeftCorner(3, m).noalias() = last.R_base.transpose() * alfa.topRows<3>();
+    last.A.bottomLeftCorner(3, m).noalias() = last.R_base.transpose() * alfa.bottomRows<3>();
+  }
+  const bool has_tau = ff_torques.size() != 0;
+  for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
+    Segment& s = segs_[i];
+    Vector6 pa;
+    Eigen::Matrix<double, 6, kMaxConstraints> Aproj;  // constraint wrenches passed to the parent
+    if (s.joint >= 0) {
+      s.u.noalias() = s.IA * s.S;
+      s.D = s.rotor + s.S.dot(s.u);
+      if (!(s.D > d_tolerance_)) {
+        return fail(E_DEGENERATE_INERTIA,
+                    "joint %d ('%s') has zero articulated inertia (%g): the bodies it moves have no "
+                    "mass or inertia about its axis and it has no rotor inertia",
+                    s.joint, chain_.getSegment(i).getJoint().getName().c_str(), s.D);
+      }
+      s.Dinv = 1.0 / s.D;
+      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
+      const Vector6 IAc = s.IA * s.c;
+      // Joint acceleration with the parent at rest and no constraint: the free part.
+      const double free = s.Dinv * (tau - s.S.dot(s.pA + IAc));
+      // Apparent bias force: pA + IA c + u (tau - S^T (pA + IA c)) / D  (equals P pA + ... ).
+      pa = s.pA + IAc + s.u * (free);
+      if (m > 0) {
+        const auto A = s.A.leftCols(m);
+        Eigen::Matrix<double, 1, kMaxConstraints> e;  // S^T A
+        e.leftCols(m).noalias() = s.S.transpose() * A;
+        U0_.noalias() += A.transpose() * (s.c + s.S * free);
+        L0_.noalias() -= s.Dinv * e.leftCols(m).transpose() * e.leftCols(m);
+        Aproj.leftCols(m) = A;
+        Aproj.leftCols(m).noalias() -= s.Dinv * s.u * e.leftCols(m);
+      }
+    } else {
+      pa = s.pA;  // rigid attachment: no joint freedom, no velocity product
+      if (m > 0) Aproj.leftCols(m) = s.A.leftCols(m);
+    }
+    if (i > 0) {
+      Segment& p = segs_[i - 1];
+      // Apparent inertia IA - u u^T / D (or IA for a fixed joint), moved to the parent.
+      if (s.joint >= 0) {
+        Matrix6 Ia = s.IA;
+        Ia.noalias() -= s.Dinv * s.u * s.u.transpose();
+        addInertiaToParent(s.X, Ia, p.IA);
+      } else {
+        addInertiaToParent(s.X, s.IA, p.IA);
+      }
+      p.pA += forceToParent(s.X, pa);
+      for (int k = 0; k < m; ++k) p.A.col(k) = forceToParent(s.X, Aproj.col(k));
+    } else {
+      // Constraint wrenches at the base frame: the balance uses A_0^T Xdd_0.
+      for (int k = 0; k < m; ++k) U0_(k) += forceToParent(s.X, Aproj.col(k)).dot(root_acc_);
+    }
+  }
+  return E_NOERROR;
+}
+
+void ChainHdSolver::factorizeCoupling() {
+  const int m = m_;
+  rank_ = 0;
+  sigma_min_ = 0.0;
+  inv_eigen_.setZero(m);
+  if (m == 0) return;
+  const MatrixC K = -L0_;  // symmetric positive semi-definite
+  eig_.compute(K);
+  const auto& lam = eig_.eigenvalues();  // ascending
+  const double lmax = std::max(lam(m - 1), 0.0);
+  const double cut = options_.rcond * lmax;
+  sigma_min_ = std::max(lam(0), 0.0);
+  for (int k = 0; k < m; ++k) {
+    const double l = std::max(lam(k), 0.0);
+    const bool kept = lmax > 0.0 && l > cut;
+    if (kept) ++rank_;
+    if (options_.policy == SingularityPolicy::TruncatedPseudoInverse) {
+      inv_eigen_(k) = kept ? 1.0 / l : 0.0;
+    } else {
+      inv_eigen_(k) = l / (l * l + options_.damping * options_.damping);
+    }
+  }
+}
+
+void ChainHdSolver::applyCouplingInverse(const VectorC& rhs, VectorC& out) const {
+  const int m = m_;
+  if (m == 0) {
+    out.resize(0);
+    return;
+  }
+  VectorC t;
+  t.noalias() = eig_.eigenvectors().transpose() * rhs;
+  t.array() *= inv_eigen_.array();
+  out.noalias() = eig_.eigenvectors() * t;
+}
+
+// tau_cmd = -J^T alfa nu: the wrench -A_N nu on the last segment carried rigidly to each joint.
+void ChainHdSolver::commandFromNu(const VectorC& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) const {
+  tau_cmd.setZero();
+  if (m_ == 0 || ns_ == 0) return;
+  Vector6 f;
+  f.noalias() = -(segs_[ns_ - 1].A.leftCols(m_) * nu);
+  // segs_[ns_-1].A was overwritten by nothing: the last segment's A is alfa in tip axes.
+  for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
+    const Segment& s = segs_[i];
+    if (s.joint >= 0) tau_cmd(s.joint) = s.S.dot(f);
+    if (i > 0) f = forceToParent(s.X, f);
+  }
+}
+
+int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
+                         const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                         const Eigen::Ref<const Matrix6X>& alfa,
+                         const Eigen::Ref<const Eigen::VectorXd>& beta,
+                         const Eigen::Ref<const Matrix6X>& f_ext,
+                         const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  solved_ = false;
+  int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques);
+  if (rc != E_NOERROR) return rc;
+  outwardSweep(q, q_dot, f_ext);
+  rc = inwardSweep(alfa, ff_torques);
+  if (rc != E_NOERROR) return rc;
+
+  // Balance of acceleration energy at the base: A_0^T Xdd_0 + U_0 + L_0 nu = beta.
+  factorizeCoupling();
+  const int m = m_;
+  VectorC rhs = U0_ - beta;  // nu = L0^-1 (beta - U0) = K^+ (U0 - beta), K = -L0
+  applyCouplingInverse(rhs, nu_);
+
+  // Final outward sweep: joint and link accelerations.
+  const bool has_tau = ff_torques.size() != 0;
+  Vector6 xdd_parent = root_acc_;
+  link_acc_.col(0) = root_acc_;
+  for (unsigned int i = 0; i < ns_; ++i) {
+    Segment& s = segs_[i];
+    Vector6 a = motionToChild(s.X, xdd_parent);
+    a += s.c;
+    if (s.joint >= 0) {
+      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
+      double f = s.S.dot(s.pA) + s.u.dot(a);  // S^T IA a = u^T a (IA symmetric)
+      if (m > 0) f += s.S.dot(s.A.leftCols(m) * nu_);
+      const double qdd = s.Dinv * (tau - f);
+      qdd_(s.joint) = qdd;
+      a += s.S * qdd;
+    }
+    s.xdd = a;
+    link_acc_.col(i + 1).head<3>().noalias() = s.R_base * a.head<3>();
+    link_acc_.col(i + 1).tail<3>().noalias() = s.R_base * a.tail<3>();
+    xdd_parent = a;
+  }
+  commandFromNu(nu_, tau_cmd_);
+  solved_ = true;
+  error = E_NOERROR;
+  return E_NOERROR;
+}
+
+int ChainHdSolver::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot,
+                             KDL::JntArray& q_dotdot, const KDL::Jacobian& alfa,
+                             const KDL::JntArray& beta, const KDL::Wrenches& f_ext,
+                             const KDL::JntArray& ff_torques, KDL::JntArray& command_torques) {
+  if (q_dotdot.rows() != nj_)
+    return fail(E_SIZE_MISMATCH, "q_dotdot has %u entries, expected %u", q_dotdot.rows(), nj_);
+  if (command_torques.rows() != nj_)
+    return fail(E_SIZE_MISMATCH, "command_torques has %u entries, expected %u",
+                command_torques.rows(), nj_);
+  if (f_ext.size() != ns_)
+    return fail(E_SIZE_MISMATCH, "f_ext has %zu wrenches, expected %u (segments)", f_ext.size(), ns_);
+  if (ff_torques.rows() != nj_)
+    return fail(E_SIZE_MISMATCH, "ff_torques has %u entries, expected %u", ff_torques.rows(), nj_);
+  for (unsigned int i = 0; i < ns_; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      f_ext_buf_(k, i) = f_ext[i].force(k);
+      f_ext_buf_(3 + k, i) = f_ext[i].torque(k);
+    }
+  }
+  const int rc = solve(q.data, q_dot.data, alfa.data, beta.data, f_ext_buf_, ff_torques.data);
+  if (rc != E_NOERROR) return rc;
+  q_dotdot.data = qdd_;
+  command_torques.data = tau_cmd_;
+  return E_NOERROR;
+}
+
+void ChainHdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot) const {
+  x_dotdot.resize(ns_ + 1);
+  for (unsigned int i = 0; i <= ns_; ++i) {
+    const auto a = link_acc_.col(i);
+    x_dotdot[i] = KDL::Twist(KDL::Vector(a(0), a(1), a(2)), KDL::Vector(a(3), a(4), a(5)));
+  }
+}
+
+int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints,
+                                   Eigen::Ref<Eigen::MatrixXd> dqdd,
+                                   Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
+  if (!solved_) return fail(E_NO_SOLUTION, "responseColumns() needs a successful solve() first");
+  const long k = joints.size();
+  if (dqdd.rows() != nj_ || dqdd.cols() != k)
+    return fail(E_SIZE_MISMATCH, "dqdd is %ldx%ld, expected %ux%ld", (long)dqdd.rows(),
+                (long)dqdd.cols(), nj_, k);
+  if (dtau_cmd.rows() != nj_ || dtau_cmd.cols() != k)
+    return fail(E_SIZE_MISMATCH, "dtau_cmd is %ldx%ld, expected %ux%ld", (long)dtau_cmd.rows(),
+                (long)dtau_cmd.cols(), nj_, k);
+  for (long c = 0; c < k; ++c) {
+    if (joints(c) < 0 || joints(c) >= static_cast<int>(nj_))
+      return fail(E_OUT_OF_RANGE, "joint index %d out of range [0, %u)", joints(c), nj_);
+  }
+  const int m = m_;
+  for (long c = 0; c < k; ++c) {
+    const int jt = joints(c);
+    // Inward, force part only: a unit torque at joint jt; bodies distal to it feel nothing.
+    VectorC dU = VectorC::Zero(m);
+    Vector6 dp = Vector6::Zero();  // apparent bias force passed to the parent
+    bool started = false;
+    for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
+      Segment& s = segs_[i];
+      if (!started) {
+        s.dpA.setZero();
+        if (s.joint != jt) continue;
+        started = true;
+      } else {
+        s.dpA = forceToParent(segs_[i + 1].X, dp);
+      }
+      if (s.joint >= 0) {
+        const double dtau = s.joint == jt ? 1.0 : 0.0;
+        const double dfree = s.Dinv * (dtau - s.S.dot(s.dpA));
+        dp = s.dpA + s.u * dfree;
+        if (m > 0) dU.noalias() += s.A.leftCols(m).transpose() * (s.S * dfree);
+      } else {
+        dp = s.dpA;
+      }
+    }
+    VectorC dnu;
+    applyCouplingInverse(dU, dnu);  // d nu = K^+ dU
+    Vector6 a = Vector6::Zero();
+    for (unsigned int i = 0; i < ns_; ++i) {
+      const Segment& s = segs_[i];
+      a = motionToChild(s.X, a);
+      if (s.joint >= 0) {
+        const double dtau = s.joint == jt ? 1.0 : 0.0;
+        double f = s.S.dot(s.dpA) + s.u.dot(a);
+        if (m > 0) f += s.S.dot(s.A.leftCols(m) * dnu);
+        const double dq = s.Dinv * (dtau - f);
+        dqdd(s.joint, c) = dq;
+        a += s.S * dq;
+      }
+    }
+    commandFromNu(dnu, dtau_cmd.col(c));
+  }
+  return E_NOERROR;
+}
+
+}  // namespace vereshchagin
