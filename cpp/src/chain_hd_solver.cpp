@@ -100,6 +100,7 @@ void ChainHdSolver::buildModel() {
   m_ = 0;
   rank_ = 0;
   sigma_min_ = 0.0;
+  sigma_known_ = true;
 
   double scale = 0.0;  // typical size of a joint inertia, for the degeneracy tolerance
   unsigned int j = 0;
@@ -169,8 +170,12 @@ void ChainHdSolver::buildModel() {
   }
   d_tolerance_ = 1e-13 * std::max(scale, std::numeric_limits<double>::min());
 
-  // Reject chains whose joints have no inertia to move (checked at q = 0, at rest).
-  outwardSweep(zero_joints_, zero_joints_, zero_f_ext_);
+  // Reject chains whose joints have no inertia to move. Checked at a generic configuration (not
+  // q = 0, where a body may sit on an axis by coincidence); a configuration-dependent loss of
+  // inertia is reported by solve().
+  Eigen::VectorXd q_generic(nj_);
+  for (unsigned int k = 0; k < nj_; ++k) q_generic(k) = 0.7 + 0.61 * k;
+  outwardSweep(q_generic, zero_joints_, zero_f_ext_);
   const int rc = inwardSweep(alfa_buf_.leftCols(0), zero_joints_);
   if (rc != E_NOERROR) model_error_ = rc;
 }
@@ -244,25 +249,44 @@ void ChainHdSolver::outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q,
 }
 
 // Inward sweep: articulated inertias and bias forces, constraint wrenches felt by each segment,
-// acceleration-energy contributions U and L.
+// acceleration-energy contributions U and L. Templated on the constraint count so that the
+// per-segment constraint algebra runs on fixed-size blocks.
 int ChainHdSolver::inwardSweep(const Eigen::Ref<const Matrix6X>& alfa,
                                const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  const int m = static_cast<int>(alfa.cols());
-  m_ = m;
-  U0_.setZero(m);
-  L0_.setZero(m, m);
-  if (ns_ == 0) return E_NOERROR;
-  {
+  switch (alfa.cols()) {
+    case 0: return inwardSweepT<0>(alfa, ff_torques);
+    case 1: return inwardSweepT<1>(alfa, ff_torques);
+    case 2: return inwardSweepT<2>(alfa, ff_torques);
+    case 3: return inwardSweepT<3>(alfa, ff_torques);
+    case 4: return inwardSweepT<4>(alfa, ff_torques);
+    case 5: return inwardSweepT<5>(alfa, ff_torques);
+    default: return inwardSweepT<6>(alfa, ff_torques);
+  }
+}
+
+template <int M>
+int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
+                                const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  using RowM = Eigen::Matrix<double, 1, M>;
+  using VecM = Eigen::Matrix<double, M, 1>;
+  using MatM = Eigen::Matrix<double, M, M>;
+  using Mat6M = Eigen::Matrix<double, 6, M>;
+  m_ = M;
+  VecM U = VecM::Zero();
+  MatM L = MatM::Zero();
+  if (ns_ > 0 && M > 0) {
     // alfa: base axes -> last tip axes (moment reference point is already the tip origin).
     Segment& last = segs_[ns_ - 1];
-    last.A.topLeftCorner(3, m).noalias() = last.R_base.transpose() * alfa.topRows<3>();
-    last.A.bottomLeftCorner(3, m).noalias() = last.R_base.transpose() * alfa.bottomRows<3>();
+    last.A.template topLeftCorner<3, M>().noalias() = last.R_base.transpose() * alfa.template topLeftCorner<3, M>();
+    last.A.template bottomLeftCorner<3, M>().noalias() =
+        last.R_base.transpose() * alfa.template bottomLeftCorner<3, M>();
   }
   const bool has_tau = ff_torques.size() != 0;
   for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
     Segment& s = segs_[i];
     Vector6 pa;
-    Eigen::Matrix<double, 6, kMaxConstraints> Aproj;  // constraint wrenches passed to the parent
+    Mat6M Aproj;  // constraint wrenches passed to the parent
+    const auto A = s.A.template leftCols<M>();
     if (s.joint >= 0) {
       s.u.noalias() = s.IA * s.S;
       s.D = s.rotor + s.S.dot(s.u);
@@ -277,20 +301,19 @@ int ChainHdSolver::inwardSweep(const Eigen::Ref<const Matrix6X>& alfa,
       const Vector6 IAc = s.IA * s.c;
       // Joint acceleration with the parent at rest and no constraint: the free part.
       const double free = s.Dinv * (tau - s.S.dot(s.pA + IAc));
-      // Apparent bias force: pA + IA c + u (tau - S^T (pA + IA c)) / D  (equals P pA + ... ).
-      pa = s.pA + IAc + s.u * (free);
-      if (m > 0) {
-        const auto A = s.A.leftCols(m);
-        Eigen::Matrix<double, 1, kMaxConstraints> e;  // S^T A
-        e.leftCols(m).noalias() = s.S.transpose() * A;
-        U0_.noalias() += A.transpose() * (s.c + s.S * free);
-        L0_.noalias() -= s.Dinv * e.leftCols(m).transpose() * e.leftCols(m);
-        Aproj.leftCols(m) = A;
-        Aproj.leftCols(m).noalias() -= s.Dinv * s.u * e.leftCols(m);
+      // Apparent bias force: pA + IA c + u (tau - S^T (pA + IA c)) / D.
+      pa = s.pA + IAc + s.u * free;
+      if (M > 0) {
+        RowM e;  // S^T A
+        e.noalias() = s.S.transpose() * A;
+        U.noalias() += A.transpose() * (s.c + s.S * free);
+        L.noalias() -= s.Dinv * e.transpose() * e;
+        Aproj = A;
+        Aproj.noalias() -= s.Dinv * s.u * e;
       }
     } else {
       pa = s.pA;  // rigid attachment: no joint freedom, no velocity product
-      if (m > 0) Aproj.leftCols(m) = s.A.leftCols(m);
+      if (M > 0) Aproj = A;
     }
     if (i > 0) {
       Segment& p = segs_[i - 1];
@@ -303,27 +326,74 @@ int ChainHdSolver::inwardSweep(const Eigen::Ref<const Matrix6X>& alfa,
         addInertiaToParent(s.X, s.IA, p.IA);
       }
       p.pA += forceToParent(s.X, pa);
-      for (int k = 0; k < m; ++k) p.A.col(k) = forceToParent(s.X, Aproj.col(k));
-    } else {
+      if (M > 0) {
+        // Constraint wrenches to the parent frame, all columns at once: f = R f', n = R n' + p x f.
+        auto top = p.A.template topLeftCorner<3, M>();
+        auto bottom = p.A.template bottomLeftCorner<3, M>();
+        top.noalias() = s.X.R * Aproj.template topRows<3>();
+        bottom.noalias() = s.X.R * Aproj.template bottomRows<3>();
+        bottom.noalias() += skew(s.X.p) * top;
+      }
+    } else if (M > 0) {
       // Constraint wrenches at the base frame: the balance uses A_0^T Xdd_0.
-      for (int k = 0; k < m; ++k) U0_(k) += forceToParent(s.X, Aproj.col(k)).dot(root_acc_);
+      Mat6M A0;
+      A0.template topRows<3>().noalias() = s.X.R * Aproj.template topRows<3>();
+      A0.template bottomRows<3>().noalias() = s.X.R * Aproj.template bottomRows<3>();
+      A0.template bottomRows<3>().noalias() += skew(s.X.p) * A0.template topRows<3>();
+      U.noalias() += A0.transpose() * root_acc_;
     }
   }
+  U0_ = U;
+  L0_ = L;
   return E_NOERROR;
+}
+
+// Final outward sweep: joint and link accelerations, given the constraint magnitudes nu_.
+template <int M>
+void ChainHdSolver::finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  const bool has_tau = ff_torques.size() != 0;
+  Eigen::Matrix<double, M, 1> nu;
+  if (M > 0) nu = nu_;
+  Vector6 xdd_parent = root_acc_;
+  link_acc_.col(0) = root_acc_;
+  for (unsigned int i = 0; i < ns_; ++i) {
+    Segment& s = segs_[i];
+    Vector6 a = motionToChild(s.X, xdd_parent);
+    a += s.c;
+    if (s.joint >= 0) {
+      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
+      double f = s.S.dot(s.pA) + s.u.dot(a);  // S^T IA a = u^T a (IA symmetric)
+      if (M > 0) f += s.S.dot(s.A.template leftCols<M>() * nu);
+      const double qdd = s.Dinv * (tau - f);
+      qdd_(s.joint) = qdd;
+      a += s.S * qdd;
+    }
+    s.xdd = a;
+    link_acc_.col(i + 1).head<3>().noalias() = s.R_base * a.head<3>();
+    link_acc_.col(i + 1).tail<3>().noalias() = s.R_base * a.tail<3>();
+    xdd_parent = a;
+  }
 }
 
 void ChainHdSolver::factorizeCoupling() {
   const int m = m_;
   rank_ = 0;
-  sigma_min_ = 0.0;
-  inv_eigen_.setZero(m);
+  sigma_known_ = false;
+  use_cholesky_ = false;
   if (m == 0) return;
-  const MatrixC K = -L0_;  // symmetric positive semi-definite
-  eig_.compute(K);
+  K_ = -L0_;  // symmetric positive semi-definite
+  if (options_.policy == SingularityPolicy::TruncatedPseudoInverse && choleskyFullRank()) {
+    use_cholesky_ = true;
+    rank_ = m;
+    return;
+  }
+  eig_.compute(K_);
+  inv_eigen_.setZero(m);
   const auto& lam = eig_.eigenvalues();  // ascending
   const double lmax = std::max(lam(m - 1), 0.0);
   const double cut = options_.rcond * lmax;
   sigma_min_ = std::max(lam(0), 0.0);
+  sigma_known_ = true;
   for (int k = 0; k < m; ++k) {
     const double l = std::max(lam(k), 0.0);
     const bool kept = lmax > 0.0 && l > cut;
@@ -336,10 +406,73 @@ void ChainHdSolver::factorizeCoupling() {
   }
 }
 
+// Cholesky factor K = L L^T (into chol_), and a proof that every eigenvalue of K is above the
+// truncation threshold: lambda_min(K) = 1 / ||L^-1||_2^2 >= 1 / ||L^-1||_F^2 and
+// lambda_max(K) <= trace(K). False if the factorisation breaks down or the proof fails.
+bool ChainHdSolver::choleskyFullRank() {
+  const int m = m_;
+  chol_.setZero(m, m);
+  double trace = 0.0;
+  for (int j = 0; j < m; ++j) {
+    trace += K_(j, j);
+    double d = K_(j, j);
+    for (int k = 0; k < j; ++k) d -= chol_(j, k) * chol_(j, k);
+    if (!(d > 0.0)) return false;
+    const double ljj = std::sqrt(d);
+    chol_(j, j) = ljj;
+    for (int i = j + 1; i < m; ++i) {
+      double v = K_(i, j);
+      for (int k = 0; k < j; ++k) v -= chol_(i, k) * chol_(j, k);
+      chol_(i, j) = v / ljj;
+    }
+  }
+  // ||L^-1||_F^2, column by column of X = L^-1 (lower triangular) by forward substitution.
+  double frob2 = 0.0;
+  for (int c = 0; c < m; ++c) {
+    double x[kMaxConstraints];
+    for (int i = c; i < m; ++i) {
+      double v = i == c ? 1.0 : 0.0;
+      for (int k = c; k < i; ++k) v -= chol_(i, k) * x[k];
+      x[i] = v / chol_(i, i);
+      frob2 += x[i] * x[i];
+    }
+  }
+  const double lower = 1.0 / frob2;
+  return std::isfinite(lower) && lower > options_.rcond * trace;
+}
+
+double ChainHdSolver::smallestSingularValue() const {
+  if (!sigma_known_) {
+    if (m_ == 0) {
+      sigma_min_ = 0.0;
+    } else {
+      sigma_eig_.compute(K_, Eigen::EigenvaluesOnly);
+      sigma_min_ = std::max(sigma_eig_.eigenvalues()(0), 0.0);
+    }
+    sigma_known_ = true;
+  }
+  return sigma_min_;
+}
+
 void ChainHdSolver::applyCouplingInverse(const VectorC& rhs, VectorC& out) const {
   const int m = m_;
   if (m == 0) {
     out.resize(0);
+    return;
+  }
+  if (use_cholesky_) {
+    // K x = rhs with K = L L^T: forward then backward substitution.
+    out.resize(m);
+    for (int i = 0; i < m; ++i) {
+      double v = rhs(i);
+      for (int k = 0; k < i; ++k) v -= chol_(i, k) * out(k);
+      out(i) = v / chol_(i, i);
+    }
+    for (int i = m - 1; i >= 0; --i) {
+      double v = out(i);
+      for (int k = i + 1; k < m; ++k) v -= chol_(k, i) * out(k);
+      out(i) = v / chol_(i, i);
+    }
     return;
   }
   VectorC t;
@@ -381,26 +514,14 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
   VectorC rhs = U0_ - beta;  // nu = L0^-1 (beta - U0) = K^+ (U0 - beta), K = -L0
   applyCouplingInverse(rhs, nu_);
 
-  // Final outward sweep: joint and link accelerations.
-  const bool has_tau = ff_torques.size() != 0;
-  Vector6 xdd_parent = root_acc_;
-  link_acc_.col(0) = root_acc_;
-  for (unsigned int i = 0; i < ns_; ++i) {
-    Segment& s = segs_[i];
-    Vector6 a = motionToChild(s.X, xdd_parent);
-    a += s.c;
-    if (s.joint >= 0) {
-      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
-      double f = s.S.dot(s.pA) + s.u.dot(a);  // S^T IA a = u^T a (IA symmetric)
-      if (m > 0) f += s.S.dot(s.A.leftCols(m) * nu_);
-      const double qdd = s.Dinv * (tau - f);
-      qdd_(s.joint) = qdd;
-      a += s.S * qdd;
-    }
-    s.xdd = a;
-    link_acc_.col(i + 1).head<3>().noalias() = s.R_base * a.head<3>();
-    link_acc_.col(i + 1).tail<3>().noalias() = s.R_base * a.tail<3>();
-    xdd_parent = a;
+  switch (m) {
+    case 0: finalSweepT<0>(ff_torques); break;
+    case 1: finalSweepT<1>(ff_torques); break;
+    case 2: finalSweepT<2>(ff_torques); break;
+    case 3: finalSweepT<3>(ff_torques); break;
+    case 4: finalSweepT<4>(ff_torques); break;
+    case 5: finalSweepT<5>(ff_torques); break;
+    default: finalSweepT<6>(ff_torques); break;
   }
   commandFromNu(nu_, tau_cmd_);
   solved_ = true;

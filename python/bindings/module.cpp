@@ -380,14 +380,22 @@ class PySolver {
   }
 
   py::tuple responseColumns(const py::object& joints) {
-    py::array_t<long long, py::array::c_style | py::array::forcecast> idx = py::array_t<long long>::ensure(joints);
-    if (!idx || idx.ndim() != 1) raise("joints must be a 1-D sequence of joint indices");
+    const char* what = "joints must be a 1-D sequence of integer joint indices";
+    if (joints.is_none() || py::isinstance<py::str>(joints)) raise(what);
+    py::array idx_any = py::array::ensure(joints);
+    if (!idx_any) {
+      PyErr_Clear();
+      raise(what);
+    }
+    if (idx_any.ndim() != 1 || (idx_any.size() > 0 && idx_any.dtype().kind() != 'i' && idx_any.dtype().kind() != 'u'))
+      raise(std::string(what) + ", got shape " + shapeStr(idx_any) + " of dtype " + std::string(py::str(idx_any.dtype())));
+    auto idx = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(idx_any);
     const py::ssize_t k = idx.shape(0);
     Eigen::VectorXi j(k);
     for (py::ssize_t c = 0; c < k; ++c) {
       const long long v = idx.at(c);
       if (v < 0 || v >= static_cast<long long>(nj_))
-        raise("joint index " + std::to_string(v) + " out of range [0, " + std::to_string(nj_) + ")");
+        raise("joints: index " + std::to_string(v) + " out of range [0, " + std::to_string(nj_) + ")");
       j(c) = static_cast<int>(v);
     }
     Eigen::MatrixXd dq(nj_, k), dt(nj_, k);
@@ -433,7 +441,30 @@ PYBIND11_MODULE(_core, mod) {
 
   py::class_<PyChain>(mod, "Chain")
       .def(py::init<>())
-      .def("add_segment", &PyChain::addSegment, py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(),
+      .def("add_segment", &PyChain::addSegment, R"doc(Append a segment (a joint followed by a rigid body).
+
+Parameters
+----------
+name : str
+    Segment (link) name.
+joint : str or Joint
+    'rot_x', 'rot_y', 'rot_z', 'trans_x', 'trans_y', 'trans_z' (about / along the axes of the
+    segment's root frame, i.e. the previous segment's tip frame), 'fixed', or
+    Joint.revolute(axis, origin) (rotation about the line through ``origin`` along ``axis``) /
+    Joint.prismatic(axis) (translation along ``axis``), in the root frame.
+tip : array_like, shape (4, 4), optional
+    Pose of the segment's tip frame in its root frame when the joint is at 0 (KDL convention).
+mass : float
+    kg, >= 0.
+com : array_like, shape (3,), optional
+    Centre of mass in the tip frame, m.
+inertia : array_like, shape (3, 3), optional
+    Rotational inertia about the centre of mass, tip-frame axes, kg m^2 (symmetric PSD).
+rotor_inertia : float
+    Motor rotor inertia reflected to the joint (kg m^2 or kg), added to the joint's inertia.
+joint_name : str, optional
+    Defaults to ``name + '_joint'``.
+)doc", py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(),
            py::arg("mass") = 0.0, py::arg("com") = py::none(), py::arg("inertia") = py::none(),
            py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "")
       .def_property_readonly("n_joints", [](const PyChain& c) { return c.chain.getNrOfJoints(); })

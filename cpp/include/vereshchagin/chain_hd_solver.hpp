@@ -42,7 +42,9 @@
 // Singular tasks: K is inverted by eigen-decomposition. Policy TruncatedPseudoInverse (default)
 // drops eigenvalues below rcond * largest eigenvalue (the rank reported counts the others);
 // DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda. Both give
-// finite outputs for any valid input.
+// finite outputs for any valid input. Fast path: when a Cholesky factor K = L L^T proves every
+// eigenvalue above the threshold (lambda_min >= 1 / ||L^-1||_F^2 > rcond * trace K >= rcond *
+// lambda_max), K^+ = K^-1 is applied through L, which is the same solution at a fraction of the cost.
 //
 // Affine structure: qdd and tau_cmd are affine in ff_torques. After a solve, responseColumns()
 // returns d(qdd)/d(tau_j) and d(tau_cmd)/d(tau_j) for requested joints j, O(n) per column, reusing
@@ -123,7 +125,8 @@ class ChainHdSolver : public KDL::SolverI {
   const Matrix6X& linkAccelerations() const { return link_acc_; }
   int constraintCount() const { return m_; }
   int constraintRank() const { return rank_; }
-  double smallestSingularValue() const { return sigma_min_; }
+  // Smallest eigenvalue (= singular value) of K; computed on first request after a solve.
+  double smallestSingularValue() const;
 
   // KDL-style getters.
   void getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot) const;
@@ -177,7 +180,12 @@ class ChainHdSolver : public KDL::SolverI {
   void outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                     const Eigen::Ref<const Matrix6X>& f_ext);
   int inwardSweep(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  template <int M>
+  int inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  template <int M>
+  void finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   void factorizeCoupling();
+  bool choleskyFullRank();
   // out = K^+ rhs under the singularity policy (K = -L0).
   void applyCouplingInverse(const VectorC& rhs, VectorC& out) const;
   void commandFromNu(const VectorC& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
@@ -195,12 +203,18 @@ class ChainHdSolver : public KDL::SolverI {
   Matrix6X link_acc_, f_ext_buf_, zero_f_ext_;
   Matrix6 alfa_buf_;
   int m_ = 0, rank_ = 0;
-  double sigma_min_ = 0.0;
   bool solved_ = false;
   VectorC U0_, nu_;
-  MatrixC L0_;
+  MatrixC L0_, K_;
+  // K is factorised by Cholesky when it is certainly of full rank (fast path), else by a full
+  // eigen-decomposition that applies the singularity policy.
+  bool use_cholesky_ = false;
+  MatrixC chol_;  // lower Cholesky factor of K on the fast path
   Eigen::SelfAdjointEigenSolver<MatrixC> eig_;
   VectorC inv_eigen_;   // per-eigenvalue multiplier of the policy
+  mutable bool sigma_known_ = false;
+  mutable double sigma_min_ = 0.0;
+  mutable Eigen::SelfAdjointEigenSolver<MatrixC> sigma_eig_;
 };
 
 }  // namespace vereshchagin
