@@ -1,0 +1,99 @@
+// Shared helpers of the Python bindings: the exception type and checked numpy conversions that
+// name the offending argument in their messages.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <sstream>
+#include <string>
+
+#include <Eigen/Dense>
+#include <kdl/frames.hpp>
+
+namespace vsbind {
+
+namespace py = pybind11;
+
+struct SolverError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+[[noreturn]] inline void raise(const std::string& msg) { throw SolverError(msg); }
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+inline std::string shapeStr(const py::array& a) {
+  std::ostringstream s;
+  s << "(";
+  for (py::ssize_t k = 0; k < a.ndim(); ++k) s << (k ? ", " : "") << a.shape(k);
+  if (a.ndim() == 1) s << ",";
+  s << ")";
+  return s.str();
+}
+
+inline Array toArray(const py::handle& obj, const char* name) {
+  Array a = Array::ensure(obj);
+  if (!a) {
+    PyErr_Clear();
+    raise(std::string(name) + " must be a numeric array-like of floats");
+  }
+  return a;
+}
+
+inline void requireFinite(const Array& a, const char* name) {
+  const double* p = a.data();
+  for (py::ssize_t k = 0; k < a.size(); ++k) {
+    if (!std::isfinite(p[k])) {
+      raise(std::string(name) + " contains NaN or Inf (flat index " + std::to_string(k) + ")");
+    }
+  }
+}
+
+inline Array vectorArg(const py::handle& obj, const char* name, py::ssize_t n) {
+  Array a = toArray(obj, name);
+  if (a.ndim() != 1 || a.shape(0) != n) {
+    raise(std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + shapeStr(a));
+  }
+  requireFinite(a, name);
+  return a;
+}
+
+inline KDL::Frame frameFrom4x4(const py::handle& obj, const char* name) {
+  Array T = toArray(obj, name);
+  if (T.ndim() != 2 || T.shape(0) != 4 || T.shape(1) != 4) {
+    raise(std::string(name) + " must be a 4x4 homogeneous transform, got shape " + shapeStr(T));
+  }
+  requireFinite(T, name);
+  auto t = T.unchecked<2>();
+  if (std::abs(t(3, 0)) > 1e-12 || std::abs(t(3, 1)) > 1e-12 || std::abs(t(3, 2)) > 1e-12 ||
+      std::abs(t(3, 3) - 1.0) > 1e-12) {
+    raise(std::string(name) + " must have last row [0, 0, 0, 1]");
+  }
+  Eigen::Matrix3d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = t(r, c);
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-9 ||
+      R.determinant() < 0.0) {
+    raise(std::string(name) + ": the upper-left 3x3 block must be a rotation matrix (orthonormal, det +1)");
+  }
+  return KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0),
+                                  R(2, 1), R(2, 2)),
+                    KDL::Vector(t(0, 3), t(1, 3), t(2, 3)));
+}
+
+inline KDL::Vector vec3(const py::handle& obj, const char* name) {
+  Array a = vectorArg(obj, name, 3);
+  return KDL::Vector(a.at(0), a.at(1), a.at(2));
+}
+
+inline py::array_t<double> copyVector(const double* p, py::ssize_t n) {
+  py::array_t<double> a(n);
+  std::copy(p, p + n, a.mutable_data());
+  return a;
+}
+
+
+}  // namespace vsbind

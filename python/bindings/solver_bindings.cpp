@@ -1,0 +1,271 @@
+// Python Solver and SolveResult: checked inputs, GIL released during solves, one lock per solver.
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <functional>
+#include <mutex>
+
+#include "chain_bindings.hpp"
+#include "common.hpp"
+#include "vereshchagin/chain_hd_solver.hpp"
+
+namespace vsbind {
+
+using vereshchagin::ChainHdSolver;
+
+namespace {
+
+struct SolveResult {
+  py::array_t<double> qdd, tau_command, nu, link_acc;
+  int constraint_rank = 0;
+  double smallest_singular_value = 0.0;
+};
+
+class PySolver {
+ public:
+  PySolver(const PyChain& chain, const py::object& gravity, double rcond, py::object damping)
+      : solver_(chain.chain, KDL::Twist::Zero()) {
+    if (solver_.modelError() != ChainHdSolver::E_NOERROR) raise(std::string("invalid chain: ") + solver_.errorMessage());
+    setGravity(gravity);
+    vereshchagin::SolverOptions opt;
+    opt.rcond = rcond;
+    if (!damping.is_none()) {
+      opt.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
+      opt.damping = damping.cast<double>();
+    }
+    if (solver_.setOptions(opt) != ChainHdSolver::E_NOERROR) raise(solver_.errorMessage());
+    nj_ = solver_.nrOfJoints();
+    ns_ = solver_.nrOfSegments();
+  }
+
+  void setGravity(const py::object& gravity) {
+    const KDL::Vector g = vec3(gravity, "gravity");
+    gravity_ = g;
+    solver_.setRootAcceleration(KDL::Twist(-g, KDL::Vector::Zero()));  // base accelerates up
+  }
+  py::array_t<double> gravity() const { return copyVector(gravity_.data, 3); }
+
+  // Checked, converted inputs of one solve (views into numpy memory, kept alive by the arrays).
+  struct Inputs {
+    Array q, qd, alpha, beta, f_ext, tau;
+    bool has_f_ext = false, has_tau = false;
+    py::ssize_t m = 0;
+  };
+
+  Inputs parse(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
+               const py::object& f_ext, const py::object& tau_ff) const {
+    Inputs in;
+    in.q = vectorArg(q, "q", nj_);
+    in.qd = vectorArg(qd, "qd", nj_);
+    if (!alpha.is_none()) {
+      in.alpha = toArray(alpha, "alpha");
+      if (in.alpha.ndim() == 1 && in.alpha.shape(0) == 6) in.alpha = in.alpha.reshape({6, 1});
+      if (in.alpha.ndim() != 2 || in.alpha.shape(0) != 6)
+        raise("alpha must have shape (6, m) with rows [force; moment], got " + shapeStr(in.alpha));
+      in.m = in.alpha.shape(1);
+      if (in.m > 6) raise("alpha has " + std::to_string(in.m) + " columns; at most 6 constraints are supported");
+      requireFinite(in.alpha, "alpha");
+    }
+    if (beta.is_none()) {
+      if (in.m > 0) raise("beta is required when alpha is given (shape (" + std::to_string(in.m) + ",))");
+    } else {
+      if (alpha.is_none()) raise("beta given without alpha");
+      in.beta = vectorArg(beta, "beta", in.m);
+    }
+    if (!f_ext.is_none()) {
+      in.f_ext = toArray(f_ext, "f_ext");
+      if (in.f_ext.ndim() != 2 || in.f_ext.shape(0) != static_cast<py::ssize_t>(ns_) || in.f_ext.shape(1) != 6)
+        raise("f_ext must have shape (" + std::to_string(ns_) + ", 6) (one [force, moment] row per segment), got " +
+              shapeStr(in.f_ext));
+      requireFinite(in.f_ext, "f_ext");
+      in.has_f_ext = true;
+    }
+    if (!tau_ff.is_none()) {
+      in.tau = vectorArg(tau_ff, "tau_ff", nj_);
+      in.has_tau = true;
+    }
+    return in;
+  }
+
+  // Runs the C++ solve without the GIL. Caller holds mutex_.
+  void run(const Inputs& in) {
+    using Map6X = Eigen::Map<const ChainHdSolver::Matrix6X>;
+    using MapV = Eigen::Map<const Eigen::VectorXd>;
+    const auto m = in.m;
+    for (py::ssize_t r = 0; r < 6; ++r)
+      for (py::ssize_t c = 0; c < m; ++c) alfa_(r, c) = in.alpha.data()[r * m + c];
+    const MapV q(in.q.data(), nj_), qd(in.qd.data(), nj_);
+    const MapV beta(m ? in.beta.data() : nullptr, m);
+    const Map6X f(in.has_f_ext ? in.f_ext.data() : nullptr, 6, in.has_f_ext ? ns_ : 0);
+    const MapV tau(in.has_tau ? in.tau.data() : nullptr, in.has_tau ? nj_ : 0);
+    int rc;
+    {
+      py::gil_scoped_release release;
+      rc = solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau);
+    }
+    if (rc != ChainHdSolver::E_NOERROR) raise(solver_.errorMessage());
+  }
+
+  SolveResult result() const {
+    SolveResult r;
+    r.qdd = copyVector(solver_.qdd().data(), nj_);
+    r.tau_command = copyVector(solver_.commandTorques().data(), nj_);
+    r.nu = copyVector(solver_.nu().data(), solver_.constraintCount());
+    r.link_acc = py::array_t<double>({static_cast<py::ssize_t>(ns_ + 1), static_cast<py::ssize_t>(6)});
+    std::copy(solver_.linkAccelerations().data(), solver_.linkAccelerations().data() + 6 * (ns_ + 1),
+              r.link_acc.mutable_data());
+    r.constraint_rank = solver_.constraintRank();
+    r.smallest_singular_value = solver_.smallestSingularValue();
+    return r;
+  }
+
+  SolveResult solve(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
+                    const py::object& f_ext, const py::object& tau_ff) {
+    Inputs in = parse(q, qd, alpha, beta, f_ext, tau_ff);
+    std::lock_guard<std::mutex> lock(mutex_);
+    run(in);
+    return result();
+  }
+
+  py::dict solveBatch(const py::object& Q, const py::object& QD, const py::object& alpha, const py::object& beta,
+                      const py::object& f_ext, const py::object& tau_ff) {
+    Array q = toArray(Q, "q"), qd = toArray(QD, "qd");
+    if (q.ndim() != 2 || q.shape(1) != static_cast<py::ssize_t>(nj_))
+      raise("q must have shape (B, " + std::to_string(nj_) + "), got " + shapeStr(q));
+    const py::ssize_t B = q.shape(0);
+    if (qd.ndim() != 2 || qd.shape(0) != B || qd.shape(1) != static_cast<py::ssize_t>(nj_))
+      raise("qd must have shape (" + std::to_string(B) + ", " + std::to_string(nj_) + "), got " + shapeStr(qd));
+    // Per-row argument: either one value shared by all rows or a leading batch axis.
+    auto rowOf = [B](const py::object& obj, int single_ndim, const char* name) -> std::function<py::object(py::ssize_t)> {
+      if (obj.is_none()) return [](py::ssize_t) { return py::object(py::none()); };
+      Array a = toArray(obj, name);
+      if (a.ndim() == single_ndim + 1) {
+        if (a.shape(0) != B)
+          raise(std::string(name) + " has a batch axis of " + std::to_string(a.shape(0)) + " rows, expected " +
+                std::to_string(B));
+        return [a](py::ssize_t b) { return py::object(a[py::int_(b)]); };
+      }
+      return [a](py::ssize_t) { return py::object(a); };
+    };
+    const int alpha_nd = (!alpha.is_none() && toArray(alpha, "alpha").ndim() == 1) ? 1 : 2;
+    auto alphaRow = rowOf(alpha, alpha_nd, "alpha");
+    auto betaRow = rowOf(beta, 1, "beta");
+    auto fRow = rowOf(f_ext, 2, "f_ext");
+    auto tauRow = rowOf(tau_ff, 1, "tau_ff");
+    std::vector<Inputs> rows;
+    rows.reserve(B);
+    for (py::ssize_t b = 0; b < B; ++b) {
+      try {
+        rows.push_back(parse(q[py::int_(b)], qd[py::int_(b)], alphaRow(b), betaRow(b), fRow(b), tauRow(b)));
+      } catch (const SolverError& e) {
+        raise("batch row " + std::to_string(b) + ": " + e.what());
+      }
+    }
+    py::ssize_t m_max = 0;
+    for (const auto& r : rows) m_max = std::max(m_max, r.m);
+    py::array_t<double> qdd({B, static_cast<py::ssize_t>(nj_)}), tau({B, static_cast<py::ssize_t>(nj_)});
+    py::array_t<double> nu({B, m_max}), acc({B, static_cast<py::ssize_t>(ns_ + 1), static_cast<py::ssize_t>(6)});
+    py::array_t<int> rank(B);
+    py::array_t<double> smin(B);
+    std::fill(nu.mutable_data(), nu.mutable_data() + nu.size(), std::nan(""));
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (py::ssize_t b = 0; b < B; ++b) {
+      try {
+        run(rows[b]);
+      } catch (const SolverError& e) {
+        raise("batch row " + std::to_string(b) + ": " + e.what());
+      }
+      std::copy(solver_.qdd().data(), solver_.qdd().data() + nj_, qdd.mutable_data() + b * nj_);
+      std::copy(solver_.commandTorques().data(), solver_.commandTorques().data() + nj_, tau.mutable_data() + b * nj_);
+      std::copy(solver_.nu().data(), solver_.nu().data() + solver_.constraintCount(), nu.mutable_data() + b * m_max);
+      std::copy(solver_.linkAccelerations().data(), solver_.linkAccelerations().data() + 6 * (ns_ + 1),
+                acc.mutable_data() + b * 6 * (ns_ + 1));
+      rank.mutable_data()[b] = solver_.constraintRank();
+      smin.mutable_data()[b] = solver_.smallestSingularValue();
+    }
+    py::dict out;
+    out["qdd"] = qdd;
+    out["tau_command"] = tau;
+    out["nu"] = nu;
+    out["link_acc"] = acc;
+    out["constraint_rank"] = rank;
+    out["smallest_singular_value"] = smin;
+    return out;
+  }
+
+  py::tuple responseColumns(const py::object& joints) {
+    const char* what = "joints must be a 1-D sequence of integer joint indices";
+    if (joints.is_none() || py::isinstance<py::str>(joints)) raise(what);
+    py::array idx_any = py::array::ensure(joints);
+    if (!idx_any) {
+      PyErr_Clear();
+      raise(what);
+    }
+    if (idx_any.ndim() != 1 || (idx_any.size() > 0 && idx_any.dtype().kind() != 'i' && idx_any.dtype().kind() != 'u'))
+      raise(std::string(what) + ", got shape " + shapeStr(idx_any) + " of dtype " + std::string(py::str(idx_any.dtype())));
+    auto idx = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(idx_any);
+    const py::ssize_t k = idx.shape(0);
+    Eigen::VectorXi j(k);
+    for (py::ssize_t c = 0; c < k; ++c) {
+      const long long v = idx.at(c);
+      if (v < 0 || v >= static_cast<long long>(nj_))
+        raise("joints: index " + std::to_string(v) + " out of range [0, " + std::to_string(nj_) + ")");
+      j(c) = static_cast<int>(v);
+    }
+    Eigen::MatrixXd dq(nj_, k), dt(nj_, k);
+    std::lock_guard<std::mutex> lock(mutex_);
+    int rc;
+    {
+      py::gil_scoped_release release;
+      rc = solver_.responseColumns(j, dq, dt);
+    }
+    if (rc != ChainHdSolver::E_NOERROR) raise(solver_.errorMessage());
+    auto toNumpy = [&](const Eigen::MatrixXd& M) {
+      py::array_t<double> a({static_cast<py::ssize_t>(nj_), k});
+      auto v = a.mutable_unchecked<2>();
+      for (py::ssize_t r = 0; r < static_cast<py::ssize_t>(nj_); ++r)
+        for (py::ssize_t c = 0; c < k; ++c) v(r, c) = M(r, c);
+      return a;
+    };
+    return py::make_tuple(toNumpy(dq), toNumpy(dt));
+  }
+
+  unsigned int nj_ = 0, ns_ = 0;
+
+ private:
+  ChainHdSolver solver_;
+  KDL::Vector gravity_;
+  Eigen::Matrix<double, 6, 6> alfa_ = Eigen::Matrix<double, 6, 6>::Zero();
+  std::mutex mutex_;
+};
+
+}  // namespace
+
+void bindSolver(py::module_& mod) {
+  py::class_<SolveResult>(mod, "SolveResult")
+      .def_readonly("qdd", &SolveResult::qdd)
+      .def_readonly("tau_command", &SolveResult::tau_command)
+      .def_readonly("nu", &SolveResult::nu)
+      .def_readonly("link_acc", &SolveResult::link_acc)
+      .def_readonly("constraint_rank", &SolveResult::constraint_rank)
+      .def_readonly("smallest_singular_value", &SolveResult::smallest_singular_value)
+      .def("__repr__", [](const SolveResult& r) {
+        return "<vereshchagin.SolveResult n_joints=" + std::to_string(r.qdd.size()) +
+               " m=" + std::to_string(r.nu.size()) + " rank=" + std::to_string(r.constraint_rank) + ">";
+      });
+
+  py::class_<PySolver>(mod, "Solver")
+      .def(py::init<const PyChain&, const py::object&, double, py::object>(), py::arg("chain"),
+           py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
+           py::arg("damping") = py::none())
+      .def("solve", &PySolver::solve, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
+           py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none())
+      .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
+           py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none())
+      .def("response_columns", &PySolver::responseColumns, py::arg("joints"))
+      .def_property("gravity", &PySolver::gravity, &PySolver::setGravity)
+      .def_property_readonly("n_joints", [](const PySolver& s) { return s.nj_; })
+      .def_property_readonly("n_segments", [](const PySolver& s) { return s.ns_; });
+}
+
+}  // namespace vsbind
