@@ -274,6 +274,7 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
   m_ = M;
   VecM U = VecM::Zero();
   MatM L = MatM::Zero();
+  double kappa = 0.0;
   if (ns_ > 0 && M > 0) {
     // alfa: base axes -> last tip axes (moment reference point is already the tip origin).
     Segment& last = segs_[ns_ - 1];
@@ -308,6 +309,7 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
         e.noalias() = s.S.transpose() * A;
         U.noalias() += A.transpose() * (s.c + s.S * free);
         L.noalias() -= s.Dinv * e.transpose() * e;
+        kappa += s.Dinv * s.S.squaredNorm() * A.squaredNorm();
         Aproj = A;
         Aproj.noalias() -= s.Dinv * s.u * e;
       }
@@ -345,6 +347,7 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
   }
   U0_ = U;
   L0_ = L;
+  kappa_ = kappa;
   return E_NOERROR;
 }
 
@@ -391,12 +394,12 @@ void ChainHdSolver::factorizeCoupling() {
   inv_eigen_.setZero(m);
   const auto& lam = eig_.eigenvalues();  // ascending
   const double lmax = std::max(lam(m - 1), 0.0);
-  const double cut = options_.rcond * lmax;
+  const double cut = options_.rcond * std::max(lmax, kappa_);
   sigma_min_ = std::max(lam(0), 0.0);
   sigma_known_ = true;
   for (int k = 0; k < m; ++k) {
     const double l = std::max(lam(k), 0.0);
-    const bool kept = lmax > 0.0 && l > cut;
+    const bool kept = l > 0.0 && l > cut;
     if (kept) ++rank_;
     if (options_.policy == SingularityPolicy::TruncatedPseudoInverse) {
       inv_eigen_(k) = kept ? 1.0 / l : 0.0;
@@ -407,14 +410,13 @@ void ChainHdSolver::factorizeCoupling() {
 }
 
 // Cholesky factor K = L L^T (into chol_), and a proof that every eigenvalue of K is above the
-// truncation threshold: lambda_min(K) = 1 / ||L^-1||_2^2 >= 1 / ||L^-1||_F^2 and
-// lambda_max(K) <= trace(K). False if the factorisation breaks down or the proof fails.
+// truncation threshold rcond * max(lambda_max, kappa) = rcond * kappa: lambda_min(K) =
+// 1 / ||L^-1||_2^2 >= 1 / ||L^-1||_F^2 and lambda_max(K) <= trace(K) <= kappa. False if the
+// factorisation breaks down or the proof fails.
 bool ChainHdSolver::choleskyFullRank() {
   const int m = m_;
   chol_.setZero(m, m);
-  double trace = 0.0;
   for (int j = 0; j < m; ++j) {
-    trace += K_(j, j);
     double d = K_(j, j);
     for (int k = 0; k < j; ++k) d -= chol_(j, k) * chol_(j, k);
     if (!(d > 0.0)) return false;
@@ -438,7 +440,7 @@ bool ChainHdSolver::choleskyFullRank() {
     }
   }
   const double lower = 1.0 / frob2;
-  return std::isfinite(lower) && lower > options_.rcond * trace;
+  return std::isfinite(lower) && lower > options_.rcond * kappa_;
 }
 
 double ChainHdSolver::smallestSingularValue() const {

@@ -40,11 +40,14 @@
 //    (m x m, symmetric positive semi-definite, units 1/kg-like: acceleration per force).
 //
 // Singular tasks: K is inverted by eigen-decomposition. Policy TruncatedPseudoInverse (default)
-// drops eigenvalues below rcond * largest eigenvalue (the rank reported counts the others);
-// DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda. Both give
-// finite outputs for any valid input. Fast path: when a Cholesky factor K = L L^T proves every
-// eigenvalue above the threshold (lambda_min >= 1 / ||L^-1||_F^2 > rcond * trace K >= rcond *
-// lambda_max), K^+ = K^-1 is applied through L, which is the same solution at a fraction of the cost.
+// drops eigenvalues below rcond * max(lambda_max, kappa), where kappa = sum_i D_i^-1 |S_i|^2
+// |A_i|_F^2 >= trace K is the size K would have if no projection cancelled the constraint
+// wrenches A_i felt at the joints (so a constraint that no joint can affect, e.g. along a
+// stretched arm, counts as rank 0 even when it is the only one); the rank reported counts the
+// others. DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda.
+// Both give finite outputs for any valid input. Fast path: when a Cholesky factor K = L L^T
+// proves every eigenvalue above the threshold (lambda_min >= 1 / ||L^-1||_F^2 > rcond * kappa),
+// K^+ = K^-1 is applied through L: the same solution at a fraction of the cost.
 //
 // Affine structure: qdd and tau_cmd are affine in ff_torques. After a solve, responseColumns()
 // returns d(qdd)/d(tau_j) and d(tau_cmd)/d(tau_j) for requested joints j, O(n) per column, reusing
@@ -74,7 +77,7 @@ enum class SingularityPolicy { TruncatedPseudoInverse, DampedLeastSquares };
 
 struct SolverOptions {
   SingularityPolicy policy = SingularityPolicy::TruncatedPseudoInverse;
-  // Truncation threshold relative to the largest eigenvalue of the coupling matrix (>= 0).
+  // Truncation threshold relative to the coupling matrix's scale (see above), in [0, 1).
   double rcond = 1e-12;
   // Damping of the damped-least-squares policy, in the eigenvalues' units (> 0 for that policy).
   double damping = 1e-6;
@@ -206,6 +209,7 @@ class ChainHdSolver : public KDL::SolverI {
   bool solved_ = false;
   VectorC U0_, nu_;
   MatrixC L0_, K_;
+  double kappa_ = 0.0;  // scale of K: sum of D_i^-1 |S_i|^2 |A_i|_F^2 (>= trace K)
   // K is factorised by Cholesky when it is certainly of full rank (fast path), else by a full
   // eigen-decomposition that applies the singularity policy.
   bool use_cholesky_ = false;
