@@ -144,6 +144,7 @@ void ChainHdSolver::buildModel() {
     s.I = rigidInertia(mass, c, 0.5 * (I_origin + I_origin.transpose()));
     scale += I_com.trace() + mass * (c.squaredNorm() + seg.getFrameToTip().p.Norm() *
                                                            seg.getFrameToTip().p.Norm());
+    s.X0 = toPose(seg.pose(0.0));
     if (joint.getType() == KDL::Joint::Fixed) {
       s.joint = -1;
       s.S.setZero();
@@ -161,6 +162,7 @@ void ChainHdSolver::buildModel() {
       const KDL::Rotation Rt = seg.pose(0.0).M.Inverse();  // root axes -> tip axes
       const KDL::Vector v = Rt * t.vel, w = Rt * t.rot;
       s.S << v.x(), v.y(), v.z(), w.x(), w.y(), w.z();
+      s.w_norm = s.S.tail<3>().norm();
       if (!s.S.allFinite() || s.S.norm() == 0.0) {
         model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite",
                             s.joint, joint.getName().c_str());
@@ -216,6 +218,33 @@ int ChainHdSolver::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q,
   return E_NOERROR;
 }
 
+// Pose of the tip frame at joint position q: the tip moves by the screw motion exp(q S) of its
+// own joint axis (constant in the tip frame), so X(q) = X(0) * exp(q [S]) with, for S = [v; w]
+// and theta = |w| q, unit axis k = w / |w|:  E.R = Rodrigues(k, theta),
+// E.p = (I - E.R) (k x v) / |w| + k (k . v) q;  for |w| = 0 (prismatic) E = (I, v q).
+void ChainHdSolver::screwPose(Segment& s, double q) const {
+  const Vector3 v = s.S.head<3>();
+  if (s.w_norm == 0.0) {
+    s.X.R = s.X0.R;
+    s.X.p.noalias() = s.X0.p + s.X0.R * (v * q);
+    return;
+  }
+  const Vector3 k = s.S.tail<3>() / s.w_norm;
+  const double theta = s.w_norm * q;
+  const double sn = std::sin(theta), c1 = 1.0 - std::cos(theta);
+  const Matrix3 K = skew(k);
+  const Matrix3 KK = K * K;
+  Matrix3 R = Matrix3::Identity();
+  R.noalias() += sn * K + c1 * KK;
+  // (I - R) = -(sn K + c1 KK), applied to k x v / |w|.
+  const Vector3 kxv = k.cross(v) / s.w_norm;
+  Vector3 p;
+  p.noalias() = -(sn * (K * kxv) + c1 * (KK * kxv));
+  p.noalias() += k * (k.dot(v) * q);
+  s.X.R.noalias() = s.X0.R * R;
+  s.X.p.noalias() = s.X0.p + s.X0.R * p;
+}
+
 // Outward sweep: poses, velocities, velocity-product accelerations, rigid bias forces.
 void ChainHdSolver::outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q,
                                  const Eigen::Ref<const Eigen::VectorXd>& q_dot,
@@ -225,8 +254,11 @@ void ChainHdSolver::outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q,
   const bool has_fext = f_ext.cols() != 0;
   for (unsigned int i = 0; i < ns_; ++i) {
     Segment& s = segs_[i];
-    const double qi = s.joint >= 0 ? q(s.joint) : 0.0;
-    s.X = toPose(chain_.getSegment(i).pose(qi));
+    if (s.joint >= 0) {
+      screwPose(s, q(s.joint));
+    } else {
+      s.X = s.X0;
+    }
     s.R_base.noalias() = R_parent * s.X.R;
     s.v = motionToChild(s.X, v_parent);
     if (s.joint >= 0) {

@@ -160,7 +160,8 @@ class ChainHdSolver : public KDL::SolverI {
 
  private:
   struct Segment {
-    Pose X;                 // pose of this tip frame in the parent tip frame (q-dependent)
+    Pose X0;                // pose of this tip frame in the parent tip frame at q = 0
+    Pose X;                 // the same at the current q
     Matrix3 R_base;         // orientation of this tip frame in the base frame
     Vector6 S;              // joint motion axis in the tip frame (zero for fixed joints)
     Matrix6 I;              // rigid-body inertia about the tip origin, tip frame
@@ -171,6 +172,7 @@ class ChainHdSolver : public KDL::SolverI {
     Vector6 dpA;            // workspace of responseColumns()
     Eigen::Matrix<double, 6, kMaxConstraints> A;  // constraint wrenches felt by this segment
     double rotor = 0.0, D = 0.0, Dinv = 0.0;
+    double w_norm = 0.0;    // |angular part of S| (0 for prismatic joints)
     int joint = -1;         // joint index or -1 for a fixed joint
   };
 
@@ -180,6 +182,7 @@ class ChainHdSolver : public KDL::SolverI {
                   const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                   const Eigen::Ref<const Matrix6X>& f_ext,
                   const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void screwPose(Segment& s, double q) const;
   void outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                     const Eigen::Ref<const Matrix6X>& f_ext);
   int inwardSweep(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
