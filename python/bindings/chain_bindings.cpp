@@ -2,7 +2,219 @@
 
 #include <pybind11/stl.h>
 
+#include <fstream>
+
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainfksolvervel_recursive.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+
+#include "vereshchagin/urdf_loader.hpp"
+
 namespace vsbind {
+
+PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, const std::string& tip) {
+  vereshchagin::UrdfResult r;
+  if (source.find('<') != std::string::npos) {
+    r = vereshchagin::chainFromUrdfString(source, root, tip);
+  } else {
+    std::ifstream probe(source);
+    if (!probe) raise("URDF source is neither XML text nor a readable file: '" + source + "'");
+    r = vereshchagin::chainFromUrdfFile(source, root, tip);
+  }
+  if (!r.ok) raise(r.message);
+  PyChain c;
+  c.robot = std::move(r.robot);
+  return c;
+}
+
+void PyChain::addSegment(const std::string& name, const py::object& joint, const py::object& tip, double mass,
+                         const py::object& com, const py::object& inertia, double rotor_inertia,
+                         const std::string& joint_name) {
+  JointSpec spec;
+  if (py::isinstance<py::str>(joint)) {
+    spec = jointFromString(joint.cast<std::string>());
+  } else if (py::isinstance<JointSpec>(joint)) {
+    spec = joint.cast<JointSpec>();
+  } else {
+    raise("joint must be a joint-type string such as 'rot_z' or a vereshchagin.Joint");
+  }
+  const KDL::Frame f_tip = tip.is_none() ? KDL::Frame::Identity() : frameFrom4x4(tip, "tip");
+  if (!std::isfinite(mass) || mass < 0.0) raise("mass must be finite and >= 0, got " + std::to_string(mass));
+  const KDL::Vector c = com.is_none() ? KDL::Vector::Zero() : vec3(com, "com");
+  Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
+  if (!inertia.is_none()) {
+    Array a = toArray(inertia, "inertia");
+    if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
+      raise("inertia must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + shapeStr(a));
+    requireFinite(a, "inertia");
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) I(r, k) = a.at(r, k);
+  }
+  const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
+  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) raise("inertia must be symmetric");
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I, Eigen::EigenvaluesOnly);
+  if (es.eigenvalues().minCoeff() < -1e-12 * scale)
+    raise("inertia must be positive semi-definite (smallest eigenvalue " +
+          std::to_string(es.eigenvalues().minCoeff()) + ")");
+  if (!std::isfinite(rotor_inertia) || rotor_inertia < 0.0)
+    raise("rotor_inertia must be finite and >= 0, got " + std::to_string(rotor_inertia));
+  if (spec.type == KDL::Joint::Fixed && rotor_inertia != 0.0) raise("a fixed joint has no rotor inertia");
+  const std::string jname = joint_name.empty() ? name + "_joint" : joint_name;
+  KDL::Joint j = spec.has_axis ? KDL::Joint(jname, spec.origin, spec.axis, spec.type, 1.0, 0.0, rotor_inertia)
+                               : KDL::Joint(jname, spec.type, 1.0, 0.0, rotor_inertia);
+  const KDL::RotationalInertia Ic(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2));
+  const unsigned int seg = robot.chain.getNrOfSegments();
+  robot.chain.addSegment(KDL::Segment(name, j, f_tip, KDL::RigidBodyInertia(mass, c, Ic)));
+  robot.links.push_back({name, static_cast<int>(seg), KDL::Frame::Identity()});
+  if (spec.type != KDL::Joint::Fixed) {
+    vereshchagin::JointInfo info;
+    info.name = jname;
+    const bool prismatic = spec.type == KDL::Joint::TransX || spec.type == KDL::Joint::TransY ||
+                           spec.type == KDL::Joint::TransZ || spec.type == KDL::Joint::TransAxis;
+    info.type = prismatic ? "prismatic" : "continuous";
+    info.segment = seg;
+    robot.joints.push_back(info);
+  }
+}
+
+std::vector<std::string> PyChain::segmentNames() const {
+  std::vector<std::string> out;
+  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) out.push_back(robot.chain.getSegment(i).getName());
+  return out;
+}
+
+std::vector<std::string> PyChain::jointNames() const {
+  std::vector<std::string> out;
+  for (const auto& j : robot.joints) out.push_back(j.name);
+  return out;
+}
+
+py::array_t<double> PyChain::jointField(double vereshchagin::JointInfo::*field) const {
+  py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
+  for (size_t k = 0; k < robot.joints.size(); ++k) a.mutable_data()[k] = robot.joints[k].*field;
+  return a;
+}
+
+py::array_t<double> PyChain::rotorInertia() const {
+  py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
+  for (size_t k = 0; k < robot.joints.size(); ++k)
+    a.mutable_data()[k] = robot.chain.getSegment(robot.joints[k].segment).getJoint().getInertia();
+  return a;
+}
+
+void PyChain::setRotorInertia(const py::object& values) {
+  Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(robot.joints.size()));
+  for (py::ssize_t k = 0; k < a.size(); ++k)
+    if (a.at(k) < 0.0) raise("rotor_inertia must be >= 0, got " + std::to_string(a.at(k)) + " at joint " + std::to_string(k));
+  KDL::Chain rebuilt;
+  size_t jk = 0;
+  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) {
+    const KDL::Segment& seg = robot.chain.getSegment(i);
+    const KDL::Joint& j = seg.getJoint();
+    KDL::Joint nj = j;
+    if (j.getType() != KDL::Joint::Fixed) {
+      const double rotor = a.at(static_cast<py::ssize_t>(jk++));
+      if (j.getType() == KDL::Joint::RotAxis || j.getType() == KDL::Joint::TransAxis) {
+        nj = KDL::Joint(j.getName(), j.JointOrigin(), j.JointAxis(), j.getType(), 1.0, 0.0, rotor);
+      } else {
+        nj = KDL::Joint(j.getName(), j.getType(), 1.0, 0.0, rotor);
+      }
+    }
+    rebuilt.addSegment(KDL::Segment(seg.getName(), nj, seg.getFrameToTip(), seg.getInertia()));
+  }
+  robot.chain = rebuilt;
+}
+
+int PyChain::resolveSegment(const py::object& which, KDL::Frame& link_in_tip) const {
+  const int ns = static_cast<int>(robot.chain.getNrOfSegments());
+  link_in_tip = KDL::Frame::Identity();
+  if (which.is_none()) return ns - 1;
+  if (py::isinstance<py::str>(which)) {
+    const std::string name = which.cast<std::string>();
+    for (int i = 0; i < ns; ++i)
+      if (robot.chain.getSegment(i).getName() == name) return i;
+    for (const auto& l : robot.links) {
+      if (l.link == name) {
+        link_in_tip = l.in_segment_tip;
+        return l.segment;  // -1: a base link
+      }
+    }
+    raise("segment: no segment or link named '" + name + "'");
+  }
+  if (py::isinstance<py::bool_>(which) || !py::isinstance<py::int_>(which)) raise("segment must be an int index or a name");
+  int idx = which.cast<int>();
+  if (idx < 0) idx += ns;
+  if (idx < 0 || idx >= ns) raise("segment index " + std::to_string(which.cast<int>()) + " out of range for " + std::to_string(ns) + " segments");
+  return idx;
+}
+
+namespace {
+
+KDL::JntArray jointArray(const py::object& obj, const char* name, unsigned int n) {
+  Array a = vectorArg(obj, name, n);
+  KDL::JntArray q(n);
+  for (unsigned int k = 0; k < n; ++k) q(k) = a.at(k);
+  return q;
+}
+
+py::array_t<double> toMatrix4(const KDL::Frame& f) {
+  py::array_t<double> T({4, 4});
+  auto t = T.mutable_unchecked<2>();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) t(r, c) = r < 3 ? (c < 3 ? f.M(r, c) : f.p(r)) : (c == 3 ? 1.0 : 0.0);
+  return T;
+}
+
+}  // namespace
+
+py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segment) const {
+  const KDL::JntArray q = jointArray(q_obj, "q", robot.chain.getNrOfJoints());
+  KDL::Frame link_in_tip;
+  const int seg = resolveSegment(segment, link_in_tip);
+  KDL::Frame f = KDL::Frame::Identity();
+  if (seg >= 0) {
+    KDL::ChainFkSolverPos_recursive solver(robot.chain);
+    if (solver.JntToCart(q, f, seg + 1) < 0) raise("forward kinematics failed");
+  }
+  return toMatrix4(f * link_in_tip);
+}
+
+py::array_t<double> PyChain::jacobian(const py::object& q_obj, const py::object& segment) const {
+  const unsigned int n = robot.chain.getNrOfJoints();
+  const KDL::JntArray q = jointArray(q_obj, "q", n);
+  KDL::Frame link_in_tip;
+  const int seg = resolveSegment(segment, link_in_tip);
+  KDL::Jacobian J(n);
+  J.data.setZero();
+  if (seg >= 0) {
+    KDL::ChainJntToJacSolver solver(robot.chain);
+    if (solver.JntToJac(q, J, seg + 1) < 0) raise("Jacobian computation failed");
+    // Move the reference point from the segment tip to the link origin (base axes).
+    KDL::ChainFkSolverPos_recursive fks(robot.chain);
+    KDL::Frame f;
+    fks.JntToCart(q, f, seg + 1);
+    J.changeRefPoint(f.M * link_in_tip.p);
+  }
+  py::array_t<double> out({static_cast<py::ssize_t>(6), static_cast<py::ssize_t>(n)});
+  auto o = out.mutable_unchecked<2>();
+  for (int r = 0; r < 6; ++r)
+    for (unsigned int c = 0; c < n; ++c) o(r, c) = J.data(r, c);
+  return out;
+}
+
+py::array_t<double> PyChain::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& segment) const {
+  py::array_t<double> J = jacobian(q_obj, segment);
+  const unsigned int n = robot.chain.getNrOfJoints();
+  Array qd = vectorArg(qd_obj, "qd", n);
+  py::array_t<double> out(6);
+  auto j = J.unchecked<2>();
+  for (int r = 0; r < 6; ++r) {
+    double v = 0.0;
+    for (unsigned int c = 0; c < n; ++c) v += j(r, c) * qd.at(c);
+    out.mutable_data()[r] = v;
+  }
+  return out;
+}
 
 void bindChain(py::module_& mod) {
   py::class_<JointSpec>(mod, "Joint")
@@ -41,13 +253,52 @@ joint_name : str, optional
 )doc", py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(),
            py::arg("mass") = 0.0, py::arg("com") = py::none(), py::arg("inertia") = py::none(),
            py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "")
-      .def_property_readonly("n_joints", [](const PyChain& c) { return c.chain.getNrOfJoints(); })
-      .def_property_readonly("n_segments", [](const PyChain& c) { return c.chain.getNrOfSegments(); })
+      .def_static("from_urdf", &PyChain::fromUrdf, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
+                  R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
+
+Fixed joints are merged into their parent link (masses and inertias combined); the last
+segment's tip frame is the ``tip`` link's frame. Defaults: the URDF's root link and its single
+leaf. Raises SolverError for malformed XML, unknown links, tip not below root, floating, planar
+or mimic joints on the path, negative mass or a non-PSD inertia.
+)doc")
+      .def_property_readonly("n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); })
+      .def_property_readonly("n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); })
       .def_property_readonly("segment_names", &PyChain::segmentNames)
       .def_property_readonly("joint_names", &PyChain::jointNames)
+      .def_property_readonly("lower", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::lower); })
+      .def_property_readonly("upper", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::upper); })
+      .def_property_readonly("velocity_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::velocity_limit); })
+      .def_property_readonly("effort_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::effort_limit); })
+      .def_property_readonly("friction", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::friction); })
+      .def_property_readonly("damping", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::damping); })
+      .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia)
+      .def_property_readonly("joint_types", [](const PyChain& c) {
+        std::vector<std::string> t;
+        for (const auto& j : c.robot.joints) t.push_back(j.type);
+        return t; })
+      .def_property_readonly("segment_masses", [](const PyChain& c) {
+        py::array_t<double> m(static_cast<py::ssize_t>(c.robot.chain.getNrOfSegments()));
+        for (unsigned int i = 0; i < c.robot.chain.getNrOfSegments(); ++i)
+          m.mutable_data()[i] = c.robot.chain.getSegment(i).getInertia().getMass();
+        return m; })
+      .def_property_readonly("root_link", [](const PyChain& c) { return c.robot.root_link; })
+      .def_property_readonly("notes", [](const PyChain& c) { return c.robot.notes; })
+      .def_property_readonly("link_names", [](const PyChain& c) {
+        std::vector<std::string> t;
+        for (const auto& l : c.robot.links) t.push_back(l.link);
+        return t; })
+      .def("segment_index", [](const PyChain& c, const py::object& which) {
+        KDL::Frame f;
+        return c.resolveSegment(which, f); }, py::arg("name"))
+      .def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(),
+           "4x4 pose of a segment tip (index or name; default the last) or of a merged link, base frame.")
+      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(),
+           "(6, n) Jacobian [linear; angular] of a segment tip or link origin, base-frame axes.")
+      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
+           "(6,) twist [v; omega] of a segment tip or link origin, base-frame axes.")
       .def("__repr__", [](const PyChain& c) {
-        return "<vereshchagin.Chain with " + std::to_string(c.chain.getNrOfSegments()) + " segments, " +
-               std::to_string(c.chain.getNrOfJoints()) + " joints>";
+        return "<vereshchagin.Chain with " + std::to_string(c.robot.chain.getNrOfSegments()) + " segments, " +
+               std::to_string(c.robot.chain.getNrOfJoints()) + " joints>";
       });
 
 }

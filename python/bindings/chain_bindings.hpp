@@ -6,6 +6,8 @@
 
 #include <kdl/chain.hpp>
 
+#include "vereshchagin/robot_chain.hpp"
+
 #include "common.hpp"
 
 namespace vsbind {
@@ -55,62 +57,25 @@ inline JointSpec jointFromString(const std::string& s) {
         "Joint.revolute(axis, origin) or Joint.prismatic(axis, origin)");
 }
 
-// The Python Chain: a KDL::Chain built segment by segment.
+// The Python Chain: a RobotChain (KDL::Chain plus joint and link metadata), built segment by
+// segment or from a URDF.
 struct PyChain {
-  KDL::Chain chain;
+  vereshchagin::RobotChain robot;
 
+  static PyChain fromUrdf(const std::string& source, const std::string& root, const std::string& tip);
   void addSegment(const std::string& name, const py::object& joint, const py::object& tip, double mass,
                   const py::object& com, const py::object& inertia, double rotor_inertia,
-                  const std::string& joint_name) {
-    JointSpec spec;
-    if (py::isinstance<py::str>(joint)) {
-      spec = jointFromString(joint.cast<std::string>());
-    } else if (py::isinstance<JointSpec>(joint)) {
-      spec = joint.cast<JointSpec>();
-    } else {
-      raise("joint must be a joint-type string such as 'rot_z' or a vereshchagin.Joint");
-    }
-    const KDL::Frame f_tip = tip.is_none() ? KDL::Frame::Identity() : frameFrom4x4(tip, "tip");
-    if (!std::isfinite(mass) || mass < 0.0) raise("mass must be finite and >= 0, got " + std::to_string(mass));
-    const KDL::Vector c = com.is_none() ? KDL::Vector::Zero() : vec3(com, "com");
-    Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
-    if (!inertia.is_none()) {
-      Array a = toArray(inertia, "inertia");
-      if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
-        raise("inertia must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + shapeStr(a));
-      requireFinite(a, "inertia");
-      for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k) I(r, k) = a.at(r, k);
-    }
-    const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
-    if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) raise("inertia must be symmetric");
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I, Eigen::EigenvaluesOnly);
-    if (es.eigenvalues().minCoeff() < -1e-12 * scale)
-      raise("inertia must be positive semi-definite (smallest eigenvalue " +
-            std::to_string(es.eigenvalues().minCoeff()) + ")");
-    if (!std::isfinite(rotor_inertia) || rotor_inertia < 0.0)
-      raise("rotor_inertia must be finite and >= 0, got " + std::to_string(rotor_inertia));
-    if (spec.type == KDL::Joint::Fixed && rotor_inertia != 0.0) raise("a fixed joint has no rotor inertia");
-    const std::string jname = joint_name.empty() ? name + "_joint" : joint_name;
-    KDL::Joint j = spec.has_axis ? KDL::Joint(jname, spec.origin, spec.axis, spec.type, 1.0, 0.0, rotor_inertia)
-                                 : KDL::Joint(jname, spec.type, 1.0, 0.0, rotor_inertia);
-    const KDL::RotationalInertia Ic(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2));
-    chain.addSegment(KDL::Segment(name, j, f_tip, KDL::RigidBodyInertia(mass, c, Ic)));
-  }
-
-  std::vector<std::string> segmentNames() const {
-    std::vector<std::string> out;
-    for (unsigned int i = 0; i < chain.getNrOfSegments(); ++i) out.push_back(chain.getSegment(i).getName());
-    return out;
-  }
-  std::vector<std::string> jointNames() const {
-    std::vector<std::string> out;
-    for (unsigned int i = 0; i < chain.getNrOfSegments(); ++i) {
-      const KDL::Joint& j = chain.getSegment(i).getJoint();
-      if (j.getType() != KDL::Joint::Fixed) out.push_back(j.getName());
-    }
-    return out;
-  }
+                  const std::string& joint_name);
+  std::vector<std::string> segmentNames() const;
+  std::vector<std::string> jointNames() const;
+  py::array_t<double> jointField(double vereshchagin::JointInfo::*field) const;
+  py::array_t<double> rotorInertia() const;
+  void setRotorInertia(const py::object& values);
+  // Segment index and the pose of the named link (or the segment tip) in that segment's tip frame.
+  int resolveSegment(const py::object& which, KDL::Frame& link_in_tip) const;
+  py::array_t<double> fk(const py::object& q, const py::object& segment) const;
+  py::array_t<double> jacobian(const py::object& q, const py::object& segment) const;
+  py::array_t<double> twist(const py::object& q, const py::object& qd, const py::object& segment) const;
 };
 
 void bindChain(py::module_& mod);

@@ -24,7 +24,7 @@ struct SolveResult {
 class PySolver {
  public:
   PySolver(const PyChain& chain, const py::object& gravity, double rcond, py::object damping)
-      : solver_(chain.chain, KDL::Twist::Zero()) {
+      : solver_(chain.robot.chain, KDL::Twist::Zero()) {
     if (solver_.modelError() != ChainHdSolver::E_NOERROR) raise(std::string("invalid chain: ") + solver_.errorMessage());
     setGravity(gravity);
     vereshchagin::SolverOptions opt;
