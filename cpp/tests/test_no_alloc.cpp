@@ -1,0 +1,225 @@
+// Real-time property: after construction, solve(), CartToJnt() and responseColumns() allocate no
+// heap memory. Every global operator new/delete overload is replaced by a counting version; on
+// glibc, malloc/calloc/realloc/memalign/posix_memalign/aligned_alloc are interposed as well (Eigen
+// allocates with malloc, not operator new). The test proves the counters work by allocating on
+// purpose in a counted region.
+#include <atomic>
+#include <cerrno>
+#include <cstdlib>
+#include <new>
+
+#include <kdl/chainhdsolver_vereshchagin.hpp>
+
+#include "random_chain.hpp"
+#include "test_common.hpp"
+#include "vereshchagin/chain_hd_solver.hpp"
+
+namespace {
+std::atomic<long> g_new_calls{0};
+std::atomic<long> g_malloc_calls{0};
+
+void* countedNew(std::size_t n) {
+  g_new_calls.fetch_add(1, std::memory_order_relaxed);
+  if (n == 0) n = 1;
+  void* p = std::malloc(n);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+
+void* countedNewAligned(std::size_t n, std::align_val_t al) {
+  g_new_calls.fetch_add(1, std::memory_order_relaxed);
+  std::size_t a = static_cast<std::size_t>(al);
+  if (a < sizeof(void*)) a = sizeof(void*);
+  if (n == 0) n = 1;
+  void* p = nullptr;
+  if (posix_memalign(&p, a, n) != 0) throw std::bad_alloc();
+  return p;
+}
+}  // namespace
+
+// ---- counting replacements of the global allocation functions ----
+void* operator new(std::size_t n) { return countedNew(n); }
+void* operator new[](std::size_t n) { return countedNew(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  try { return countedNew(n); } catch (...) { return nullptr; }
+}
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
+  try { return countedNew(n); } catch (...) { return nullptr; }
+}
+void* operator new(std::size_t n, std::align_val_t a) { return countedNewAligned(n, a); }
+void* operator new[](std::size_t n, std::align_val_t a) { return countedNewAligned(n, a); }
+void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  try { return countedNewAligned(n, a); } catch (...) { return nullptr; }
+}
+void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  try { return countedNewAligned(n, a); } catch (...) { return nullptr; }
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+
+#if defined(__GLIBC__)
+#define VERESHCHAGIN_TEST_COUNT_MALLOC 1
+// Interpose the C allocator (the executable's definitions take precedence over libc's for every
+// shared object); forward to glibc's internal entry points.
+extern "C" {
+void* __libc_malloc(std::size_t);
+void __libc_free(void*);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+
+void* malloc(std::size_t n) noexcept {
+  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(n);
+}
+void free(void* p) noexcept { __libc_free(p); }
+void* calloc(std::size_t a, std::size_t b) noexcept {
+  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(a, b);
+}
+void* realloc(void* p, std::size_t n) noexcept {
+  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(p, n);
+}
+void* memalign(std::size_t a, std::size_t n) noexcept {
+  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_memalign(a, n);
+}
+void* aligned_alloc(std::size_t a, std::size_t n) noexcept {
+  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_memalign(a, n);
+}
+int posix_memalign(void** out, std::size_t a, std::size_t n) noexcept {
+  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+  void* p = __libc_memalign(a, n);
+  if (!p) return ENOMEM;
+  *out = p;
+  return 0;
+}
+}
+#else
+#define VERESHCHAGIN_TEST_COUNT_MALLOC 0
+#endif
+
+namespace {
+void* volatile g_sink = nullptr;  // keeps the deliberate allocations observable
+
+struct Counts {
+  long news, mallocs;
+};
+Counts now() { return {g_new_calls.load(), g_malloc_calls.load()}; }
+}  // namespace
+
+int main() {
+  using testutil::str;
+  using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+  testutil::Checker ck("test_no_alloc");
+
+  // Counting must work: a std::vector and an Eigen vector allocated on purpose are seen.
+  {
+    const Counts c0 = now();
+    auto* v = new std::vector<int>(100, 1);
+    g_sink = v->data();
+    delete v;
+    const Counts c1 = now();
+    ck.check(c1.news - c0.news >= 2, "operator new replacement does not count (std::vector)");
+    Eigen::VectorXd* e = new Eigen::VectorXd(Eigen::VectorXd::Ones(100));
+    g_sink = e->data();
+    delete e;
+    const Counts c2 = now();
+    if (VERESHCHAGIN_TEST_COUNT_MALLOC) ck.check(c2.mallocs - c1.mallocs >= 2, "malloc interposition does not count (Eigen)");
+  }
+
+  testutil::RandomGen g(777);
+  const KDL::Chain chain = g.chain(7);
+  const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments();
+  const KDL::Twist grav(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero());
+  vereshchagin::ChainHdSolver solver(chain, grav);
+  vereshchagin::SolverOptions dls;
+  dls.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
+  vereshchagin::ChainHdSolver solver_dls(chain, grav, dls);
+
+  // All inputs and outputs are prepared before counting.
+  const int kSets = 8;
+  std::vector<KDL::JntArray> q, qd, ff;
+  std::vector<KDL::Wrenches> fext;
+  std::vector<Matrix6X> fext_m;
+  for (int i = 0; i < kSets; ++i) {
+    q.push_back(g.q(n));
+    qd.push_back(g.qdot(n));
+    ff.push_back(g.torques(n));
+    fext.push_back(g.fext(ns));
+    fext_m.push_back(testutil::toMatrix(fext.back()));
+  }
+  std::vector<KDL::Jacobian> alfa;
+  std::vector<Matrix6X> alfa_m;
+  std::vector<KDL::JntArray> beta;
+  for (int nc = 0; nc <= 6; ++nc) {
+    alfa.push_back(g.alfa(nc));
+    alfa_m.push_back(alfa.back().data);
+    beta.push_back(g.beta(nc));
+  }
+  Eigen::VectorXi joints(3);
+  joints << 0, 3, 6;
+  Eigen::MatrixXd dqdd(n, 3), dtau(n, 3);
+  KDL::JntArray qdd(n), tau(n);
+  const Eigen::VectorXd empty_tau(0);
+  const Matrix6X empty_fext(6, 0);
+  const Eigen::VectorXd bad_q(n + 1);
+  int failures = 0;
+  double checksum = 0.0;
+
+  const Counts c0 = now();
+  for (int it = 0; it < 1000; ++it) {
+    const int s = it % kSets, nc = it % 7, nc2 = (it * 5 + 3) % 7;
+    if (solver.solve(q[s].data, qd[s].data, alfa_m[nc], beta[nc].data, fext_m[s], ff[s].data) != 0) ++failures;
+    if (solver.responseColumns(joints, dqdd, dtau) != 0) ++failures;
+    checksum += solver.qdd()(0) + dqdd(1, 1) + solver.smallestSingularValue() + solver.constraintRank();
+    if (solver.CartToJnt(q[s], qd[s], qdd, alfa[nc2], beta[nc2], fext[s], ff[s], tau) != 0) ++failures;
+    if (solver.responseColumns(joints, dqdd, dtau) != 0) ++failures;
+    checksum += qdd(0) + tau(0) + dtau(0, 0);
+    if (solver.solve(q[s].data, qd[s].data, alfa_m[nc2], beta[nc2].data, empty_fext, empty_tau) != 0) ++failures;
+    if (solver_dls.solve(q[s].data, qd[s].data, alfa_m[nc], beta[nc].data, fext_m[s], ff[s].data) != 0) ++failures;
+    if (solver_dls.responseColumns(joints, dqdd, dtau) != 0) ++failures;
+    checksum += solver_dls.qdd()(0) + solver_dls.smallestSingularValue();
+  }
+  const Counts c1 = now();
+  ck.check(failures == 0, "solver calls failed: " + str(failures));
+  ck.check(std::isfinite(checksum), "non-finite results");
+  ck.check(c1.news == c0.news, "operator new called " + str(c1.news - c0.news) + " times in 1000 iterations");
+  ck.check(c1.mallocs == c0.mallocs, "malloc family called " + str(c1.mallocs - c0.mallocs) + " times in 1000 iterations");
+
+  // Error paths (they format a message) do not allocate either.
+  const Counts c2 = now();
+  for (int it = 0; it < 100; ++it) {
+    if (solver.solve(bad_q, qd[0].data, alfa_m[1], beta[1].data, fext_m[0], ff[0].data) == 0) ++failures;
+  }
+  const Counts c3 = now();
+  ck.check(failures == 0, "size-mismatched solve did not fail");
+  ck.check(c3.news == c2.news && c3.mallocs == c2.mallocs,
+           "error path allocates: new " + str(c3.news - c2.news) + ", malloc " + str(c3.mallocs - c2.mallocs));
+
+  // The counters also see allocations made inside a shared library: KDL's solver allocates on
+  // every CartToJnt with constraints (defect 4 of the KDL notes).
+  {
+    KDL::ChainHdSolver_Vereshchagin kdl(chain, grav, 2);
+    const Counts k0 = now();
+    const int rc = kdl.CartToJnt(q[0], qd[0], qdd, alfa[2], beta[2], fext[0], ff[0], tau);
+    const Counts k1 = now();
+    ck.check(rc == 0 && (k1.news - k0.news) + (k1.mallocs - k0.mallocs) > 0,
+             "allocations inside KDL's CartToJnt were not counted");
+  }
+
+  return ck.finish(std::string("8000 counted calls on a 7-joint chain, nc 0..6 (malloc counted too: ") +
+                   (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no") + ")");
+}
