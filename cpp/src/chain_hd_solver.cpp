@@ -5,6 +5,11 @@
 // produced by bias forces and torques, L (m x m) the one produced by unit constraint forces.
 #include "vereshchagin/chain_hd_solver.hpp"
 
+#if defined(__GNUC__) && !defined(__clang__)
+// GCC 12 reports a false -Warray-bounds on Eigen's SSE loads of 1x1 fixed-size products.
+#pragma GCC diagnostic ignored "-Warray-bounds"
+#endif
+
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>

@@ -23,12 +23,12 @@ struct LoadError : std::runtime_error {
 class CaptureHandler : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
       if (!messages.empty()) messages += "; ";
       messages += text;
     }
   }
-  std::string messages;
+  std::string messages;  // error-level messages only
 };
 
 std::mutex& parserMutex() {
@@ -167,6 +167,11 @@ class Builder {
     for (size_t i = 0; i < first_moving; ++i) {
       if (i > 0) prev_tip_to_link = prev_tip_to_link * toFrame(path[i]->parent_joint->parent_to_joint_origin_transform);
       out_.links.push_back({path[i]->name, -1, prev_tip_to_link});
+      // Side branches of the base: fixed to the world, recorded for their frames only.
+      for (const auto& child : path[i]->child_links) {
+        if (i + 1 < path.size() && child->name == path[i + 1]->name) continue;
+        placeBaseSubtree(*child, prev_tip_to_link * toFrame(child->parent_joint->parent_to_joint_origin_transform));
+      }
     }
     size_t k = first_moving;
     while (k < path.size()) {
@@ -256,6 +261,13 @@ class Builder {
       lumpSubtree(*child, pose * toFrame(child->parent_joint->parent_to_joint_origin_transform), seg, inertia);
   }
 
+  // Links hanging off the base (at joint positions 0): frames only, their inertia is irrelevant.
+  void placeBaseSubtree(const urdf::Link& link, const KDL::Frame& pose) {
+    out_.links.push_back({link.name, -1, pose});
+    for (const auto& child : link.child_links)
+      placeBaseSubtree(*child, pose * toFrame(child->parent_joint->parent_to_joint_origin_transform));
+  }
+
   const urdf::ModelInterface& model_;
   RobotChain& out_;
 };
@@ -264,7 +276,9 @@ UrdfResult load(const std::string& xml, const std::string& root, const std::stri
   UrdfResult result;
   std::string messages;
   urdf::ModelInterfaceSharedPtr model = parse(xml, messages);
-  if (!model) {
+  // urdfdom returns a model even when it could not read some values (they silently become 0):
+  // any error it reported fails the load.
+  if (!model || !messages.empty()) {
     result.message = "malformed URDF" + (messages.empty() ? std::string() : ": " + messages);
     return result;
   }

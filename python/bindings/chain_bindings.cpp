@@ -253,7 +253,12 @@ joint_name : str, optional
 )doc", py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(),
            py::arg("mass") = 0.0, py::arg("com") = py::none(), py::arg("inertia") = py::none(),
            py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "")
-      .def_static("from_urdf", &PyChain::fromUrdf, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
+      .def_static("from_urdf", [](const py::object& source, const std::string& root, const std::string& tip) {
+        const py::object os = py::module_::import("os");
+        if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
+          raise("source must be URDF XML text or a file path");
+        return PyChain::fromUrdf(py::str(os.attr("fspath")(source)).cast<std::string>(), root, tip);
+      }, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
                   R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
 
 Fixed joints are merged into their parent link (masses and inertias combined); the last

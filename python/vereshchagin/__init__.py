@@ -6,7 +6,8 @@ feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL
 ``ChainHdSolver_Vereshchagin``; see :class:`Solver`.
 """
 from ._core import Chain, Joint, SolveResult, SolverError
+from . import robots, task
 from .solver import BatchResult, Solver
 
-__all__ = ["BatchResult", "Chain", "Joint", "SolveResult", "Solver", "SolverError"]
+__all__ = ["BatchResult", "Chain", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
 __version__ = "0.1.0"
