@@ -15,7 +15,7 @@ Everything is plain numpy.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence, Union
+from typing import Sequence, Union
 
 import numpy as np
 
