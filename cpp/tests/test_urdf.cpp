@@ -1,0 +1,164 @@
+// C++ URDF loader: structure of the chain, merged inertias and errors, on hand-written URDFs.
+// Expected values come from hand composition of the URDF's transforms and KDL's inertia algebra.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <kdl/chainfksolverpos_recursive.hpp>
+
+#include "vereshchagin/urdf_loader.hpp"
+
+namespace {
+
+int failures = 0, checks = 0;
+
+void check(bool ok, const std::string& what) {
+  ++checks;
+  if (!ok) {
+    ++failures;
+    std::printf("[test_urdf] FAIL: %s\n", what.c_str());
+  }
+}
+
+bool near(double a, double b, double tol = 1e-12) { return std::abs(a - b) <= tol * std::max(1.0, std::abs(b)); }
+
+bool nearFrame(const KDL::Frame& a, const KDL::Frame& b) {
+  for (int r = 0; r < 3; ++r) {
+    if (!near(a.p(r), b.p(r))) return false;
+    for (int c = 0; c < 3; ++c)
+      if (!near(a.M(r, c), b.M(r, c))) return false;
+  }
+  return true;
+}
+
+const char* kArm = R"(<robot name="arm">
+  <link name="base"/>
+  <joint name="j1" type="revolute">
+    <parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0.3" rpy="0 0 0.2"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2.5" effort="40" velocity="1.5"/>
+    <dynamics damping="0.3" friction="1.2"/>
+  </joint>
+  <link name="l1">
+    <inertial><origin xyz="0 0 0.1" rpy="0.1 0 0"/><mass value="2"/>
+      <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <joint name="f1" type="fixed">
+    <parent link="l1"/><child link="l1b"/><origin xyz="0.1 0 0.2" rpy="0 0.3 0"/>
+  </joint>
+  <link name="l1b">
+    <inertial><origin xyz="0.05 0 0"/><mass value="0.5"/>
+      <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial>
+  </link>
+  <joint name="j2" type="prismatic">
+    <parent link="l1b"/><child link="l2"/>
+    <origin xyz="0 0.1 0"/><axis xyz="1 1 0"/>
+    <limit lower="0" upper="0.4" effort="100" velocity="0.5"/>
+  </joint>
+  <link name="l2">
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <joint name="tool_joint" type="fixed">
+    <parent link="l2"/><child link="tool"/><origin xyz="0 0 0.15"/>
+  </joint>
+  <link name="tool">
+    <inertial><mass value="0.25"/><inertia ixx="0.0001" ixy="0" ixz="0" iyy="0.0001" iyz="0" izz="0.0001"/></inertial>
+  </link>
+</robot>)";
+
+KDL::RigidBodyInertia diagInertia(double m, const KDL::Vector& c, double ixx, double iyy, double izz) {
+  return KDL::RigidBodyInertia(m, c, KDL::RotationalInertia(ixx, iyy, izz, 0, 0, 0));
+}
+
+void testStructure() {
+  const vereshchagin::UrdfResult r = vereshchagin::chainFromUrdfString(kArm);
+  check(r.ok, "arm loads: " + r.message);
+  if (!r.ok) return;
+  const KDL::Chain& ch = r.robot.chain;
+  check(ch.getNrOfSegments() == 2 && ch.getNrOfJoints() == 2, "two moving joints -> two segments");
+  check(ch.getSegment(0).getName() == "l1b" && ch.getSegment(1).getName() == "tool",
+        "segments are named after their tip links");
+  check(r.robot.joints.size() == 2 && r.robot.joints[0].name == "j1" && r.robot.joints[1].type == "prismatic",
+        "joint metadata");
+  check(near(r.robot.joints[0].lower, -2) && near(r.robot.joints[0].upper, 2.5) &&
+            near(r.robot.joints[0].effort_limit, 40) && near(r.robot.joints[0].velocity_limit, 1.5) &&
+            near(r.robot.joints[0].friction, 1.2) && near(r.robot.joints[0].damping, 0.3),
+        "limits, friction and damping of j1");
+
+  // Forward kinematics at q = (0.7, 0.2) against hand composition of the URDF transforms.
+  const double q1 = 0.7, q2 = 0.2;
+  const KDL::Frame o1(KDL::Rotation::RPY(0, 0, 0.2), KDL::Vector(0, 0, 0.3));
+  const KDL::Frame f1(KDL::Rotation::RPY(0, 0.3, 0), KDL::Vector(0.1, 0, 0.2));
+  const KDL::Frame o2(KDL::Rotation::Identity(), KDL::Vector(0, 0.1, 0));
+  const KDL::Vector ax2 = KDL::Vector(1, 1, 0) / std::sqrt(2.0);
+  const KDL::Frame tool_in_l2(KDL::Vector(0, 0, 0.15));
+  const KDL::Frame l1b = o1 * KDL::Frame(KDL::Rotation::RotZ(q1)) * f1;
+  const KDL::Frame tool = l1b * o2 * KDL::Frame(ax2 * q2) * tool_in_l2;
+  KDL::ChainFkSolverPos_recursive fk(ch);
+  KDL::JntArray q(2);
+  q(0) = q1;
+  q(1) = q2;
+  KDL::Frame got0, got1;
+  fk.JntToCart(q, got0, 1);
+  fk.JntToCart(q, got1, 2);
+  check(nearFrame(got0, l1b), "segment 0 tip is link l1b");
+  check(nearFrame(got1, tool), "segment 1 tip is the tool link");
+
+  // Merged inertias, expressed in each segment's tip frame.
+  const KDL::Frame in1(KDL::Rotation::RPY(0.1, 0, 0), KDL::Vector(0, 0, 0.1));
+  KDL::RigidBodyInertia l1_in_l1 = in1 * diagInertia(2, KDL::Vector::Zero(), 0.02, 0.03, 0.01);
+  const KDL::RigidBodyInertia l1b_own = diagInertia(0.5, KDL::Vector(0.05, 0, 0), 0.001, 0.002, 0.002);
+  const KDL::RigidBodyInertia seg0 = f1.Inverse() * l1_in_l1 + l1b_own;
+  const KDL::RigidBodyInertia got_seg0 = ch.getSegment(0).getInertia();
+  bool same0 = near(got_seg0.getMass(), 2.5) && near(got_seg0.getMass(), seg0.getMass());
+  for (int k = 0; k < 3; ++k) same0 = same0 && near(got_seg0.getCOG()(k), seg0.getCOG()(k));
+  for (int k = 0; k < 9; ++k) same0 = same0 && near(got_seg0.getRotationalInertia().data[k], seg0.getRotationalInertia().data[k]);
+  check(same0, "segment 0 inertia = l1 (moved into l1b's frame) + l1b");
+  const KDL::RigidBodyInertia seg1 = tool_in_l2.Inverse() * diagInertia(1, KDL::Vector::Zero(), 0.01, 0.01, 0.01) +
+                                     diagInertia(0.25, KDL::Vector::Zero(), 1e-4, 1e-4, 1e-4);
+  const KDL::RigidBodyInertia got_seg1 = ch.getSegment(1).getInertia();
+  bool same1 = near(got_seg1.getMass(), 1.25);
+  for (int k = 0; k < 3; ++k) same1 = same1 && near(got_seg1.getCOG()(k), seg1.getCOG()(k));
+  for (int k = 0; k < 9; ++k) same1 = same1 && near(got_seg1.getRotationalInertia().data[k], seg1.getRotationalInertia().data[k]);
+  check(same1, "segment 1 inertia = l2 (moved into the tool frame) + tool");
+}
+
+void expectError(const std::string& xml, const std::string& root, const std::string& tip, const std::string& fragment,
+                 const std::string& what) {
+  const vereshchagin::UrdfResult r = vereshchagin::chainFromUrdfString(xml, root, tip);
+  check(!r.ok && r.message.find(fragment) != std::string::npos,
+        what + " (message: '" + r.message + "', expected to contain '" + fragment + "')");
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  const size_t at = s.find(from);
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+void testErrors() {
+  expectError("<robot name='x'><link name='a'>", "", "", "malformed URDF", "malformed XML");
+  expectError(kArm, "nowhere", "", "root link 'nowhere' not found", "missing root");
+  expectError(kArm, "", "nowhere", "tip link 'nowhere' not found", "missing tip");
+  expectError(kArm, "l2", "l1", "is not below root", "tip above root");
+  expectError(replaced(kArm, "type=\"prismatic\"", "type=\"floating\""), "", "", "floating", "floating joint on the path");
+  expectError(replaced(kArm, "<mass value=\"0.5\"/>", "<mass value=\"-0.5\"/>"), "", "", "negative mass", "negative mass");
+  expectError(replaced(kArm, "ixx=\"0.001\"", "ixx=\"-0.5\""), "", "", "not positive semi-definite", "indefinite inertia");
+  expectError(replaced(kArm, "<mass value=\"1\"/>", "<mass value=\"abc\"/>"), "", "", "malformed URDF",
+              "unparsable number (urdfdom would silently use 0)");
+  const vereshchagin::UrdfResult missing = vereshchagin::chainFromUrdfFile("/nonexistent/robot.urdf");
+  check(!missing.ok && missing.message.find("cannot read") != std::string::npos, "missing file");
+}
+
+}  // namespace
+
+int main() {
+  testStructure();
+  testErrors();
+  if (failures) {
+    std::printf("test_urdf: FAIL (%d of %d checks failed)\n", failures, checks);
+    return 1;
+  }
+  std::printf("test_urdf: PASS (%d checks)\n", checks);
+  return 0;
+}
