@@ -304,7 +304,6 @@ int ChainHdSolver::inwardSweep(const Eigen::Ref<const Matrix6X>& alfa,
 template <int M>
 int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
                                 const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  using RowM = Eigen::Matrix<double, 1, M>;
   using VecM = Eigen::Matrix<double, M, 1>;
   using MatM = Eigen::Matrix<double, M, M>;
   using Mat6M = Eigen::Matrix<double, 6, M>;
@@ -342,7 +341,7 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
       // Apparent bias force: pA + IA c + u (tau - S^T (pA + IA c)) / D.
       pa = s.pA + IAc + s.u * free;
       if (M > 0) {
-        RowM e;  // S^T A
+        auto e = s.e.template leftCols<M>();  // S^T A, kept for the final sweep
         e.noalias() = s.S.transpose() * A;
         U.noalias() += A.transpose() * (s.c + s.S * free);
         L.noalias() -= s.Dinv * e.transpose() * e;
@@ -403,7 +402,7 @@ void ChainHdSolver::finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torq
     if (s.joint >= 0) {
       const double tau = has_tau ? ff_torques(s.joint) : 0.0;
       double f = s.S.dot(s.pA) + s.u.dot(a);  // S^T IA a = u^T a (IA symmetric)
-      if (M > 0) f += s.S.dot(s.A.template leftCols<M>() * nu);
+      if (M > 0) f += s.e.template leftCols<M>().dot(nu.transpose());
       const double qdd = s.Dinv * (tau - f);
       qdd_(s.joint) = qdd;
       a += s.S * qdd;

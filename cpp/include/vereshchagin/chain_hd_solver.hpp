@@ -171,6 +171,7 @@ class ChainHdSolver : public KDL::SolverI {
     Vector6 xdd;            // spatial acceleration (tip frame)
     Vector6 dpA;            // workspace of responseColumns()
     Eigen::Matrix<double, 6, kMaxConstraints> A;  // constraint wrenches felt by this segment
+    Eigen::Matrix<double, 1, kMaxConstraints> e;  // S^T A
     double rotor = 0.0, D = 0.0, Dinv = 0.0;
     double w_norm = 0.0;    // |angular part of S| (0 for prismatic joints)
     int joint = -1;         // joint index or -1 for a fixed joint
