@@ -8,6 +8,7 @@
 #include "chain_bindings.hpp"
 #include "common.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
+#include "vereshchagin/friction_solver.hpp"
 
 namespace vsbind {
 
@@ -19,12 +20,16 @@ struct SolveResult {
   py::array_t<double> qdd, tau_command, nu, link_acc;
   int constraint_rank = 0;
   double smallest_singular_value = 0.0;
+  // Friction-aware solves only (None otherwise).
+  py::object friction_torque = py::none(), status = py::none(), gauss_value = py::none(), iterations = py::none();
 };
 
 class PySolver {
  public:
   PySolver(const PyChain& chain, const py::object& gravity, double rcond, py::object damping)
-      : solver_(chain.robot.chain, KDL::Twist::Zero()) {
+      : solver_(chain.robot.chain, KDL::Twist::Zero()), friction_solver_(chain.robot.chain, KDL::Twist::Zero()) {
+    chain_friction_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(chain.robot.joints.size()));
+    for (size_t k = 0; k < chain.robot.joints.size(); ++k) chain_friction_(k) = chain.robot.joints[k].friction;
     if (solver_.modelError() != ChainHdSolver::E_NOERROR) raise(std::string("invalid chain: ") + solver_.errorMessage());
     setGravity(gravity);
     vereshchagin::SolverOptions opt;
@@ -34,6 +39,7 @@ class PySolver {
       opt.damping = damping.cast<double>();
     }
     if (solver_.setOptions(opt) != ChainHdSolver::E_NOERROR) raise(solver_.errorMessage());
+    friction_solver_.setOptions(opt);
     nj_ = solver_.nrOfJoints();
     ns_ = solver_.nrOfSegments();
   }
@@ -42,6 +48,7 @@ class PySolver {
     const KDL::Vector g = vec3(gravity, "gravity");
     gravity_ = g;
     solver_.setRootAcceleration(KDL::Twist(-g, KDL::Vector::Zero()));  // base accelerates up
+    friction_solver_.setRootAcceleration(KDL::Twist(-g, KDL::Vector::Zero()));
   }
   py::array_t<double> gravity() const { return copyVector(gravity_.data, 3); }
 
@@ -87,8 +94,36 @@ class PySolver {
     return in;
   }
 
+  // friction: None/False (frictionless), True (the chain's friction values, static = kinetic), or
+  // an object with attributes static, kinetic (or None) and velocity_tolerance.
+  bool parseFriction(const py::object& friction, vereshchagin::FrictionModel& fm) const {
+    if (friction.is_none()) return false;
+    if (py::isinstance<py::bool_>(friction)) {
+      if (!friction.cast<bool>()) return false;
+      fm.static_friction = chain_friction_;
+      fm.kinetic_friction.resize(0);
+      return true;
+    }
+    if (!py::hasattr(friction, "static"))
+      raise("friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)");
+    Array fs = vectorArg(friction.attr("static"), "friction.static", nj_);
+    fm.static_friction = Eigen::Map<const Eigen::VectorXd>(fs.data(), nj_);
+    const py::object kin = py::getattr(friction, "kinetic", py::none());
+    if (kin.is_none()) {
+      fm.kinetic_friction.resize(0);
+    } else {
+      Array fk = vectorArg(kin, "friction.kinetic", nj_);
+      fm.kinetic_friction = Eigen::Map<const Eigen::VectorXd>(fk.data(), nj_);
+    }
+    const py::object tol = py::getattr(friction, "velocity_tolerance", py::none());
+    if (!tol.is_none()) fm.velocity_tolerance = tol.cast<double>();
+    for (Eigen::Index j = 0; j < fm.static_friction.size(); ++j)
+      if (fm.static_friction(j) < 0.0) raise("friction.static must be >= 0 (joint " + std::to_string(j) + ")");
+    return true;
+  }
+
   // Runs the C++ solve without the GIL. Caller holds mutex_.
-  void run(const Inputs& in) {
+  void run(const Inputs& in, const vereshchagin::FrictionModel* fm = nullptr) {
     using Map6X = Eigen::Map<const ChainHdSolver::Matrix6X>;
     using MapV = Eigen::Map<const Eigen::VectorXd>;
     const auto m = in.m;
@@ -99,31 +134,46 @@ class PySolver {
     const Map6X f(in.has_f_ext ? in.f_ext.data() : nullptr, 6, in.has_f_ext ? ns_ : 0);
     const MapV tau(in.has_tau ? in.tau.data() : nullptr, in.has_tau ? nj_ : 0);
     int rc;
+    last_friction_ = fm != nullptr;
     {
       py::gil_scoped_release release;
-      rc = solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau);
+      rc = fm ? friction_solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau, *fm)
+              : solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau);
     }
-    if (rc != ChainHdSolver::E_NOERROR) raise(solver_.errorMessage());
+    if (rc != ChainHdSolver::E_NOERROR) raise(fm ? friction_solver_.errorMessage() : solver_.errorMessage());
   }
 
-  SolveResult result() const {
+  // The solver that answered the last run().
+  ChainHdSolver& answered() { return last_friction_ ? friction_solver_.hdSolver() : solver_; }
+
+  SolveResult result() {
+    const ChainHdSolver& s = answered();
     SolveResult r;
-    r.qdd = copyVector(solver_.qdd().data(), nj_);
-    r.tau_command = copyVector(solver_.commandTorques().data(), nj_);
-    r.nu = copyVector(solver_.nu().data(), solver_.constraintCount());
+    r.qdd = copyVector(s.qdd().data(), nj_);
+    r.tau_command = copyVector(s.commandTorques().data(), nj_);
+    r.nu = copyVector(s.nu().data(), s.constraintCount());
     r.link_acc = py::array_t<double>({static_cast<py::ssize_t>(ns_ + 1), static_cast<py::ssize_t>(6)});
-    std::copy(solver_.linkAccelerations().data(), solver_.linkAccelerations().data() + 6 * (ns_ + 1),
-              r.link_acc.mutable_data());
-    r.constraint_rank = solver_.constraintRank();
-    r.smallest_singular_value = solver_.smallestSingularValue();
+    std::copy(s.linkAccelerations().data(), s.linkAccelerations().data() + 6 * (ns_ + 1), r.link_acc.mutable_data());
+    r.constraint_rank = s.constraintRank();
+    r.smallest_singular_value = s.smallestSingularValue();
+    if (last_friction_) {
+      r.friction_torque = copyVector(friction_solver_.frictionTorques().data(), nj_);
+      py::array_t<int> st(static_cast<py::ssize_t>(nj_));
+      for (unsigned int j = 0; j < nj_; ++j) st.mutable_data()[j] = friction_solver_.status()[j];
+      r.status = st;
+      r.gauss_value = py::float_(friction_solver_.gaussValue());
+      r.iterations = py::int_(friction_solver_.iterations());
+    }
     return r;
   }
 
   SolveResult solve(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
-                    const py::object& f_ext, const py::object& tau_ff) {
+                    const py::object& f_ext, const py::object& tau_ff, const py::object& friction) {
     Inputs in = parse(q, qd, alpha, beta, f_ext, tau_ff);
+    vereshchagin::FrictionModel fm;
+    const bool with_friction = parseFriction(friction, fm);
     std::lock_guard<std::mutex> lock(mutex_);
-    run(in);
+    run(in, with_friction ? &fm : nullptr);
     return result();
   }
 
@@ -171,7 +221,7 @@ class PySolver {
     std::lock_guard<std::mutex> lock(mutex_);
     for (py::ssize_t b = 0; b < B; ++b) {
       try {
-        run(rows[b]);
+        run(rows[b]);  // frictionless
       } catch (const SolverError& e) {
         raise("batch row " + std::to_string(b) + ": " + e.what());
       }
@@ -217,9 +267,9 @@ class PySolver {
     int rc;
     {
       py::gil_scoped_release release;
-      rc = solver_.responseColumns(j, dq, dt);
+      rc = answered().responseColumns(j, dq, dt);
     }
-    if (rc != ChainHdSolver::E_NOERROR) raise(solver_.errorMessage());
+    if (rc != ChainHdSolver::E_NOERROR) raise(answered().errorMessage());
     auto toNumpy = [&](const Eigen::MatrixXd& M) {
       py::array_t<double> a({static_cast<py::ssize_t>(nj_), k});
       auto v = a.mutable_unchecked<2>();
@@ -234,6 +284,9 @@ class PySolver {
 
  private:
   ChainHdSolver solver_;
+  vereshchagin::FrictionSolver friction_solver_;
+  Eigen::VectorXd chain_friction_;
+  bool last_friction_ = false;
   KDL::Vector gravity_;
   Eigen::Matrix<double, 6, 6> alfa_ = Eigen::Matrix<double, 6, 6>::Zero();
   std::mutex mutex_;
@@ -249,6 +302,10 @@ void bindSolver(py::module_& mod) {
       .def_readonly("link_acc", &SolveResult::link_acc)
       .def_readonly("constraint_rank", &SolveResult::constraint_rank)
       .def_readonly("smallest_singular_value", &SolveResult::smallest_singular_value)
+      .def_readonly("friction_torque", &SolveResult::friction_torque)
+      .def_readonly("status", &SolveResult::status)
+      .def_readonly("gauss_value", &SolveResult::gauss_value)
+      .def_readonly("iterations", &SolveResult::iterations)
       .def("__repr__", [](const SolveResult& r) {
         return "<vereshchagin.SolveResult n_joints=" + std::to_string(r.qdd.size()) +
                " m=" + std::to_string(r.nu.size()) + " rank=" + std::to_string(r.constraint_rank) + ">";
@@ -259,7 +316,8 @@ void bindSolver(py::module_& mod) {
            py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
            py::arg("damping") = py::none())
       .def("solve", &PySolver::solve, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
-           py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none())
+           py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
+           py::arg("friction") = py::none())
       .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none())
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"))

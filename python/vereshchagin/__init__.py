@@ -7,7 +7,8 @@ feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL
 """
 from ._core import Chain, Joint, SolveResult, SolverError
 from . import robots, task
+from .friction import Friction
 from .solver import BatchResult, Solver
 
-__all__ = ["BatchResult", "Chain", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
+__all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
 __version__ = "0.1.0"

@@ -1,0 +1,108 @@
+// Popov-Vereshchagin hybrid dynamics with static (breakaway) joint friction, solved exactly.
+//
+// Problem (report 000, Vereshchagin's max-min; the precise statement is in the project's
+// reference friction-maxmin.md): joints at rest (|qd_j| <= velocity_tolerance) with breakaway
+// friction f_j > 0 get the friction torque -mu_j, |mu_j| <= f_j, that maximises the dissipation:
+//
+//   qdd* = argmin_qdd  Z0(qdd) + sum_{j at rest} f_j |qdd_j|   subject to the task,
+//   mu*  = argmax_{|mu| <= f}  g(mu),  g(mu) = c^T mu - 1/2 mu^T Q mu,
+//
+// with Z0 the frictionless Gauss function, Q = W G W^T (G the constrained inverse inertia of
+// ChainHdSolver::responseColumns, W the selection of resting joints) and c = W qdd(0). Moving
+// joints get the kinetic (Coulomb) friction -fk_j sign(qd_j) as a feed-forward torque.
+//
+// Method: one full solve, the response columns of the resting joints (O(n) each, no
+// refactorisation), then the k x k box QP by a primal active-set method (exact: complementarity
+// holds to round-off; singular Q handled through zero-curvature directions). When several mu
+// give the same qdd* (the task fixes some resting joints' accelerations), the one minimising the
+// motor command ||tau_cmd||^2 is chosen (a least-distance problem on the optimal face): static
+// friction holds what it can and the motors add only the rest.
+//
+// Units and frames are those of ChainHdSolver. Outputs after solve():
+//  * qdd (n): joint accelerations.
+//  * commandTorques (n): tau_cmd = -J^T alfa nu at the optimum: what the motors add to
+//    ff_torques. Forward dynamics with ff_torques + tau_cmd + frictionTorques reproduces qdd.
+//  * frictionTorques (n): the physical friction torque on each joint (-mu* at rest,
+//    -fk sign(qd) when moving).
+//  * status (n): Moving, Stick, SlipPositive (qdd > 0) or SlipNegative (qdd < 0).
+//  * nu, constraint rank: as ChainHdSolver at the optimum.
+//  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
+//    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
+//    (computed on request: one extra O(n) solve).
+//  * iterations(): active-set iterations of the last solve.
+// No heap allocation in solve() or gaussValue().
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "vereshchagin/chain_hd_solver.hpp"
+
+namespace vereshchagin {
+
+struct FrictionModel {
+  Eigen::VectorXd static_friction;   // f_j >= 0 per joint (N m or N)
+  Eigen::VectorXd kinetic_friction;  // 0 <= fk_j <= f_j per joint; empty: equal to static_friction
+  double velocity_tolerance = 1e-6;  // |qd_j| at or below this: the joint is at rest
+};
+
+class FrictionSolver {
+ public:
+  enum JointStatus : signed char { Moving = 0, Stick = 1, SlipPositive = 2, SlipNegative = 3 };
+  enum {
+    E_INVALID_FRICTION = -110,     // sizes, negative or non-finite values, kinetic > static
+    E_NOT_CONVERGED = -111,        // the active-set bound was exceeded (not expected)
+  };
+
+  FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc,
+                 const SolverOptions& options = SolverOptions());
+
+  int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+            const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+            const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+
+  const Eigen::VectorXd& qdd() const { return qdd_; }
+  const Eigen::VectorXd& commandTorques() const { return tau_cmd_; }
+  const Eigen::VectorXd& frictionTorques() const { return friction_; }
+  const std::vector<signed char>& status() const { return status_; }
+  Eigen::Map<const Eigen::VectorXd> nu() const { return hd_.nu(); }
+  int constraintRank() const { return hd_.constraintRank(); }
+  int iterations() const { return iterations_; }
+  double gaussValue();
+
+  ChainHdSolver& hdSolver() { return hd_; }
+  const char* errorMessage() const { return message_.data(); }
+  int modelError() const { return hd_.modelError(); }
+  void setRootAcceleration(const KDL::Twist& root_acc) { hd_.setRootAcceleration(root_acc); free_.setRootAcceleration(root_acc); }
+  int setOptions(const SolverOptions& options);
+
+ private:
+  int fail(int code, const char* fmt, ...);
+  int boxQp(int k);                 // stage 1 on Q_, c_, lo_, hi_ -> x_
+  void leastCommand(int k);         // stage 2: tie-break on the optimal face
+  // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
+  // (returns true) when g_F has a component in null(Q_FF).
+  bool freeStep(int nf);
+
+  ChainHdSolver hd_, free_;
+  unsigned int nj_ = 0;
+  std::array<char, 512> message_{};
+  Eigen::VectorXd qdd_, tau_cmd_, friction_, tau0_, qdd0_, tau_cmd0_;
+  std::vector<signed char> status_;
+  int iterations_ = 0;
+  bool solved_ = false;
+  // Inputs kept for gaussValue().
+  Eigen::VectorXd q_keep_, qd_keep_;
+  ChainHdSolver::Matrix6X f_keep_;
+  bool has_f_ = false;
+  Eigen::VectorXd fstatic_;  // static friction of the last solve
+  // Optimisation workspace (k <= n resting joints).
+  Eigen::VectorXi rest_;     // joint index of each resting joint
+  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_, V_, N_, B_;
+  Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_;
+  Eigen::VectorXi state_, free_idx_, rows_;
+};
+
+}  // namespace vereshchagin

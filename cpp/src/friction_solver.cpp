@@ -1,0 +1,360 @@
+// Static-friction max-min on top of the Popov-Vereshchagin solver. Math in friction_solver.hpp.
+#include "vereshchagin/friction_solver.hpp"
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <limits>
+
+#include "dense_small.hpp"
+
+namespace vereshchagin {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}
+
+FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
+    : hd_(chain, root_acc, options), free_(chain, root_acc, options) {
+  nj_ = hd_.nrOfJoints();
+  const int n = static_cast<int>(nj_);
+  qdd_ = tau_cmd_ = friction_ = tau0_ = qdd0_ = tau_cmd0_ = Eigen::VectorXd::Zero(n);
+  q_keep_ = qd_keep_ = fstatic_ = Eigen::VectorXd::Zero(n);
+  f_keep_ = ChainHdSolver::Matrix6X::Zero(6, hd_.nrOfSegments());
+  status_.assign(n, Moving);
+  rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
+  Gc_ = Tc_ = Q_ = work_ = L_ = V_ = N_ = B_ = Eigen::MatrixXd::Zero(n, n);
+  c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = Eigen::VectorXd::Zero(n);
+}
+
+int FrictionSolver::setOptions(const SolverOptions& options) {
+  const int rc = hd_.setOptions(options);
+  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  free_.setOptions(options);
+  return rc;
+}
+
+int FrictionSolver::fail(int code, const char* fmt, ...) {
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(message_.data(), message_.size(), fmt, args);
+  va_end(args);
+  solved_ = false;
+  return code;
+}
+
+int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
+                          const Eigen::Ref<const Eigen::VectorXd>& beta,
+                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
+  solved_ = false;
+  const long n = nj_;
+  const Eigen::VectorXd& fs = friction.static_friction;
+  const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
+  if (fs.size() != n)
+    return fail(E_INVALID_FRICTION, "static friction has %ld entries, expected %ld (joints)", (long)fs.size(), n);
+  if (fk.size() != n)
+    return fail(E_INVALID_FRICTION, "kinetic friction has %ld entries, expected %ld (joints) or 0", (long)fk.size(), n);
+  if (!std::isfinite(friction.velocity_tolerance) || friction.velocity_tolerance < 0.0)
+    return fail(E_INVALID_FRICTION, "velocity tolerance must be finite and >= 0, got %g", friction.velocity_tolerance);
+  for (long j = 0; j < n; ++j) {
+    if (!std::isfinite(fs(j)) || fs(j) < 0.0)
+      return fail(E_INVALID_FRICTION, "static friction of joint %ld must be finite and >= 0, got %g", j, fs(j));
+    if (!std::isfinite(fk(j)) || fk(j) < 0.0 || fk(j) > fs(j))
+      return fail(E_INVALID_FRICTION, "kinetic friction of joint %ld must be in [0, static = %g], got %g", j, fs(j), fk(j));
+  }
+  if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0)) {
+    // Let the hybrid-dynamics solver report the size problem with its message.
+    const int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, ff_torques);
+    return fail(rc, "%s", hd_.errorMessage());
+  }
+  if (!q_dot.allFinite()) {
+    const int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, ff_torques);
+    return fail(rc, "%s", hd_.errorMessage());
+  }
+
+  // Kinetic friction of moving joints as feed-forward; collect the resting joints.
+  int k = 0;
+  for (long j = 0; j < n; ++j) {
+    tau0_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
+    if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
+      tau0_(j) -= fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
+    } else if (fs(j) > 0.0) {
+      rest_(k++) = static_cast<int>(j);
+    }
+  }
+  int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, tau0_);
+  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  q_keep_ = q;
+  qd_keep_ = q_dot;
+  has_f_ = f_ext.cols() != 0;
+  if (has_f_) f_keep_ = f_ext;
+  fstatic_ = fs;
+  iterations_ = 0;
+
+  if (k > 0) {
+    qdd0_ = hd_.qdd();
+    tau_cmd0_ = hd_.commandTorques();
+    rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(k));
+    if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+    for (int a = 0; a < k; ++a) {
+      c_(a) = qdd0_(rest_(a));
+      lo_(a) = -fs(rest_(a));
+      hi_(a) = fs(rest_(a));
+      for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
+    }
+    rc = boxQp(k);
+    if (rc != ChainHdSolver::E_NOERROR) return rc;
+    leastCommand(k);
+    // Final solve with the optimal friction torques: qdd, nu, tau_cmd and link accelerations
+    // consistent at the optimum.
+    for (int a = 0; a < k; ++a) tau0_(rest_(a)) -= x_(a);
+    rc = hd_.solve(q, q_dot, alfa, beta, f_ext, tau0_);
+    if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+    for (int a = 0; a < k; ++a) tau0_(rest_(a)) += x_(a);  // tau0_ stays "without static friction"
+  }
+  qdd_ = hd_.qdd();
+  tau_cmd_ = hd_.commandTorques();
+
+  // Friction torques and status.
+  const double acc_scale = std::max(1.0, qdd_.cwiseAbs().maxCoeff());
+  int a = 0;
+  for (long j = 0; j < n; ++j) {
+    if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
+      friction_(j) = -fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
+      status_[j] = Moving;
+      continue;
+    }
+    friction_(j) = 0.0;
+    if (a < k && rest_(a) == j) friction_(j) = -x_(a++);
+    const double acc = qdd_(j);
+    status_[j] = std::abs(acc) <= 1e-9 * acc_scale ? Stick : (acc > 0.0 ? SlipPositive : SlipNegative);
+  }
+  solved_ = true;
+  return ChainHdSolver::E_NOERROR;
+}
+
+// Free-set step. Q_FF (nf x nf) is built in work_; p_ = -Q_FF^+ g_F. Returns true with a
+// zero-curvature descent direction in d_ when g_F has a component in null(Q_FF).
+bool FrictionSolver::freeStep(int nf) {
+  auto W = work_.topLeftCorner(nf, nf);
+  for (int a = 0; a < nf; ++a)
+    for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
+  auto g = tmp_.head(nf);
+  for (int a = 0; a < nf; ++a) g(a) = grad_(free_idx_(a));
+  auto p = p_.head(nf);
+  auto L = L_.topLeftCorner(nf, nf);
+  if (detail::choleskyCertified(W, L, 1e-10)) {
+    p = -g;
+    detail::choleskySolve(L, p);
+    return false;
+  }
+  auto V = V_.topLeftCorner(nf, nf);
+  auto lam = eig_.head(nf);
+  detail::jacobiEigen(W, V, lam);
+  const double lmax = std::max(lam.maxCoeff(), 0.0);
+  const double qscale = std::max(lmax, Q_.diagonal().head(nf).cwiseAbs().maxCoeff());
+  const double thr = 1e-10 * qscale;
+  auto d = d_.head(nf);
+  p.setZero();
+  d.setZero();
+  for (int e = 0; e < nf; ++e) {
+    const double proj = V.col(e).dot(g);
+    if (lam(e) > thr) {
+      p.noalias() -= (proj / lam(e)) * V.col(e);
+    } else {
+      d.noalias() -= proj * V.col(e);
+    }
+  }
+  const double gscale = std::max({g.cwiseAbs().maxCoeff(), c_.cwiseAbs().maxCoeff(), 1e-300});
+  return d.cwiseAbs().maxCoeff() > 1e-12 * gscale;
+}
+
+// Stage 1: minimise 1/2 x^T Q x - c^T x over lo <= x <= hi by a primal active-set method.
+int FrictionSolver::boxQp(int k) {
+  auto x = x_.head(k);
+  x.setZero();  // feasible: every box contains 0
+  auto state = state_.head(k);
+  state.setZero();  // 0 free, -1 at lower bound, +1 at upper bound
+  const double xscale = std::max(hi_.head(k).cwiseAbs().maxCoeff(), 1e-300);
+  const double gscale = std::max({c_.head(k).cwiseAbs().maxCoeff(), Q_.topLeftCorner(k, k).cwiseAbs().maxCoeff() * xscale, 1e-300});
+  const double tol_g = 1e-11 * gscale;
+  const int max_iterations = 50 + 20 * k;
+  bool face_optimal = false;
+  for (int it = 0; it < max_iterations; ++it) {
+    iterations_ = it + 1;
+    grad_.head(k).noalias() = Q_.topLeftCorner(k, k) * x;
+    grad_.head(k) -= c_.head(k);
+    int nf = 0;
+    for (int i = 0; i < k; ++i)
+      if (state(i) == 0) free_idx_(nf++) = i;
+    if (nf > 0 && !face_optimal) {
+      const bool zero_curvature = freeStep(nf);
+      const auto dir = zero_curvature ? d_.head(nf) : p_.head(nf);
+      double alpha = zero_curvature ? kInf : 1.0;
+      int block = -1, side = 0;
+      for (int a = 0; a < nf; ++a) {
+        const int i = free_idx_(a);
+        const double s = dir(a);
+        if (s > 0.0 && hi_(i) < kInf) {
+          const double t = (hi_(i) - x(i)) / s;
+          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = 1;
+        } else if (s < 0.0 && lo_(i) > -kInf) {
+          const double t = (lo_(i) - x(i)) / s;
+          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = -1;
+        }
+      }
+      if (!std::isfinite(alpha))
+        return fail(E_NOT_CONVERGED, "friction optimisation is unbounded (no bound stops a zero-curvature direction)");
+      for (int a = 0; a < nf; ++a) x(free_idx_(a)) += alpha * dir(a);
+      if (block >= 0) {
+        state(block) = side;
+        x(block) = side > 0 ? hi_(block) : lo_(block);
+        face_optimal = false;
+        continue;
+      }
+      face_optimal = true;  // full Newton step: optimal on this face
+      continue;
+    }
+    // Optimal on the current face: the bound multipliers must have the right sign.
+    int release = -1;
+    double worst = tol_g;
+    for (int i = 0; i < k; ++i) {
+      const double violation = state(i) < 0 ? -grad_(i) : (state(i) > 0 ? grad_(i) : 0.0);
+      if (violation > worst) worst = violation, release = i;
+    }
+    if (release < 0) return ChainHdSolver::E_NOERROR;
+    state(release) = 0;
+    face_optimal = false;
+  }
+  return fail(E_NOT_CONVERGED, "friction optimisation did not converge in %d active-set iterations", max_iterations);
+}
+
+// Stage 2: among the optimal friction vectors (same qdd), the one minimising ||tau_cmd||^2.
+// On the optimal face only the sticking resting joints' mu may change, along null(Q_StSt), and
+// there tau_cmd changes by exactly the change of mu (the motion is unchanged), so the problem is
+// min ||x_St + t||^2 with t = tau_cmd at the stage-1 optimum, over x_St = x*_St + N z in the box:
+// a least-distance problem in z (N orthonormal), solved by a primal active-set method.
+void FrictionSolver::leastCommand(int k) {
+  auto x = x_.head(k);
+  grad_.head(k).noalias() = Q_.topLeftCorner(k, k) * x;
+  grad_.head(k) -= c_.head(k);  // = -(accelerations of the resting joints)
+  const double acc_scale = std::max(c_.head(k).cwiseAbs().maxCoeff(), 1e-300);
+  int ns = 0;
+  for (int a = 0; a < k; ++a)
+    if (std::abs(grad_(a)) <= 1e-10 * std::max(acc_scale, 1.0)) rows_(ns++) = a;
+  if (ns == 0) return;
+  auto W = work_.topLeftCorner(ns, ns);
+  for (int a = 0; a < ns; ++a)
+    for (int b = 0; b < ns; ++b) W(a, b) = Q_(rows_(a), rows_(b));
+  const double qscale = std::max(W.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+  auto V = V_.topLeftCorner(ns, ns);
+  auto lam = eig_.head(ns);
+  detail::jacobiEigen(W, V, lam);
+  int dn = 0;
+  for (int e = 0; e < ns; ++e)
+    if (lam(e) <= 1e-10 * qscale) N_.col(dn++).head(ns) = V.col(e);
+  if (dn == 0) return;
+  auto N = N_.topLeftCorner(ns, dn);
+  // Target: x_St = -tau_cmd_St at the stage-1 optimum (tau_cmd = tau_cmd0 - Tc x).
+  auto t = tmp_.head(ns);
+  for (int a = 0; a < ns; ++a) {
+    const int j = rest_(rows_(a));
+    double tc = tau_cmd0_(j);
+    for (int b = 0; b < k; ++b) tc -= Tc_(j, b) * x(b);
+    t(a) = -tc;  // desired change of x_St: tau_cmd_St + change = 0
+  }
+  auto z0 = d_.head(dn);
+  z0.noalias() = N.transpose() * t;
+  auto z = p_.head(dn);
+  z.setZero();
+  // Working set: rows of N (indices into St) held at a bound; side -1 lower, +1 upper.
+  int nw = 0;
+  Eigen::VectorXi& wrow = free_idx_;
+  Eigen::VectorXi& wside = state_;
+  auto lowerRoom = [&](int a) { return lo_(rows_(a)) - x(rows_(a)); };
+  auto upperRoom = [&](int a) { return hi_(rows_(a)) - x(rows_(a)); };
+  const double zscale = std::max(hi_.head(k).cwiseAbs().maxCoeff(), 1e-300);
+  for (int it = 0; it < 50 + 20 * ns; ++it) {
+    // Projection of z0 onto {z : N_W z = b_W}: zp = z0 - B^T (B B^T)^-1 (B z0 - b).
+    auto zp = tmp2_.head(dn);
+    zp = z0;
+    auto y = eig_.head(nw);
+    auto B = B_.topLeftCorner(nw, dn);
+    auto BBt = work_.topLeftCorner(nw, nw);
+    auto L = L_.topLeftCorner(nw, nw);
+    if (nw > 0) {
+      for (int w = 0; w < nw; ++w) B.row(w) = N.row(wrow(w));
+      BBt.noalias() = B * B.transpose();
+      if (!detail::choleskyCertified(BBt, L, 1e-13)) break;  // degenerate: keep the feasible z
+      for (int w = 0; w < nw; ++w) y(w) = N.row(wrow(w)).dot(z0) - (wside(w) < 0 ? lowerRoom(wrow(w)) : upperRoom(wrow(w)));
+      detail::choleskySolve(L, y);
+      zp.noalias() -= B.transpose() * y;
+    }
+    auto step = zp - z;
+    if (step.cwiseAbs().maxCoeff() <= 1e-13 * zscale) {
+      if (nw == 0) break;
+      // Multipliers: z - z0 = B^T (sigma .* lambda), lambda >= 0 required.
+      for (int w = 0; w < nw; ++w) y(w) = B.row(w).dot(z - z0);
+      detail::choleskySolve(L, y);
+      int drop = -1;
+      double worst = -1e-12 * std::max(z0.cwiseAbs().maxCoeff(), 1e-300);
+      for (int w = 0; w < nw; ++w) {
+        const double lambda = (wside(w) < 0 ? 1.0 : -1.0) * y(w);
+        if (lambda < worst) worst = lambda, drop = w;
+      }
+      if (drop < 0) break;
+      wrow(drop) = wrow(nw - 1);
+      wside(drop) = wside(nw - 1);
+      --nw;
+      continue;
+    }
+    double alpha = 1.0;
+    int block = -1, side = 0;
+    for (int a = 0; a < ns; ++a) {
+      bool in_w = false;
+      for (int w = 0; w < nw; ++w) in_w = in_w || wrow(w) == a;
+      if (in_w) continue;
+      const double s = N.row(a).dot(step), cur = N.row(a).dot(z);
+      if (s > 1e-15) {
+        const double tt = (upperRoom(a) - cur) / s;
+        if (tt < alpha) alpha = std::max(tt, 0.0), block = a, side = 1;
+      } else if (s < -1e-15) {
+        const double tt = (lowerRoom(a) - cur) / s;
+        if (tt < alpha) alpha = std::max(tt, 0.0), block = a, side = -1;
+      }
+    }
+    z += alpha * step;
+    if (block >= 0) {
+      wrow(nw) = block;
+      wside(nw) = side;
+      ++nw;
+    }
+  }
+  for (int a = 0; a < ns; ++a) {
+    const int i = rows_(a);
+    x(i) = std::min(hi_(i), std::max(lo_(i), x(i) + N.row(a).dot(z)));
+  }
+}
+
+double FrictionSolver::gaussValue() {
+  if (!solved_) return std::numeric_limits<double>::quiet_NaN();
+  // qdd_free: unconstrained motion under ff torques and kinetic friction (tau0_).
+  const Eigen::Matrix<double, 6, 0> no_alfa;
+  const Eigen::Matrix<double, 0, 1> no_beta;
+  const int rc = has_f_ ? free_.solve(q_keep_, qd_keep_, no_alfa, no_beta, f_keep_, tau0_)
+                        : free_.solve(q_keep_, qd_keep_, no_alfa, no_beta, f_keep_.leftCols(0), tau0_);
+  if (rc != ChainHdSolver::E_NOERROR) return std::numeric_limits<double>::quiet_NaN();
+  // H (qdd* - qdd_free) = tau_cmd* + friction torques of the resting joints.
+  double z0 = 0.0, dissipation = 0.0;
+  for (unsigned int j = 0; j < nj_; ++j) {
+    const bool resting = status_[j] != Moving;
+    const double torque = tau_cmd_(j) + (resting ? friction_(j) : 0.0);
+    z0 += 0.5 * (qdd_(j) - free_.qdd()(j)) * torque;
+    if (resting) dissipation += fstatic_(j) * std::abs(qdd_(j));
+  }
+  return z0 + dissipation;
+}
+
+}  // namespace vereshchagin
