@@ -13,6 +13,7 @@
 #include "random_chain.hpp"
 #include "test_common.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
+#include "vereshchagin/friction_solver.hpp"
 
 namespace {
 std::atomic<long> g_new_calls{0};
@@ -220,6 +221,40 @@ int main() {
              "allocations inside KDL's CartToJnt were not counted");
   }
 
-  return ck.finish(std::string("8000 counted calls on a 7-joint chain, nc 0..6 (malloc counted too: ") +
+  // Friction-aware solves: all joints at rest (k = 7 resting joints), some moving, nc 0..6, with
+  // the Gauss value on request; also a singular task (the tie-break path) and DLS options.
+  {
+    vereshchagin::FrictionSolver fsolver(chain, grav);
+    vereshchagin::FrictionModel fm;
+    fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
+    fm.kinetic_friction = 0.5 * fm.static_friction;
+    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd mixed = Eigen::VectorXd::Zero(n);
+    mixed(1) = 0.3;
+    mixed(4) = -0.2;
+    const Matrix6X full = Matrix6X::Identity(6, 6);
+    const Eigen::VectorXd hold = (Eigen::VectorXd(6) << 0, 0, 9.81, 0, 0, 0).finished();
+    double fsum = 0.0;
+    int ffail = 0;
+    // Warm-up outside the counted region (first use of every code path).
+    fsolver.solve(q[0].data, rest, alfa_m[6], beta[6].data, fext_m[0], ff[0].data, fm);
+    const Counts f0 = now();
+    for (int it = 0; it < 1000; ++it) {
+      const int s = it % kSets, nc = it % 7;
+      if (fsolver.solve(q[s].data, rest, alfa_m[nc], beta[nc].data, fext_m[s], ff[s].data, fm) != 0) ++ffail;
+      fsum += fsolver.qdd()(0) + fsolver.frictionTorques()(2) + fsolver.gaussValue() + fsolver.iterations();
+      if (fsolver.solve(q[s].data, mixed, alfa_m[nc], beta[nc].data, empty_fext, empty_tau, fm) != 0) ++ffail;
+      if (fsolver.solve(q[s].data, rest, full, hold, empty_fext, ff[s].data, fm) != 0) ++ffail;
+      fsum += fsolver.commandTorques()(0) + fsolver.gaussValue();
+    }
+    const Counts f1 = now();
+    ck.check(ffail == 0, "friction solves failed: " + str(ffail) + " (" + fsolver.errorMessage() + ")");
+    ck.check(std::isfinite(fsum), "non-finite friction results");
+    ck.check(f1.news == f0.news && f1.mallocs == f0.mallocs,
+             "friction-aware solves allocated: operator new " + str(f1.news - f0.news) + ", malloc " +
+                 str(f1.mallocs - f0.mallocs) + " in 3000 solves");
+  }
+
+  return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves on a 7-joint chain, nc 0..6 (malloc counted too: ") +
                    (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no") + ")");
 }
