@@ -95,6 +95,7 @@ void ChainHdSolver::buildModel() {
   nj_ = chain_.getNrOfJoints();
   ns_ = chain_.getNrOfSegments();
   segs_.assign(ns_, Segment());
+  joint_segment_.assign(nj_, 0);
   qdd_ = Eigen::VectorXd::Zero(nj_);
   tau_cmd_ = Eigen::VectorXd::Zero(nj_);
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
@@ -154,6 +155,7 @@ void ChainHdSolver::buildModel() {
       s.joint = -1;
       s.S.setZero();
     } else {
+      joint_segment_[j] = static_cast<int>(i);
       s.joint = static_cast<int>(j++);
       s.rotor = joint.getInertia();
       if (!std::isfinite(s.rotor) || s.rotor < 0.0) {

@@ -15,17 +15,14 @@ using MatBlock = Eigen::Block<Eigen::MatrixXd>;
 using VecBlock = Eigen::VectorBlock<Eigen::VectorXd>;
 
 // A = L L^T into the lower triangle of L (k x k). Fails (false) when a pivot is not above
-// rel_tol times the largest diagonal entry of A, i.e. when A is not safely positive definite.
+// min_pivot, i.e. when A is not safely positive definite at the caller's scale.
 template <typename MA, typename ML>
-bool choleskyCertified(const MA& A, ML& L, double rel_tol) {
+bool choleskyCertified(const MA& A, ML& L, double min_pivot) {
   const int k = static_cast<int>(A.rows());
-  double dmax = 0.0;
-  for (int i = 0; i < k; ++i) dmax = std::max(dmax, A(i, i));
-  if (!(dmax > 0.0)) return false;
   for (int j = 0; j < k; ++j) {
     double d = A(j, j);
     for (int p = 0; p < j; ++p) d -= L(j, p) * L(j, p);
-    if (!(d > rel_tol * dmax)) return false;
+    if (!(d > min_pivot)) return false;
     const double ljj = std::sqrt(d);
     L(j, j) = ljj;
     for (int i = j + 1; i < k; ++i) {

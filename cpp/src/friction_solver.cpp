@@ -12,6 +12,8 @@ namespace vereshchagin {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Curvatures (eigenvalues of Q, Cholesky pivots) below this fraction of Q's scale are zero.
+constexpr double kZeroCurvature = 1e-10;
 }
 
 FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
@@ -104,6 +106,12 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
       hi_(a) = fs(rest_(a));
       for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
     }
+    // Scale of Q for every "is it zero" decision: max over the resting joints of Q_jj and of
+    // 1 / D_j <= (H^-1)_jj (a task can make Q vanish up to round-off; its entries are then no
+    // scale for themselves).
+    qscale_ = 0.0;
+    for (int a = 0; a < k; ++a)
+      qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_.articulatedInertia(static_cast<unsigned int>(rest_(a)))});
     rc = boxQp(k);
     if (rc != ChainHdSolver::E_NOERROR) return rc;
     leastCommand(k);
@@ -145,7 +153,7 @@ bool FrictionSolver::freeStep(int nf) {
   for (int a = 0; a < nf; ++a) g(a) = grad_(free_idx_(a));
   auto p = p_.head(nf);
   auto L = L_.topLeftCorner(nf, nf);
-  if (detail::choleskyCertified(W, L, 1e-10)) {
+  if (detail::choleskyCertified(W, L, kZeroCurvature * qscale_)) {
     p = -g;
     detail::choleskySolve(L, p);
     return false;
@@ -153,9 +161,7 @@ bool FrictionSolver::freeStep(int nf) {
   auto V = V_.topLeftCorner(nf, nf);
   auto lam = eig_.head(nf);
   detail::jacobiEigen(W, V, lam);
-  const double lmax = std::max(lam.maxCoeff(), 0.0);
-  const double qscale = std::max(lmax, Q_.diagonal().head(nf).cwiseAbs().maxCoeff());
-  const double thr = 1e-10 * qscale;
+  const double thr = kZeroCurvature * qscale_;
   auto d = d_.head(nf);
   p.setZero();
   d.setZero();
@@ -248,13 +254,12 @@ void FrictionSolver::leastCommand(int k) {
   auto W = work_.topLeftCorner(ns, ns);
   for (int a = 0; a < ns; ++a)
     for (int b = 0; b < ns; ++b) W(a, b) = Q_(rows_(a), rows_(b));
-  const double qscale = std::max(W.diagonal().cwiseAbs().maxCoeff(), 1e-300);
   auto V = V_.topLeftCorner(ns, ns);
   auto lam = eig_.head(ns);
   detail::jacobiEigen(W, V, lam);
   int dn = 0;
   for (int e = 0; e < ns; ++e)
-    if (lam(e) <= 1e-10 * qscale) N_.col(dn++).head(ns) = V.col(e);
+    if (lam(e) <= kZeroCurvature * qscale_) N_.col(dn++).head(ns) = V.col(e);
   if (dn == 0) return;
   auto N = N_.topLeftCorner(ns, dn);
   // Target: x_St = -tau_cmd_St at the stage-1 optimum (tau_cmd = tau_cmd0 - Tc x).
@@ -287,7 +292,7 @@ void FrictionSolver::leastCommand(int k) {
     if (nw > 0) {
       for (int w = 0; w < nw; ++w) B.row(w) = N.row(wrow(w));
       BBt.noalias() = B * B.transpose();
-      if (!detail::choleskyCertified(BBt, L, 1e-13)) break;  // degenerate: keep the feasible z
+      if (!detail::choleskyCertified(BBt, L, 1e-13)) break;  // degenerate (rows of N have norm <= 1)
       for (int w = 0; w < nw; ++w) y(w) = N.row(wrow(w)).dot(z0) - (wside(w) < 0 ? lowerRoom(wrow(w)) : upperRoom(wrow(w)));
       detail::choleskySolve(L, y);
       zp.noalias() -= B.transpose() * y;

@@ -127,6 +127,9 @@ class ChainHdSolver : public KDL::SolverI {
   Eigen::Map<const Eigen::VectorXd> nu() const { return Eigen::Map<const Eigen::VectorXd>(nu_.data(), m_); }
   const Matrix6X& linkAccelerations() const { return link_acc_; }
   int constraintCount() const { return m_; }
+  // Articulated inertia D_j of joint j (its own rotor plus everything it moves, with its parent
+  // held) at the last solve: a lower bound of the unconstrained (H^-1)_jj is 1 / D_j.
+  double articulatedInertia(unsigned int joint) const { return segs_[joint_segment_[joint]].D; }
   int constraintRank() const { return rank_; }
   // Smallest eigenvalue (= singular value) of K; computed on first request after a solve.
   double smallestSingularValue() const;
@@ -206,6 +209,7 @@ class ChainHdSolver : public KDL::SolverI {
   std::array<char, 512> message_{};
 
   std::vector<Segment> segs_;
+  std::vector<int> joint_segment_;  // segment index of each joint
   Eigen::VectorXd qdd_, tau_cmd_, zero_joints_;
   Matrix6X link_acc_, f_ext_buf_, zero_f_ext_;
   Matrix6 alfa_buf_;

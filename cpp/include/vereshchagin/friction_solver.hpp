@@ -92,6 +92,7 @@ class FrictionSolver {
   Eigen::VectorXd qdd_, tau_cmd_, friction_, tau0_, qdd0_, tau_cmd0_;
   std::vector<signed char> status_;
   int iterations_ = 0;
+  double qscale_ = 0.0;  // scale of Q (see solve())
   bool solved_ = false;
   // Inputs kept for gaussValue().
   Eigen::VectorXd q_keep_, qd_keep_;
