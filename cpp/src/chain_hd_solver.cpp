@@ -100,6 +100,7 @@ void ChainHdSolver::buildModel() {
   tau_cmd_ = Eigen::VectorXd::Zero(nj_);
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
   link_acc_ = Matrix6X::Zero(6, ns_ + 1);
+  link_acc_known_ = true;  // zeros until the first solve
   f_ext_buf_ = Matrix6X::Zero(6, ns_);
   zero_f_ext_ = Matrix6X::Zero(6, ns_);
   alfa_buf_.setZero();
@@ -396,7 +397,7 @@ void ChainHdSolver::finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torq
   Eigen::Matrix<double, M, 1> nu;
   if (M > 0) nu = nu_;
   Vector6 xdd_parent = root_acc_;
-  link_acc_.col(0) = root_acc_;
+  link_acc_known_ = false;
   for (unsigned int i = 0; i < ns_; ++i) {
     Segment& s = segs_[i];
     Vector6 a = motionToChild(s.X, xdd_parent);
@@ -410,8 +411,6 @@ void ChainHdSolver::finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torq
       a += s.S * qdd;
     }
     s.xdd = a;
-    link_acc_.col(i + 1).head<3>().noalias() = s.R_base * a.head<3>();
-    link_acc_.col(i + 1).tail<3>().noalias() = s.R_base * a.tail<3>();
     xdd_parent = a;
   }
 }
@@ -595,10 +594,24 @@ int ChainHdSolver::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot,
   return E_NOERROR;
 }
 
+// Link accelerations in base axes, computed from the tip-frame ones on first request.
+const ChainHdSolver::Matrix6X& ChainHdSolver::linkAccelerations() const {
+  if (!link_acc_known_) {
+    link_acc_.col(0) = root_acc_;
+    for (unsigned int i = 0; i < ns_; ++i) {
+      const Segment& s = segs_[i];
+      link_acc_.col(i + 1).head<3>().noalias() = s.R_base * s.xdd.head<3>();
+      link_acc_.col(i + 1).tail<3>().noalias() = s.R_base * s.xdd.tail<3>();
+    }
+    link_acc_known_ = true;
+  }
+  return link_acc_;
+}
+
 void ChainHdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot) const {
   x_dotdot.resize(ns_ + 1);
   for (unsigned int i = 0; i <= ns_; ++i) {
-    const auto a = link_acc_.col(i);
+    const auto a = linkAccelerations().col(i);
     x_dotdot[i] = KDL::Twist(KDL::Vector(a(0), a(1), a(2)), KDL::Vector(a(3), a(4), a(5)));
   }
 }

@@ -125,7 +125,7 @@ class ChainHdSolver : public KDL::SolverI {
   const Eigen::VectorXd& qdd() const { return qdd_; }
   const Eigen::VectorXd& commandTorques() const { return tau_cmd_; }
   Eigen::Map<const Eigen::VectorXd> nu() const { return Eigen::Map<const Eigen::VectorXd>(nu_.data(), m_); }
-  const Matrix6X& linkAccelerations() const { return link_acc_; }
+  const Matrix6X& linkAccelerations() const;  // computed on first request after a solve
   int constraintCount() const { return m_; }
   // Articulated inertia D_j of joint j (its own rotor plus everything it moves, with its parent
   // held) at the last solve: a lower bound of the unconstrained (H^-1)_jj is 1 / D_j.
@@ -211,7 +211,9 @@ class ChainHdSolver : public KDL::SolverI {
   std::vector<Segment> segs_;
   std::vector<int> joint_segment_;  // segment index of each joint
   Eigen::VectorXd qdd_, tau_cmd_, zero_joints_;
-  Matrix6X link_acc_, f_ext_buf_, zero_f_ext_;
+  mutable Matrix6X link_acc_;
+  mutable bool link_acc_known_ = false;
+  Matrix6X f_ext_buf_, zero_f_ext_;
   Matrix6 alfa_buf_;
   int m_ = 0, rank_ = 0;
   bool solved_ = false;
