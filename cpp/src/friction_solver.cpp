@@ -20,7 +20,7 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
     : hd_(chain, root_acc, options), free_(chain, root_acc, options) {
   nj_ = hd_.nrOfJoints();
   const int n = static_cast<int>(nj_);
-  qdd_ = tau_cmd_ = friction_ = tau0_ = qdd0_ = tau_cmd0_ = Eigen::VectorXd::Zero(n);
+  qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = Eigen::VectorXd::Zero(n);
   q_keep_ = qd_keep_ = fstatic_ = Eigen::VectorXd::Zero(n);
   f_keep_ = ChainHdSolver::Matrix6X::Zero(6, hd_.nrOfSegments());
   status_.assign(n, Moving);
@@ -66,6 +66,17 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
     if (!std::isfinite(fk(j)) || fk(j) < 0.0 || fk(j) > fs(j))
       return fail(E_INVALID_FRICTION, "kinetic friction of joint %ld must be in [0, static = %g], got %g", j, fs(j), fk(j));
   }
+  const bool limits = friction.lower.size() != 0 || friction.upper.size() != 0;
+  if (limits) {
+    if (friction.lower.size() != n || friction.upper.size() != n)
+      return fail(E_INVALID_FRICTION, "joint limits need lower and upper with %ld entries each", n);
+    if (!std::isfinite(friction.limit_tolerance) || friction.limit_tolerance < 0.0)
+      return fail(E_INVALID_FRICTION, "limit tolerance must be finite and >= 0, got %g", friction.limit_tolerance);
+    for (long j = 0; j < n; ++j)
+      if (std::isnan(friction.lower(j)) || std::isnan(friction.upper(j)) || friction.lower(j) > friction.upper(j))
+        return fail(E_INVALID_FRICTION, "joint %ld: limits must satisfy lower <= upper (got %g, %g)", j,
+                    friction.lower(j), friction.upper(j));
+  }
   if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0)) {
     // Let the hybrid-dynamics solver report the size problem with its message.
     const int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, ff_torques);
@@ -76,13 +87,25 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
     return fail(rc, "%s", hd_.errorMessage());
   }
 
-  // Kinetic friction of moving joints as feed-forward; collect the resting joints.
+  // Kinetic friction of moving joints as feed-forward; collect the resting joints with friction
+  // or on a limit, and the bounds of their mu (friction torque -mu): [-f, f], opened to -inf at a
+  // lower limit (the reaction pushes up) and to +inf at an upper limit.
+  if (!q.allFinite()) {
+    const int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, ff_torques);
+    return fail(rc, "%s", hd_.errorMessage());
+  }
   int k = 0;
   for (long j = 0; j < n; ++j) {
     tau0_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
     if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
       tau0_(j) -= fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
-    } else if (fs(j) > 0.0) {
+      continue;
+    }
+    const bool at_lower = limits && q(j) <= friction.lower(j) + friction.limit_tolerance;
+    const bool at_upper = limits && q(j) >= friction.upper(j) - friction.limit_tolerance;
+    if (fs(j) > 0.0 || at_lower || at_upper) {
+      lo_(k) = at_lower ? -kInf : -fs(j);
+      hi_(k) = at_upper ? kInf : fs(j);
       rest_(k++) = static_cast<int>(j);
     }
   }
@@ -102,8 +125,6 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
     if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
     for (int a = 0; a < k; ++a) {
       c_(a) = qdd0_(rest_(a));
-      lo_(a) = -fs(rest_(a));
-      hi_(a) = fs(rest_(a));
       for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
     }
     // Scale of Q for every "is it zero" decision: max over the resting joints of Q_jj and of
@@ -131,11 +152,18 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   for (long j = 0; j < n; ++j) {
     if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
       friction_(j) = -fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
+      limit_(j) = 0.0;
       status_[j] = Moving;
       continue;
     }
     friction_(j) = 0.0;
-    if (a < k && rest_(a) == j) friction_(j) = -x_(a++);
+    limit_(j) = 0.0;
+    if (a < k && rest_(a) == j) {
+      // Friction holds what it can (up to f_j); a limit reaction takes the rest.
+      const double total = -x_(a++);
+      friction_(j) = std::min(fs(j), std::max(-fs(j), total));
+      limit_(j) = total - friction_(j);
+    }
     const double acc = qdd_(j);
     status_[j] = std::abs(acc) <= 1e-9 * acc_scale ? Stick : (acc > 0.0 ? SlipPositive : SlipNegative);
   }
@@ -183,7 +211,11 @@ int FrictionSolver::boxQp(int k) {
   x.setZero();  // feasible: every box contains 0
   auto state = state_.head(k);
   state.setZero();  // 0 free, -1 at lower bound, +1 at upper bound
-  const double xscale = std::max(hi_.head(k).cwiseAbs().maxCoeff(), 1e-300);
+  double xscale = 1e-300;  // largest finite bound
+  for (int i = 0; i < k; ++i) {
+    if (std::isfinite(hi_(i))) xscale = std::max(xscale, std::abs(hi_(i)));
+    if (std::isfinite(lo_(i))) xscale = std::max(xscale, std::abs(lo_(i)));
+  }
   const double gscale = std::max({c_.head(k).cwiseAbs().maxCoeff(), Q_.topLeftCorner(k, k).cwiseAbs().maxCoeff() * xscale, 1e-300});
   const double tol_g = 1e-11 * gscale;
   const int max_iterations = 50 + 20 * k;
@@ -212,7 +244,8 @@ int FrictionSolver::boxQp(int k) {
         }
       }
       if (!std::isfinite(alpha))
-        return fail(E_NOT_CONVERGED, "friction optimisation is unbounded (no bound stops a zero-curvature direction)");
+        return fail(E_NOT_CONVERGED,
+                    "the task drives a joint into its position limit: the limit reaction would be unbounded");
       for (int a = 0; a < nf; ++a) x(free_idx_(a)) += alpha * dir(a);
       if (block >= 0) {
         state(block) = side;
@@ -280,7 +313,12 @@ void FrictionSolver::leastCommand(int k) {
   Eigen::VectorXi& wside = state_;
   auto lowerRoom = [&](int a) { return lo_(rows_(a)) - x(rows_(a)); };
   auto upperRoom = [&](int a) { return hi_(rows_(a)) - x(rows_(a)); };
-  const double zscale = std::max(hi_.head(k).cwiseAbs().maxCoeff(), 1e-300);
+  double zscale = 1e-300;  // largest finite bound, or the target's size
+  for (int i = 0; i < k; ++i) {
+    if (std::isfinite(hi_(i))) zscale = std::max(zscale, std::abs(hi_(i)));
+    if (std::isfinite(lo_(i))) zscale = std::max(zscale, std::abs(lo_(i)));
+  }
+  zscale = std::max(zscale, z0.cwiseAbs().maxCoeff());
   for (int it = 0; it < 50 + 20 * ns; ++it) {
     // Projection of z0 onto {z : N_W z = b_W}: zp = z0 - B^T (B B^T)^-1 (B z0 - b).
     auto zp = tmp2_.head(dn);
@@ -351,11 +389,11 @@ double FrictionSolver::gaussValue() {
   const int rc = has_f_ ? free_.solve(q_keep_, qd_keep_, no_alfa, no_beta, f_keep_, tau0_)
                         : free_.solve(q_keep_, qd_keep_, no_alfa, no_beta, f_keep_.leftCols(0), tau0_);
   if (rc != ChainHdSolver::E_NOERROR) return std::numeric_limits<double>::quiet_NaN();
-  // H (qdd* - qdd_free) = tau_cmd* + friction torques of the resting joints.
+  // H (qdd* - qdd_free) = tau_cmd* + friction and limit torques of the resting joints.
   double z0 = 0.0, dissipation = 0.0;
   for (unsigned int j = 0; j < nj_; ++j) {
     const bool resting = status_[j] != Moving;
-    const double torque = tau_cmd_(j) + (resting ? friction_(j) : 0.0);
+    const double torque = tau_cmd_(j) + (resting ? friction_(j) + limit_(j) : 0.0);
     z0 += 0.5 * (qdd_(j) - free_.qdd()(j)) * torque;
     if (resting) dissipation += fstatic_(j) * std::abs(qdd_(j));
   }

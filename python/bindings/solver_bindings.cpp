@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <limits>
 #include <mutex>
 
 #include "chain_bindings.hpp"
@@ -21,15 +22,21 @@ struct SolveResult {
   int constraint_rank = 0;
   double smallest_singular_value = 0.0;
   // Friction-aware solves only (None otherwise).
-  py::object friction_torque = py::none(), status = py::none(), gauss_value = py::none(), iterations = py::none();
+  py::object friction_torque = py::none(), limit_torque = py::none(), status = py::none(), gauss_value = py::none(),
+             iterations = py::none();
 };
 
 class PySolver {
  public:
   PySolver(const PyChain& chain, const py::object& gravity, double rcond, py::object damping)
       : solver_(chain.robot.chain, KDL::Twist::Zero()), friction_solver_(chain.robot.chain, KDL::Twist::Zero()) {
-    chain_friction_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(chain.robot.joints.size()));
-    for (size_t k = 0; k < chain.robot.joints.size(); ++k) chain_friction_(k) = chain.robot.joints[k].friction;
+    const auto nj = static_cast<Eigen::Index>(chain.robot.joints.size());
+    chain_friction_ = chain_lower_ = chain_upper_ = Eigen::VectorXd::Zero(nj);
+    for (Eigen::Index k = 0; k < nj; ++k) {
+      chain_friction_(k) = chain.robot.joints[k].friction;
+      chain_lower_(k) = chain.robot.joints[k].lower;
+      chain_upper_(k) = chain.robot.joints[k].upper;
+    }
     if (solver_.modelError() != ChainHdSolver::E_NOERROR) raise(std::string("invalid chain: ") + solver_.errorMessage());
     setGravity(gravity);
     vereshchagin::SolverOptions opt;
@@ -102,6 +109,8 @@ class PySolver {
       if (!friction.cast<bool>()) return false;
       fm.static_friction = chain_friction_;
       fm.kinetic_friction.resize(0);
+      fm.lower = chain_lower_;
+      fm.upper = chain_upper_;
       return true;
     }
     if (!py::hasattr(friction, "static"))
@@ -117,6 +126,25 @@ class PySolver {
     }
     const py::object tol = py::getattr(friction, "velocity_tolerance", py::none());
     if (!tol.is_none()) fm.velocity_tolerance = tol.cast<double>();
+    const py::object lower = py::getattr(friction, "lower", py::none()), upper = py::getattr(friction, "upper", py::none());
+    if (!lower.is_none() || !upper.is_none()) {
+      fm.lower = Eigen::VectorXd::Constant(nj_, -std::numeric_limits<double>::infinity());
+      fm.upper = Eigen::VectorXd::Constant(nj_, std::numeric_limits<double>::infinity());
+      auto limitArg = [&](const py::object& obj, const char* name, Eigen::VectorXd& out) {
+        if (obj.is_none()) return;
+        Array a = toArray(obj, name);
+        if (a.ndim() != 1 || a.shape(0) != static_cast<py::ssize_t>(nj_))
+          raise(std::string(name) + " must have shape (" + std::to_string(nj_) + ",), got " + shapeStr(a));
+        for (py::ssize_t j = 0; j < a.shape(0); ++j) {
+          if (std::isnan(a.at(j))) raise(std::string(name) + " contains NaN");
+          out(j) = a.at(j);
+        }
+      };
+      limitArg(lower, "friction.lower", fm.lower);
+      limitArg(upper, "friction.upper", fm.upper);
+      const py::object ltol = py::getattr(friction, "limit_tolerance", py::none());
+      if (!ltol.is_none()) fm.limit_tolerance = ltol.cast<double>();
+    }
     for (Eigen::Index j = 0; j < fm.static_friction.size(); ++j)
       if (fm.static_friction(j) < 0.0) raise("friction.static must be >= 0 (joint " + std::to_string(j) + ")");
     return true;
@@ -158,6 +186,7 @@ class PySolver {
     r.smallest_singular_value = s.smallestSingularValue();
     if (last_friction_) {
       r.friction_torque = copyVector(friction_solver_.frictionTorques().data(), nj_);
+      r.limit_torque = copyVector(friction_solver_.limitTorques().data(), nj_);
       py::array_t<int> st(static_cast<py::ssize_t>(nj_));
       for (unsigned int j = 0; j < nj_; ++j) st.mutable_data()[j] = friction_solver_.status()[j];
       r.status = st;
@@ -285,7 +314,7 @@ class PySolver {
  private:
   ChainHdSolver solver_;
   vereshchagin::FrictionSolver friction_solver_;
-  Eigen::VectorXd chain_friction_;
+  Eigen::VectorXd chain_friction_, chain_lower_, chain_upper_;
   bool last_friction_ = false;
   KDL::Vector gravity_;
   Eigen::Matrix<double, 6, 6> alfa_ = Eigen::Matrix<double, 6, 6>::Zero();
@@ -303,6 +332,7 @@ void bindSolver(py::module_& mod) {
       .def_readonly("constraint_rank", &SolveResult::constraint_rank)
       .def_readonly("smallest_singular_value", &SolveResult::smallest_singular_value)
       .def_readonly("friction_torque", &SolveResult::friction_torque)
+      .def_readonly("limit_torque", &SolveResult::limit_torque)
       .def_readonly("status", &SolveResult::status)
       .def_readonly("gauss_value", &SolveResult::gauss_value)
       .def_readonly("iterations", &SolveResult::iterations)

@@ -66,6 +66,13 @@ class Solver(_core.Solver):
     wrench on the last segment is ``-alpha @ nu``); ``link_acc`` (n_segments + 1, 6) spatial
     accelerations ``[linear, angular]`` of the base and each segment's tip (base axes, tip
     origin, including ``-gravity``); ``constraint_rank``; ``smallest_singular_value``.
+
+    ``friction=Friction(...)`` (or ``True`` for the chain's URDF values) adds static friction:
+    the exact max-min of report 000. Then also ``friction_torque`` (physical, opposes motion),
+    ``limit_torque`` (reactions of joint limits), ``status`` (0 moving, 1 stick, 2 slip +,
+    3 slip -), ``gauss_value`` (Z0(qdd) + sum f |qdd| over resting joints) and ``iterations``;
+    ``tau_command`` is what the motors add to ``tau_ff`` with friction acting, and the least such
+    command when friction could hold in several ways.
     The GIL is released while solving; use one solver per thread for parallel work.
     """
 

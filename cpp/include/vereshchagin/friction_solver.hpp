@@ -22,8 +22,10 @@
 //  * qdd (n): joint accelerations.
 //  * commandTorques (n): tau_cmd = -J^T alfa nu at the optimum: what the motors add to
 //    ff_torques. Forward dynamics with ff_torques + tau_cmd + frictionTorques reproduces qdd.
-//  * frictionTorques (n): the physical friction torque on each joint (-mu* at rest,
-//    -fk sign(qd) when moving).
+//  * frictionTorques (n): the physical friction torque on each joint (-mu* at rest, at most f_j
+//    in size; -fk sign(qd) when moving).
+//  * limitTorques (n): the reaction of joint limits (>= 0 at a lower limit, <= 0 at an upper
+//    one): what friction cannot hold of the total -mu* at a joint resting on its limit.
 //  * status (n): Moving, Stick, SlipPositive (qdd > 0) or SlipNegative (qdd < 0).
 //  * nu, constraint rank: as ChainHdSolver at the optimum.
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
@@ -45,6 +47,12 @@ struct FrictionModel {
   Eigen::VectorXd static_friction;   // f_j >= 0 per joint (N m or N)
   Eigen::VectorXd kinetic_friction;  // 0 <= fk_j <= f_j per joint; empty: equal to static_friction
   double velocity_tolerance = 1e-6;  // |qd_j| at or below this: the joint is at rest
+  // Joint position limits (report 000, sec. 5.2: a second dissipative force). A joint at rest
+  // with q_j <= lower_j + limit_tolerance (or >= upper_j - limit_tolerance) gets, in the same
+  // optimisation, a one-sided reaction that stops it from moving further into the limit (no
+  // bound on its size). Empty vectors: no limits; +-infinity entries: no limit on that side.
+  Eigen::VectorXd lower, upper;
+  double limit_tolerance = 1e-9;
 };
 
 class FrictionSolver {
@@ -66,6 +74,7 @@ class FrictionSolver {
   const Eigen::VectorXd& qdd() const { return qdd_; }
   const Eigen::VectorXd& commandTorques() const { return tau_cmd_; }
   const Eigen::VectorXd& frictionTorques() const { return friction_; }
+  const Eigen::VectorXd& limitTorques() const { return limit_; }
   const std::vector<signed char>& status() const { return status_; }
   Eigen::Map<const Eigen::VectorXd> nu() const { return hd_.nu(); }
   int constraintRank() const { return hd_.constraintRank(); }
@@ -89,7 +98,7 @@ class FrictionSolver {
   ChainHdSolver hd_, free_;
   unsigned int nj_ = 0;
   std::array<char, 512> message_{};
-  Eigen::VectorXd qdd_, tau_cmd_, friction_, tau0_, qdd0_, tau_cmd0_;
+  Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_;
   std::vector<signed char> status_;
   int iterations_ = 0;
   double qscale_ = 0.0;  // scale of Q (see solve())
