@@ -5,6 +5,8 @@
 // produced by bias forces and torques, L (m x m) the one produced by unit constraint forces.
 #include "vereshchagin/chain_hd_solver.hpp"
 
+#include "dense_small.hpp"
+
 #if defined(__GNUC__) && !defined(__clang__)
 // GCC 12 reports a false -Warray-bounds on Eigen's SSE loads of 1x1 fixed-size products.
 #pragma GCC diagnostic ignored "-Warray-bounds"
@@ -453,18 +455,7 @@ void ChainHdSolver::factorizeCoupling() {
 bool ChainHdSolver::choleskyFullRank() {
   const int m = m_;
   chol_.setZero(m, m);
-  for (int j = 0; j < m; ++j) {
-    double d = K_(j, j);
-    for (int k = 0; k < j; ++k) d -= chol_(j, k) * chol_(j, k);
-    if (!(d > 0.0)) return false;
-    const double ljj = std::sqrt(d);
-    chol_(j, j) = ljj;
-    for (int i = j + 1; i < m; ++i) {
-      double v = K_(i, j);
-      for (int k = 0; k < j; ++k) v -= chol_(i, k) * chol_(j, k);
-      chol_(i, j) = v / ljj;
-    }
-  }
+  if (!detail::choleskyCertified(K_, chol_, 0.0)) return false;
   // ||L^-1||_F^2, column by column of X = L^-1 (lower triangular) by forward substitution.
   double frob2 = 0.0;
   for (int c = 0; c < m; ++c) {
@@ -500,18 +491,8 @@ void ChainHdSolver::applyCouplingInverse(const VectorC& rhs, VectorC& out) const
     return;
   }
   if (use_cholesky_) {
-    // K x = rhs with K = L L^T: forward then backward substitution.
-    out.resize(m);
-    for (int i = 0; i < m; ++i) {
-      double v = rhs(i);
-      for (int k = 0; k < i; ++k) v -= chol_(i, k) * out(k);
-      out(i) = v / chol_(i, i);
-    }
-    for (int i = m - 1; i >= 0; --i) {
-      double v = out(i);
-      for (int k = i + 1; k < m; ++k) v -= chol_(k, i) * out(k);
-      out(i) = v / chol_(i, i);
-    }
+    out = rhs;  // K out = rhs with K = L L^T
+    detail::choleskySolve(chol_, out);
     return;
   }
   VectorC t;
