@@ -1,20 +1,98 @@
-"""Command line: ``python -m vereshchagin demo``."""
+"""Command line: ``python -m vereshchagin demo`` and ``python -m vereshchagin reproduce``."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+from pathlib import Path
+
+
+def _say(line: str) -> None:
+    print(line, flush=True)
+
+
+def _rel(path: Path, root: Path) -> str:
+    return Path(os.path.relpath(path, root)).as_posix()
+
+
+def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
+    """Run the selected experiments, write their outputs and ``index.md`` into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+    quick : bool
+        Coarser sampling of the friction figures (the optimum is exact either way).
+    case : {"friction", "demo", "all"}
+
+    Returns
+    -------
+    int
+        0 if every check passed, 1 otherwise.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    index = ["# vereshchagin: reproduced results", "",
+             f"Command: `python -m vereshchagin reproduce --out {out_dir}{' --quick' if quick else ''} --case {case}`",
+             ""]
+    ok = True
+    if case in ("friction", "all"):
+        from .experiments.friction_figures import run as run_friction
+
+        _say(f"[reproduce] report 000 friction figures -> {out}{' (quick)' if quick else ''}")
+        res = run_friction(out, quick=quick, progress=_say)
+        ok &= bool(res["ok"])
+        index += ["## Static joint friction on the 1-DOF arm (report 000, chapters 5-6)", "",
+                  f"Table: [{_rel(res['table_md'], out)}]({_rel(res['table_md'], out)}) "
+                  f"(CSV: [{_rel(res['table_csv'], out)}]({_rel(res['table_csv'], out)}))", ""]
+        table = res["table_md"].read_text(encoding="utf-8").splitlines()
+        index += [line for line in table if line.startswith("|")] + [""]
+        index += ["Figures (friction torque = -mu over [-f, f], f = 10 N m; the star is the exact optimum of "
+                  "`Solver.solve(..., friction=...)`):", ""]
+        for num, what, path in res["figures"]:
+            ref = f"report fig. {num}" if num else "no report figure"
+            index.append(f"- [{_rel(path, out)}]({_rel(path, out)}): {what} ({ref})")
+        index.append("")
+        _say(f"[reproduce] friction checks: {'ok' if res['ok'] else 'MISMATCH'}")
+    if case in ("demo", "all"):
+        from .demo import run as run_demo
+
+        _say("[reproduce] demo: three tasks on a 7-joint arm")
+        lines = []
+
+        def out_line(s=""):
+            lines.append(str(s))
+            _say(str(s))
+
+        run_demo(out=out_line)
+        demo_path = out / "demo.txt"
+        demo_path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        index += ["## Demonstration (7-joint arm)", "", f"Output: [{_rel(demo_path, out)}]({_rel(demo_path, out)})",
+                  "", "```text", *lines, "```", ""]
+    index_path = out / "index.md"
+    index_path.write_text("\n".join(index), encoding="utf-8")
+    _say(f"[reproduce] wrote {index_path}")
+    return 0 if ok else 1
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="vereshchagin", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("demo", help="solve three tasks on a 7-joint arm and print the results")
+    rep = sub.add_parser("reproduce", help="reproduce report 000's friction figures (and the demo) into a folder")
+    rep.add_argument("--out", default="results", help="output folder (default: ./results)")
+    rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures")
+    rep.add_argument("--case", choices=("friction", "demo", "all"), default="all",
+                     help="which experiments to run (default: all)")
     args = parser.parse_args(argv)
     if args.command == "demo":
         from .demo import run
 
         run()
-    return 0
+        return 0
+    if args.command == "reproduce":
+        return reproduce(args.out, quick=args.quick, case=args.case)
+    return 2  # pragma: no cover
 
 
 if __name__ == "__main__":
