@@ -598,8 +598,22 @@ void ChainHdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_do
 }
 
 int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints,
-                                   Eigen::Ref<Eigen::MatrixXd> dqdd,
-                                   Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
+                                   Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
+  return responseColumnsImpl(joints, dqdd, dtau_cmd, nullptr);
+}
+
+int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints,
+                                   Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd,
+                                   Eigen::Ref<Eigen::MatrixXd> dnu) {
+  if (solved_ && (dnu.rows() < m_ || dnu.cols() < joints.size()))
+    return fail(E_SIZE_MISMATCH, "dnu is %ldx%ld, expected at least %dx%ld", (long)dnu.rows(), (long)dnu.cols(), m_,
+                (long)joints.size());
+  return responseColumnsImpl(joints, dqdd, dtau_cmd, &dnu);
+}
+
+int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& joints,
+                                       Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd,
+                                       Eigen::Ref<Eigen::MatrixXd>* dnu_out) {
   if (!solved_) return fail(E_NO_SOLUTION, "responseColumns() needs a successful solve() first");
   const long k = joints.size();
   if (dqdd.rows() != nj_ || dqdd.cols() != k)
@@ -639,6 +653,8 @@ int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& join
     }
     VectorC dnu;
     applyCouplingInverse(dU, dnu);  // d nu = K^+ dU
+    if (dnu_out)
+      for (int r = 0; r < m; ++r) (*dnu_out)(r, c) = dnu(r);
     Vector6 a = Vector6::Zero();
     for (unsigned int i = 0; i < ns_; ++i) {
       const Segment& s = segs_[i];

@@ -27,6 +27,10 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
   Gc_ = Tc_ = Q_ = work_ = L_ = V_ = N_ = B_ = Eigen::MatrixXd::Zero(n, n);
   c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = Eigen::VectorXd::Zero(n);
+  dnu_ = Eigen::MatrixXd::Zero(ChainHdSolver::kMaxConstraints, n);
+  nu0_ = nu_ = Eigen::VectorXd::Zero(ChainHdSolver::kMaxConstraints);
+  alfa_keep_.setZero();
+  beta_keep_.setZero();
 }
 
 int FrictionSolver::setOptions(const SolverOptions& options) {
@@ -121,7 +125,8 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   if (k > 0) {
     qdd0_ = hd_.qdd();
     tau_cmd0_ = hd_.commandTorques();
-    rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(k));
+    nu0_.head(hd_.constraintCount()) = hd_.nu();
+    rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(k), dnu_.leftCols(k));
     if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
     for (int a = 0; a < k; ++a) {
       c_(a) = qdd0_(rest_(a));
@@ -136,15 +141,24 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
     rc = boxQp(k);
     if (rc != ChainHdSolver::E_NOERROR) return rc;
     leastCommand(k);
-    // Final solve with the optimal friction torques: qdd, nu, tau_cmd and link accelerations
-    // consistent at the optimum.
-    for (int a = 0; a < k; ++a) tau0_(rest_(a)) -= x_(a);
-    rc = hd_.solve(q, q_dot, alfa, beta, f_ext, tau0_);
-    if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
-    for (int a = 0; a < k; ++a) tau0_(rest_(a)) += x_(a);  // tau0_ stays "without static friction"
+    // The outputs are affine in the friction torques: update them from the columns (no new solve).
+    qdd_ = qdd0_;
+    qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
+    tau_cmd_ = tau_cmd0_;
+    tau_cmd_.noalias() -= Tc_.leftCols(k) * x_.head(k);
+    const int m = hd_.constraintCount();
+    nu_.head(m) = nu0_.head(m);
+    nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);
+  } else {
+    qdd_ = hd_.qdd();
+    tau_cmd_ = hd_.commandTorques();
+    nu_.head(hd_.constraintCount()) = hd_.nu();
   }
-  qdd_ = hd_.qdd();
-  tau_cmd_ = hd_.commandTorques();
+  m_keep_ = hd_.constraintCount();
+  alfa_keep_.leftCols(m_keep_) = alfa;
+  beta_keep_.head(m_keep_) = beta;
+  k_ = k;
+  link_acc_known_ = k == 0;
 
   // Friction torques and status.
   const double acc_scale = std::max(1.0, qdd_.cwiseAbs().maxCoeff());
@@ -379,6 +393,21 @@ void FrictionSolver::leastCommand(int k) {
     const int i = rows_(a);
     x(i) = std::min(hi_(i), std::max(lo_(i), x(i) + N.row(a).dot(z)));
   }
+}
+
+const ChainHdSolver::Matrix6X& FrictionSolver::linkAccelerations() {
+  if (!link_acc_known_ && solved_) {
+    // One solve with the optimal friction torques as feed-forward (inputs kept from solve()).
+    tmp_ = tau0_;
+    for (int a = 0; a < k_; ++a) tmp_(rest_(a)) -= x_(a);
+    if (has_f_) {
+      hd_.solve(q_keep_, qd_keep_, alfa_keep_.leftCols(m_keep_), beta_keep_.head(m_keep_), f_keep_, tmp_);
+    } else {
+      hd_.solve(q_keep_, qd_keep_, alfa_keep_.leftCols(m_keep_), beta_keep_.head(m_keep_), f_keep_.leftCols(0), tmp_);
+    }
+    link_acc_known_ = true;
+  }
+  return hd_.linkAccelerations();
 }
 
 double FrictionSolver::gaussValue() {

@@ -101,11 +101,22 @@ void randomChains(testutil::Checker& ck, int& compared) {
     }
     KDL::ChainFdSolver_RNE fd(chain, KDL::Vector(0, 0, gravity ? -9.81 : 0.0));
     KDL::JntArray torques(n), qdd_fd(n);
-    torques.data = ff.data + fs.commandTorques() + fs.frictionTorques();
+    torques.data = ff.data + fs.commandTorques() + fs.frictionTorques() + fs.limitTorques();
     fd.CartToJnt(q, qd, torques, fext_local, qdd_fd);
     ck.check(testutil::relErr(qdd_fd.data, fs.qdd()) < 1e-9,
              "trial " + str(trial) + ": FD(ff + tau_cmd + friction) != qdd, rel err " +
                  str(testutil::relErr(qdd_fd.data, fs.qdd())));
+    // The affine update equals a plain solve with the friction torques as feed-forward (qdd, nu,
+    // tau_cmd), and the link accelerations (computed by that extra solve on request) agree.
+    vereshchagin::ChainHdSolver plain(chain, root);
+    const Eigen::VectorXd ff_total = ff.data + fs.limitTorques() + fs.frictionTorques();
+    ck.check(plain.solve(q.data, qd.data, alfa.data, beta.data, testutil::toMatrix(fext), ff_total) == 0,
+             "trial " + str(trial) + ": plain solve failed");
+    ck.check(testutil::relErr(plain.qdd(), fs.qdd()) < 1e-9 && testutil::relErr(plain.commandTorques(), fs.commandTorques()) < 1e-9 &&
+                 testutil::relErr(plain.nu(), fs.nu()) < 1e-9,
+             "trial " + str(trial) + ": affine update differs from a solve with the friction torques");
+    ck.check(testutil::relErr(plain.linkAccelerations(), fs.linkAccelerations()) < 1e-9,
+             "trial " + str(trial) + ": link accelerations at the optimum differ");
     // Complementarity and kinetic friction.
     const double acc_scale = std::max(1.0, fs.qdd().cwiseAbs().maxCoeff());
     for (int jj = 0; jj < n; ++jj) {

@@ -177,11 +177,18 @@ class PySolver {
   SolveResult result() {
     const ChainHdSolver& s = answered();
     SolveResult r;
-    r.qdd = copyVector(s.qdd().data(), nj_);
-    r.tau_command = copyVector(s.commandTorques().data(), nj_);
-    r.nu = copyVector(s.nu().data(), s.constraintCount());
+    if (last_friction_) {  // outputs at the friction optimum
+      r.qdd = copyVector(friction_solver_.qdd().data(), nj_);
+      r.tau_command = copyVector(friction_solver_.commandTorques().data(), nj_);
+      r.nu = copyVector(friction_solver_.nu().data(), friction_solver_.nu().size());
+    } else {
+      r.qdd = copyVector(s.qdd().data(), nj_);
+      r.tau_command = copyVector(s.commandTorques().data(), nj_);
+      r.nu = copyVector(s.nu().data(), s.constraintCount());
+    }
+    const ChainHdSolver::Matrix6X& acc = last_friction_ ? friction_solver_.linkAccelerations() : s.linkAccelerations();
     r.link_acc = py::array_t<double>({static_cast<py::ssize_t>(ns_ + 1), static_cast<py::ssize_t>(6)});
-    std::copy(s.linkAccelerations().data(), s.linkAccelerations().data() + 6 * (ns_ + 1), r.link_acc.mutable_data());
+    std::copy(acc.data(), acc.data() + 6 * (ns_ + 1), r.link_acc.mutable_data());
     r.constraint_rank = s.constraintRank();
     r.smallest_singular_value = s.smallestSingularValue();
     if (last_friction_) {

@@ -143,6 +143,10 @@ class ChainHdSolver : public KDL::SolverI {
   // dqdd, dtau_cmd: n_joints x k outputs (column c answers joint joints[c]).
   int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                       Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
+  // The same, plus d(nu)/d(tau_j) into dnu (constraintCount() x k; its storage may be larger:
+  // only the top m rows are written).
+  int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                      Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd> dnu);
 
   void setRootAcceleration(const KDL::Twist& root_acc);
   int setOptions(const SolverOptions& options);
@@ -199,6 +203,8 @@ class ChainHdSolver : public KDL::SolverI {
   // out = K^+ rhs under the singularity policy (K = -L0).
   void applyCouplingInverse(const VectorC& rhs, VectorC& out) const;
   void commandFromNu(const VectorC& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
+  int responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                          Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd>* dnu);
 
   KDL::Chain chain_;
   SolverOptions options_;

@@ -76,11 +76,15 @@ class FrictionSolver {
   const Eigen::VectorXd& frictionTorques() const { return friction_; }
   const Eigen::VectorXd& limitTorques() const { return limit_; }
   const std::vector<signed char>& status() const { return status_; }
-  Eigen::Map<const Eigen::VectorXd> nu() const { return hd_.nu(); }
+  Eigen::Map<const Eigen::VectorXd> nu() const { return Eigen::Map<const Eigen::VectorXd>(nu_.data(), m_keep_); }
+  // Link accelerations at the optimum (base axes, tip origins): one extra solve on first request.
+  const ChainHdSolver::Matrix6X& linkAccelerations();
   int constraintRank() const { return hd_.constraintRank(); }
   int iterations() const { return iterations_; }
   double gaussValue();
 
+  // The underlying solver; after solve() it holds the solve without static friction (before
+  // linkAccelerations() is called) — its responseColumns() are valid for the optimum too.
   ChainHdSolver& hdSolver() { return hd_; }
   const char* errorMessage() const { return message_.data(); }
   int modelError() const { return hd_.modelError(); }
@@ -98,7 +102,12 @@ class FrictionSolver {
   ChainHdSolver hd_, free_;
   unsigned int nj_ = 0;
   std::array<char, 512> message_{};
-  Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_;
+  Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;
+  Eigen::MatrixXd dnu_;
+  Eigen::Matrix<double, 6, 6> alfa_keep_;
+  Eigen::Matrix<double, 6, 1> beta_keep_;
+  int m_keep_ = 0, k_ = 0;
+  bool link_acc_known_ = false;
   std::vector<signed char> status_;
   int iterations_ = 0;
   double qscale_ = 0.0;  // scale of Q (see solve())
