@@ -3,12 +3,15 @@
 
   python benchmarks/run_all.py [--build-dir DIR] [--out FILE]
 
-1. configures and builds the C++ benchmark (Release, benchmarks on, tests off) in DIR
+1. configures and builds the C++ benchmarks (Release, benchmarks on, tests off) in DIR
    (default: build/bench under the repository) with CMake and Ninja;
 2. runs DIR/benchmarks/bench_solver (ours vs KDL, about 35 s);
 3. runs benchmarks/bench_pinocchio.py (ours vs Pinocchio from Python, about 25 s);
-4. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
-   the method, the target check and both reports.
+4. runs DIR/benchmarks/bench_friction (static friction: ours vs our plain solve, KDL and the
+   report's vertex enumeration, about 30 s) and benchmarks/bench_friction_pinocchio.py (static
+   friction vs Pinocchio's JointFrictionConstraintModel + ADMM, about 10 s);
+5. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
+   the method, the target checks and all reports.
 """
 from __future__ import annotations
 
@@ -94,6 +97,39 @@ def target_lines(cpp_md):
     return [head] + lines, met
 
 
+def friction_summary(fr_file):
+    """The static-friction target lines of bench_friction's report, for the summary at the top."""
+    if not fr_file.exists():
+        return ["- Static-friction targets: bench_friction produced no report (see the Static friction section)."]
+    lines = [l for l in fr_file.read_text().splitlines() if l.startswith("- **Target:")]
+    return ["- Static-friction targets (section Static friction; friction-aware solve on a 7-joint arm, all joints "
+            "at rest, m = 0, 1, 6):"] + ["  " + l.replace("- **Target: ", "- **", 1) for l in lines]
+
+
+def friction_section(fr_file, fr_rc, frpy_file, frpy_rc):
+    """The "Static friction" section: bench_friction's report and bench_friction_pinocchio.py's."""
+    md = [
+        "## Static friction",
+        "",
+        "Issue targets for the friction-aware solve (`vereshchagin::FrictionSolver`, the exact max-min of report 000 "
+        "by one solve, the response columns of the resting joints and a box QP by an active-set method) on a 7-joint "
+        "arm with every joint at rest, m = 0, 1, 6: at most 2.5x our plain solve (`ChainHdSolver::solve`, same "
+        "inputs, no friction) and faster than one KDL plain solve (`ChainHdSolver_Vereshchagin::CartToJnt`); at "
+        "least 100x faster than the report's vertex enumeration (2^7 KDL solves and Gauss-function evaluations). "
+        "Pinocchio 4.1's joint friction (`JointFrictionConstraintModel` with its ADMM solver) is compared from "
+        "Python, m = 0 only.",
+        "",
+    ]
+    for name, f, rc in (("bench_friction", fr_file, fr_rc), ("bench_friction_pinocchio.py", frpy_file, frpy_rc)):
+        if rc:
+            md += [f"**{name} exited with code {rc}" + (": see its report below.**" if f.exists() else
+                                                         " and wrote no report.**"), ""]
+        if f.exists():
+            md += ["##" + l if l.startswith("#") else l for l in f.read_text().rstrip().splitlines()]
+            md += [""]
+    return md
+
+
 def main():
     ap = argparse.ArgumentParser(description="Build and run the benchmarks, write BENCHMARKS.md.")
     ap.add_argument("--build-dir", type=Path, default=REPO / "build" / "bench")
@@ -118,6 +154,12 @@ def main():
                 stdout=subprocess.DEVNULL).returncode
     if not py_file.exists():
         sys.exit(f"bench_pinocchio.py failed (exit code {py_rc})")
+    fr_file, frpy_file = build / "bench_friction.md", build / "bench_friction_pinocchio.md"
+    for f in (fr_file, frpy_file):
+        f.unlink(missing_ok=True)
+    fr_rc = run([build / "benchmarks" / "bench_friction", fr_file], stdout=subprocess.DEVNULL).returncode
+    frpy_rc = run([sys.executable, REPO / "benchmarks" / "bench_friction_pinocchio.py", "--out", frpy_file],
+                  stdout=subprocess.DEVNULL).returncode
     load_end = loadavg()
 
     cpp_md, py_md = cpp_file.read_text(), py_file.read_text()
@@ -140,6 +182,7 @@ def main():
         f"- Versions: KDL {kdl_version()} (Debian); pinocchio {pinocchio.__version__} "
         f"(`{Path(pinocchio.__file__).parent}`); numpy {numpy.__version__}; Python {platform.python_version()}",
         *target,
+        *friction_summary(fr_file),
         "",
         "## Method",
         "",
@@ -170,9 +213,10 @@ def main():
         md += [f"**bench_pinocchio.py exited with code {py_rc}: some results disagree (see below).**", ""]
     md += ["#" + l if l.startswith("#") else l for l in cpp_md.rstrip().splitlines()]
     md += ["", py_md.rstrip(), ""]
+    md += friction_section(fr_file, fr_rc, frpy_file, frpy_rc)
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
-    return 0 if cpp_rc == 0 and py_rc == 0 else 1
+    return 0 if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 else 1
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 // Small dense symmetric linear algebra on preallocated storage (no heap allocation): Cholesky
-// with a certification threshold, and a cyclic Jacobi eigen-decomposition for the positive
-// semi-definite matrices of the friction optimisation (dimension <= number of joints).
+// with a pivot threshold, and a pivoted (rank-revealing) Cholesky for the positive semi-definite
+// matrices of the friction optimisation (dimension <= number of joints).
 #pragma once
 
 #include <algorithm>
@@ -50,48 +50,34 @@ void choleskySolve(const ML& L, VB& b) {
   }
 }
 
-// Symmetric A (k x k, overwritten) -> eigenvalues in `values` (A's diagonal at the end) and
-// orthonormal eigenvectors as the columns of V, by cyclic Jacobi rotations. Converges
-// quadratically; at most 60 sweeps (bounded work).
-template <typename MA, typename MV, typename VV>
-void jacobiEigen(MA& A, MV& V, VV& values) {
-  const int k = static_cast<int>(A.rows());
-  V.setIdentity();
-  for (int sweep = 0; sweep < 60; ++sweep) {
-    double off = 0.0, diag = 0.0;
-    for (int i = 0; i < k; ++i) {
-      diag += A(i, i) * A(i, i);
-      for (int j = i + 1; j < k; ++j) off += A(i, j) * A(i, j);
+// Pivoted (rank-revealing) Cholesky of a symmetric positive semi-definite W (k x k, overwritten
+// by its Schur complements): W(perm, perm) = L L^T with L (k x r) lower trapezoidal, stopping when
+// the largest remaining diagonal entry is <= tol. Returns the rank r.
+template <typename MW, typename ML, typename VP>
+int pivotedCholesky(MW& W, ML& L, VP& perm, double tol) {
+  const int k = static_cast<int>(W.rows());
+  for (int i = 0; i < k; ++i) perm(i) = i;
+  for (int j = 0; j < k; ++j) {
+    int p = j;
+    for (int i = j + 1; i < k; ++i)
+      if (W(i, i) > W(p, p)) p = i;
+    if (!(W(p, p) > tol)) return j;
+    if (p != j) {  // symmetric swap of rows/columns j and p, and of the rows of L built so far
+      W.row(j).swap(W.row(p));
+      W.col(j).swap(W.col(p));
+      for (int c = 0; c < j; ++c) std::swap(L(j, c), L(p, c));
+      std::swap(perm(j), perm(p));
     }
-    if (off <= 1e-32 * diag || off == 0.0) break;
-    for (int p = 0; p < k; ++p) {
-      for (int q = p + 1; q < k; ++q) {
-        const double apq = A(p, q);
-        if (apq == 0.0) continue;
-        // Rotation zeroing A(p, q): tan(2 phi) = 2 apq / (aqq - app).
-        const double theta = (A(q, q) - A(p, p)) / (2.0 * apq);
-        const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
-        const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
-        for (int r = 0; r < k; ++r) {  // A <- A G (columns p, q)
-          const double arp = A(r, p), arq = A(r, q);
-          A(r, p) = c * arp - s * arq;
-          A(r, q) = s * arp + c * arq;
-        }
-        for (int r = 0; r < k; ++r) {  // A <- G^T A (rows p, q)
-          const double apr = A(p, r), aqr = A(q, r);
-          A(p, r) = c * apr - s * aqr;
-          A(q, r) = s * apr + c * aqr;
-        }
-        A(p, q) = A(q, p) = 0.0;
-        for (int r = 0; r < k; ++r) {
-          const double vrp = V(r, p), vrq = V(r, q);
-          V(r, p) = c * vrp - s * vrq;
-          V(r, q) = s * vrp + c * vrq;
-        }
+    const double ljj = std::sqrt(W(j, j));
+    L(j, j) = ljj;
+    for (int i = j + 1; i < k; ++i) L(i, j) = W(i, j) / ljj;
+    for (int i = j + 1; i < k; ++i)
+      for (int c = j + 1; c <= i; ++c) {
+        W(i, c) -= L(i, j) * L(c, j);
+        W(c, i) = W(i, c);
       }
-    }
   }
-  for (int i = 0; i < k; ++i) values(i) = A(i, i);
+  return k;
 }
 
 }  // namespace detail

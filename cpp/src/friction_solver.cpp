@@ -185,38 +185,56 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   return ChainHdSolver::E_NOERROR;
 }
 
-// Free-set step. Q_FF (nf x nf) is built in work_; p_ = -Q_FF^+ g_F. Returns true with a
-// zero-curvature descent direction in d_ when g_F has a component in null(Q_FF).
+// Free-set step. Q_FF (nf x nf) is built in work_; p_ = a solution of Q_FF p = -g_F. Returns
+// true with a zero-curvature descent direction in d_ when g_F has a component in null(Q_FF).
+// Pivoted Cholesky Q_FF(perm, perm) = [L1; L2][L1; L2]^T of rank r; with y = L1^-1 g1 and
+// w = g2 - L2 y (zero iff g is in the range): p = -[L1^-T y; 0], or d = [L1^-T L2^T w; -w]
+// (in null(Q_FF), g^T d = -|w|^2 < 0).
 bool FrictionSolver::freeStep(int nf) {
   auto W = work_.topLeftCorner(nf, nf);
   for (int a = 0; a < nf; ++a)
     for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
-  auto g = tmp_.head(nf);
-  for (int a = 0; a < nf; ++a) g(a) = grad_(free_idx_(a));
-  auto p = p_.head(nf);
   auto L = L_.topLeftCorner(nf, nf);
-  if (detail::choleskyCertified(W, L, kZeroCurvature * qscale_)) {
-    p = -g;
-    detail::choleskySolve(L, p);
-    return false;
+  auto perm = rows_.head(nf);
+  const int r = detail::pivotedCholesky(W, L, perm, kZeroCurvature * qscale_);
+  auto gp = tmp_.head(nf);  // g in pivot order
+  for (int a = 0; a < nf; ++a) gp(a) = grad_(free_idx_(perm(a)));
+  // y = L1^-1 g1 (forward substitution), in tmp2_.
+  auto y = tmp2_.head(nf);
+  for (int i = 0; i < r; ++i) {
+    double v = gp(i);
+    for (int c = 0; c < i; ++c) v -= L(i, c) * y(c);
+    y(i) = v / L(i, i);
   }
-  auto V = V_.topLeftCorner(nf, nf);
-  auto lam = eig_.head(nf);
-  detail::jacobiEigen(W, V, lam);
-  const double thr = kZeroCurvature * qscale_;
-  auto d = d_.head(nf);
-  p.setZero();
-  d.setZero();
-  for (int e = 0; e < nf; ++e) {
-    const double proj = V.col(e).dot(g);
-    if (lam(e) > thr) {
-      p.noalias() -= (proj / lam(e)) * V.col(e);
-    } else {
-      d.noalias() -= proj * V.col(e);
+  // w = g2 - L2 y, kept in y's tail.
+  double wmax = 0.0;
+  for (int i = r; i < nf; ++i) {
+    double v = gp(i);
+    for (int c = 0; c < r; ++c) v -= L(i, c) * y(c);
+    y(i) = v;
+    wmax = std::max(wmax, std::abs(v));
+  }
+  const double gscale = std::max({gp.cwiseAbs().maxCoeff(), c_.cwiseAbs().maxCoeff(), 1e-300});
+  const bool zero_curvature = wmax > 1e-12 * gscale;
+  // Back substitution L1^T u = rhs, rhs = -y1 (Newton step) or L2^T w (descent direction).
+  auto u = eig_.head(nf);
+  for (int i = 0; i < r; ++i) {
+    double v = -y(i);
+    if (zero_curvature) {
+      v = 0.0;
+      for (int t = r; t < nf; ++t) v += L(t, i) * y(t);
     }
+    u(i) = v;
   }
-  const double gscale = std::max({g.cwiseAbs().maxCoeff(), c_.cwiseAbs().maxCoeff(), 1e-300});
-  return d.cwiseAbs().maxCoeff() > 1e-12 * gscale;
+  for (int i = r - 1; i >= 0; --i) {
+    double v = u(i);
+    for (int c = i + 1; c < r; ++c) v -= L(c, i) * u(c);
+    u(i) = v / L(i, i);
+  }
+  for (int i = r; i < nf; ++i) u(i) = zero_curvature ? -y(i) : 0.0;
+  auto out = zero_curvature ? d_.head(nf) : p_.head(nf);
+  for (int a = 0; a < nf; ++a) out(perm(a)) = u(a);
+  return zero_curvature;
 }
 
 // Stage 1: minimise 1/2 x^T Q x - c^T x over lo <= x <= hi by a primal active-set method.
@@ -298,16 +316,35 @@ void FrictionSolver::leastCommand(int k) {
   for (int a = 0; a < k; ++a)
     if (std::abs(grad_(a)) <= 1e-10 * std::max(acc_scale, 1.0)) rows_(ns++) = a;
   if (ns == 0) return;
+  // Null space of Q_StSt from its pivoted Cholesky: columns [-L1^-T L2^T; I] (pivot order),
+  // orthonormalised by modified Gram-Schmidt.
   auto W = work_.topLeftCorner(ns, ns);
   for (int a = 0; a < ns; ++a)
     for (int b = 0; b < ns; ++b) W(a, b) = Q_(rows_(a), rows_(b));
-  auto V = V_.topLeftCorner(ns, ns);
-  auto lam = eig_.head(ns);
-  detail::jacobiEigen(W, V, lam);
-  int dn = 0;
-  for (int e = 0; e < ns; ++e)
-    if (lam(e) <= kZeroCurvature * qscale_) N_.col(dn++).head(ns) = V.col(e);
+  auto Lc = L_.topLeftCorner(ns, ns);
+  auto perm = state_.head(ns);  // state_ is free after stage 1
+  const int r = detail::pivotedCholesky(W, Lc, perm, kZeroCurvature * qscale_);
+  const int dn = ns - r;
   if (dn == 0) return;
+  for (int e = 0; e < dn; ++e) {
+    auto col = tmp2_.head(ns);  // pivot order
+    col.setZero();
+    col(r + e) = 1.0;
+    // Solve L1^T v = -L2^T e_e for the first r entries.
+    for (int i = r - 1; i >= 0; --i) {
+      double v = -Lc(r + e, i);
+      for (int c = i + 1; c < r; ++c) v -= Lc(c, i) * col(c);
+      col(i) = v / Lc(i, i);
+    }
+    for (int a = 0; a < ns; ++a) N_(perm(a), e) = col(a);
+  }
+  for (int e = 0; e < dn; ++e) {
+    for (int f = 0; f < e; ++f) {
+      const double proj = N_.col(f).head(ns).dot(N_.col(e).head(ns));
+      N_.col(e).head(ns) -= proj * N_.col(f).head(ns);
+    }
+    N_.col(e).head(ns) /= N_.col(e).head(ns).norm();
+  }
   auto N = N_.topLeftCorner(ns, dn);
   // Target: x_St = -tau_cmd_St at the stage-1 optimum (tau_cmd = tau_cmd0 - Tc x).
   auto t = tmp_.head(ns);
