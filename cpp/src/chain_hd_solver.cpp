@@ -101,6 +101,7 @@ void ChainHdSolver::buildModel() {
   qdd_ = Eigen::VectorXd::Zero(nj_);
   tau_cmd_ = Eigen::VectorXd::Zero(nj_);
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
+  cmd_per_nu_ = Eigen::MatrixXd::Zero(nj_, kMaxConstraints);
   link_acc_ = Matrix6X::Zero(6, ns_ + 1);
   link_acc_known_ = true;  // zeros until the first solve
   f_ext_buf_ = Matrix6X::Zero(6, ns_);
@@ -627,6 +628,11 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       return fail(E_OUT_OF_RANGE, "joint index %d out of range [0, %u)", joints(c), nj_);
   }
   const int m = m_;
+  for (int r = 0; r < m; ++r) {
+    VectorC unit = VectorC::Zero(m);
+    unit(r) = 1.0;
+    commandFromNu(unit, cmd_per_nu_.col(r));
+  }
   for (long c = 0; c < k; ++c) {
     const int jt = joints(c);
     // Inward, force part only: a unit torque at joint jt; bodies distal to it feel nothing.
@@ -662,13 +668,18 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       if (s.joint >= 0) {
         const double dtau = s.joint == jt ? 1.0 : 0.0;
         double f = s.S.dot(s.dpA) + s.u.dot(a);
-        if (m > 0) f += s.S.dot(s.A.leftCols(m) * dnu);
+        if (m > 0) f += s.e.leftCols(m).dot(dnu.transpose());
         const double dq = s.Dinv * (dtau - f);
         dqdd(s.joint, c) = dq;
         a += s.S * dq;
       }
     }
-    commandFromNu(dnu, dtau_cmd.col(c));
+    // tau_cmd is linear in nu: d tau_cmd = (d tau_cmd / d nu) d nu, the m columns built once.
+    if (m > 0) {
+      dtau_cmd.col(c).noalias() = cmd_per_nu_.leftCols(m) * dnu;
+    } else {
+      dtau_cmd.col(c).setZero();
+    }
   }
   return E_NOERROR;
 }

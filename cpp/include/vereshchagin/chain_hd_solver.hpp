@@ -217,6 +217,7 @@ class ChainHdSolver : public KDL::SolverI {
   std::vector<Segment> segs_;
   std::vector<int> joint_segment_;  // segment index of each joint
   Eigen::VectorXd qdd_, tau_cmd_, zero_joints_;
+  Eigen::MatrixXd cmd_per_nu_;  // d tau_cmd / d nu (n_joints x m), workspace of responseColumns()
   mutable Matrix6X link_acc_;
   mutable bool link_acc_known_ = false;
   Matrix6X f_ext_buf_, zero_f_ext_;
