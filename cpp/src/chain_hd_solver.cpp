@@ -102,6 +102,12 @@ void ChainHdSolver::buildModel() {
   tau_cmd_ = Eigen::VectorXd::Zero(nj_);
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
   cmd_per_nu_ = Eigen::MatrixXd::Zero(nj_, kMaxConstraints);
+  seg_force_.assign(ns_, Matrix6X::Zero(6, nj_));
+  col_force_ = Matrix6X::Zero(6, nj_);
+  col_energy_ = Eigen::MatrixXd::Zero(kMaxConstraints, nj_);
+  col_nu_ = Eigen::MatrixXd::Zero(kMaxConstraints, nj_);
+  col_row_ = Eigen::VectorXd::Zero(nj_);
+  col_tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nj_);
   link_acc_ = Matrix6X::Zero(6, ns_ + 1);
   link_acc_known_ = true;  // zeros until the first solve
   f_ext_buf_ = Matrix6X::Zero(6, ns_);
@@ -633,52 +639,75 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     unit(r) = 1.0;
     commandFromNu(unit, cmd_per_nu_.col(r));
   }
-  for (long c = 0; c < k; ++c) {
-    const int jt = joints(c);
-    // Inward, force part only: a unit torque at joint jt; bodies distal to it feel nothing.
-    VectorC dU = VectorC::Zero(m);
-    Vector6 dp = Vector6::Zero();  // apparent bias force passed to the parent
-    bool started = false;
+  // All columns at once (coefficient-wise products: no GEMM workspace on the heap), in chunks of
+  // at most n_joints (the workspace width): a unit torque at
+  // joint joints(c) changes only the force part of the sweeps; bodies distal to it feel nothing.
+  for (long c0 = 0; c0 < k; c0 += nj_) {
+    const long kc = std::min<long>(nj_, k - c0);
+    auto DP = col_force_.leftCols(kc);  // apparent bias-force change passed to the parent (6 x kc)
+    auto DU = col_energy_.topLeftCorner(m, kc);
+    auto row = col_row_.head(kc);
+    DU.setZero();
     for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
       Segment& s = segs_[i];
-      if (!started) {
-        s.dpA.setZero();
-        if (s.joint != jt) continue;
-        started = true;
-      } else {
-        s.dpA = forceToParent(segs_[i + 1].X, dp);
+      auto dpA = seg_force_[i].leftCols(kc);
+      if (i == static_cast<int>(ns_) - 1) {
+        dpA.setZero();
+      } else {  // child's apparent force to this frame: f = R f', n = R n' + p x f
+        const Pose& X = segs_[i + 1].X;
+        dpA.topRows<3>().noalias() = X.R.lazyProduct(DP.topRows<3>());
+        dpA.bottomRows<3>().noalias() = X.R.lazyProduct(DP.bottomRows<3>());
+        dpA.bottomRows<3>().noalias() += skew(X.p).lazyProduct(dpA.topRows<3>());
       }
       if (s.joint >= 0) {
-        const double dtau = s.joint == jt ? 1.0 : 0.0;
-        const double dfree = s.Dinv * (dtau - s.S.dot(s.dpA));
-        dp = s.dpA + s.u * dfree;
-        if (m > 0) dU.noalias() += s.A.leftCols(m).transpose() * (s.S * dfree);
+        row.noalias() = -(s.S.transpose().lazyProduct(dpA)).transpose();
+        for (long c = 0; c < kc; ++c)
+          if (joints(c0 + c) == s.joint) row(c) += 1.0;
+        row *= s.Dinv;  // change of the free joint acceleration
+        DP = dpA;
+        DP.noalias() += s.u.lazyProduct(row.transpose());
+        if (m > 0) DU.noalias() += s.e.leftCols(m).transpose().lazyProduct(row.transpose());
       } else {
-        dp = s.dpA;
+        DP = dpA;
       }
     }
-    VectorC dnu;
-    applyCouplingInverse(dU, dnu);  // d nu = K^+ dU
-    if (dnu_out)
-      for (int r = 0; r < m; ++r) (*dnu_out)(r, c) = dnu(r);
-    Vector6 a = Vector6::Zero();
+    auto DNU = col_nu_.topLeftCorner(m, kc);
+    for (long c = 0; c < kc; ++c) {
+      VectorC du = DU.col(c), dn;
+      applyCouplingInverse(du, dn);  // d nu = K^+ dU
+      DNU.col(c) = dn;
+      if (dnu_out)
+        for (int r = 0; r < m; ++r) (*dnu_out)(r, c0 + c) = dn(r);
+    }
+    // Outward: accelerations of all columns (6 x kc), base at rest.
+    auto ACC = col_force_.leftCols(kc);
+    ACC.setZero();
     for (unsigned int i = 0; i < ns_; ++i) {
       const Segment& s = segs_[i];
-      a = motionToChild(s.X, a);
+      // motion to the child frame: w' = R^T w, v' = R^T (v - p x w)
+      auto top = ACC.topRows<3>();
+      auto bottom = ACC.bottomRows<3>();
+      top.noalias() -= skew(s.X.p).lazyProduct(bottom);
+      col_tmp3_.leftCols(kc).noalias() = s.X.R.transpose().lazyProduct(top);
+      top = col_tmp3_.leftCols(kc);
+      col_tmp3_.leftCols(kc).noalias() = s.X.R.transpose().lazyProduct(bottom);
+      bottom = col_tmp3_.leftCols(kc);
       if (s.joint >= 0) {
-        const double dtau = s.joint == jt ? 1.0 : 0.0;
-        double f = s.S.dot(s.dpA) + s.u.dot(a);
-        if (m > 0) f += s.e.leftCols(m).dot(dnu.transpose());
-        const double dq = s.Dinv * (dtau - f);
-        dqdd(s.joint, c) = dq;
-        a += s.S * dq;
+        row.noalias() = -(s.S.transpose().lazyProduct(seg_force_[i].leftCols(kc))).transpose();
+        row.noalias() -= (s.u.transpose().lazyProduct(ACC)).transpose();
+        if (m > 0) row.noalias() -= (s.e.leftCols(m).lazyProduct(DNU)).transpose();
+        for (long c = 0; c < kc; ++c)
+          if (joints(c0 + c) == s.joint) row(c) += 1.0;
+        row *= s.Dinv;
+        dqdd.row(s.joint).segment(c0, kc) = row.transpose();
+        ACC.noalias() += s.S.lazyProduct(row.transpose());
       }
     }
     // tau_cmd is linear in nu: d tau_cmd = (d tau_cmd / d nu) d nu, the m columns built once.
     if (m > 0) {
-      dtau_cmd.col(c).noalias() = cmd_per_nu_.leftCols(m) * dnu;
+      dtau_cmd.middleCols(c0, kc).noalias() = cmd_per_nu_.leftCols(m).lazyProduct(DNU);
     } else {
-      dtau_cmd.col(c).setZero();
+      dtau_cmd.middleCols(c0, kc).setZero();
     }
   }
   return E_NOERROR;

@@ -176,7 +176,6 @@ class ChainHdSolver : public KDL::SolverI {
     Vector6 v, c, pA;       // velocity, velocity-product acceleration, articulated bias force
     Vector6 u;              // IA * S
     Vector6 xdd;            // spatial acceleration (tip frame)
-    Vector6 dpA;            // workspace of responseColumns()
     Eigen::Matrix<double, 6, kMaxConstraints> A;  // constraint wrenches felt by this segment
     Eigen::Matrix<double, 1, kMaxConstraints> e;  // S^T A
     double rotor = 0.0, D = 0.0, Dinv = 0.0;
@@ -217,7 +216,13 @@ class ChainHdSolver : public KDL::SolverI {
   std::vector<Segment> segs_;
   std::vector<int> joint_segment_;  // segment index of each joint
   Eigen::VectorXd qdd_, tau_cmd_, zero_joints_;
-  Eigen::MatrixXd cmd_per_nu_;  // d tau_cmd / d nu (n_joints x m), workspace of responseColumns()
+  // Workspace of responseColumns(): d tau_cmd / d nu (n_joints x m), per-segment force changes
+  // (6 x n_joints each) and column blocks.
+  Eigen::MatrixXd cmd_per_nu_, col_energy_, col_nu_;
+  std::vector<Matrix6X> seg_force_;
+  Matrix6X col_force_;
+  Eigen::VectorXd col_row_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> col_tmp3_;
   mutable Matrix6X link_acc_;
   mutable bool link_acc_known_ = false;
   Matrix6X f_ext_buf_, zero_f_ext_;
