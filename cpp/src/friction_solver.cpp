@@ -14,6 +14,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Curvatures (eigenvalues of Q, Cholesky pivots) below this fraction of Q's scale are zero.
 constexpr double kZeroCurvature = 1e-10;
+// Gradient entries (accelerations) below this fraction of the gradient's scale are zero.
+constexpr double kGradientTolerance = 1e-11;
 }
 
 FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
@@ -214,8 +216,7 @@ bool FrictionSolver::freeStep(int nf) {
     y(i) = v;
     wmax = std::max(wmax, std::abs(v));
   }
-  const double gscale = std::max({gp.cwiseAbs().maxCoeff(), c_.cwiseAbs().maxCoeff(), 1e-300});
-  const bool zero_curvature = wmax > 1e-12 * gscale;
+  const bool zero_curvature = wmax > kGradientTolerance * gscale_;
   // Back substitution L1^T u = rhs, rhs = -y1 (Newton step) or L2^T w (descent direction).
   auto u = eig_.head(nf);
   for (int i = 0; i < r; ++i) {
@@ -248,8 +249,10 @@ int FrictionSolver::boxQp(int k) {
     if (std::isfinite(hi_(i))) xscale = std::max(xscale, std::abs(hi_(i)));
     if (std::isfinite(lo_(i))) xscale = std::max(xscale, std::abs(lo_(i)));
   }
-  const double gscale = std::max({c_.head(k).cwiseAbs().maxCoeff(), Q_.topLeftCorner(k, k).cwiseAbs().maxCoeff() * xscale, 1e-300});
-  const double tol_g = 1e-11 * gscale;
+  // Scale of the gradient (accelerations): the frictionless ones and what the largest friction
+  // bound can cause, at Q's physical scale (not Q's entries, which a task can make vanish).
+  gscale_ = std::max({c_.head(k).cwiseAbs().maxCoeff(), qscale_ * xscale, 1e-300});
+  const double tol_g = kGradientTolerance * gscale_;
   const int max_iterations = 50 + 20 * k;
   bool face_optimal = false;
   for (int it = 0; it < max_iterations; ++it) {
@@ -311,10 +314,9 @@ void FrictionSolver::leastCommand(int k) {
   auto x = x_.head(k);
   grad_.head(k).noalias() = Q_.topLeftCorner(k, k) * x;
   grad_.head(k) -= c_.head(k);  // = -(accelerations of the resting joints)
-  const double acc_scale = std::max(c_.head(k).cwiseAbs().maxCoeff(), 1e-300);
   int ns = 0;
   for (int a = 0; a < k; ++a)
-    if (std::abs(grad_(a)) <= 1e-10 * std::max(acc_scale, 1.0)) rows_(ns++) = a;
+    if (std::abs(grad_(a)) <= 10.0 * kGradientTolerance * gscale_) rows_(ns++) = a;
   if (ns == 0) return;
   // Null space of Q_StSt from its pivoted Cholesky: columns [-L1^-T L2^T; I] (pivot order),
   // orthonormalised by modified Gram-Schmidt.

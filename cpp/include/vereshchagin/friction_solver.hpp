@@ -111,6 +111,7 @@ class FrictionSolver {
   std::vector<signed char> status_;
   int iterations_ = 0;
   double qscale_ = 0.0;  // scale of Q (see solve())
+  double gscale_ = 0.0;  // scale of the QP gradient (see boxQp())
   bool solved_ = false;
   // Inputs kept for gaussValue().
   Eigen::VectorXd q_keep_, qd_keep_;
