@@ -153,6 +153,18 @@ inline void addBench(std::vector<Bench>& group, const std::string& name, std::fu
   group.push_back(std::move(b));
 }
 
+// A benchmark body: `reps` passes over `items`, summing what `call` returns into g_sink so that
+// no timed result can be optimised away.
+template <class Items, class Call>
+std::function<void(int)> overStates(const Items& items, Call call) {
+  return [&items, call](int reps) mutable {
+    double acc = 0.0;
+    for (int r = 0; r < reps; ++r)
+      for (const auto& item : items) acc += call(item);
+    g_sink += acc;
+  };
+}
+
 inline double secondsOf(const std::function<void(int)>& run, int reps) {
   const auto t0 = Clock::now();
   run(reps);

@@ -332,42 +332,23 @@ int main(int argc, char** argv) {
       if (row.g_violations) ++failures;
 
       std::vector<Bench> group;
-      addBench(group, "friction", [&](int reps) {
-        double acc = 0.0;
-        for (int r = 0; r < reps; ++r)
-          for (const State& s : states) {
-            const Task& t = s.tasks[ti];
-            fric.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau, s.friction);
-            acc += fric.qdd()(n - 1);
-          }
-        g_sink += acc;
-      });
-      addBench(group, "plain", [&](int reps) {
-        double acc = 0.0;
-        for (int r = 0; r < reps; ++r)
-          for (const State& s : states) {
-            const Task& t = s.tasks[ti];
-            plain.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
-            acc += plain.qdd()(n - 1);
-          }
-        g_sink += acc;
-      });
-      addBench(group, "KDL", [&](int reps) {
-        double acc = 0.0;
-        for (int r = 0; r < reps; ++r)
-          for (const State& s : states) {
-            const Task& t = s.tasks[ti];
-            kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_out_kdl);
-            acc += qdd_kdl(n - 1);
-          }
-        g_sink += acc;
-      });
-      addBench(group, "vertex enumeration", [&](int reps) {
-        double acc = 0.0;
-        for (int r = 0; r < reps; ++r)
-          for (const State& s : states) acc += vertices.run(s, s.tasks[ti]);
-        g_sink += acc;
-      });
+      addBench(group, "friction", overStates(states, [&](const State& s) {
+        const Task& t = s.tasks[ti];
+        fric.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau, s.friction);
+        return fric.qdd()(n - 1);
+      }));
+      addBench(group, "plain", overStates(states, [&](const State& s) {
+        const Task& t = s.tasks[ti];
+        plain.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
+        return plain.qdd()(n - 1);
+      }));
+      addBench(group, "KDL", overStates(states, [&](const State& s) {
+        const Task& t = s.tasks[ti];
+        kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_out_kdl);
+        return qdd_kdl(n - 1);
+      }));
+      addBench(group, "vertex enumeration",
+               overStates(states, [&](const State& s) { return vertices.run(s, s.tasks[ti]); }));
       std::cerr << "timing " << label << " ..." << std::endl;
       runGroup(group, label);
       row.friction = median(group[0].us);

@@ -214,38 +214,21 @@ int main(int argc, char** argv) {
       }
 
       std::vector<Bench> group;
-      addBench(group, "ours CartToJnt", [&](int reps) {
-                         double acc = 0.0;
-                         for (int r = 0; r < reps; ++r)
-                           for (const State& s : states) {
-                             const Task& t = s.tasks[ti];
-                             ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl,
-                                            s.tau_kdl, tau_cmd);
-                             acc += qdd_ours(n - 1);
-                           }
-                         g_sink += acc;
-                       });
-      addBench(group, "ours solve()", [&](int reps) {
-                         double acc = 0.0;
-                         for (int r = 0; r < reps; ++r)
-                           for (const State& s : states) {
-                             const Task& t = s.tasks[ti];
-                             ours.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
-                             acc += ours.qdd()(n - 1);
-                           }
-                         g_sink += acc;
-                       });
-      addBench(group, "KDL Vereshchagin", [&](int reps) {
-                         double acc = 0.0;
-                         for (int r = 0; r < reps; ++r)
-                           for (const State& s : states) {
-                             const Task& t = s.tasks[ti];
-                             kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl,
-                                              s.tau_kdl, tau_out_kdl);
-                             acc += qdd_kdl(n - 1);
-                           }
-                         g_sink += acc;
-                       });
+      addBench(group, "ours CartToJnt", overStates(states, [&](const State& s) {
+        const Task& t = s.tasks[ti];
+        ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_cmd);
+        return qdd_ours(n - 1);
+      }));
+      addBench(group, "ours solve()", overStates(states, [&](const State& s) {
+        const Task& t = s.tasks[ti];
+        ours.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
+        return ours.qdd()(n - 1);
+      }));
+      addBench(group, "KDL Vereshchagin", overStates(states, [&](const State& s) {
+        const Task& t = s.tasks[ti];
+        kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_out_kdl);
+        return qdd_kdl(n - 1);
+      }));
       const std::string label = "n " + cc.label + ", m " + std::to_string(m);
       std::cerr << "timing " << label << " ..." << std::endl;
       runGroup(group, label);
@@ -266,36 +249,20 @@ int main(int argc, char** argv) {
 
     // KDL's recursive Newton-Euler solvers for scale (independent of m).
     std::vector<Bench> group;
-    addBench(group, "KDL ChainIdSolver_RNE", [&](int reps) {
-                       double acc = 0.0;
-                       for (int r = 0; r < reps; ++r)
-                         for (const State& s : states) {
-                           kdl_id.CartToJnt(s.q_kdl, s.qd_kdl, qdd_zero, f_ext_kdl, tau_out_kdl);
-                           acc += tau_out_kdl(n - 1);
-                         }
-                       g_sink += acc;
-                     });
-    addBench(group, "KDL ChainFdSolver_RNE", [&](int reps) {
-                       double acc = 0.0;
-                       for (int r = 0; r < reps; ++r)
-                         for (const State& s : states) {
-                           kdl_fd.CartToJnt(s.q_kdl, s.qd_kdl, s.tau_kdl, f_ext_kdl, qdd_kdl);
-                           acc += qdd_kdl(n - 1);
-                         }
-                       g_sink += acc;
-                     });
+    addBench(group, "KDL ChainIdSolver_RNE", overStates(states, [&](const State& s) {
+        kdl_id.CartToJnt(s.q_kdl, s.qd_kdl, qdd_zero, f_ext_kdl, tau_out_kdl);
+        return tau_out_kdl(n - 1);
+      }));
+    addBench(group, "KDL ChainFdSolver_RNE", overStates(states, [&](const State& s) {
+        kdl_fd.CartToJnt(s.q_kdl, s.qd_kdl, s.tau_kdl, f_ext_kdl, qdd_kdl);
+        return qdd_kdl(n - 1);
+      }));
     // Ours without constraints (m = 0) again, interleaved with these for paired ratios.
-    addBench(group, "ours CartToJnt m=0", [&](int reps) {
-                       double acc = 0.0;
-                       for (int r = 0; r < reps; ++r)
-                         for (const State& s : states) {
-                           const Task& t = s.tasks[0];
-                           ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl,
-                                          s.tau_kdl, tau_cmd);
-                           acc += qdd_ours(n - 1);
-                         }
-                       g_sink += acc;
-                     });
+    addBench(group, "ours CartToJnt m=0", overStates(states, [&](const State& s) {
+        const Task& t = s.tasks[0];
+        ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_cmd);
+        return qdd_ours(n - 1);
+      }));
     const std::string label = "n " + cc.label + ", RNE";
     std::cerr << "timing " << label << " ..." << std::endl;
     runGroup(group, label);
