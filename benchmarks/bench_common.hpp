@@ -3,6 +3,17 @@
 // and the report helpers. Header-only (inline), one translation unit per benchmark executable.
 #pragma once
 
+// Build facts passed by benchmarks/CMakeLists.txt (defaults when built otherwise).
+#ifndef BENCH_CXX_FLAGS
+#define BENCH_CXX_FLAGS "(unknown)"
+#endif
+#ifndef BENCH_BUILD_TYPE
+#define BENCH_BUILD_TYPE "(unknown)"
+#endif
+#ifndef BENCH_CXX_COMPILER
+#define BENCH_CXX_COMPILER "(unknown)"
+#endif
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>

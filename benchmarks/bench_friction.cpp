@@ -62,16 +62,6 @@
 
 #include "bench_common.hpp"
 
-#ifndef BENCH_CXX_FLAGS
-#define BENCH_CXX_FLAGS "(unknown)"
-#endif
-#ifndef BENCH_BUILD_TYPE
-#define BENCH_BUILD_TYPE "(unknown)"
-#endif
-#ifndef BENCH_CXX_COMPILER
-#define BENCH_CXX_COMPILER "(unknown)"
-#endif
-
 namespace {
 
 using namespace bench;

@@ -65,16 +65,6 @@
 
 #include "bench_common.hpp"  // Rng, the Gen3 and random chains, the interleaved-batch timer, report helpers
 
-#ifndef BENCH_CXX_FLAGS
-#define BENCH_CXX_FLAGS "(unknown)"
-#endif
-#ifndef BENCH_BUILD_TYPE
-#define BENCH_BUILD_TYPE "(unknown)"
-#endif
-#ifndef BENCH_CXX_COMPILER
-#define BENCH_CXX_COMPILER "(unknown)"
-#endif
-
 namespace {
 
 using namespace bench;

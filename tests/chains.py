@@ -327,3 +327,11 @@ def assert_close(actual, expected, rtol=1e-9, what=""):
     err = np.linalg.norm(actual - expected)
     scale = max(np.linalg.norm(expected), 1.0)
     assert err <= rtol * scale, f"{what}: |error| = {err:.3e} > {rtol:.0e} * {scale:.3e}\nactual={actual}\nexpected={expected}"
+
+
+def pin_configuration(model, q):
+    """Pinocchio configuration of joint positions q: continuous joints (nq = 2) as (cos, sin)."""
+    out = []
+    for joint, qi in zip(model.joints[1:], q):
+        out += [np.cos(qi), np.sin(qi)] if joint.nq == 2 else [qi]
+    return np.array(out)

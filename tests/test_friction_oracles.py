@@ -26,6 +26,7 @@ import pytest
 
 import vereshchagin as vs
 from chains import (
+    pin_configuration,
     G_EARTH,
     SegmentSpec,
     build,
@@ -637,11 +638,7 @@ def _gen3(**kw):
 ROBOTS = {"panda": _panda, "gen3": _gen3}
 
 
-def _pin_q(model, q):
-    out = []
-    for joint, qi in zip(model.joints[1:], q):
-        out += [np.cos(qi), np.sin(qi)] if joint.nq == 2 else [qi]
-    return np.array(out)
+_pin_q = pin_configuration
 
 
 def _robot_case(name, rng, m, rest, friction, task="random", accept=None, **kw):

@@ -14,6 +14,7 @@ import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
+from chains import pin_configuration
 
 ROOT = Path(__file__).resolve().parents[1]
 from vereshchagin import robots  # noqa: E402
@@ -98,12 +99,7 @@ def _pin_model(**kw):
     return model
 
 
-def _pin_q(model, q):
-    """Pinocchio configuration of joint angles q (continuous joints are (cos, sin) pairs)."""
-    out = []
-    for joint, qi in zip(model.joints[1:], q):
-        out += [math.cos(qi), math.sin(qi)] if joint.nq == 2 else [qi]
-    return np.array(out)
+_pin_q = pin_configuration
 
 
 def _tip_pose(model, q):

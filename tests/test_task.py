@@ -12,6 +12,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import vereshchagin as vs
+from chains import pin_configuration
 from vereshchagin.robots import example_robot_urdf, gen3, gen3_urdf
 from vereshchagin.task import Task, beta_for, directions, pose_error, twist_error
 
@@ -41,10 +42,7 @@ class Robot:
         self.solver = vs.Solver(self.chain, gravity=G)
 
     def pin_q(self, q):
-        out = []
-        for joint, qi in zip(self.model.joints[1:], q):
-            out += [np.cos(qi), np.sin(qi)] if joint.nq == 2 else [qi]
-        return np.array(out)
+        return pin_configuration(self.model, q)
 
     def random_state(self, rng):
         lo = np.maximum(self.chain.lower, -np.pi)

@@ -24,6 +24,7 @@ import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
+from chains import pin_configuration
 from vereshchagin.robots import example_robot_urdf, gen3, gen3_urdf
 
 RTOL = 1e-8
@@ -50,11 +51,7 @@ class Robot:
     links: tuple  # merged / base links whose frames we compare too
 
     def pin_q(self, q):
-        """Pinocchio configuration: continuous joints (nq = 2) as (cos, sin)."""
-        out = []
-        for joint, qi in zip(self.model.joints[1:], q):
-            out += [np.cos(qi), np.sin(qi)] if joint.nq == 2 else [qi]
-        return np.array(out)
+        return pin_configuration(self.model, q)
 
     def random_state(self, rng):
         lo = np.maximum(self.chain.lower, -np.pi)
