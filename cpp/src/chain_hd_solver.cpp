@@ -5,6 +5,7 @@
 // produced by bias forces and torques, L (m x m) the one produced by unit constraint forces.
 #include "vereshchagin/chain_hd_solver.hpp"
 
+#include "articulated_step.hpp"
 #include "dense_small.hpp"
 
 #if defined(__GNUC__) && !defined(__clang__)
@@ -101,11 +102,8 @@ void ChainHdSolver::buildModel() {
   qdd_ = Eigen::VectorXd::Zero(nj_);
   tau_cmd_ = Eigen::VectorXd::Zero(nj_);
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
-  cmd_per_nu_ = Eigen::MatrixXd::Zero(nj_, kMaxConstraints);
   seg_force_.assign(ns_, Matrix6X::Zero(6, nj_));
   col_force_ = Matrix6X::Zero(6, nj_);
-  col_energy_ = Eigen::MatrixXd::Zero(kMaxConstraints, nj_);
-  col_nu_ = Eigen::MatrixXd::Zero(kMaxConstraints, nj_);
   col_row_ = Eigen::VectorXd::Zero(nj_);
   col_tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nj_);
   link_acc_ = Matrix6X::Zero(6, ns_ + 1);
@@ -113,6 +111,18 @@ void ChainHdSolver::buildModel() {
   f_ext_buf_ = Matrix6X::Zero(6, ns_);
   zero_f_ext_ = Matrix6X::Zero(6, ns_);
   alfa_buf_.setZero();
+  mcap_ = std::max<int>(kMaxConstraints, kMaxConstraints * static_cast<int>(ns_));
+  general_ = false;
+  order_ = Eigen::VectorXi::Zero(mcap_);
+  seg_count_ = Eigen::VectorXi::Zero(ns_);
+  active_.assign(ns_ + 1, 0);
+  anew_ = acur_ = aproj_ = Matrix6X::Zero(6, mcap_);
+  eg_ = Eigen::MatrixXd::Zero(mcap_, std::max<unsigned int>(ns_, 1));
+  ug_ = nug_ = nu_user_ = rhs_g_ = tmp_g_ = invg_ = Eigen::VectorXd::Zero(mcap_);
+  kg_ = cholg_ = vg_ = work_g_ = work_v_ = Eigen::MatrixXd::Zero(mcap_, mcap_);
+  cmd_per_nu_ = Eigen::MatrixXd::Zero(nj_, mcap_);
+  col_energy_ = Eigen::MatrixXd::Zero(mcap_, nj_);
+  col_nu_ = Eigen::MatrixXd::Zero(mcap_, nj_);
   m_ = 0;
   rank_ = 0;
   sigma_min_ = 0.0;
@@ -204,7 +214,7 @@ int ChainHdSolver::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q,
                                const Eigen::Ref<const Matrix6X>& alfa,
                                const Eigen::Ref<const Eigen::VectorXd>& beta,
                                const Eigen::Ref<const Matrix6X>& f_ext,
-                               const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+                               const Eigen::Ref<const Eigen::VectorXd>& ff_torques, int max_columns) {
   if (model_error_ != E_NOERROR) {
     error = model_error_;
     return model_error_;  // message_ still holds the model's problem
@@ -219,9 +229,9 @@ int ChainHdSolver::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (f_ext.cols() != ns && f_ext.cols() != 0)
     return fail(E_SIZE_MISMATCH, "f_ext has %ld wrenches, expected %ld (segments) or 0",
                 (long)f_ext.cols(), ns);
-  if (alfa.cols() > kMaxConstraints)
+  if (alfa.cols() > max_columns)
     return fail(E_TOO_MANY_CONSTRAINTS, "alfa has %ld columns, at most %d constraints are supported",
-                (long)alfa.cols(), kMaxConstraints);
+                (long)alfa.cols(), max_columns);
   if (beta.size() != alfa.cols())
     return fail(E_SIZE_MISMATCH, "beta has %ld entries, expected %ld (one per alfa column)",
                 (long)beta.size(), (long)alfa.cols());
@@ -337,21 +347,8 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
     Mat6M Aproj;  // constraint wrenches passed to the parent
     const auto A = s.A.template leftCols<M>();
     if (s.joint >= 0) {
-      s.u.noalias() = s.IA * s.S;
-      s.D = s.rotor + s.S.dot(s.u);
-      if (!(s.D > d_tolerance_)) {
-        return fail(E_DEGENERATE_INERTIA,
-                    "joint %d ('%s') has zero articulated inertia (%g): the bodies it moves have no "
-                    "mass or inertia about its axis and it has no rotor inertia",
-                    s.joint, chain_.getSegment(i).getJoint().getName().c_str(), s.D);
-      }
-      s.Dinv = 1.0 / s.D;
-      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
-      const Vector6 IAc = s.IA * s.c;
-      // Joint acceleration with the parent at rest and no constraint: the free part.
-      const double free = s.Dinv * (tau - s.S.dot(s.pA + IAc));
-      // Apparent bias force: pA + IA c + u (tau - S^T (pA + IA c)) / D.
-      pa = s.pA + IAc + s.u * free;
+      double free = 0.0;
+      if (!articulate(s, has_tau ? ff_torques(s.joint) : 0.0, pa, free)) return degenerate(i);
       if (M > 0) {
         auto e = s.e.template leftCols<M>();  // S^T A, kept for the final sweep
         e.noalias() = s.S.transpose() * A;
@@ -366,16 +363,8 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
       if (M > 0) Aproj = A;
     }
     if (i > 0) {
+      passToParent(i, pa);
       Segment& p = segs_[i - 1];
-      // Apparent inertia IA - u u^T / D (or IA for a fixed joint), moved to the parent.
-      if (s.joint >= 0) {
-        Matrix6 Ia = s.IA;
-        Ia.noalias() -= s.Dinv * s.u * s.u.transpose();
-        addInertiaToParent(s.X, Ia, p.IA);
-      } else {
-        addInertiaToParent(s.X, s.IA, p.IA);
-      }
-      p.pA += forceToParent(s.X, pa);
       if (M > 0) {
         // Constraint wrenches to the parent frame, all columns at once: f = R f', n = R n' + p x f.
         auto top = p.A.template topLeftCorner<3, M>();
@@ -397,6 +386,14 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
   L0_ = L;
   kappa_ = kappa;
   return E_NOERROR;
+}
+
+int ChainHdSolver::degenerate(int i) {
+  const Segment& s = segs_[i];
+  return fail(E_DEGENERATE_INERTIA,
+              "joint %d ('%s') has zero articulated inertia (%g): the bodies it moves have no "
+              "mass or inertia about its axis and it has no rotor inertia",
+              s.joint, chain_.getSegment(i).getJoint().getName().c_str(), s.D);
 }
 
 // Final outward sweep: joint and link accelerations, given the constraint magnitudes nu_.
@@ -482,6 +479,12 @@ double ChainHdSolver::smallestSingularValue() const {
   if (!sigma_known_) {
     if (m_ == 0) {
       sigma_min_ = 0.0;
+    } else if (general_) {
+      auto W = work_g_.topLeftCorner(m_, m_);
+      auto V = work_v_.topLeftCorner(m_, m_);
+      W = kg_.topLeftCorner(m_, m_);
+      detail::jacobiEigen(W, V);
+      sigma_min_ = std::max(W.diagonal().minCoeff(), 0.0);
     } else {
       sigma_eig_.compute(K_, Eigen::EigenvaluesOnly);
       sigma_min_ = std::max(sigma_eig_.eigenvalues()(0), 0.0);
@@ -529,7 +532,8 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Matrix6X>& f_ext,
                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   solved_ = false;
-  int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques);
+  general_ = false;
+  int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques, kMaxConstraints);
   if (rc != E_NOERROR) return rc;
   outwardSweep(q, q_dot, f_ext);
   rc = inwardSweep(alfa, ff_torques);
@@ -634,11 +638,21 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       return fail(E_OUT_OF_RANGE, "joint index %d out of range [0, %u)", joints(c), nj_);
   }
   const int m = m_;
+  // d tau_cmd / d nu, one column per constraint; the end-segment path's S^T A rows into eg_ so
+  // that both paths share the sweeps below.
   for (int r = 0; r < m; ++r) {
-    VectorC unit = VectorC::Zero(m);
-    unit(r) = 1.0;
-    commandFromNu(unit, cmd_per_nu_.col(r));
+    if (general_) {
+      rhs_g_.head(m).setZero();
+      rhs_g_(r) = 1.0;
+      commandFromNuGeneral(rhs_g_.head(m), cmd_per_nu_.col(r));
+    } else {
+      VectorC unit = VectorC::Zero(m);
+      unit(r) = 1.0;
+      commandFromNu(unit, cmd_per_nu_.col(r));
+    }
   }
+  if (!general_ && m > 0)
+    for (unsigned int i = 0; i < ns_; ++i) eg_.col(i).head(m) = segs_[i].e.leftCols(m).transpose();
   // All columns at once (coefficient-wise products: no GEMM workspace on the heap), in chunks of
   // at most n_joints (the workspace width): a unit torque at
   // joint joints(c) changes only the force part of the sweeps; bodies distal to it feel nothing.
@@ -666,18 +680,16 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
         row *= s.Dinv;  // change of the free joint acceleration
         DP = dpA;
         DP.noalias() += s.u.lazyProduct(row.transpose());
-        if (m > 0) DU.noalias() += s.e.leftCols(m).transpose().lazyProduct(row.transpose());
+        if (m > 0) DU.noalias() += eg_.col(i).head(m).lazyProduct(row.transpose());
       } else {
         DP = dpA;
       }
     }
     auto DNU = col_nu_.topLeftCorner(m, kc);
     for (long c = 0; c < kc; ++c) {
-      VectorC du = DU.col(c), dn;
-      applyCouplingInverse(du, dn);  // d nu = K^+ dU
-      DNU.col(c) = dn;
+      couplingSolve(DU.col(c), DNU.col(c));  // d nu = K^+ dU
       if (dnu_out)
-        for (int r = 0; r < m; ++r) (*dnu_out)(r, c0 + c) = dn(r);
+        for (int r = 0; r < m; ++r) (*dnu_out)(general_ ? order_(r) : r, c0 + c) = DNU(r, c);
     }
     // Outward: accelerations of all columns (6 x kc), base at rest.
     auto ACC = col_force_.leftCols(kc);
@@ -695,7 +707,7 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       if (s.joint >= 0) {
         row.noalias() = -(s.S.transpose().lazyProduct(seg_force_[i].leftCols(kc))).transpose();
         row.noalias() -= (s.u.transpose().lazyProduct(ACC)).transpose();
-        if (m > 0) row.noalias() -= (s.e.leftCols(m).lazyProduct(DNU)).transpose();
+        if (m > 0) row.noalias() -= (eg_.col(i).head(m).transpose().lazyProduct(DNU)).transpose();
         for (long c = 0; c < kc; ++c)
           if (joints(c0 + c) == s.joint) row(c) += 1.0;
         row *= s.Dinv;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -78,6 +79,51 @@ int pivotedCholesky(MW& W, ML& L, VP& perm, double tol) {
       }
   }
   return k;
+}
+
+// Cyclic Jacobi eigen-decomposition of a symmetric k x k matrix A: rotations J_pq zero one
+// off-diagonal pair at a time, A <- J^T A J, V <- V J. On return the diagonal of A holds the
+// eigenvalues (unsorted) and the columns of V the orthonormal eigenvectors. Stops when the
+// off-diagonal mass is below eps^2 of A's Frobenius norm squared, after at most max_sweeps sweeps
+// (convergence is quadratic; 6-10 sweeps are typical). Returns the number of sweeps.
+template <typename MA, typename MV>
+int jacobiEigen(MA& A, MV& V, int max_sweeps = 60) {
+  const int k = static_cast<int>(A.rows());
+  V.setIdentity();
+  const double total = A.squaredNorm();
+  const double eps = std::numeric_limits<double>::epsilon();
+  int sweep = 0;
+  for (; sweep < max_sweeps; ++sweep) {
+    double off = 0.0;
+    for (int p = 0; p < k; ++p)
+      for (int q = p + 1; q < k; ++q) off += 2.0 * A(p, q) * A(p, q);
+    if (!(off > eps * eps * total)) break;
+    for (int p = 0; p < k; ++p) {
+      for (int q = p + 1; q < k; ++q) {
+        const double apq = A(p, q);
+        if (apq == 0.0) continue;
+        const double theta = (A(q, q) - A(p, p)) / (2.0 * apq);
+        const double t = std::abs(theta) > 1e150
+                             ? 0.5 / theta
+                             : (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+        const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+        A(p, p) -= t * apq;
+        A(q, q) += t * apq;
+        A(p, q) = A(q, p) = 0.0;
+        for (int r = 0; r < k; ++r) {
+          if (r != p && r != q) {
+            const double arp = A(r, p), arq = A(r, q);
+            A(r, p) = A(p, r) = c * arp - s * arq;
+            A(r, q) = A(q, r) = s * arp + c * arq;
+          }
+          const double vrp = V(r, p), vrq = V(r, q);
+          V(r, p) = c * vrp - s * vrq;
+          V(r, q) = s * vrp + c * vrq;
+        }
+      }
+    }
+  }
+  return sweep;
 }
 
 }  // namespace detail

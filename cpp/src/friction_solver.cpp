@@ -29,10 +29,11 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
   Gc_ = Tc_ = Q_ = work_ = L_ = V_ = N_ = B_ = Eigen::MatrixXd::Zero(n, n);
   c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = Eigen::VectorXd::Zero(n);
-  dnu_ = Eigen::MatrixXd::Zero(ChainHdSolver::kMaxConstraints, n);
-  nu0_ = nu_ = Eigen::VectorXd::Zero(ChainHdSolver::kMaxConstraints);
-  alfa_keep_.setZero();
-  beta_keep_.setZero();
+  const int mcap = hd_.maxConstraints();
+  dnu_ = Eigen::MatrixXd::Zero(mcap, n);
+  nu0_ = nu_ = beta_keep_ = Eigen::VectorXd::Zero(mcap);
+  alfa_keep_ = ChainHdSolver::Matrix6X::Zero(6, mcap);
+  seg_keep_ = Eigen::VectorXi::Zero(mcap);
 }
 
 int FrictionSolver::setOptions(const SolverOptions& options) {
@@ -56,6 +57,33 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
                           const Eigen::Ref<const Eigen::VectorXd>& beta,
                           const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
                           const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
+  return solveImpl(q, q_dot, alfa, beta, nullptr, f_ext, ff_torques, friction);
+}
+
+int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
+                          const Eigen::Ref<const Eigen::VectorXd>& beta,
+                          const Eigen::Ref<const Eigen::VectorXi>& segments,
+                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
+  return solveImpl(q, q_dot, alfa, beta, &segments, f_ext, ff_torques, friction);
+}
+
+int FrictionSolver::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                            const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
+                            const Eigen::Ref<const Eigen::VectorXd>& beta,
+                            const Eigen::Ref<const Eigen::VectorXi>* segments,
+                            const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                            const Eigen::Ref<const Eigen::VectorXd>& tau) {
+  return segments ? hd_.solve(q, q_dot, alfa, beta, *segments, f_ext, tau) : hd_.solve(q, q_dot, alfa, beta, f_ext, tau);
+}
+
+int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                              const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
+                              const Eigen::Ref<const Eigen::VectorXd>& beta,
+                              const Eigen::Ref<const Eigen::VectorXi>* segments,
+                              const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                              const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
   solved_ = false;
   const long n = nj_;
   const Eigen::VectorXd& fs = friction.static_friction;
@@ -85,11 +113,11 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   }
   if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0)) {
     // Let the hybrid-dynamics solver report the size problem with its message.
-    const int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, ff_torques);
+    const int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
     return fail(rc, "%s", hd_.errorMessage());
   }
   if (!q_dot.allFinite()) {
-    const int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, ff_torques);
+    const int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
     return fail(rc, "%s", hd_.errorMessage());
   }
 
@@ -97,7 +125,7 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   // or on a limit, and the bounds of their mu (friction torque -mu): [-f, f], opened to -inf at a
   // lower limit (the reaction pushes up) and to +inf at an upper limit.
   if (!q.allFinite()) {
-    const int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, ff_torques);
+    const int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
     return fail(rc, "%s", hd_.errorMessage());
   }
   int k = 0;
@@ -115,7 +143,7 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
       rest_(k++) = static_cast<int>(j);
     }
   }
-  int rc = hd_.solve(q, q_dot, alfa, beta, f_ext, tau0_);
+  int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
   if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
   q_keep_ = q;
   qd_keep_ = q_dot;
@@ -159,6 +187,8 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   m_keep_ = hd_.constraintCount();
   alfa_keep_.leftCols(m_keep_) = alfa;
   beta_keep_.head(m_keep_) = beta;
+  has_segments_ = segments != nullptr;
+  if (has_segments_) seg_keep_.head(m_keep_) = *segments;
   k_ = k;
   link_acc_known_ = k == 0;
 
@@ -439,11 +469,9 @@ const ChainHdSolver::Matrix6X& FrictionSolver::linkAccelerations() {
     // One solve with the optimal friction torques as feed-forward (inputs kept from solve()).
     tmp_ = tau0_;
     for (int a = 0; a < k_; ++a) tmp_(rest_(a)) -= x_(a);
-    if (has_f_) {
-      hd_.solve(q_keep_, qd_keep_, alfa_keep_.leftCols(m_keep_), beta_keep_.head(m_keep_), f_keep_, tmp_);
-    } else {
-      hd_.solve(q_keep_, qd_keep_, alfa_keep_.leftCols(m_keep_), beta_keep_.head(m_keep_), f_keep_.leftCols(0), tmp_);
-    }
+    const Eigen::Ref<const Eigen::VectorXi> segs = seg_keep_.head(m_keep_);
+    hdSolve(q_keep_, qd_keep_, alfa_keep_.leftCols(m_keep_), beta_keep_.head(m_keep_), has_segments_ ? &segs : nullptr,
+            has_f_ ? f_keep_.leftCols(f_keep_.cols()) : f_keep_.leftCols(0), tmp_);
     link_acc_known_ = true;
   }
   return hd_.linkAccelerations();

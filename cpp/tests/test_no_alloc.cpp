@@ -255,6 +255,44 @@ int main() {
                  str(f1.mallocs - f0.mallocs) + " in 3000 solves");
   }
 
-  return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves on a 7-joint chain, nc 0..6 (malloc counted too: ") +
+  // Constraints on several segments (general path: Cholesky and Jacobi factorisations, both
+  // policies, response columns, friction on top), 1..18 columns on up to three segments.
+  {
+    vereshchagin::FrictionSolver fsolver(chain, grav);
+    vereshchagin::FrictionModel fm;
+    fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
+    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+    Matrix6X A(6, 18);
+    for (int c = 0; c < 18; ++c) A.col(c) = alfa_m[6].col(c % 6);
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(18, -1.0, 2.0);
+    Eigen::VectorXi segs(18);
+    for (int c = 0; c < 18; ++c) segs(c) = c < 6 ? 2 : (c < 12 ? static_cast<int>(ns) - 1 : 4);
+    Eigen::MatrixXd dnu(18, 3);
+    double gsum = 0.0;
+    int gfail = 0;
+    solver.solve(q[0].data, qd[0].data, A, b, segs, fext_m[0], ff[0].data);
+    fsolver.solve(q[0].data, rest, A.leftCols(3), b.head(3), segs.head(3), fext_m[0], ff[0].data, fm);
+    const Counts g0 = now();
+    for (int it = 0; it < 500; ++it) {
+      const int s = it % kSets, m = 1 + it % 18;
+      if (solver.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), fext_m[s], ff[s].data) != 0) ++gfail;
+      if (solver.responseColumns(joints, dqdd, dtau, dnu) != 0) ++gfail;
+      gsum += solver.qdd()(0) + solver.nu()(0) + dnu(0, 0) + solver.smallestSingularValue();
+      if (solver_dls.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), empty_fext, empty_tau) != 0) ++gfail;
+      gsum += solver_dls.commandTorques()(1);
+      const int mf = 1 + it % 7;  // at most n columns keeps the friction QP well posed
+      if (fsolver.solve(q[s].data, rest, A.leftCols(mf), b.head(mf), segs.head(mf), fext_m[s], ff[s].data, fm) != 0) ++gfail;
+      gsum += fsolver.qdd()(0) + fsolver.gaussValue();
+    }
+    const Counts g1 = now();
+    ck.check(gfail == 0, "segment-constraint solves failed: " + str(gfail) + " (" + solver.errorMessage() + " / " +
+                             fsolver.errorMessage() + ")");
+    ck.check(std::isfinite(gsum), "non-finite segment-constraint results");
+    ck.check(g1.news == g0.news && g1.mallocs == g0.mallocs,
+             "segment-constraint solves allocated: operator new " + str(g1.news - g0.news) + ", malloc " +
+                 str(g1.mallocs - g0.mallocs));
+  }
+
+  return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves + 2000 with segment constraints on a 7-joint chain, nc 0..6 (malloc counted too: ") +
                    (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no") + ")");
 }

@@ -29,7 +29,7 @@ struct SolveResult {
 class PySolver {
  public:
   PySolver(const PyChain& chain, const py::object& gravity, double rcond, py::object damping)
-      : solver_(chain.robot.chain, KDL::Twist::Zero()), friction_solver_(chain.robot.chain, KDL::Twist::Zero()) {
+      : chain_(chain), solver_(chain.robot.chain, KDL::Twist::Zero()), friction_solver_(chain.robot.chain, KDL::Twist::Zero()) {
     const auto nj = static_cast<Eigen::Index>(chain.robot.joints.size());
     chain_friction_ = chain_lower_ = chain_upper_ = Eigen::VectorXd::Zero(nj);
     for (Eigen::Index k = 0; k < nj; ++k) {
@@ -49,6 +49,9 @@ class PySolver {
     friction_solver_.setOptions(opt);
     nj_ = solver_.nrOfJoints();
     ns_ = solver_.nrOfSegments();
+    alfa_ = ChainHdSolver::Matrix6X::Zero(6, solver_.maxConstraints());
+    beta_ = Eigen::VectorXd::Zero(solver_.maxConstraints());
+    segs_ = Eigen::VectorXi::Zero(solver_.maxConstraints());
   }
 
   void setGravity(const py::object& gravity) {
@@ -64,7 +67,67 @@ class PySolver {
     Array q, qd, alpha, beta, f_ext, tau;
     bool has_f_ext = false, has_tau = false;
     py::ssize_t m = 0;
+    // constraints={segment: (alpha_i, beta_i)}: one entry per segment, in the dict's order.
+    bool has_segments = false;
+    std::vector<int> seg;
+    std::vector<Array> seg_alpha, seg_beta;
+    py::ssize_t m_total = 0;  // m plus the segment columns
   };
+
+  // alpha (6, m) or (6,) -> (6, m), checked; `name` for messages.
+  static Array alphaArg(const py::object& alpha, const std::string& name) {
+    Array a = toArray(alpha, name.c_str());
+    if (a.ndim() == 1 && a.shape(0) == 6) a = a.reshape({6, 1});
+    if (a.ndim() != 2 || a.shape(0) != 6)
+      raise(name + " must have shape (6, m) with rows [force; moment], got " + shapeStr(a));
+    if (a.shape(1) > 6) raise(name + " has " + std::to_string(a.shape(1)) + " columns; at most 6 constraints per segment");
+    requireFinite(a, name.c_str());
+    return a;
+  }
+
+  void parseConstraints(const py::object& constraints, Inputs& in) const {
+    if (constraints.is_none()) return;
+    if (!py::isinstance<py::dict>(constraints))
+      raise("constraints must be a dict {segment name or index: (alpha (6, m_i), beta (m_i,))}");
+    in.has_segments = true;
+    in.m_total = in.m;
+    std::vector<int> seen;
+    for (auto item : constraints.cast<py::dict>()) {
+      const py::object key = py::reinterpret_borrow<py::object>(item.first);
+      const std::string label = "constraints[" + std::string(py::repr(key)) + "]";
+      if (!py::isinstance<py::str>(key) && !py::isinstance<py::int_>(key))
+        raise(label + ": keys must be segment names (str) or indices (int)");
+      int seg;
+      if (py::isinstance<py::int_>(key)) {
+        const long long v = key.cast<long long>();
+        const long long ns = static_cast<long long>(ns_);
+        if (v < -ns || v >= ns) raise(label + ": segment index out of range [" + std::to_string(-ns) + ", " + std::to_string(ns) + ")");
+        seg = static_cast<int>(v < 0 ? v + ns : v);
+      } else {
+        KDL::Frame offset;
+        seg = chain_.resolveSegment(key, offset);  // raises for unknown names
+        if (!KDL::Equal(offset, KDL::Frame::Identity(), 1e-12))
+          raise(label + ": '" + key.cast<std::string>() + "' is a link merged into segment '" +
+                chain_.robot.chain.getSegment(seg).getName() + "' (constraints are about segment tip origins: use that name)");
+      }
+      if (std::find(seen.begin(), seen.end(), seg) != seen.end())
+        raise(label + ": segment " + std::to_string(seg) + " appears twice");
+      seen.push_back(seg);
+      py::object value = py::reinterpret_borrow<py::object>(item.second);
+      if (!py::isinstance<py::tuple>(value) && !py::isinstance<py::list>(value))
+        raise(label + " must be a pair (alpha (6, m_i), beta (m_i,))");
+      py::sequence pair = value.cast<py::sequence>();
+      if (pair.size() != 2) raise(label + " must be a pair (alpha (6, m_i), beta (m_i,))");
+      Array a = alphaArg(pair[0], label + " alpha");
+      Array b = vectorArg(pair[1], (label + " beta").c_str(), a.shape(1));
+      if (seg == static_cast<int>(ns_) - 1 && in.m > 0 && in.m + a.shape(1) > 6)
+        raise(label + ": together with alpha (last segment) more than 6 constraints on the last segment");
+      in.seg.push_back(seg);
+      in.seg_alpha.push_back(a);
+      in.seg_beta.push_back(b);
+      in.m_total += a.shape(1);
+    }
+  }
 
   Inputs parse(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
                const py::object& f_ext, const py::object& tau_ff) const {
@@ -72,13 +135,8 @@ class PySolver {
     in.q = vectorArg(q, "q", nj_);
     in.qd = vectorArg(qd, "qd", nj_);
     if (!alpha.is_none()) {
-      in.alpha = toArray(alpha, "alpha");
-      if (in.alpha.ndim() == 1 && in.alpha.shape(0) == 6) in.alpha = in.alpha.reshape({6, 1});
-      if (in.alpha.ndim() != 2 || in.alpha.shape(0) != 6)
-        raise("alpha must have shape (6, m) with rows [force; moment], got " + shapeStr(in.alpha));
+      in.alpha = alphaArg(alpha, "alpha");
       in.m = in.alpha.shape(1);
-      if (in.m > 6) raise("alpha has " + std::to_string(in.m) + " columns; at most 6 constraints are supported");
-      requireFinite(in.alpha, "alpha");
     }
     if (beta.is_none()) {
       if (in.m > 0) raise("beta is required when alpha is given (shape (" + std::to_string(in.m) + ",))");
@@ -157,6 +215,19 @@ class PySolver {
     const auto m = in.m;
     for (py::ssize_t r = 0; r < 6; ++r)
       for (py::ssize_t c = 0; c < m; ++c) alfa_(r, c) = in.alpha.data()[r * m + c];
+    for (py::ssize_t c = 0; c < m; ++c) {
+      beta_(c) = in.beta.data()[c];
+      segs_(c) = static_cast<int>(ns_) - 1;
+    }
+    py::ssize_t col = m;
+    for (std::size_t k = 0; k < in.seg.size(); ++k) {
+      const py::ssize_t mk = in.seg_alpha[k].shape(1);
+      for (py::ssize_t c = 0; c < mk; ++c, ++col) {
+        for (py::ssize_t r = 0; r < 6; ++r) alfa_(r, col) = in.seg_alpha[k].data()[r * mk + c];
+        beta_(col) = in.seg_beta[k].data()[c];
+        segs_(col) = in.seg[k];
+      }
+    }
     const MapV q(in.q.data(), nj_), qd(in.qd.data(), nj_);
     const MapV beta(m ? in.beta.data() : nullptr, m);
     const Map6X f(in.has_f_ext ? in.f_ext.data() : nullptr, 6, in.has_f_ext ? ns_ : 0);
@@ -165,8 +236,15 @@ class PySolver {
     last_friction_ = fm != nullptr;
     {
       py::gil_scoped_release release;
-      rc = fm ? friction_solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau, *fm)
-              : solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau);
+      if (in.has_segments) {
+        const auto A = alfa_.leftCols(col);
+        const auto b = beta_.head(col);
+        const auto sg = segs_.head(col);
+        rc = fm ? friction_solver_.solve(q, qd, A, b, sg, f, tau, *fm) : solver_.solve(q, qd, A, b, sg, f, tau);
+      } else {
+        rc = fm ? friction_solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau, *fm)
+                : solver_.solve(q, qd, alfa_.leftCols(m), beta, f, tau);
+      }
     }
     if (rc != ChainHdSolver::E_NOERROR) raise(fm ? friction_solver_.errorMessage() : solver_.errorMessage());
   }
@@ -204,8 +282,10 @@ class PySolver {
   }
 
   SolveResult solve(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
-                    const py::object& f_ext, const py::object& tau_ff, const py::object& friction) {
+                    const py::object& f_ext, const py::object& tau_ff, const py::object& friction,
+                    const py::object& constraints) {
     Inputs in = parse(q, qd, alpha, beta, f_ext, tau_ff);
+    parseConstraints(constraints, in);
     vereshchagin::FrictionModel fm;
     const bool with_friction = parseFriction(friction, fm);
     std::lock_guard<std::mutex> lock(mutex_);
@@ -319,12 +399,15 @@ class PySolver {
   unsigned int nj_ = 0, ns_ = 0;
 
  private:
+  PyChain chain_;  // for segment names
   ChainHdSolver solver_;
   vereshchagin::FrictionSolver friction_solver_;
   Eigen::VectorXd chain_friction_, chain_lower_, chain_upper_;
   bool last_friction_ = false;
   KDL::Vector gravity_;
-  Eigen::Matrix<double, 6, 6> alfa_ = Eigen::Matrix<double, 6, 6>::Zero();
+  ChainHdSolver::Matrix6X alfa_;  // all constraint columns of a solve (6 x maxConstraints())
+  Eigen::VectorXd beta_;
+  Eigen::VectorXi segs_;
   std::mutex mutex_;
 };
 
@@ -354,7 +437,7 @@ void bindSolver(py::module_& mod) {
            py::arg("damping") = py::none())
       .def("solve", &PySolver::solve, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
-           py::arg("friction") = py::none())
+           py::arg("friction") = py::none(), py::arg("constraints") = py::none())
       .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none())
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"))

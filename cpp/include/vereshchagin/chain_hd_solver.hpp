@@ -53,6 +53,18 @@
 // returns d(qdd)/d(tau_j) and d(tau_cmd)/d(tau_j) for requested joints j, O(n) per column, reusing
 // the factorisation (the columns of G = H^-1 - H^-1 A^T K^+ A H^-1, A = alfa^T J).
 //
+// Constraints on any segment (Shakhimardanov's extension of the recursion, KU Leuven 2015): the
+// overload of solve() with a `segments` vector puts column c of alfa on segment segments(c)
+// instead of the last one, with the same conventions there: unit wrench in base axes with the
+// moment about THAT segment's tip origin, beta(c) = alfa.col(c)^T Xdd_segments(c) including
+// root_acc. At most 6 columns per segment, any number of segments (maxConstraints() = 6 x
+// n_segments in total). In the inward sweep a segment's own columns join the wrenches felt from
+// its descendants' constraints, so the sweeps stay O(n) (times the number of active columns), and
+// one M x M coupling matrix K couples all constraints (M = total columns). nu() and the columns of
+// responseColumns()'s dnu follow the caller's column order; the command torques are
+// tau_cmd = -sum_c J_{segments(c)}^T alfa_c nu_c. Rank and singularity policy as above (a full
+// Jacobi eigen-decomposition replaces Eigen's when K is not certified by Cholesky).
+//
 // Real-time use: construction allocates everything; solve(), CartToJnt() and responseColumns()
 // allocate no heap memory and do bounded work. One instance is not thread-safe; use one per thread.
 #pragma once
@@ -121,10 +133,22 @@ class ChainHdSolver : public KDL::SolverI {
             const Eigen::Ref<const Matrix6X>& f_ext,
             const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
 
+  // Constraints on any segments: column c of alfa (6 x M) acts on segment segments(c) (base axes,
+  // moment about that segment's tip origin; see above); beta has M entries. At most 6 columns per
+  // segment. Columns all on the last segment give exactly the solve() above.
+  int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+            const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
+            const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  // Largest total number of constraint columns: 6 per segment (at least 6).
+  int maxConstraints() const { return mcap_; }
+
   // Results of the last successful solve.
   const Eigen::VectorXd& qdd() const { return qdd_; }
   const Eigen::VectorXd& commandTorques() const { return tau_cmd_; }
-  Eigen::Map<const Eigen::VectorXd> nu() const { return Eigen::Map<const Eigen::VectorXd>(nu_.data(), m_); }
+  Eigen::Map<const Eigen::VectorXd> nu() const {
+    return Eigen::Map<const Eigen::VectorXd>(general_ ? nu_user_.data() : nu_.data(), m_);
+  }
   const Matrix6X& linkAccelerations() const;  // computed on first request after a solve
   int constraintCount() const { return m_; }
   // Articulated inertia D_j of joint j (its own rotor plus everything it moves, with its parent
@@ -144,7 +168,7 @@ class ChainHdSolver : public KDL::SolverI {
   int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                       Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
   // The same, plus d(nu)/d(tau_j) into dnu (constraintCount() x k; its storage may be larger:
-  // only the top m rows are written).
+  // only the top m rows are written; rows in the order of nu()).
   int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                       Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd> dnu);
 
@@ -188,7 +212,21 @@ class ChainHdSolver : public KDL::SolverI {
   int checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                   const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                   const Eigen::Ref<const Matrix6X>& f_ext,
-                  const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+                  const Eigen::Ref<const Eigen::VectorXd>& ff_torques, int max_columns);
+  // Joint part of segment i's inward step: u, D, 1/D; returns the free joint acceleration (parent
+  // at rest, no constraint) and the apparent bias force pa; false if D is degenerate.
+  inline bool articulate(Segment& s, double tau, Vector6& pa, double& free) const;
+  // Apparent inertia and bias force of segment i > 0 added to its parent.
+  inline void passToParent(int i, const Vector6& pa);
+  int degenerate(int i);
+  // General path (constraints on several segments), in segment_constraints.cpp.
+  int sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments);
+  int inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void factorizeCouplingGeneral();
+  void finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_sorted, Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
+  // out = K^+ rhs for either path (vectors of length m_, sorted order on the general path).
+  void couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const;
   void screwPose(Segment& s, double q) const;
   void outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                     const Eigen::Ref<const Matrix6X>& f_ext);
@@ -241,6 +279,21 @@ class ChainHdSolver : public KDL::SolverI {
   mutable bool sigma_known_ = false;
   mutable double sigma_min_ = 0.0;
   mutable Eigen::SelfAdjointEigenSolver<MatrixC> sigma_eig_;
+
+  // General path: constraints on several segments (storage sized at construction).
+  bool general_ = false;             // the last solve used it
+  int mcap_ = kMaxConstraints;       // 6 per segment
+  Eigen::VectorXi order_;            // sorted position -> caller's column (distal segments first)
+  Eigen::VectorXi seg_count_;        // per segment: its number of columns
+  std::vector<int> active_;          // active_[i]: columns on segments >= i (n_segments + 1)
+  Matrix6X anew_;                    // each column's wrench in its own segment's tip axes (sorted)
+  Matrix6X acur_, aproj_;            // wrenches felt by the current segment / passed to the parent
+  Eigen::MatrixXd eg_;               // mcap x n_segments: column i = (S_i^T A_i)^T, zero past active_[i]
+  Eigen::VectorXd ug_, nug_, nu_user_, rhs_g_;
+  mutable Eigen::VectorXd tmp_g_;
+  Eigen::MatrixXd kg_, cholg_, vg_;  // coupling matrix, its Cholesky factor or eigenvectors
+  Eigen::VectorXd invg_;             // policy multiplier per eigenvalue
+  mutable Eigen::MatrixXd work_g_, work_v_;  // Jacobi workspace for the smallest singular value
 };
 
 }  // namespace vereshchagin

@@ -70,6 +70,12 @@ class FrictionSolver {
             const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
             const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
             const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+  // The same with constraints on any segments (column c of alfa on segment segments(c); see
+  // ChainHdSolver's overload).
+  int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+            const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+            const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
 
   const Eigen::VectorXd& qdd() const { return qdd_; }
   const Eigen::VectorXd& commandTorques() const { return tau_cmd_; }
@@ -93,6 +99,16 @@ class FrictionSolver {
 
  private:
   int fail(int code, const char* fmt, ...);
+  int solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                const Eigen::Ref<const Eigen::VectorXi>* segments,
+                const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+  // The hybrid-dynamics solve of the current problem with joint torques tau (segments or not).
+  int hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+              const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+              const Eigen::Ref<const Eigen::VectorXi>* segments,
+              const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& tau);
   int boxQp(int k);                 // stage 1 on Q_, c_, lo_, hi_ -> x_
   void leastCommand(int k);         // stage 2: tie-break on the optimal face
   // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
@@ -104,8 +120,10 @@ class FrictionSolver {
   std::array<char, 512> message_{};
   Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;
   Eigen::MatrixXd dnu_;
-  Eigen::Matrix<double, 6, 6> alfa_keep_;
-  Eigen::Matrix<double, 6, 1> beta_keep_;
+  ChainHdSolver::Matrix6X alfa_keep_;  // 6 x maxConstraints() storage
+  Eigen::VectorXd beta_keep_;
+  Eigen::VectorXi seg_keep_;
+  bool has_segments_ = false;
   int m_keep_ = 0, k_ = 0;
   bool link_acc_known_ = false;
   std::vector<signed char> status_;
