@@ -1,6 +1,6 @@
 """Type stubs of the compiled module vereshchagin._core."""
 import os
-from typing import Optional, Sequence
+from typing import Mapping, Optional, Sequence, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -109,6 +109,9 @@ class Solver:
         f_ext: Optional[ArrayLike] = None,
         tau_ff: Optional[ArrayLike] = None,
         friction: object = None,
+        constraints: Optional[
+            Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]
+        ] = None,
     ) -> SolveResult: ...
     def solve_batch(
         self,

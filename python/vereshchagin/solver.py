@@ -60,10 +60,16 @@ class Solver(_core.Solver):
     - ``f_ext``: (n_segments, 6) wrench ``[force, moment]`` applied to each segment by the
       environment, base-frame axes, moment about that segment's tip origin (N, N m).
     - ``tau_ff``: (n,) feed-forward joint torques (N m or N).
+    - ``constraints``: ``{segment: (alpha_i (6, m_i), beta_i (m_i,))}`` acceleration constraints on
+      any segments (Shakhimardanov's extension), keyed by segment name or index (negative counts
+      from the end), with the end-segment conventions at that segment: base-frame axes, moment
+      about *that segment's* tip origin, ``beta_i`` including ``-gravity``. At most 6 columns per
+      segment; any number of segments. Combines with ``alpha``/``beta`` (the last segment).
 
     Result fields: ``qdd`` (n,); ``tau_command`` (n,) the torques the motors must add to
-    ``tau_ff`` to realise ``qdd`` (``-J^T alpha nu``); ``nu`` (m,) constraint magnitudes (the
-    wrench on the last segment is ``-alpha @ nu``); ``link_acc`` (n_segments + 1, 6) spatial
+    ``tau_ff`` to realise ``qdd`` (``-sum_i J_i^T alpha_i nu_i`` over constrained segments);
+    ``nu`` (m,) constraint magnitudes (the wrench on the last segment is ``-alpha @ nu``), with
+    ``constraints`` the end-segment ``alpha`` columns first, then each entry's in dict order; ``link_acc`` (n_segments + 1, 6) spatial
     accelerations ``[linear, angular]`` of the base and each segment's tip (base axes, tip
     origin, including ``-gravity``); ``constraint_rank``; ``smallest_singular_value``.
 
