@@ -48,6 +48,14 @@ def gen3_model():
     return urdf, Chain.from_urdf(urdf, root="base_link", tip=robots.GEN3_TIP_LINK)
 
 
+def with_tool_link(urdf: str, name: str, xyz) -> str:
+    """The URDF with a massless link ``name`` fixed to the end-effector link at ``xyz`` (m)."""
+    link = (f'  <joint name="{name}_joint" type="fixed">\n    <parent link="{robots.GEN3_TIP_LINK}"/>\n'
+            f'    <child link="{name}"/>\n    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="0 0 0"/>\n'
+            f'  </joint>\n  <link name="{name}"/>\n')
+    return urdf.replace("</robot>", link + "</robot>")
+
+
 @dataclass
 class Phase:
     """One step of a task: drive the end-effector to ``goal`` for at most ``duration`` s.
@@ -251,6 +259,9 @@ def writing(contact: bool, quick: bool = False, progress=None) -> Run:
     gap = 0.01 if contact else 0.10
     scene = Scene(table_top=float(z_tip - gap), pen_direction=tuple(pen_dir))
     robot = MujocoGen3(build_model(urdf, chain, scene), q0)
+    # Tracked point: the end-effector origin, as in the report (the pen tip, 0.12 m below the grip,
+    # moves with orientation errors). Tracking the pen tip itself (``with_tool_link``) made the
+    # free-space variant drift in the self-motion; not pursued.
     ctl = _controller(chain, tip_ee)
     v = ctl.config.v_max
     draw_time = SLIDE / v + 1.5
