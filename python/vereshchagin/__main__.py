@@ -23,7 +23,8 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     out_dir : str or Path
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
-    case : {"friction", "demo", "all"}
+    case : {"friction", "demo", "contact", "all"}
+        ``contact``: report 003's three use cases in MuJoCo (:mod:`vereshchagin.contact.report`).
 
     Returns
     -------
@@ -69,6 +70,14 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
         demo_path.write_text("\n".join(lines) + "\n", encoding="utf-8")
         index += ["## Demonstration (7-joint arm)", "", f"Output: [{_rel(demo_path, out)}]({_rel(demo_path, out)})",
                   "", "```text", *lines, "```", ""]
+    if case in ("contact", "all"):
+        from .contact.report import run as run_contact
+
+        _say(f"[reproduce] report 003 contact use cases (MuJoCo plant){' (quick)' if quick else ''}")
+        res = run_contact(out, quick=quick, progress=_say)
+        ok &= bool(res["ok"])
+        index += res["index"]
+        _say(f"[reproduce] contact checks: {'ok' if res['ok'] else 'FAILED'} ({res['seconds']:.1f} s)")
     index_path = out / "index.md"
     index_path.write_text("\n".join(index), encoding="utf-8")
     _say(f"[reproduce] wrote {index_path}")
@@ -79,10 +88,11 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="vereshchagin", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("demo", help="solve three tasks on a 7-joint arm and print the results")
-    rep = sub.add_parser("reproduce", help="reproduce report 000's friction figures (and the demo) into a folder")
+    rep = sub.add_parser("reproduce", help="reproduce report 000's friction figures, the demo and report 003's contact "
+                         "use cases into a folder")
     rep.add_argument("--out", default="results", help="output folder (default: ./results)")
-    rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures")
-    rep.add_argument("--case", choices=("friction", "demo", "all"), default="all",
+    rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
+    rep.add_argument("--case", choices=("friction", "demo", "contact", "all"), default="all",
                      help="which experiments to run (default: all)")
     args = parser.parse_args(argv)
     if args.command == "demo":

@@ -1,0 +1,245 @@
+"""Report 003's controller (sec. 5.1): cascaded P position -> velocity -> ``beta``, our solver inside.
+
+One cycle (:meth:`CascadedController.command`):
+
+1. pose error ``e = pose_error(X_curr, X_goal)`` (translation difference, rotation axis * angle,
+   base axes) and the desired twist ``v_d = k_pos * e``, each part saturated at ``v_max`` (m/s)
+   and ``w_max`` (rad/s) -- the report gives no saturation; without it a 25 cm error and
+   k_pos = 40 ask for 10 m/s;
+2. the desired classical acceleration ``a_d = k_vel * (v_d - v_curr)``, turned into ``beta`` by
+   :func:`vereshchagin.task.beta_for` (adds ``-gravity`` and the velocity product);
+3. directions: free space constrains all six (x, y, z, rx, ry, rz); in contact the linear z is
+   released so gravity presses the tool on the surface;
+4. in contact the table's reaction enters ``f_ext`` on the last segment: a normal force ``N``
+   estimated from the model (the force along ``w = [e_z; r x e_z]`` at the contact point ``r``
+   that stops the predicted z acceleration of that point: ``N = (g - w.a_pred) / (w^T J G J^T w)``
+   with ``G`` the constrained inverse inertia from :meth:`Solver.response_columns`, clipped at 0)
+   and a friction force ``mu_est * N`` against the desired sliding direction (report 003 used
+   ``f_ext`` "to counter friction");
+5. the solver's command: ``solve(q, qd, alpha, beta, f_ext, tau_ff, friction)``. ``tau_ff`` holds
+   the plant's modelled viscous damping ``-d * qd`` (the plant applies it, the motors compensate
+   it) plus an optional motor-side posture term; ``friction=Friction(static=chain.friction)``
+   makes resting joints get the max-min static friction and moving ones Coulomb friction, so
+   ``tau_command`` is the motor torque with friction acting (friction compensation).
+   The motor torque sent is ``tau_command`` + the motor-side part of ``tau_ff``.
+
+Contact detection: |v_z| of the end-effector below ``contact_threshold`` for
+``contact_samples`` (10) consecutive samples, armed once the tool has moved (|v_z| above twice
+the threshold). On contact the gains switch to the contact set and the directions to "contact".
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Optional
+
+import numpy as np
+
+from ..friction import Friction
+from ..task import beta_for, directions, pose_error
+
+__all__ = ["CONTACT_GAINS", "FREE_GAINS", "CascadedController", "ControllerConfig", "Gains"]
+
+G = 9.81
+
+
+@dataclass(frozen=True)
+class Gains:
+    """P gains ``k_pos = (linear, angular)`` (1/s) and ``k_vel = (linear, angular)`` (1/s)."""
+
+    k_pos: tuple = (40.0, 80.0)
+    k_vel: tuple = (30.0, 2.0)
+
+
+FREE_GAINS = Gains((40.0, 80.0), (30.0, 40.0))
+"""Report 003, use case 1, before contact."""
+CONTACT_GAINS = Gains((10.0, 80.0), (4.0, 40.0))
+"""Report 003, use case 1, after contact."""
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """Controller settings (SI units).
+
+    Attributes
+    ----------
+    free_gains, contact_gains : Gains
+    v_max, w_max : float
+        Saturation of the desired twist (m/s, rad/s).
+    contact_threshold : float
+        |v_z| (m/s) below which a sample counts towards contact.
+    contact_samples : int
+        Consecutive samples needed (report: 10).
+    contact_point : (3,)
+        The tool's contact point in the end-effector frame (m), for ``f_ext``.
+    mu_estimate : float
+        Surface friction coefficient assumed in ``f_ext`` (0: no friction compensation).
+    use_friction : bool
+        Pass the chain's joint friction to the solver (friction compensation).
+    friction_velocity_tolerance : float
+        |qd| (rad/s) at or below which a joint counts as resting for the friction solver.
+    posture_gains : (float, float)
+        ``(K, D)`` of a motor-side joint posture term ``K (q_ref - q) - D qd`` in ``tau_ff``;
+        the solver realises the task regardless, so it only acts in the unconstrained
+        directions (self-motion, released z). (0, 0): off, as in the report (tau_ff = 0).
+    """
+
+    free_gains: Gains = FREE_GAINS
+    contact_gains: Gains = CONTACT_GAINS
+    v_max: float = 0.05
+    w_max: float = 0.5
+    contact_threshold: float = 0.005
+    contact_samples: int = 10
+    contact_point: tuple = (0.0, 0.0, 0.0)
+    mu_estimate: float = 0.3
+    use_friction: bool = True
+    friction_velocity_tolerance: float = 1e-3
+    posture_gains: tuple = (20.0, 3.0)
+
+
+FREE_DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+CONTACT_DIRECTIONS = ("x", "y", "rx", "ry", "rz")
+
+
+@dataclass
+class CycleInfo:
+    """What one control cycle computed (for logging)."""
+
+    pose: np.ndarray
+    twist: np.ndarray
+    error: np.ndarray
+    normal_force_estimate: float
+    contact: bool
+    result: object = field(repr=False, default=None)
+
+
+class CascadedController:
+    """The cascaded P controller of report 003 around :class:`vereshchagin.Solver` (module doc).
+
+    Parameters
+    ----------
+    chain : Chain
+    solver : Solver
+        Built from ``chain`` with gravity ``[0, 0, -9.81]``.
+    config : ControllerConfig
+    """
+
+    def __init__(self, chain, solver, config: ControllerConfig = ControllerConfig()):
+        self.chain = chain
+        self.solver = solver
+        self.config = config
+        n = chain.n_joints
+        self.n = n
+        self.damping = np.asarray(chain.damping, float)
+        self.friction = Friction(static=np.asarray(chain.friction, float),
+                                 velocity_tolerance=config.friction_velocity_tolerance) \
+            if config.use_friction and np.any(np.asarray(chain.friction) > 0) else None
+        self.goal = None
+        self.in_contact = False
+        self.detect = False
+        self._armed = False
+        self._count = 0
+        self.q_ref = None
+        self.extra_constraints = None  # dict for segment constraints (solver API of issue 5)
+        self.support_share = None  # callable(result, q) -> torque the environment supplies
+        self._all = list(range(n))
+
+    # -- task state ------------------------------------------------------------------------------
+    def set_goal(self, T_goal) -> None:
+        """Desired end-effector pose (4x4, base frame)."""
+        self.goal = np.asarray(T_goal, float)
+
+    def arm_contact_detection(self, on: bool = True) -> None:
+        """Start (or stop) watching |v_z| for contact."""
+        self.detect = on
+        self._armed = False
+        self._count = 0
+
+    def set_contact(self, contact: bool) -> None:
+        """Switch directions and gains to contact (z released) or free space."""
+        self.in_contact = contact
+
+    @property
+    def gains(self) -> Gains:
+        return self.config.contact_gains if self.in_contact else self.config.free_gains
+
+    # -- one cycle -------------------------------------------------------------------------------
+    def _contact_update(self, vz: float) -> None:
+        thr = self.config.contact_threshold
+        if not self._armed:
+            self._armed = abs(vz) > 2.0 * thr
+            return
+        self._count = self._count + 1 if abs(vz) < thr else 0
+        if self._count >= self.config.contact_samples:
+            self.in_contact = True
+            self.detect = False
+
+    def command(self, q, qd) -> tuple[np.ndarray, CycleInfo]:
+        """Motor torques (n,) for the measured ``q``, ``qd``, and what was computed."""
+        cfg = self.config
+        q = np.asarray(q, float)
+        qd = np.asarray(qd, float)
+        T = np.asarray(self.chain.fk(q))
+        tw = np.asarray(self.chain.twist(q, qd))
+        if self.detect:
+            self._contact_update(tw[2])
+        gains = self.gains
+        e = pose_error(T, self.goal)
+        v_lin = _saturate(gains.k_pos[0] * e[:3], cfg.v_max)
+        v_ang = _saturate(gains.k_pos[1] * e[3:], cfg.w_max)
+        a_des = np.concatenate([gains.k_vel[0] * (v_lin - tw[:3]), gains.k_vel[1] * (v_ang - tw[3:])])
+        alpha = directions(CONTACT_DIRECTIONS if self.in_contact else FREE_DIRECTIONS)
+        beta = beta_for(alpha, a_des, tw, self.solver.gravity)
+
+        tau_motor_ff = np.zeros(self.n)
+        K, D = cfg.posture_gains
+        if K or D:
+            if self.q_ref is None:
+                self.q_ref = q.copy()
+            tau_motor_ff = K * (self.q_ref - q) - D * qd
+        tau_ff = tau_motor_ff - self.damping * qd
+        kw = {}
+        if self.extra_constraints:
+            kw["constraints"] = self.extra_constraints(q, qd) if callable(self.extra_constraints) \
+                else self.extra_constraints
+
+        f_ext = None
+        N = 0.0
+        if self.in_contact:
+            r = T[:3, :3] @ np.asarray(cfg.contact_point, float)
+            w = np.concatenate([[0.0, 0.0, 1.0], np.cross(r, [0.0, 0.0, 1.0])])
+            if K or D:  # keep the posture term from lifting the tool: remove its push along w
+                tau_ff = self._without_push(q, qd, alpha, beta, tau_ff, tau_motor_ff, w, kw)
+                tau_motor_ff = tau_ff + self.damping * qd
+            res0 = self.solver.solve(q, qd, alpha, beta, tau_ff=tau_ff, **kw)
+            Gc, _ = self.solver.response_columns(self._all)
+            Jw = np.asarray(self.chain.jacobian(q)).T @ w
+            lam = float(Jw @ Gc @ Jw)
+            N = max(0.0, (G - float(w @ res0.link_acc[-1])) / lam) if lam > 1e-12 else 0.0
+            u = np.array([v_lin[0], v_lin[1], 0.0])
+            speed = np.linalg.norm(u)
+            u = u / speed * min(1.0, speed / 0.01) if speed > 1e-9 else np.zeros(3)
+            F = N * np.array([0.0, 0.0, 1.0]) - cfg.mu_estimate * N * u
+            f_ext = np.zeros((self.chain.n_segments, 6))
+            f_ext[-1] = np.concatenate([F, np.cross(r, F)])
+        res = self.solver.solve(q, qd, alpha, beta, f_ext=f_ext, tau_ff=tau_ff, friction=self.friction, **kw)
+        tau = np.asarray(res.tau_command) + tau_motor_ff
+        if self.support_share is not None:
+            tau = tau - self.support_share(res, q)
+        return tau, CycleInfo(pose=T, twist=tw, error=e, normal_force_estimate=N, contact=self.in_contact,
+                              result=res)
+
+    def _without_push(self, q, qd, alpha, beta, tau_ff, tau_motor_ff, w, kw):
+        """``tau_ff`` with the motor posture part's effect on the released direction ``w`` removed."""
+        self.solver.solve(q, qd, alpha, beta, tau_ff=tau_ff, **kw)
+        Gc, _ = self.solver.response_columns(self._all)
+        Jw = np.asarray(self.chain.jacobian(q)).T @ w
+        lam = float(Jw @ Gc @ Jw)
+        if lam <= 1e-12:
+            return tau_ff
+        push = float(Jw @ Gc @ tau_motor_ff) / lam
+        return tau_ff - Jw * push
+
+
+def _saturate(v: np.ndarray, limit: float) -> np.ndarray:
+    norm = float(np.linalg.norm(v))
+    return v if norm <= limit else v * (limit / norm)

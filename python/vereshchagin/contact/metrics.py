@@ -1,0 +1,71 @@
+"""Per-joint effort metrics and task outcomes of a :class:`~.use_cases.Run`.
+
+For the samples of a window (sample period dt = 1 ms), per joint j:
+
+- ``mean_tau``: average torque (N m), signed, as report 003's Table 6.2;
+- ``mean_abs_tau``: average |torque| (N m);
+- ``mean_power``: average mechanical power tau * qd (W), signed (negative: the joint brakes);
+- ``energy_abs``: integral of |tau * qd| dt (J), the mechanical work the motor moves in either
+  direction (no regeneration credited);
+- ``energy_tau2``: integral of tau^2 dt (N^2 m^2 s). Copper-loss proxy: with motor current
+  i = tau / (k_t * gear) the winding loss is R i^2, so the dissipated energy is
+  ``R / (k_t * gear)^2 * energy_tau2``; Kinova publishes no R or k_t, so the constant is left
+  out and only ratios between cases are meaningful.
+
+Torque is the motor torque the plant applied (after saturation), qd the measured velocity.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["effort", "grasp_outcome", "writing_accuracy"]
+
+
+def effort(run, mask=None) -> dict:
+    """Effort metrics (see module doc) over the samples ``mask`` (default: all), arrays of shape (n,)."""
+    m = np.ones(len(run.t), bool) if mask is None else np.asarray(mask, bool)
+    tau, qd = run.tau[m], run.qd[m]
+    dt = float(np.median(np.diff(run.t))) if len(run.t) > 1 else 1e-3
+    p = tau * qd
+    return dict(
+        mean_tau=tau.mean(0), mean_abs_tau=np.abs(tau).mean(0), mean_power=p.mean(0),
+        energy_abs=np.abs(p).sum(0) * dt, energy_tau2=(tau ** 2).sum(0) * dt, duration=m.sum() * dt,
+    )
+
+
+def grasp_outcome(run, phase: str = "slide") -> dict:
+    """Contact detection, distance slid along x, time in contact, final position error (m)."""
+    m = run.window(phase)
+    tool = run.tool[m]
+    touching = run.table_force[m] > 0.0
+    goal_x = tool[0, 0] + 0.10
+    return dict(
+        contact_detected=run.contact_time is not None,
+        contact_time=run.contact_time,
+        distance_x=float(tool[-1, 0] - tool[0, 0]),
+        contact_fraction=float(touching.mean()),
+        touched=list(run.table_touch),
+        final_error_x=float(tool[-1, 0] - goal_x),
+        final_drift_yz=float(np.hypot(tool[-1, 1] - tool[0, 1], tool[-1, 2] - tool[0, 2])),
+        mean_table_force=float(run.table_force[m].mean()),
+    )
+
+
+def writing_accuracy(run, phase: str = "write") -> dict:
+    """Displacement of the pen tip in y from the reference line (y = y at the start, along +x).
+
+    Returns maximum |dy| and the signed average dy (m) over the drawn part (x between the start
+    and start + 0.10 m), as report 003's Table 6.3, plus the fraction of those samples in which
+    the plant reports table contact.
+    """
+    m = run.window(phase)
+    tool = run.tool[m]
+    x0, y0 = tool[0, 0], tool[0, 1]
+    drawn = (tool[:, 0] >= x0 + 1e-4) & (tool[:, 0] <= x0 + 0.10)
+    dy = tool[drawn, 1] - y0
+    return dict(
+        max_displacement=float(np.abs(dy).max()) if dy.size else float("nan"),
+        mean_displacement=float(dy.mean()) if dy.size else float("nan"),
+        length=float(tool[-1, 0] - x0),
+        contact_fraction=float((run.table_force[m][drawn] > 0).mean()) if dy.size else 0.0,
+    )

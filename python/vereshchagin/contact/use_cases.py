@@ -1,0 +1,276 @@
+"""Report 003's three use cases (sec. 6.2-6.4), each with and without contact, run in closed loop.
+
+Every run: the MuJoCo plant (:mod:`.mujoco_plant`) behind :class:`~.robot_interface.RobotInterface`,
+the controller of :mod:`.controller`, a list of phases (goal, directions, contact detection,
+duration). The loop (:func:`run_loop`) only uses the interface.
+
+Geometry (base frame, m). Start pose: report 003's ``q`` (joint angles wrapped to [-pi, pi],
+:data:`vereshchagin.robots.GEN3_START_POSE`): the end-effector at (0.457, 0.001, 0.434), tool axis
+along +x. The tables are placed from that pose:
+
+- grasp: the gripper box's lowest point is ``descent`` (0.25 m as in the report, 0.05 m quick)
+  above the table; contact: approach until contact, slide 0.10 m along +x in contact (z
+  released), close the gripper; contactless: stop 0.03 m above the table, slide in the air;
+- writing: a pen (0.12 m, pointing down) in the gripper; contact: the table 0.01 m below the pen
+  tip, approach until contact, draw 0.10 m along +x with z released; contactless: the table 0.10 m
+  below the tip, draw in the air with all six directions constrained;
+- resting elbow (:mod:`.elbow`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+
+from .. import robots
+from .._core import Chain
+from ..solver import Solver
+from .controller import CascadedController, ControllerConfig
+from .mujoco_plant import MujocoGen3, Scene, build_model, pen_tip
+
+__all__ = ["JOINT_FRICTION", "JOINT_DAMPING", "Phase", "Run", "grasp", "run_loop", "writing"]
+
+JOINT_FRICTION = (0.5, 0.5, 0.5, 0.5, 0.3, 0.3, 0.3)
+"""Static (breakaway) joint friction, N m (Kinova publishes none; plausible harmonic-drive values)."""
+JOINT_DAMPING = (0.1, 0.1, 0.1, 0.1, 0.05, 0.05, 0.05)
+"""Viscous joint damping, N m s/rad."""
+
+SLIDE = 0.10  # m, report 003: d_x = 0.1
+DESCENT = 0.25  # m, report 003: "about 25 cm"
+CLEARANCE = 0.03  # m, tool above the table in the contactless grasp
+PEN_DIRECTION_WORLD = (0.0, 0.0, -1.0)
+
+
+def gen3_model():
+    """URDF text and chain of the Gen3 with the rigid gripper, friction and damping above."""
+    urdf = robots.gen3_urdf(gripper=True, joint_friction=JOINT_FRICTION, joint_damping=JOINT_DAMPING)
+    return urdf, Chain.from_urdf(urdf, root="base_link", tip=robots.GEN3_TIP_LINK)
+
+
+def with_tool_link(urdf: str, name: str, xyz) -> str:
+    """The URDF with a massless link ``name`` fixed to the end-effector link at ``xyz`` (m)."""
+    link = (f'  <joint name="{name}_joint" type="fixed">\n    <parent link="{robots.GEN3_TIP_LINK}"/>\n'
+            f'    <child link="{name}"/>\n    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="0 0 0"/>\n'
+            f'  </joint>\n  <link name="{name}"/>\n')
+    return urdf.replace("</robot>", link + "</robot>")
+
+
+@dataclass
+class Phase:
+    """One step of a task: drive the end-effector to ``goal`` for at most ``duration`` s.
+
+    ``goal`` is a 4x4 pose or a callable ``goal(log_so_far, pose_now) -> 4x4`` evaluated when the
+    phase starts. ``detect``: end the phase when contact is detected. ``contact``: directions
+    with z released (None: keep the current mode). ``gripper``: command at the phase start.
+    """
+
+    name: str
+    goal: object
+    duration: float
+    detect: bool = False
+    contact: Optional[bool] = None
+    gripper: Optional[float] = None
+
+
+@dataclass
+class Run:
+    """The log of one run (arrays over samples) and its summary."""
+
+    case: str
+    variant: str
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    tau: np.ndarray
+    tip: np.ndarray  # end-effector origin (m)
+    tool: np.ndarray  # the tool's contact point (m)
+    phase: np.ndarray  # phase index per sample
+    contact_mode: np.ndarray  # controller in contact mode
+    table_force: np.ndarray  # plant: normal force on the table (N)
+    support_force: np.ndarray  # plant: normal force on the elbow support (N)
+    table_touch: list  # names of arm geoms that ever touched the table
+    phases: list
+    contact_time: Optional[float]
+    info: dict = field(default_factory=dict)
+
+    def window(self, name: str) -> np.ndarray:
+        """Boolean mask of the samples of phase ``name``."""
+        k = [p.name for p in self.phases].index(name)
+        return self.phase == k
+
+
+def _shifted(T, dx=0.0, dy=0.0, dz=0.0, R=None):
+    """``T`` moved by (dx, dy, dz) (base axes), with orientation ``R`` if given."""
+    T = np.array(T, float)
+    T[:3, 3] += [dx, dy, dz]
+    if R is not None:
+        T[:3, :3] = R
+    return T
+
+
+def run_loop(robot, controller: CascadedController, phases, case: str, variant: str, tool_point,
+             progress: Optional[Callable[[float], None]] = None) -> Run:
+    """Run the phases on ``robot`` (any :class:`~.robot_interface.RobotInterface`).
+
+    ``tool_point`` is the contact point in the end-effector frame (logged as ``tool``).
+    ``progress(fraction)`` is called now and then.
+    """
+    dt = robot.period
+    total = int(round(sum(p.duration for p in phases) / dt)) + len(phases)
+    n = robot.n_joints
+    t, q, qd, tau = np.zeros(total), np.zeros((total, n)), np.zeros((total, n)), np.zeros((total, n))
+    tip, tool = np.zeros((total, 3)), np.zeros((total, 3))
+    ph, cm = np.zeros(total, int), np.zeros(total, bool)
+    tf, sf = np.zeros(total), np.zeros(total)
+    touch = set()
+    contact_time = None
+    tp = np.append(np.asarray(tool_point, float), 1.0)
+    diag = getattr(robot, "contact_forces", None)
+    k = 0
+    for i, p in enumerate(phases):
+        s = robot.read()
+        T_now = np.asarray(controller.chain.fk(s.q))
+        controller.set_goal(p.goal(T_now) if callable(p.goal) else p.goal)
+        if p.contact is not None:
+            controller.set_contact(p.contact)
+        controller.arm_contact_detection(p.detect)
+        if p.gripper is not None:
+            robot.set_gripper(p.gripper)
+        steps = int(round(p.duration / dt))
+        for _ in range(steps):
+            s = robot.read()
+            cmd, ci = controller.command(s.q, s.qd)
+            robot.write(cmd)
+            robot.wait()
+            s2 = robot.read()
+            t[k], q[k], qd[k], tau[k] = s2.time, s2.q, s2.qd, s2.tau
+            tip[k] = ci.pose[:3, 3]
+            tool[k] = (ci.pose @ tp)[:3]
+            ph[k], cm[k] = i, controller.in_contact
+            if diag is not None:
+                forces = diag()
+                if "table" in forces:
+                    tf[k] = forces["table"][0]
+                    touch |= forces["table"][1]
+                if "support" in forces:
+                    sf[k] = forces["support"][0]
+            k += 1
+            if progress is not None and k % 500 == 0:
+                progress(k / total)
+            if p.detect and controller.in_contact:
+                contact_time = s2.time
+                break
+    sl = slice(0, k)
+    return Run(case, variant, t[sl], q[sl], qd[sl], tau[sl], tip[sl], tool[sl], ph[sl], cm[sl], tf[sl], sf[sl],
+               sorted(touch), list(phases), contact_time)
+
+
+def _lowest_arm_point(model, q) -> float:
+    """Lowest z (m) of the arm's collision geoms at ``q`` (MuJoCo's geom AABBs)."""
+    import mujoco
+
+    d = mujoco.MjData(model)
+    d.qpos[:] = q
+    mujoco.mj_forward(model, d)
+    low = np.inf
+    for g in range(model.ngeom):
+        if model.geom_contype[g] != 1:
+            continue
+        R = d.geom_xmat[g].reshape(3, 3)
+        c = d.geom_xpos[g]
+        t = model.geom_type[g]
+        size = model.geom_size[g]
+        if t == mujoco.mjtGeom.mjGEOM_BOX:
+            ext = np.abs(R[2]) @ size
+        elif t == mujoco.mjtGeom.mjGEOM_SPHERE:
+            ext = size[0]
+        else:  # capsule / cylinder along local z
+            ext = abs(R[2, 2]) * size[1] + (size[0] if t == mujoco.mjtGeom.mjGEOM_CAPSULE
+                                             else size[0] * np.hypot(R[2, 0], R[2, 1]))
+        low = min(low, c[2] - ext)
+    return float(low)
+
+
+def _gripper_low_point(model, chain, q) -> np.ndarray:
+    """The gripper box's lowest corner at ``q`` in the end-effector frame (m)."""
+    import mujoco
+
+    d = mujoco.MjData(model)
+    d.qpos[:] = q
+    mujoco.mj_forward(model, d)
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "bracelet_link")
+    boxes = [g for g in range(model.ngeom) if model.geom_bodyid[g] == bid
+             and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
+    g = boxes[0]
+    R = d.geom_xmat[g].reshape(3, 3)
+    corner = d.geom_xpos[g] - R @ (np.sign(R[2]) * model.geom_size[g])
+    # The lowest edge runs along the box's longest axis: take its middle (sliding contact line).
+    long_axis = int(np.argmax(model.geom_size[g]))
+    corner = corner + R[:, long_axis] * np.sign(R[2, long_axis]) * model.geom_size[g][long_axis]
+    T = np.asarray(chain.fk(q))
+    return (np.linalg.inv(T) @ np.append(corner, 1.0))[:3]
+
+
+def _controller(chain, tool_point, **overrides):
+    solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
+    return CascadedController(chain, solver, ControllerConfig(contact_point=tuple(tool_point), **overrides))
+
+
+def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[float] = None) -> Run:
+    """Use case 1: approach the table, slide 0.10 m along +x (in contact or 0.03 m above), grasp."""
+    urdf, chain = gen3_model()
+    q0 = np.array(robots.GEN3_START_POSE)
+    R0 = np.asarray(chain.fk(q0))[:3, :3]
+    descent = (0.05 if quick else DESCENT) if descent is None else descent
+    probe = build_model(urdf, chain, Scene())
+    low = _gripper_low_point(probe, chain, q0)
+    z_low = (np.asarray(chain.fk(q0)) @ np.append(low, 1.0))[2]
+    scene = Scene(table_top=float(z_low - descent))
+    robot = MujocoGen3(build_model(urdf, chain, scene), q0)
+    ctl = _controller(chain, low)
+    v = ctl.config.v_max
+    approach_time = descent / v + 2.0
+    slide_time = SLIDE / v + 1.5
+    if contact:
+        phases = [Phase("approach", lambda T: _shifted(T, dz=-(descent + 0.05), R=R0), approach_time, detect=True,
+                        contact=False),
+                  Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), slide_time),
+                  Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0)]
+    else:
+        phases = [Phase("approach", lambda T: _shifted(T, dz=-(descent - CLEARANCE), R=R0), approach_time - 0.5,
+                        contact=False),
+                  Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), slide_time),
+                  Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0)]
+    run = run_loop(robot, ctl, phases, "grasp", "contact" if contact else "contactless", low, progress)
+    run.info.update(table_top=scene.table_top, descent=descent, tool_point=low)
+    return run
+
+
+def writing(contact: bool, quick: bool = False, progress=None) -> Run:
+    """Use case 2: draw a 0.10 m line along +x with the pen on the table, or 0.10 m above it."""
+    urdf, chain = gen3_model()
+    q0 = np.array(robots.GEN3_START_POSE)
+    T0 = np.asarray(chain.fk(q0))
+    R0 = T0[:3, :3]
+    pen_dir = T0[:3, :3].T @ np.array(PEN_DIRECTION_WORLD)
+    tip_ee = pen_tip(pen_dir)
+    z_tip = (T0 @ np.append(tip_ee, 1.0))[2]
+    gap = 0.01 if contact else 0.10
+    scene = Scene(table_top=float(z_tip - gap), pen_direction=tuple(pen_dir))
+    robot = MujocoGen3(build_model(urdf, chain, scene), q0)
+    # Tracked point: the end-effector origin, as in the report (the pen tip, 0.12 m below the grip,
+    # moves with orientation errors). Tracking the pen tip itself (``with_tool_link``) made the
+    # free-space variant drift in the self-motion; not pursued.
+    ctl = _controller(chain, tip_ee)
+    v = ctl.config.v_max
+    draw_time = SLIDE / v + 1.5
+    if contact:
+        phases = [Phase("approach", lambda T: _shifted(T, dz=-0.03, R=R0), 2.0, detect=True, contact=False),
+                  Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time)]
+    else:
+        phases = [Phase("settle", lambda T: _shifted(T, R=R0), 0.3, contact=False),
+                  Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time)]
+    run = run_loop(robot, ctl, phases, "writing", "contact" if contact else "contactless", tip_ee, progress)
+    run.info.update(table_top=scene.table_top, tool_point=tip_ee)
+    return run
