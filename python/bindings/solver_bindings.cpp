@@ -24,6 +24,8 @@ struct SolveResult {
   // Friction-aware solves only (None otherwise).
   py::object friction_torque = py::none(), limit_torque = py::none(), status = py::none(), gauss_value = py::none(),
              iterations = py::none();
+  // constraints= solves only: {key: nu_i} per entry of the dict (views of nu's entries).
+  py::object segment_nu = py::none();
 };
 
 class PySolver {
@@ -290,7 +292,20 @@ class PySolver {
     const bool with_friction = parseFriction(friction, fm);
     std::lock_guard<std::mutex> lock(mutex_);
     run(in, with_friction ? &fm : nullptr);
-    return result();
+    SolveResult r = result();
+    if (in.has_segments) {
+      py::dict per_segment;
+      py::ssize_t offset = in.m;
+      const double* nu = r.nu.data();
+      std::size_t k = 0;
+      for (auto item : constraints.cast<py::dict>()) {
+        const py::ssize_t mk = in.seg_alpha[k++].shape(1);
+        per_segment[item.first] = copyVector(nu + offset, static_cast<unsigned int>(mk));
+        offset += mk;
+      }
+      r.segment_nu = per_segment;
+    }
+    return r;
   }
 
   py::dict solveBatch(const py::object& Q, const py::object& QD, const py::object& alpha, const py::object& beta,
@@ -426,6 +441,7 @@ void bindSolver(py::module_& mod) {
       .def_readonly("status", &SolveResult::status)
       .def_readonly("gauss_value", &SolveResult::gauss_value)
       .def_readonly("iterations", &SolveResult::iterations)
+      .def_readonly("segment_nu", &SolveResult::segment_nu)
       .def("__repr__", [](const SolveResult& r) {
         return "<vereshchagin.SolveResult n_joints=" + std::to_string(r.qdd.size()) +
                " m=" + std::to_string(r.nu.size()) + " rank=" + std::to_string(r.constraint_rank) + ">";

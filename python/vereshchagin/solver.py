@@ -69,7 +69,8 @@ class Solver(_core.Solver):
     Result fields: ``qdd`` (n,); ``tau_command`` (n,) the torques the motors must add to
     ``tau_ff`` to realise ``qdd`` (``-sum_i J_i^T alpha_i nu_i`` over constrained segments);
     ``nu`` (m,) constraint magnitudes (the wrench on the last segment is ``-alpha @ nu``), with
-    ``constraints`` the end-segment ``alpha`` columns first, then each entry's in dict order; ``link_acc`` (n_segments + 1, 6) spatial
+    ``constraints`` the end-segment ``alpha`` columns first, then each entry's in dict order
+    (``segment_nu`` maps each ``constraints`` key to its own part); ``link_acc`` (n_segments + 1, 6) spatial
     accelerations ``[linear, angular]`` of the base and each segment's tip (base axes, tip
     origin, including ``-gravity``); ``constraint_rank``; ``smallest_singular_value``.
 
