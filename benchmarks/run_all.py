@@ -10,7 +10,9 @@
 4. runs DIR/benchmarks/bench_friction (static friction: ours vs our plain solve, KDL and the
    report's vertex enumeration, about 30 s) and benchmarks/bench_friction_pinocchio.py (static
    friction vs Pinocchio's JointFrictionConstraintModel + ADMM, about 10 s);
-5. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
+5. runs benchmarks/bench_segments.py (constraints on 1, 2, 3 segments vs Pinocchio's KKT solve, from
+   Python, about 15-20 s);
+6. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
    the method, the target checks and all reports.
 """
 from __future__ import annotations
@@ -130,6 +132,16 @@ def friction_section(fr_file, fr_rc, frpy_file, frpy_rc):
     return md
 
 
+def segments_section(seg_file, seg_rc):
+    """The "Constraints on several segments" section: bench_segments.py's report (it has the heading)."""
+    if not seg_file.exists():
+        return ["## Constraints on several segments", "",
+                f"**bench_segments.py exited with code {seg_rc} and wrote no report.**", ""]
+    heading, *body = seg_file.read_text().rstrip().splitlines()
+    warn = ["", f"**bench_segments.py exited with code {seg_rc}: see the table below.**"] if seg_rc else []
+    return [heading, *warn, *body, ""]
+
+
 def main():
     ap = argparse.ArgumentParser(description="Build and run the benchmarks, write BENCHMARKS.md.")
     ap.add_argument("--build-dir", type=Path, default=REPO / "build" / "bench")
@@ -160,6 +172,10 @@ def main():
     fr_rc = run([build / "benchmarks" / "bench_friction", fr_file], stdout=subprocess.DEVNULL).returncode
     frpy_rc = run([sys.executable, REPO / "benchmarks" / "bench_friction_pinocchio.py", "--out", frpy_file],
                   stdout=subprocess.DEVNULL).returncode
+    seg_file = build / "bench_segments.md"
+    seg_file.unlink(missing_ok=True)
+    seg_rc = run([sys.executable, REPO / "benchmarks" / "bench_segments.py", "--out", seg_file],
+                 stdout=subprocess.DEVNULL).returncode
     load_end = loadavg()
 
     cpp_md, py_md = cpp_file.read_text(), py_file.read_text()
@@ -214,9 +230,10 @@ def main():
     md += ["#" + l if l.startswith("#") else l for l in cpp_md.rstrip().splitlines()]
     md += ["", py_md.rstrip(), ""]
     md += friction_section(fr_file, fr_rc, frpy_file, frpy_rc)
+    md += segments_section(seg_file, seg_rc)
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
-    return 0 if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 else 1
+    return 0 if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 and seg_rc == 0 else 1
 
 
 if __name__ == "__main__":
