@@ -14,6 +14,7 @@
 #include <kdl/chain.hpp>
 #include <kdl/chaindynparam.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainidsolver.hpp>  // KDL::Wrenches
 #include <kdl/chainjnttojacsolver.hpp>
 #include <kdl/jacobian.hpp>
 #include <kdl/jntarray.hpp>
@@ -134,6 +135,19 @@ inline DenseModel denseModel(const KDL::Chain& chain, const KDL::JntArray& q) {
   jac.JntToJac(q, J);
   d.J = J.data;
   return d;
+}
+
+// f_ext in base axes (moment about each tip origin, the hybrid solvers' convention) -> each
+// segment's tip axes (same reference point), the convention of KDL's RNE-based solvers.
+inline KDL::Wrenches toTipAxes(const KDL::Chain& chain, const KDL::JntArray& q, const KDL::Wrenches& f_ext) {
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  KDL::Wrenches out(f_ext.size());
+  for (std::size_t i = 0; i < f_ext.size(); ++i) {
+    KDL::Frame F;
+    fk.JntToCart(q, F, static_cast<int>(i) + 1);
+    out[i] = F.M.Inverse() * f_ext[i];
+  }
+  return out;
 }
 
 // Eigenvalues (ascending) of the coupling matrix K = A H^-1 A^T, A = alfa^T J.

@@ -29,22 +29,6 @@
 using testutil::relErr;
 using testutil::str;
 
-namespace {
-
-// f_ext in base axes (moment about each tip origin) -> tip axes, for KDL's RNE-based solvers.
-KDL::Wrenches toTipAxes(const KDL::Chain& chain, const KDL::JntArray& q, const KDL::Wrenches& f_ext) {
-  KDL::ChainFkSolverPos_recursive fk(chain);
-  KDL::Wrenches out(f_ext.size());
-  for (std::size_t i = 0; i < f_ext.size(); ++i) {
-    KDL::Frame F;
-    fk.JntToCart(q, F, static_cast<int>(i) + 1);
-    out[i] = F.M.Inverse() * f_ext[i];
-  }
-  return out;
-}
-
-}  // namespace
-
 int main() {
   testutil::Checker ck("test_kdl_oracle");
   const int kSamples = 1200;
@@ -156,7 +140,7 @@ int main() {
     ck.check(e_acc <= 1e-10, tag + ": link accelerations vs KDL rel err " + str(e_acc));
 
     // Our command torques drive plain forward dynamics to our q_dotdot.
-    const KDL::Wrenches fext_tip = toTipAxes(chain, q, fext);
+    const KDL::Wrenches fext_tip = testutil::toTipAxes(chain, q, fext);
     KDL::ChainFdSolver_RNE fd(chain, grav_fd);
     KDL::JntArray tau_total(n), qdd_fd(n);
     tau_total.data = ff.data + tau_cmd.data;
