@@ -20,9 +20,11 @@ cmake -S "$HERE/tests" -B "$OUT/tests" "${GEN[@]}" -DCMAKE_BUILD_TYPE=Release -D
 cmake --build "$OUT/tests" -j "${KDL_BUILD_JOBS:-2}"
 
 # One KDL per process: the patched test must load the patched library, not Debian's.
-if ! ldd "$OUT/tests/test_patched_kdl" | grep -q "liborocos-kdl.so.* => $OUT/prefix/"; then
+# (ldd's output is captured first: `ldd | grep -q` can fail under pipefail when grep exits early.)
+LIBS="$(ldd "$OUT/tests/test_patched_kdl")"
+if ! grep -q "liborocos-kdl.so.* => $OUT/prefix/" <<< "$LIBS"; then
   echo "[patch-tests] test_patched_kdl does not load the patched KDL:" >&2
-  ldd "$OUT/tests/test_patched_kdl" | grep orocos >&2
+  grep orocos <<< "$LIBS" >&2
   exit 1
 fi
 "$OUT/tests/test_patched_kdl"
