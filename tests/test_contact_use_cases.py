@@ -102,8 +102,10 @@ def test_writing_pen_stays_on_the_paper(writing_runs):
     assert ac["contact_fraction"] > 0.95
     assert abs(ac["length"] - 0.10) < 0.005 and abs(an["length"] - 0.10) < 0.005
     assert n.table_touch == [] and an["contact_fraction"] == 0.0
+    # both lines within the report's contact accuracy (2.11 mm); before the friction solver's rest
+    # tolerance sat above the plant's creep (1e-3 -> 1e-2 rad/s) they wandered by 6-12 mm
     for a in (ac, an):
-        assert np.isfinite(a["max_displacement"]) and a["max_displacement"] < 0.03
+        assert np.isfinite(a["max_displacement"]) and a["max_displacement"] < 0.002
 
 
 @pytest.fixture(scope="module")

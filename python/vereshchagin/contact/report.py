@@ -211,7 +211,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
            "free-space angular k_vel = 40 instead of 2 (with 2 the wrist rolls away under any torque error, "
            "the failure the report met in use case 3) and the in-contact linear k_vel = 15 instead of 4 (with 4 "
            "the velocity loop corrects at most 0.2 m/s^2, less than the errors of the friction compensation "
-           "under the ~50 N the arm's weight presses with after the 25 cm descent: the slide stalls at 62 mm).", "",
+           "under the ~50 N the arm's weight presses with after the 25 cm descent: the slide stalls at 48 mm) and the friction solver's rest tolerance 0.01 rad/s (above the plant's creep under dry friction).", "",
            f"Mode: {'quick (5 cm approach)' if quick else 'full (25 cm approach as in the report)'}. "
            "Joint j in the tables is the report's 0-based joint j = our joint_(j+1).", ""]
     ok = True
