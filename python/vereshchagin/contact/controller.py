@@ -29,8 +29,7 @@ the threshold). On contact the gains switch to the contact set and the direction
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
-from typing import Optional
+from dataclasses import dataclass, field
 
 import numpy as np
 
