@@ -1,71 +1,95 @@
-"""Use case 3 (report 003 sec. 6.4): the end-effector slides while the elbow rests on a support.
+"""Use case 3 (report 003 sec. 6.4): the end-effector moves while the elbow rests on a support.
 
-Pose: report 003 does not give one (the elbow rested on a stack of books); at its start pose the
-Gen3's elbow is the arm's highest point. We use :data:`ELBOW_POSE`, a "V" posture with the elbow
-(joint 4, the ``forearm_link`` segment's tip) as the arm's lowest point, at about (0.376, 0,
-0.095) m, and the tool pointing forward-down at (0.745, 0, 0.187) m. The task: hold the pose,
-then move the end-effector 0.10 m along +x in the air (all six directions constrained), hold.
+Pose: report 003 does not give one (the elbow rested on a stack of books). With the tool held
+fixed, the Gen3's elbow (joint 4's centre, the tip of the ``forearm_link`` segment) can only move
+on the self-motion circle around the shoulder-wrist axis; at the circle's lowest point a support
+cannot carry anything to first order (the elbow's height does not change with the self-motion
+there), so the elbow is swung 50 degrees sideways from that point: :data:`ELBOW_POSE`, elbow at
+about (0.374, 0.150, 0.163) m, tool at (0.745, 0, 0.187) m pointing forward-down. There gravity
+turns the self-motion so that the elbow goes down. The task: hold the pose, move the
+end-effector 0.10 m towards the base (-x) in the air (all six directions constrained), hold.
 
 Variants:
 
-- ``unsupported``: no support; the joint posture term of the controller holds the self-motion
-  (the elbow) up -- the motors carry the whole arm;
+- ``unsupported``: no support. The controller holds the elbow's height with a segment
+  constraint on ``forearm_link``: ``alpha_e = e_z`` (base z, 1 column), ``beta_e`` the vertical
+  acceleration of the controller's cascaded P towards the start height (zero while the elbow
+  rests there; including ``-gravity``, :func:`elbow_constraint`). Seven
+  constraints (6 at the tool, 1 at the elbow) fix all seven joint accelerations; the motors
+  carry the whole arm;
 - ``plant``: a support box touches the elbow sphere from below; the controller does not know it
-  and leaves the self-motion to nature (posture damping only), so the elbow settles on the
-  support and the plant's contact carries what gravity puts on it;
-- ``constraint``: the same support, modelled in the solver as a segment constraint on the elbow
-  (``constraints={"forearm_link": (e_z, [9.81])}``, zero vertical acceleration of joint 4's
-  centre, beta including -gravity) -- needs the segment-constraint API; the support's share
-  ``-J_e^T alpha_e nu_e`` of the command is left to the support when it pushes (``nu_e < 0``).
+  (tool task only, the self-motion left to nature, posture damping only), so the elbow settles on
+  the support and the plant's contact carries what gravity puts on it;
+- ``constraint``: the same support and the same segment constraint as ``unsupported``; the
+  elbow constraint's share of the command, ``-J_e^T alpha_e nu_e`` (the torque of the upward
+  force ``-nu_e`` at the elbow), is left to the support when that force pushes up (``nu_e < 0``).
+  The plant's contact then supplies it: the motors carry the rest.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .. import robots  # noqa: F401  (documentation cross-reference)
+from ..solver import Solver
+from ..task import beta_for
 from .controller import CascadedController, ControllerConfig
 from .mujoco_plant import ELBOW_RADIUS, MujocoGen3, Scene, build_model
 from .use_cases import SLIDE, Phase, _shifted, gen3_model, run_loop
-from ..solver import Solver
-from ..task import beta_for
 
-__all__ = ["ELBOW_POSE", "ELBOW_SEGMENT", "VARIANTS", "elbow", "segment_constraints_available"]
+__all__ = ["ELBOW_POSE", "ELBOW_SEGMENT", "VARIANTS", "elbow"]
 
-ELBOW_POSE = (-0.009, 2.0383, 3.1261, 1.1587, 0.0169, -1.3965, 0.84)
-"""Joint angles (rad) of the resting-elbow posture (found by least squares, see module doc)."""
+ELBOW_POSE = (-0.4012, 1.876, 2.2002, 1.1816, 0.5691, -1.2336, 1.3689)
+"""Joint angles (rad) of the resting-elbow posture (least squares: tool pose and elbow point, module doc)."""
 ELBOW_SEGMENT = "forearm_link"
 """The segment whose tip origin is the elbow (joint 4's centre)."""
 VARIANTS = ("unsupported", "plant", "constraint")
 ELBOW_DX = -SLIDE
-"""The end-effector moves 0.10 m towards the base (-x): the elbow bends and presses down."""
+"""The end-effector moves 0.10 m towards the base (-x): the elbow circle widens, the elbow presses down."""
+ALPHA_ELBOW = np.array([[0.0], [0.0], [1.0], [0.0], [0.0], [0.0]])
+"""Elbow constraint direction: linear base z (6, 1)."""
+N_TOOL = 6
+"""Columns of the tool's ``alpha`` in free space; the elbow's ``nu`` follows them in ``result.nu``."""
 
 
-def segment_constraints_available(solver) -> bool:
-    """Whether ``solver.solve`` accepts ``constraints=`` (the segment-constraint API)."""
-    q = np.zeros(solver.n_joints)
-    try:
-        solver.solve(q, q, constraints={})
-    except TypeError:
-        return False
-    return True
+def elbow_constraint(chain, seg: int, z_ref: float, gains=(40.0, 30.0), v_max: float = 0.05):
+    """``constraints=`` callable for the controller: hold the elbow at height ``z_ref`` (m).
+
+    The elbow's vertical acceleration is the controller's cascaded P (free-space linear gains
+    ``(k_pos, k_vel)``, desired velocity saturated at ``v_max``):
+    ``a_z = k_vel (sat(k_pos (z_ref - z)) - v_z)``, zero once the elbow rests at ``z_ref``;
+    ``beta_e`` adds ``-gravity`` and the velocity product (:func:`vereshchagin.task.beta_for`).
+    """
+    k_pos, k_vel = gains
+
+    def constraints(q, qd):
+        z = float(np.asarray(chain.fk(q, segment=seg))[2, 3])
+        tw = np.asarray(chain.twist(q, qd, segment=seg))
+        v_d = float(np.clip(k_pos * (z_ref - z), -v_max, v_max))
+        a = np.zeros(6)
+        a[2] = k_vel * (v_d - tw[2])
+        return {ELBOW_SEGMENT: (ALPHA_ELBOW, beta_for(ALPHA_ELBOW, a, tw))}
+
+    return constraints
 
 
-def _support_share(chain, seg: int, m: int):
-    """Torque the support supplies: ``-J_e^T alpha_e nu_e`` when it pushes up (``nu_e < 0``)."""
+def support_share(chain, seg: int):
+    """Torque the support supplies: ``-J_e^T alpha_e nu_e`` when it pushes up (``nu_e < 0``), else 0."""
 
     def share(res, q):
-        nu = np.asarray(res.nu, float)
-        nu_e = float(nu[m]) if nu.size > m else 0.0
+        nu_e = float(np.asarray(res.nu, float)[N_TOOL])
         if nu_e >= 0.0:
             return np.zeros(chain.n_joints)
         J = np.asarray(chain.jacobian(q, segment=seg))
-        return -J.T @ np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0]) * nu_e
+        return -(J.T @ ALPHA_ELBOW[:, 0]) * nu_e
 
     return share
 
 
 def elbow(variant: str, quick: bool = False, progress=None):
-    """Run use case 3 in one of :data:`VARIANTS` (see module doc); returns a :class:`~.use_cases.Run`."""
+    """Run use case 3 in one of :data:`VARIANTS` (see module doc); returns a :class:`~.use_cases.Run`.
+
+    ``run.info``: ``elbow_z`` (elbow height per sample, m), ``support_top`` (m or None) and
+    ``support_force_model`` (the solver's ``-nu_e`` per sample, N; NaN without the constraint).
+    """
     if variant not in VARIANTS:
         raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")
     urdf, chain = gen3_model()
@@ -75,27 +99,33 @@ def elbow(variant: str, quick: bool = False, progress=None):
     support = None
     if variant != "unsupported":
         top = p_e[2] - ELBOW_RADIUS
-        support = ((p_e[0], p_e[1], top / 2.0 - 0.0), (0.05, 0.06, top / 2.0))
-    scene = Scene(support=support)
-    robot = MujocoGen3(build_model(urdf, chain, scene), q0)
+        support = ((p_e[0], p_e[1], top / 2.0), (0.05, 0.06, top / 2.0))
+    robot = MujocoGen3(build_model(urdf, chain, Scene(support=support)), q0)
     solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
-    posture = (20.0, 3.0) if variant == "unsupported" else (0.0, 3.0)
-    ctl = CascadedController(chain, solver, ControllerConfig(posture_gains=posture))
+    ctl = CascadedController(chain, solver, ControllerConfig(posture_gains=(0.0, 3.0)))
+    if variant != "plant":
+        g = ctl.config.free_gains
+        ctl.extra_constraints = elbow_constraint(chain, seg, float(p_e[2]), (g.k_pos[0], g.k_vel[0]), ctl.config.v_max)
     if variant == "constraint":
-        if not segment_constraints_available(solver):
-            raise NotImplementedError("the 'constraint' variant needs Solver.solve(..., constraints=...) "
-                                      "(segment constraints); this build does not have it")
-        alpha_e = np.array([[0.0], [0.0], [1.0], [0.0], [0.0], [0.0]])
-        ctl.extra_constraints = lambda q, qd: {  # zero vertical acceleration of the elbow (incl. -g)
-            ELBOW_SEGMENT: (alpha_e, beta_for(alpha_e, np.zeros(6), chain.twist(q, qd, segment=seg)))}
-        ctl.support_share = _support_share(chain, seg, 6)
+        ctl.support_share = support_share(chain, seg)
     R0 = np.asarray(chain.fk(q0))[:3, :3]
     v = ctl.config.v_max
     duration = 0.5 if quick else 1.0
     phases = [Phase("settle", lambda T: _shifted(T, R=R0), duration, contact=False),
               Phase("slide", lambda T: _shifted(T, dx=ELBOW_DX, R=R0), SLIDE / v + (1.0 if quick else 1.5)),
               Phase("hold", lambda T: _shifted(T, R=R0), duration)]
+    nu_log = []
+    if variant != "plant":
+        command = ctl.command
+
+        def logged(q, qd):
+            tau, info = command(q, qd)
+            nu_log.append(-float(np.asarray(info.result.nu)[N_TOOL]))
+            return tau, info
+
+        ctl.command = logged
     run = run_loop(robot, ctl, phases, "elbow", variant, (0.0, 0.0, 0.0), progress)
     elbow_z = np.array([np.asarray(chain.fk(q, segment=seg))[2, 3] for q in run.q])
-    run.info.update(elbow_z=elbow_z, support_top=None if support is None else 2 * support[0][2])
+    run.info.update(elbow_z=elbow_z, support_top=None if support is None else 2 * support[0][2],
+                    support_force_model=np.array(nu_log[:len(run.t)]) if nu_log else np.full(len(run.t), np.nan))
     return run

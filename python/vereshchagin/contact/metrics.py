@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["effort", "grasp_outcome", "writing_accuracy"]
+__all__ = ["effort", "elbow_outcome", "grasp_outcome", "writing_accuracy"]
 
 
 def effort(run, mask=None) -> dict:
@@ -68,4 +68,24 @@ def writing_accuracy(run, phase: str = "write") -> dict:
         mean_displacement=float(dy.mean()) if dy.size else float("nan"),
         length=float(tool[-1, 0] - x0),
         contact_fraction=float((run.table_force[m][drawn] > 0).mean()) if dy.size else 0.0,
+    )
+
+
+def elbow_outcome(run, phase: str = "slide", dx: float = -0.10) -> dict:
+    """Task and support outcome of a resting-elbow run (:mod:`.elbow`).
+
+    ``final_error_x``: end-effector x at the end of the run minus its goal (x at the start of
+    ``phase`` + ``dx``), m; ``drift_z``: end-effector z change over the run, m;
+    ``support_fraction``: share of the ``phase`` samples in which the plant's support pushes;
+    ``support_force``: its mean normal force over ``phase`` (N); ``model_support_force``: the
+    solver's mean constraint force ``-nu_e`` over ``phase`` (N, NaN without the constraint).
+    """
+    m = run.window(phase)
+    model = np.asarray(run.info.get("support_force_model", np.full(len(run.t), np.nan)))[m]
+    return dict(
+        final_error_x=float(run.tip[-1, 0] - (run.tip[m][0, 0] + dx)),
+        drift_z=float(run.tip[-1, 2] - run.tip[0, 2]),
+        support_fraction=float((run.support_force[m] > 0.0).mean()),
+        support_force=float(run.support_force[m].mean()),
+        model_support_force=float(model.mean()) if np.all(np.isfinite(model)) else float("nan"),
     )
