@@ -662,28 +662,46 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     auto DU = col_energy_.topLeftCorner(m, kc);
     auto row = col_row_.head(kc);
     DU.setZero();
+    // A unit torque at joint j changes nothing inward of... nothing distal to it: in the inward
+    // pass its column is zero on segments after j's. With the joints in chain order, the columns
+    // alive at segment i are a suffix [lo, kc) that grows towards the base (the friction solver
+    // asks in that order); otherwise every column is processed everywhere.
+    bool ascending = true;
+    for (long c = 1; c < kc; ++c)
+      ascending = ascending && joint_segment_[joints(c0 + c)] >= joint_segment_[joints(c0 + c - 1)];
+    long lo = ascending ? kc : 0, lo_child = lo;
     for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
       Segment& s = segs_[i];
-      auto dpA = seg_force_[i].leftCols(kc);
+      if (ascending)
+        while (lo > 0 && joint_segment_[joints(c0 + lo - 1)] >= i) --lo;
+      auto dpA_all = seg_force_[i].leftCols(kc);
       if (i == static_cast<int>(ns_) - 1) {
-        dpA.setZero();
+        dpA_all.setZero();
       } else {  // child's apparent force to this frame: f = R f', n = R n' + p x f
+        dpA_all.leftCols(lo_child).setZero();
+        auto dpA_c = dpA_all.rightCols(kc - lo_child);
+        const auto DPc = DP.rightCols(kc - lo_child);
         const Pose& X = segs_[i + 1].X;
-        dpA.topRows<3>().noalias() = X.R.lazyProduct(DP.topRows<3>());
-        dpA.bottomRows<3>().noalias() = X.R.lazyProduct(DP.bottomRows<3>());
-        dpA.bottomRows<3>().noalias() += skew(X.p).lazyProduct(dpA.topRows<3>());
+        dpA_c.topRows<3>().noalias() = X.R.lazyProduct(DPc.topRows<3>());
+        dpA_c.bottomRows<3>().noalias() = X.R.lazyProduct(DPc.bottomRows<3>());
+        dpA_c.bottomRows<3>().noalias() += skew(X.p).lazyProduct(dpA_c.topRows<3>());
       }
+      const long na = kc - lo;  // alive columns
+      auto dpA = dpA_all.rightCols(na);
+      auto DPa = DP.rightCols(na);
       if (s.joint >= 0) {
-        row.noalias() = -(s.S.transpose().lazyProduct(dpA)).transpose();
-        for (long c = 0; c < kc; ++c)
+        auto r = row.tail(na);
+        r.noalias() = -(s.S.transpose().lazyProduct(dpA)).transpose();
+        for (long c = lo; c < kc; ++c)
           if (joints(c0 + c) == s.joint) row(c) += 1.0;
-        row *= s.Dinv;  // change of the free joint acceleration
-        DP = dpA;
-        DP.noalias() += s.u.lazyProduct(row.transpose());
-        if (m > 0) DU.noalias() += eg_.col(i).head(m).lazyProduct(row.transpose());
+        r *= s.Dinv;  // change of the free joint acceleration
+        DPa = dpA;
+        DPa.noalias() += s.u.lazyProduct(r.transpose());
+        if (m > 0) DU.rightCols(na).noalias() += eg_.col(i).head(m).lazyProduct(r.transpose());
       } else {
-        DP = dpA;
+        DPa = dpA;
       }
+      lo_child = lo;
     }
     auto DNU = col_nu_.topLeftCorner(m, kc);
     for (long c = 0; c < kc; ++c) {
