@@ -228,7 +228,17 @@ bool FrictionSolver::freeStep(int nf) {
     for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
   auto L = L_.topLeftCorner(nf, nf);
   auto perm = rows_.head(nf);
-  const int r = detail::pivotedCholesky(W, L, perm, kZeroCurvature * qscale_);
+  // Positive definite at the curvature tolerance (the usual case): plain Cholesky, no pivoting;
+  // otherwise the rank-revealing pivoted factorisation.
+  int r = nf;
+  if (detail::choleskyCertified(W, L, kZeroCurvature * qscale_)) {
+    for (int a = 0; a < nf; ++a) perm(a) = a;
+  } else {
+    for (int a = 0; a < nf; ++a)
+      for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
+    r = detail::pivotedCholesky(W, L, perm, kZeroCurvature * qscale_);
+  }
+  free_full_rank_ = r == nf;
   auto gp = tmp_.head(nf);  // g in pivot order
   for (int a = 0; a < nf; ++a) gp(a) = grad_(free_idx_(perm(a)));
   // y = L1^-1 g1 (forward substitution), in tmp2_.
@@ -285,9 +295,10 @@ int FrictionSolver::boxQp(int k) {
   const double tol_g = kGradientTolerance * gscale_;
   const int max_iterations = 50 + 20 * k;
   bool face_optimal = false;
+  free_full_rank_ = false;
   for (int it = 0; it < max_iterations; ++it) {
     iterations_ = it + 1;
-    grad_.head(k).noalias() = Q_.topLeftCorner(k, k) * x;
+    grad_.head(k).noalias() = Q_.topLeftCorner(k, k).lazyProduct(x);
     grad_.head(k) -= c_.head(k);
     int nf = 0;
     for (int i = 0; i < k; ++i)
@@ -342,12 +353,19 @@ int FrictionSolver::boxQp(int k) {
 // a least-distance problem in z (N orthonormal), solved by a primal active-set method.
 void FrictionSolver::leastCommand(int k) {
   auto x = x_.head(k);
-  grad_.head(k).noalias() = Q_.topLeftCorner(k, k) * x;
+  grad_.head(k).noalias() = Q_.topLeftCorner(k, k).lazyProduct(x);
   grad_.head(k) -= c_.head(k);  // = -(accelerations of the resting joints)
   int ns = 0;
   for (int a = 0; a < k; ++a)
     if (std::abs(grad_(a)) <= 10.0 * kGradientTolerance * gscale_) rows_(ns++) = a;
   if (ns == 0) return;
+  // Sticking joints all free at the stage-1 optimum, whose free block was positive definite:
+  // Q_StSt is a principal block of it, so its null space is empty and the optimum is unique.
+  if (free_full_rank_) {
+    bool all_free = true;
+    for (int a = 0; a < ns && all_free; ++a) all_free = state_(rows_(a)) == 0;
+    if (all_free) return;
+  }
   // Null space of Q_StSt from its pivoted Cholesky: columns [-L1^-T L2^T; I] (pivot order),
   // orthonormalised by modified Gram-Schmidt.
   auto W = work_.topLeftCorner(ns, ns);

@@ -130,6 +130,7 @@ class FrictionSolver {
   int iterations_ = 0;
   double qscale_ = 0.0;  // scale of Q (see solve())
   double gscale_ = 0.0;  // scale of the QP gradient (see boxQp())
+  bool free_full_rank_ = false;  // the last free-set factorisation had full rank
   bool solved_ = false;
   // Inputs kept for gaussValue().
   Eigen::VectorXd q_keep_, qd_keep_;
