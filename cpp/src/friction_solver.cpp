@@ -293,11 +293,22 @@ int FrictionSolver::boxQp(int k) {
   // bound can cause, at Q's physical scale (not Q's entries, which a task can make vanish).
   gscale_ = std::max({c_.head(k).cwiseAbs().maxCoeff(), qscale_ * xscale, 1e-300});
   const double tol_g = kGradientTolerance * gscale_;
-  const int max_iterations = 50 + 20 * k;
-  bool face_optimal = false;
+  // Iteration bound. Between two face-optimal points each iteration binds one more variable (a
+  // blocked step) or ends on the face optimum (a full step): at most k + 1 iterations. The
+  // objective never increases, and it strictly decreases from one face-optimal point to the next
+  // (a released variable has a multiplier of the wrong sign, so the new face's minimiser is
+  // strictly lower) unless a zero-length step intervenes (degeneracy); so no working set is
+  // face-optimal twice and there are at most 3^k working sets: (k + 1) 3^k iterations. When a
+  // face-optimal value fails to decrease (degenerate cycling risk), releases switch to Bland's
+  // smallest-index rule, the classical anti-cycling safeguard. (Observed: 2-6 iterations mean.)
+  long bound = k + 1;
+  for (int i = 0; i < k && bound < 100000000L; ++i) bound *= 3;
+  const long max_iterations = std::min(bound, 100000000L);
+  bool face_optimal = false, bland = false;
+  double last_face_value = kInf;
   free_full_rank_ = false;
-  for (int it = 0; it < max_iterations; ++it) {
-    iterations_ = it + 1;
+  for (long it = 0; it < max_iterations; ++it) {
+    iterations_ = static_cast<int>(std::min<long>(it + 1, 2147483647L));
     grad_.head(k).noalias() = Q_.topLeftCorner(k, k).lazyProduct(x);
     grad_.head(k) -= c_.head(k);
     int nf = 0;
@@ -333,17 +344,23 @@ int FrictionSolver::boxQp(int k) {
       continue;
     }
     // Optimal on the current face: the bound multipliers must have the right sign.
+    const double value = 0.5 * x.dot(grad_.head(k)) - 0.5 * c_.head(k).dot(x);  // 1/2 x'Qx - c'x
+    if (!(value < last_face_value)) bland = true;
+    last_face_value = value;
     int release = -1;
     double worst = tol_g;
     for (int i = 0; i < k; ++i) {
       const double violation = state(i) < 0 ? -grad_(i) : (state(i) > 0 ? grad_(i) : 0.0);
-      if (violation > worst) worst = violation, release = i;
+      if (violation > worst) {
+        worst = violation, release = i;
+        if (bland) break;  // smallest index
+      }
     }
     if (release < 0) return ChainHdSolver::E_NOERROR;
     state(release) = 0;
     face_optimal = false;
   }
-  return fail(E_NOT_CONVERGED, "friction optimisation did not converge in %d active-set iterations", max_iterations);
+  return fail(E_NOT_CONVERGED, "friction optimisation did not converge in %ld active-set iterations", max_iterations);
 }
 
 // Stage 2: among the optimal friction vectors (same qdd), the one minimising ||tau_cmd||^2.

@@ -31,7 +31,9 @@
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
 //    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
 //    (computed on request: one extra O(n) solve).
-//  * iterations(): active-set iterations of the last solve.
+//  * iterations(): active-set iterations of the last solve (at most (k + 1) 3^k, k the resting
+//    joints with friction or on a limit; the argument is in friction_solver.cpp's boxQp()).
+//    Bland's smallest-index rule takes over if a face-optimal value fails to decrease.
 // No heap allocation in solve() or gaussValue().
 #pragma once
 
@@ -60,7 +62,8 @@ class FrictionSolver {
   enum JointStatus : signed char { Moving = 0, Stick = 1, SlipPositive = 2, SlipNegative = 3 };
   enum {
     E_INVALID_FRICTION = -110,     // sizes, negative or non-finite values, kinetic > static
-    E_NOT_CONVERGED = -111,        // the active-set bound was exceeded (not expected)
+    E_NOT_CONVERGED = -111,        // the iteration bound was exceeded (not expected), or the task
+                                   // drives a joint into its limit (unbounded reaction)
   };
 
   FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc,
