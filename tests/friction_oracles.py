@@ -39,6 +39,20 @@ Oracles:
 (c) ``mujoco_qacc``: MuJoCo with ``frictionloss`` per joint, qvel = 0, main solver converged to
     tolerance 0 and the noslip post-processor (unregularised projected Gauss-Seidel on the friction
     rows) iterated to convergence. Only for tasks without alpha.
+
+Joint position limits (friction-maxmin.md sec. 2, report 000 sec. 5.2). A resting joint flagged
+``at_lower`` (``at_upper``) may not accelerate further into its limit: the primal gains the one-sided
+constraint qdd_j >= 0 (qdd_j <= 0); both flags: qdd_j = 0. The objective is unchanged (the limit does
+no work). In the stationarity condition the limit's multiplier joins mu_j, whose bounds open on one
+side: mu_j in (-inf, f_j] at a lower limit, [-f_j, +inf) at an upper one, (-inf, inf) at both
+(``FrictionProblem.mu_bounds``). Complementarity of such a joint: qdd_j = 0 and mu_j in its bounds
+(stick, the limit may push without bound), or it slips AWAY from the limit with mu_j = f_j sign(qdd_j).
+The physical torques are split as friction = clip(-mu_j, -f_j, f_j) and limit = -mu_j - friction
+(>= 0 at a lower limit, <= 0 at an upper one). The oracles: (a) bounds u_j >= 0 / <= 0 on the SLSQP
+variables and the opened bounds in the BVLS certificate; (b) only the slip directions away from the
+limit are enumerated and the tie-break uses the opened bounds. An infeasible primal (the task forces
+a joint into its limit) is ``OracleInfeasible`` from (b) and a negative margin of ``limit_margin`` (an
+LP by HiGHS).
 """
 from __future__ import annotations
 
@@ -58,6 +72,10 @@ class OracleFailure(AssertionError):
     """An oracle could not produce a certified answer (the test must not silently pass)."""
 
 
+class OracleInfeasible(OracleFailure):
+    """No stick/slip pattern is feasible: the task and the joint limits admit no acceleration."""
+
+
 # ------------------------------------------------------------------------------------------------
 # The problem
 # ------------------------------------------------------------------------------------------------
@@ -71,6 +89,8 @@ class FrictionProblem:
     static: np.ndarray  # (n,) breakaway friction f_j >= 0 (used for resting joints)
     kinetic_torque: np.ndarray = None  # (n,) -fk sign(qd) on moving joints, 0 on resting ones
     extra: dict = field(default_factory=dict)
+    at_lower: np.ndarray = None  # (n,) bool: resting joint on its lower limit (qdd_j >= 0); default none
+    at_upper: np.ndarray = None  # (n,) bool: resting joint on its upper limit (qdd_j <= 0); default none
 
     def __post_init__(self):
         self.H = 0.5 * (np.asarray(self.H, float) + np.asarray(self.H, float).T)
@@ -82,6 +102,9 @@ class FrictionProblem:
         self.static = np.asarray(self.static, float)
         if self.kinetic_torque is None:
             self.kinetic_torque = np.zeros(n)
+        # limits act on resting joints only (a moving joint is not "on" its limit)
+        self.at_lower = np.zeros(n, bool) if self.at_lower is None else np.asarray(self.at_lower, bool) & self.resting
+        self.at_upper = np.zeros(n, bool) if self.at_upper is None else np.asarray(self.at_upper, bool) & self.resting
 
     @property
     def n(self):
@@ -90,6 +113,28 @@ class FrictionProblem:
     @property
     def rest_idx(self):
         return np.flatnonzero(self.resting)
+
+    @property
+    def on_limit(self):
+        return self.at_lower | self.at_upper
+
+    def mu_bounds(self):
+        """(lo, hi), each (n,): the bounds of mu_j (friction torque -mu_j plus limit reaction):
+        [-f_j, f_j], opened to -inf at a lower limit and to +inf at an upper one."""
+        lo = np.where(self.at_lower, -np.inf, -self.static)
+        hi = np.where(self.at_upper, np.inf, self.static)
+        return lo, hi
+
+    def slip_allowed(self, j, sign):
+        """May resting joint j slip in direction sign (+1 / -1)? Not into a limit it rests on."""
+        return not (self.at_lower[j] if sign < 0 else self.at_upper[j])
+
+    def split_torque(self, mu):
+        """Physical (friction, limit) torques of multipliers mu (n,) on resting joints: friction
+        clip(-mu, -f, f) on limit joints (-mu elsewhere), the limit reaction the rest."""
+        total = -np.asarray(mu, float)
+        friction = np.where(self.on_limit, np.clip(total, -self.static, self.static), total)
+        return friction, total - friction
 
     def gauss(self, qdd):
         d = np.asarray(qdd) - self.qdd_free
@@ -133,6 +178,7 @@ class OracleResult:
     tau_command: np.ndarray = None  # -A^T lam, tie-broken
     lam: np.ndarray = None
     info: dict = field(default_factory=dict)
+    limit_torque: np.ndarray = None  # reactions of the joint limits (>= 0 lower, <= 0 upper), tie-broken
 
 
 def _sym(M, n):
@@ -141,11 +187,13 @@ def _sym(M, n):
 
 
 def pinocchio_problem(model, data, q, qd, *, tau_ff=None, fext_tau=None, static, kinetic=None,
-                      velocity_tolerance=1e-6, tip_frame=None, alpha=None, beta=None):
+                      velocity_tolerance=1e-6, tip_frame=None, alpha=None, beta=None, at_lower=None,
+                      at_upper=None):
     """The friction problem of a Pinocchio model (gravity = model.gravity).
 
     q: Pinocchio configuration (nq); qd (nv); tau_ff (nv); fext_tau: generalised external force
-    J_ext^T f_ext (nv) or None; static / kinetic: per joint; alpha (6 x m), beta (m) on tip_frame.
+    J_ext^T f_ext (nv) or None; static / kinetic: per joint; alpha (6 x m), beta (m) on tip_frame;
+    at_lower / at_upper: (nv,) bool limit flags (see :func:`limit_flags`), default none.
     """
     nv = model.nv
     qd = np.asarray(qd, float)
@@ -169,7 +217,48 @@ def pinocchio_problem(model, data, q, qd, *, tau_ff=None, fext_tau=None, static,
         A = alpha.T @ J
         b = np.asarray(beta, float).reshape(-1) - alpha.T @ (a0 + np.r_[-g, 0.0, 0.0, 0.0])
     return FrictionProblem(H, qdd_free, A, b, resting, static, kin,
-                           extra=dict(J=J, tau_ff=tau_ff, fext_tau=fext_tau, g=g))
+                           extra=dict(J=J, tau_ff=tau_ff, fext_tau=fext_tau, g=g),
+                           at_lower=at_lower, at_upper=at_upper)
+
+
+def limit_flags(q, lower, upper, limit_tolerance=1e-9):
+    """(at_lower, at_upper) of joint positions q: q_j <= lower_j + tol, q_j >= upper_j - tol
+    (the rule of vereshchagin.Friction; +-inf limits never hold)."""
+    q = np.asarray(q, float)
+    return q <= np.asarray(lower, float) + limit_tolerance, q >= np.asarray(upper, float) - limit_tolerance
+
+
+def limit_margin(prob, cap=1.0):
+    """Largest t <= cap such that some qdd meets the task with qdd_j >= t at lower limits,
+    qdd_j <= -t at upper limits and qdd_j = 0 at joints on both, by linear programming (HiGHS).
+    > 0: the primal has a point strictly inside its one-sided constraints; < 0: it is infeasible
+    (the task forces a joint into its limit); 0: feasible only on the boundary. qdd is measured in
+    units of ``accel_scale()``. -inf if even the equalities (task, locked joints) are inconsistent;
+    None if no joint is on a limit."""
+    from scipy.optimize import linprog
+
+    if not prob.on_limit.any():
+        return None
+    n, s = prob.n, prob.accel_scale()
+    locked = prob.at_lower & prob.at_upper
+    # variables [qdd / s (n), t]; maximise t
+    rows = []
+    for j in np.flatnonzero(prob.on_limit & ~locked):
+        r = np.zeros(n + 1)
+        r[j], r[n] = (-1.0 if prob.at_lower[j] else 1.0), 1.0  # t <= qdd_j (lower), t <= -qdd_j (upper)
+        rows.append(r)
+    E = np.zeros((int(locked.sum()), n))
+    E[np.arange(E.shape[0]), np.flatnonzero(locked)] = 1.0
+    Aeq = np.hstack([np.vstack([prob.A, E]), np.zeros((prob.A.shape[0] + E.shape[0], 1))])
+    beq = np.r_[prob.b / s, np.zeros(E.shape[0])]
+    res = linprog(np.r_[np.zeros(n), -1.0], A_ub=np.array(rows) if rows else None,
+                  b_ub=np.zeros(len(rows)) if rows else None, A_eq=Aeq if Aeq.shape[0] else None,
+                  b_eq=beq if Aeq.shape[0] else None, bounds=[(None, None)] * n + [(None, cap)], method="highs")
+    if res.status == 2:
+        return -np.inf
+    if res.status != 0:
+        raise OracleFailure(f"limit_margin: linprog status {res.status}: {res.message}")
+    return float(res.x[n])
 
 
 def random_problem(rng, n, m, resting_fraction=1.0, friction="mixed"):
@@ -293,31 +382,49 @@ def _tie_break_data(prob, qdd, zero_tol):
     return Zj, Sj, c, N
 
 
+def _bound_table(lo, hi):
+    """(|B|, K) matrix of all choices of a finite bound (hi or lo) per entry; K = 0 if some entry
+    has none (a joint at both limits cannot be held at a bound)."""
+    choices = [[v for v in (h, l) if np.isfinite(v)] for l, h in zip(lo, hi)]
+    if any(not c for c in choices):
+        return np.zeros((len(choices), 0))
+    if not choices:
+        return np.zeros((0, 1))
+    return np.array(list(itertools.product(*choices)), float).T
+
+
 def tie_break(prob, qdd, zero_tol=None):
-    """Exact tie-break by enumerating the active sets (free / +f / -f) of the free multipliers:
+    """Exact tie-break by enumerating the active sets (free / hi / lo) of the free multipliers:
 
-        minimise ||tau||^2,  tau = c + E_Z mu_Z,  N^T tau = 0,  |mu_Z| <= f_Z.
+        minimise ||tau||^2,  tau = c + E_Z mu_Z,  N^T tau = 0,  lo_Z <= mu_Z <= hi_Z
 
-    Each active set is an equality-constrained least-squares problem (exact); the lowest value among
-    the feasible ones is the optimum (strictly convex in mu_Z). Returns (mu (n,), tau_command (n,),
-    lam (m,)). Raises OracleFailure if no valid multiplier exists (then qdd is not optimal)."""
+    (bounds -+f_Z, opened at joint limits: ``FrictionProblem.mu_bounds``). Each active set is an
+    equality-constrained least-squares problem (exact); the lowest value among the feasible ones is
+    the optimum (strictly convex in mu_Z). Returns (mu (n,), tau_command (n,), lam (m,)). Raises
+    OracleFailure if no valid multiplier exists (then qdd is not optimal)."""
     if zero_tol is None:
         zero_tol = 1e-12 * prob.accel_scale(qdd)
     Zj, Sj, c, N = _tie_break_data(prob, qdd, zero_tol)
-    f = prob.static[Zj]
+    lo_all, hi_all = prob.mu_bounds()
+    lo, hi = lo_all[Zj], hi_all[Zj]
     tscale = prob.torque_scale(qdd)
     best, best_val = None, np.inf
     kz = Zj.size
     for free_mask in itertools.product((True, False), repeat=kz):
         free_mask = np.array(free_mask, bool)
         free, bnd = np.flatnonzero(free_mask), np.flatnonzero(~free_mask)
-        signs = _sign_table(bnd.size)  # (|B|, K)
-        K = signs.shape[1]
+        vals_b = _bound_table(lo[bnd], hi[bnd])  # (|B|, K)
+        K = vals_b.shape[1]
+        if K == 0:
+            continue
         base = np.repeat(c[:, None], K, axis=1)  # (n, K)
-        base[Zj[bnd], :] += f[bnd, None] * signs
+        base[Zj[bnd], :] += vals_b
         X, ok = equality_qp_batch(np.eye(free.size), base[Zj[free], :], N[Zj[free], :].T, -N.T @ base,
                                   feas_rtol=1e-10)
-        ok &= np.all(np.abs(X) <= f[free, None] * (1.0 + 1e-12) + 1e-14 * tscale, axis=0)
+        slack_hi = np.where(np.isfinite(hi[free]), np.abs(hi[free]) * 1e-12, 0.0)[:, None] + 1e-14 * tscale
+        slack_lo = np.where(np.isfinite(lo[free]), np.abs(lo[free]) * 1e-12, 0.0)[:, None] + 1e-14 * tscale
+        ok &= np.all(X <= hi[free, None] + slack_hi, axis=0)
+        ok &= np.all(X >= lo[free, None] - slack_lo, axis=0)
         tau = base
         tau[Zj[free], :] += X
         ok &= np.linalg.norm(N.T @ tau, axis=0) <= 1e-9 * tscale
@@ -328,11 +435,11 @@ def tie_break(prob, qdd, zero_tol=None):
         if vals[i] < best_val:
             best_val = vals[i]
             mu = np.zeros(kz)
-            mu[bnd] = f[bnd] * signs[:, i]
+            mu[bnd] = vals_b[:, i]
             mu[free] = X[:, i]
             best = mu
     if best is None:
-        raise OracleFailure("tie_break: no multipliers with |mu_j| <= f_j satisfy stationarity: qdd is not optimal")
+        raise OracleFailure("tie_break: no multipliers within their bounds satisfy stationarity: qdd is not optimal")
     mu_full = np.zeros(prob.n)
     mu_full[Sj] = prob.static[Sj] * np.sign(qdd[Sj])
     mu_full[Zj] = best
@@ -370,9 +477,13 @@ def tie_break_scipy(prob, qdd, zero_tol=None):
 def _finish(prob, qdd, objective, info, zero_tol=None):
     mu, tau, lam = tie_break(prob, qdd, zero_tol)
     friction = prob.kinetic_torque.copy()
-    friction[prob.rest_idx] = -mu[prob.rest_idx]
+    fr, limit = prob.split_torque(mu)
+    R = prob.rest_idx
+    friction[R] = fr[R]
+    limit_torque = np.zeros(prob.n)
+    limit_torque[R] = limit[R]
     zt = 1e-12 * prob.accel_scale(qdd) if zero_tol is None else zero_tol
-    return OracleResult(qdd, objective, classify(prob, qdd, zt), friction, tau, lam, info)
+    return OracleResult(qdd, objective, classify(prob, qdd, zt), friction, tau, lam, info, limit_torque)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -386,15 +497,24 @@ def enumeration_oracle(prob, max_resting=7):
     if k > max_resting:
         raise ValueError(f"enumeration_oracle: {k} resting joints > {max_resting}")
     Hx0 = prob.H @ prob.qdd_free
-    best, best_val, n_feasible = None, np.inf, 0
+    best, best_val, n_feasible, n_patterns = None, np.inf, 0, 0
+    locked = prob.at_lower & prob.at_upper  # on both limits: cannot slip at all
     for stick_mask in itertools.product((True, False), repeat=k):
         stick_mask = np.array(stick_mask, bool)
+        if np.any(locked[R[~stick_mask]]):
+            continue
         stick = np.zeros(n, bool)
         stick[R[stick_mask]] = True
         F = np.flatnonzero(~stick)
         T = np.flatnonzero(np.isin(F, R))  # slipping resting joints, positions in F
         signs = _sign_table(T.size)
+        # a joint on a limit slips only away from it
+        allowed = np.array([all(prob.slip_allowed(F[t], s) for t, s in zip(T, col)) for col in signs.T], bool)
+        signs = signs[:, allowed]
         K = signs.shape[1]
+        n_patterns += K
+        if K == 0:
+            continue
         p = np.repeat(-Hx0[F][:, None], K, axis=1)
         p[T, :] += prob.static[F[T], None] * signs
         X, ok = equality_qp_batch(prob.H[np.ix_(F, F)], p, prob.A[:, F], np.repeat(prob.b[:, None], K, axis=1))
@@ -414,17 +534,19 @@ def enumeration_oracle(prob, max_resting=7):
         if vals[i] < best_val:
             best_val, best = vals[i], Xf[:, i].copy()
     if best is None:
-        raise OracleFailure("enumeration_oracle: no feasible pattern (inconsistent task?)")
-    return _finish(prob, best, prob.objective(best), dict(patterns=3 ** k, feasible=n_feasible))
+        raise OracleInfeasible(f"enumeration_oracle: no feasible pattern among {n_patterns} (inconsistent task, "
+                               f"or the task forces a joint into its limit?)")
+    return _finish(prob, best, prob.objective(best), dict(patterns=n_patterns, feasible=n_feasible))
 
 
 # ------------------------------------------------------------------------------------------------
 # (a) scipy on the primal problem, polished and certified
 # ------------------------------------------------------------------------------------------------
 def _certify(prob, x, stick_joints):
-    """Is there (lam, mu_stick) with |mu_stick| <= f and H (x - x0) + mu + A^T lam = 0 (mu of the
+    """Is there (lam, mu_stick) with mu_stick in its bounds and H (x - x0) + mu + A^T lam = 0 (mu of the
     other resting joints = f sign(x))? Bounded least squares by BVLS (an exact active-set method).
-    Returns (scaled residual, unconstrained least-squares multipliers of the stuck joints)."""
+    Bounds opened at joint limits (``mu_bounds``). Returns (scaled residual, unconstrained
+    least-squares multipliers of the stuck joints)."""
     R = prob.rest_idx
     S = np.array([j for j in R if j in stick_joints], int)
     P = np.array([j for j in R if j not in stick_joints], int)
@@ -437,8 +559,9 @@ def _certify(prob, x, stick_joints):
     if M.shape[1] == 0:
         return np.linalg.norm(c) / prob.torque_scale(x), np.zeros(0)
     free_mu = np.linalg.lstsq(M, -c, rcond=None)[0][m:]
-    lo = np.r_[np.full(m, -np.inf), -prob.static[S]]
-    hi = np.r_[np.full(m, np.inf), prob.static[S]]
+    mlo, mhi = prob.mu_bounds()
+    lo = np.r_[np.full(m, -np.inf), mlo[S]]
+    hi = np.r_[np.full(m, np.inf), mhi[S]]
     hi = np.where(hi <= lo, lo + 1e-300, hi)  # f = 0: lsq_linear needs lo < hi
     sol = lsq_linear(M, -c, bounds=(lo, hi), method="bvls", tol=1e-15, max_iter=10000)
     return np.linalg.norm(M @ sol.x + c) / prob.torque_scale(x), free_mu
@@ -468,9 +591,13 @@ def _slsqp_primal(prob):
     u0 = equality_qp(H, -Hx0, prob.A, prob.b)  # frictionless constrained motion (feasible start)
     if u0 is None:
         raise OracleFailure("scipy_oracle: inconsistent task")
+    # a joint on a lower (upper) limit: u_j >= 0 (<= 0); the start is moved into these bounds
+    u0 = np.where(prob.at_lower, np.maximum(u0, 0.0), u0)
+    u0 = np.where(prob.at_upper, np.minimum(u0, 0.0), u0)
     y0 = np.r_[u0, np.maximum(u0[R], 0.0), np.maximum(-u0[R], 0.0)]
     cons = [dict(type="eq", fun=lambda y: Ceq @ y - deq, jac=lambda y: Ceq)] if m + k else []
-    bounds = [(None, None)] * n + [(0.0, None)] * (2 * k)
+    bounds = [(0.0 if prob.at_lower[j] else None, 0.0 if prob.at_upper[j] else None) for j in range(n)]
+    bounds += [(0.0, None)] * (2 * k)
     res = minimize(fun, y0, jac=jac, bounds=bounds, constraints=cons, method="SLSQP",
                    options=dict(ftol=1e-12, maxiter=300))
     return res.x[:n], res
@@ -516,6 +643,8 @@ def scipy_oracle(prob, thresholds=(1e-6, 1e-9, 1e-3), max_polish=None):
     log = []
     for thr in thresholds:
         pattern = {j: (STICK if abs(u[j]) <= thr * scale else (SLIP_POS if u[j] > 0 else SLIP_NEG)) for j in R}
+        pattern = {j: (p if p == STICK or prob.slip_allowed(j, 1 if p == SLIP_POS else -1) else STICK)
+                   for j, p in pattern.items()}
         for step in range(max_polish + 1):
             x = _kkt_candidate(prob, pattern)
             if x is None:
@@ -535,12 +664,13 @@ def scipy_oracle(prob, thresholds=(1e-6, 1e-9, 1e-3), max_polish=None):
                                     certificate_residual=resid, polish_shift=np.linalg.norm(x - u) / scale),
                                zero_tol=0.0)
             S = sorted(stick)
-            ratio = [abs(mu_ls[i]) - prob.static[j] for i, j in enumerate(S)]
+            mlo, mhi = prob.mu_bounds()
+            ratio = [max(mu_ls[i] - mhi[j], mlo[j] - mu_ls[i]) for i, j in enumerate(S)]
             if not S or max(ratio) <= 0:
                 log.append((thr, step, f"certificate residual {resid:.2e}"))
                 break
             i = int(np.argmax(ratio))
-            pattern[S[i]] = SLIP_POS if mu_ls[i] > 0 else SLIP_NEG
+            pattern[S[i]] = SLIP_POS if mu_ls[i] > mhi[S[i]] else SLIP_NEG
             log.append((thr, step, f"release joint {S[i]}"))
     raise OracleFailure(f"scipy_oracle: no polished pattern certified optimal (SLSQP: {res.message}); log {log}")
 
