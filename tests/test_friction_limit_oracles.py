@@ -19,9 +19,9 @@ friction is +2 and the limit +2.9); the task; |friction_j| <= f_j; limit_torque 
 <= 0 at an upper one, exactly 0 elsewhere; a nonzero limit torque only at a joint sticking on its
 limit with its friction at the bound; qdd_j >= 0 at a lower limit and <= 0 at an upper one.
 
-``test_small_friction_on_limit_held_by_task`` is a strict xfail: a known solver bug (friction
-<~ 1e-6 of the torques, or 0, on a limit joint whose acceleration the task fixes); remove the mark
-when it is fixed.
+``test_small_friction_on_limit_held_by_task`` is the regression test of a fixed solver bug: with
+friction 0 or <~ 1e-6 of the torques on a limit joint whose acceleration the task fixes, the QP's
+gradient tolerance fell below the round-off of its gradient ('unbounded' error, no tie-break).
 """
 from __future__ import annotations
 
@@ -447,10 +447,6 @@ def _arm_1dof():
     return chain
 
 
-@pytest.mark.xfail(strict=True, reason="solver bug: with f_j <~ 1e-6 x the torques (incl. 0) on a limit joint whose "
-                                       "acceleration the task fixes, the box QP's gradient tolerance "
-                                       "(1e-11 x max(|c|, qscale x largest finite bound)) is below the round-off "
-                                       "of c: 'unbounded' SolverError, or no least-command tie-break")
 @pytest.mark.parametrize("f", [0.0, 1e-6])
 @pytest.mark.parametrize("side", ["lower", "upper"])
 @pytest.mark.parametrize("push", ["into", "away"])

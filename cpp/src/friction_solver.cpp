@@ -291,7 +291,12 @@ int FrictionSolver::boxQp(int k) {
   }
   // Scale of the gradient (accelerations): the frictionless ones and what the largest friction
   // bound can cause, at Q's physical scale (not Q's entries, which a task can make vanish).
-  gscale_ = std::max({c_.head(k).cwiseAbs().maxCoeff(), qscale_ * xscale, 1e-300});
+  // Also the torques acting (feed-forward, kinetic friction, the frictionless motor command)
+  // times Q's scale, and all frictionless accelerations: when a task fixes the resting joints
+  // and the friction bounds are zero or tiny, c is round-off and the bounds are no scale.
+  const double torque_scale = std::max(tau0_.cwiseAbs().maxCoeff(), tau_cmd0_.cwiseAbs().maxCoeff());
+  gscale_ = std::max({c_.head(k).cwiseAbs().maxCoeff(), qscale_ * xscale, qscale_ * torque_scale,
+                      qdd0_.cwiseAbs().maxCoeff(), 1e-300});
   const double tol_g = kGradientTolerance * gscale_;
   // Iteration bound. Between two face-optimal points each iteration binds one more variable (a
   // blocked step) or ends on the face optimum (a full step): at most k + 1 iterations. The
