@@ -6,6 +6,7 @@
 #include "vereshchagin/chain_hd_solver.hpp"
 
 #include "dense_small.hpp"
+#include "model_validation.hpp"
 
 #if defined(__GNUC__) && !defined(__clang__)
 // GCC 12 reports a false -Warray-bounds on Eigen's SSE loads of 1x1 fixed-size products.
@@ -86,6 +87,7 @@ const char* ChainHdSolver::strError(const int code) const {
     case E_TOO_MANY_CONSTRAINTS: return "More than 6 constraints on one segment";
     case E_NO_SOLUTION: return "No successful solve to take the response from";
     case E_INVALID_OPTIONS: return "Invalid solver options";
+    case E_NONFINITE_RESULT: return "The results overflow (inputs too large)";
     default: return KDL::SolverI::strError(code);
   }
 }
@@ -124,6 +126,10 @@ void ChainHdSolver::buildModel() {
     const KDL::Segment& seg = chain_.getSegment(i);
     const KDL::Joint& joint = seg.getJoint();
     Segment& s = segs_[i];
+    if (const char* why = detail::segmentGeometryProblem(seg)) {
+      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): %s", i, seg.getName().c_str(), why);
+      return;
+    }
     const KDL::RigidBodyInertia& rbi = seg.getInertia();
     const double mass = rbi.getMass();
     const KDL::Vector cog = rbi.getCOG();
@@ -551,6 +557,14 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
     default: finalSweepT<6>(ff_torques); break;
   }
   commandFromNu(nu_, tau_cmd_);
+  // Finite inputs can still overflow (|q_dot| ~ 1e160 squares to Inf): never return Inf or NaN.
+  bool finite = qdd_.allFinite() && tau_cmd_.allFinite() && nu_.allFinite();
+  for (unsigned int i = 0; finite && i < ns_; ++i) finite = segs_[i].xdd.allFinite();
+  if (!finite)
+    return fail(E_NONFINITE_RESULT, "the results overflow to Inf/NaN: inputs too large (max |q_dot| %g, "
+                "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
+                ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
+                f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   error = E_NOERROR;
   return E_NOERROR;

@@ -61,27 +61,27 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   const Eigen::VectorXd& fs = friction.static_friction;
   const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
   if (fs.size() != n)
-    return fail(E_INVALID_FRICTION, "static friction has %ld entries, expected %ld (joints)", (long)fs.size(), n);
+    return fail(E_INVALID_FRICTION, "friction.static_friction has %ld entries, expected %ld (joints)", (long)fs.size(), n);
   if (fk.size() != n)
-    return fail(E_INVALID_FRICTION, "kinetic friction has %ld entries, expected %ld (joints) or 0", (long)fk.size(), n);
+    return fail(E_INVALID_FRICTION, "friction.kinetic_friction has %ld entries, expected %ld (joints) or 0", (long)fk.size(), n);
   if (!std::isfinite(friction.velocity_tolerance) || friction.velocity_tolerance < 0.0)
-    return fail(E_INVALID_FRICTION, "velocity tolerance must be finite and >= 0, got %g", friction.velocity_tolerance);
+    return fail(E_INVALID_FRICTION, "friction.velocity_tolerance must be finite and >= 0, got %g", friction.velocity_tolerance);
   for (long j = 0; j < n; ++j) {
     if (!std::isfinite(fs(j)) || fs(j) < 0.0)
-      return fail(E_INVALID_FRICTION, "static friction of joint %ld must be finite and >= 0, got %g", j, fs(j));
+      return fail(E_INVALID_FRICTION, "friction.static_friction(%ld) must be finite and >= 0, got %g", j, fs(j));
     if (!std::isfinite(fk(j)) || fk(j) < 0.0 || fk(j) > fs(j))
-      return fail(E_INVALID_FRICTION, "kinetic friction of joint %ld must be in [0, static = %g], got %g", j, fs(j), fk(j));
+      return fail(E_INVALID_FRICTION, "friction.kinetic_friction(%ld) must be finite and in [0, static_friction = %g], got %g", j, fs(j), fk(j));
   }
   const bool limits = friction.lower.size() != 0 || friction.upper.size() != 0;
   if (limits) {
     if (friction.lower.size() != n || friction.upper.size() != n)
-      return fail(E_INVALID_FRICTION, "joint limits need lower and upper with %ld entries each", n);
+      return fail(E_INVALID_FRICTION, "friction.lower and friction.upper must have %ld entries each (or both be empty)", n);
     if (!std::isfinite(friction.limit_tolerance) || friction.limit_tolerance < 0.0)
-      return fail(E_INVALID_FRICTION, "limit tolerance must be finite and >= 0, got %g", friction.limit_tolerance);
+      return fail(E_INVALID_FRICTION, "friction.limit_tolerance must be finite and >= 0, got %g", friction.limit_tolerance);
     for (long j = 0; j < n; ++j)
       if (std::isnan(friction.lower(j)) || std::isnan(friction.upper(j)) || friction.lower(j) > friction.upper(j))
-        return fail(E_INVALID_FRICTION, "joint %ld: limits must satisfy lower <= upper (got %g, %g)", j,
-                    friction.lower(j), friction.upper(j));
+        return fail(E_INVALID_FRICTION, "friction.lower(%ld) must be <= friction.upper(%ld), neither NaN, got %g and %g",
+                    j, j, friction.lower(j), friction.upper(j));
   }
   if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0)) {
     // Let the hybrid-dynamics solver report the size problem with its message.
@@ -163,7 +163,7 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
   link_acc_known_ = k == 0;
 
   // Friction torques and status.
-  const double acc_scale = std::max(1.0, qdd_.cwiseAbs().maxCoeff());
+  const double acc_scale = std::max(1.0, n ? qdd_.cwiseAbs().maxCoeff() : 0.0);  // (no joints: empty)
   int a = 0;
   for (long j = 0; j < n; ++j) {
     if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
@@ -183,6 +183,12 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
     const double acc = qdd_(j);
     status_[j] = std::abs(acc) <= 1e-9 * acc_scale ? Stick : (acc > 0.0 ? SlipPositive : SlipNegative);
   }
+  // The optimum is affine in finite friction bounds, but huge values can still overflow.
+  if (!(qdd_.allFinite() && tau_cmd_.allFinite() && friction_.allFinite() && limit_.allFinite() &&
+        nu_.head(m_keep_).allFinite()))
+    return fail(ChainHdSolver::E_NONFINITE_RESULT,
+                "the results overflow to Inf/NaN: friction or other inputs too large (max static friction %g)",
+                n ? fs.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   return ChainHdSolver::E_NOERROR;
 }

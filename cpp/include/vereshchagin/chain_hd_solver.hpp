@@ -99,6 +99,7 @@ class ChainHdSolver : public KDL::SolverI {
     E_TOO_MANY_CONSTRAINTS = -103, // alfa has more than 6 columns
     E_NO_SOLUTION = -104,          // responseColumns() called before a successful solve
     E_INVALID_OPTIONS = -105,      // rcond < 0, damping <= 0 for the damped policy, non-finite
+    E_NONFINITE_RESULT = -106,     // finite inputs whose results overflow (e.g. |q_dot| ~ 1e160)
   };
 
   // The chain is copied. root_acc: base acceleration (gravity as +9.81 along up), see above.
