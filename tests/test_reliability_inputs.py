@@ -119,29 +119,33 @@ def test_overflowing_inputs_raise_instead_of_nan(kw):
 
 # URDF ---------------------------------------------------------------------------------------------
 def urdf(joint_extra="", origin='xyz="0 0 0.1" rpy="0 0 0"', mass="1.0", inertial_origin='xyz="0 0 0.1"',
-         ixx="0.01", axis="0 0 1"):
+         ixx="0.01", axis="0 0 1", jtype="continuous"):
     return f"""<robot name="r">
   <link name="base"/>
   <link name="l1"><inertial><origin {inertial_origin}/><mass value="{mass}"/>
     <inertia ixx="{ixx}" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
-  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin {origin}/>
+  <joint name="j1" type="{jtype}"><parent link="base"/><child link="l1"/><origin {origin}/>
     <axis xyz="{axis}"/>{joint_extra}</joint>
 </robot>"""
 
 
 def test_valid_urdf_loads():
-    chain = vs.Chain.from_urdf(urdf('<limit lower="-1" upper="1" effort="1" velocity="1"/>'))
+    chain = vs.Chain.from_urdf(urdf('<limit lower="-1" upper="1" effort="1" velocity="1"/>', jtype="revolute"))
     assert chain.n_joints == 1
 
 
 @pytest.mark.parametrize("kw,fragments", [
     (dict(mass="-2"), ["l1", "mass"]),
     (dict(ixx="-1"), ["l1", "inertia", "positive semi-definite"]),
-    (dict(origin='xyz="nan 0 0"'), ["j1", "origin", "finite"]),
-    (dict(origin='xyz="0 0 0" rpy="0 inf 0"'), ["j1", "origin", "finite"]),
-    (dict(inertial_origin='xyz="0 nan 0"'), ["l1", "finite"]),
+    (dict(origin='xyz="nan 0 0"'), ["j1", "origin", "nan"]),       # urdfdom rejects NaN / Inf text,
+    (dict(origin='xyz="0 0 0" rpy="0 inf 0"'), ["j1", "origin"]),   # the loader overflowing values
+    (dict(origin='xyz="1e400 0 0"'), ["j1", "origin"]),
+    (dict(inertial_origin='xyz="0 nan 0"'), ["l1", "inertial"]),
+    (dict(inertial_origin='xyz="0 1e999 0"'), ["l1", "inertial"]),
+    (dict(mass="1e999"), ["l1", "mass"]),
     (dict(axis="0 0 0"), ["j1", "axis"]),
-    (dict(joint_extra='<limit lower="1" upper="-1" effort="1" velocity="1"/>'), ["j1", "lower limit above upper"]),
+    (dict(jtype="revolute", joint_extra='<limit lower="1" upper="-1" effort="1" velocity="1"/>'),
+     ["j1", "lower limit above upper"]),
     (dict(joint_extra='<dynamics friction="-0.5"/>'), ["j1", "friction", ">= 0"]),
     (dict(joint_extra='<dynamics damping="-0.5"/>'), ["j1", "damping", ">= 0"]),
 ])

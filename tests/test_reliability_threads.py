@@ -23,7 +23,8 @@ def workload(seed, count=12):
         m = k % 4
         alpha = random_alpha(rng, m) if m else None
         beta = rng.normal(size=m) if m else None
-        fr = vs.Friction(static=rng.uniform(0, 3, n), kinetic=rng.uniform(0, 1, n))
+        fs = rng.uniform(0, 3, n)
+        fr = vs.Friction(static=fs, kinetic=fs * rng.uniform(0, 1, n))
         calls.append((q, qd, alpha, beta, random_f_ext(rng, rc), rng.normal(size=n), fr))
     batch = (rng.uniform(-1, 1, (16, n)), rng.uniform(-1, 1, (16, n)))
     return rc, calls, batch

@@ -124,7 +124,9 @@ std::string exerciseChain(const KDL::Chain& chain, ByteReader& r, const Eigen::V
   if (!bad.empty()) return bad;
   if (rc == 0) {
     if (!fs.linkAccelerations().allFinite()) return "FrictionSolver::linkAccelerations non-finite after success";
-    if (!std::isfinite(fs.gaussValue())) return "FrictionSolver::gaussValue non-finite after success";
+    if (!std::isfinite(fs.gaussValue()))
+      return "FrictionSolver::gaussValue non-finite after success: " + std::to_string(fs.gaussValue()) + " (max abs qdd " +
+             std::to_string(n ? fs.qdd().cwiseAbs().maxCoeff() : 0.0) + ")";
     for (unsigned int k = 0; k < n; ++k) {
       const double f = fs.frictionTorques()(k);
       const double bound = std::abs(qd(k)) > fm.velocity_tolerance

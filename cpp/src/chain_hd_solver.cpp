@@ -363,7 +363,11 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
         e.noalias() = s.S.transpose() * A;
         U.noalias() += A.transpose() * (s.c + s.S * free);
         L.noalias() -= s.Dinv * e.transpose() * e;
-        kappa += s.Dinv * s.S.squaredNorm() * A.squaredNorm();
+        // |e_c| = |v.f_c + w.n_c| <= |v||f_c| + |w||n_c|: a bound in consistent units (the
+        // product of |S|^2 and |A_c|^2 mixes N with N m and inflates at small lengths).
+        kappa += s.Dinv * (s.S.template head<3>().norm() * A.template topRows<3>().colwise().norm() +
+                           s.S.template tail<3>().norm() * A.template bottomRows<3>().colwise().norm())
+                              .squaredNorm();
         Aproj = A;
         Aproj.noalias() -= s.Dinv * s.u * e;
       }
@@ -557,11 +561,12 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
     default: finalSweepT<6>(ff_torques); break;
   }
   commandFromNu(nu_, tau_cmd_);
-  // Finite inputs can still overflow (|q_dot| ~ 1e160 squares to Inf): never return Inf or NaN.
-  bool finite = qdd_.allFinite() && tau_cmd_.allFinite() && nu_.allFinite();
-  for (unsigned int i = 0; finite && i < ns_; ++i) finite = segs_[i].xdd.allFinite();
+  // Finite inputs can still overflow (|q_dot| ~ 1e160 squares to Inf): never return Inf or NaN,
+  // nor results beyond kMaxResult whose products (energies, powers) would overflow.
+  bool finite = detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu_);
+  for (unsigned int i = 0; finite && i < ns_; ++i) finite = detail::bounded(segs_[i].xdd);
   if (!finite)
-    return fail(E_NONFINITE_RESULT, "the results overflow to Inf/NaN: inputs too large (max |q_dot| %g, "
+    return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
                 "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
                 ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
                 f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "dense_small.hpp"
+#include "model_validation.hpp"
 
 namespace vereshchagin {
 
@@ -184,10 +185,11 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
     status_[j] = std::abs(acc) <= 1e-9 * acc_scale ? Stick : (acc > 0.0 ? SlipPositive : SlipNegative);
   }
   // The optimum is affine in finite friction bounds, but huge values can still overflow.
-  if (!(qdd_.allFinite() && tau_cmd_.allFinite() && friction_.allFinite() && limit_.allFinite() &&
-        nu_.head(m_keep_).allFinite()))
+  if (!(detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(friction_) && detail::bounded(limit_) &&
+        detail::bounded(nu_.head(m_keep_))))
     return fail(ChainHdSolver::E_NONFINITE_RESULT,
-                "the results overflow to Inf/NaN: friction or other inputs too large (max static friction %g)",
+                "the results overflow (Inf/NaN or beyond 1e150): friction or other inputs too large (max static "
+                "friction %g)",
                 n ? fs.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   return ChainHdSolver::E_NOERROR;

@@ -6,8 +6,8 @@
 //  * FrictionSolver messages name the FrictionModel field; huge static friction (1e300) holds a
 //    resting arm exactly (no overflow, qdd = 0, |friction| <= static);
 //  * extreme but valid scales: masses 1e-6..1e4 kg and lengths 1e-4..1e2 m (every combination)
-//    give finite outputs, and the command torques reproduce qdd through unconstrained forward
-//    dynamics to 1e-8 relative;
+//    give finite outputs, full constraint rank with the task met, and command torques that
+//    reproduce qdd through unconstrained forward dynamics to 1e-8 relative;
 //  * determinism: two instances and repeated calls give bit-identical outputs.
 #include <cmath>
 #include <string>
@@ -195,6 +195,11 @@ int main() {
       const Eigen::Vector2d beta(9.81, 0.0);
       int rc = s.solve(q, qd, alfa, beta, Matrix6X(6, 0), ff);
       if (!ck.check(rc == 0 && allFinite(s), tag + ": rc " + str(rc) + " " + s.errorMessage())) continue;
+      // Both constraints are independent at every scale (regression: the truncation scale kappa
+      // mixed N and N m and dropped the linear constraint at lengths 1e-4).
+      ck.check(s.constraintRank() == 2, tag + ": constraint rank " + str(s.constraintRank()) + ", expected 2");
+      const Eigen::Vector2d met(s.linkAccelerations()(2, 6), s.linkAccelerations()(4, 6));
+      ck.check(testutil::relErr(met, beta) <= 1e-8, tag + ": task not met: " + testutil::mat(met));
       rc = free.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), ff + s.commandTorques());
       ck.check(rc == 0 && testutil::relErr(free.qdd(), s.qdd()) <= 1e-8,
                tag + ": command torques do not reproduce qdd: " + testutil::mat(free.qdd()) + " vs " + testutil::mat(s.qdd()));
