@@ -20,7 +20,7 @@ hypothesis on failure.
 """
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 import vereshchagin as vs
@@ -112,7 +112,9 @@ def test_friction_complementarity(params, m, rest_mask, friction_scale, kinetic_
     except vs.SolverError as e:
         # the only documented failure of a valid friction problem: a task pushing into a limit
         assert "limit" in str(e), str(e)
+        event("task drives a joint into its limit")
         return
+    event("solved")
     assert_finite(res, "qdd", "tau_command", "nu", "friction_torque", "limit_torque", "link_acc")
     assert np.isfinite(res.gauss_value)
     acc_scale = max(1.0, np.abs(res.qdd).max())

@@ -125,3 +125,17 @@ def test_friction_zero_and_huge(f):
         np.testing.assert_allclose(res.qdd, free.qdd, rtol=1e-12, atol=1e-12)
     assert np.all(np.abs(res.friction_torque) <= f)
     reproduces(chain, q, qd, res, tau_ff=res.friction_torque)
+
+
+@pytest.mark.parametrize("fixed_segments", [0, 2])
+def test_chain_without_moving_joints(fixed_segments):
+    # Regression: the friction solve read the maximum of an empty vector (a crash).
+    chain = vs.Chain()
+    for k in range(fixed_segments):
+        chain.add_segment(f"plate{k}", vs.Joint.fixed(), tip=homogeneous(None, [0, 0, 0.1]), mass=1.0)
+    solver = vs.Solver(chain)
+    for kw in (dict(), dict(friction=vs.Friction(static=np.zeros(0))), dict(friction=True),
+               dict(alpha=np.eye(6)[:, [2]], beta=[1.0], friction=vs.Friction(static=[]))):
+        res = solver.solve(np.zeros(0), np.zeros(0), **kw)
+        finite(res)
+        assert res.qdd.shape == (0,)
