@@ -107,7 +107,8 @@ def test_friction_errors(kw, fragments):
 # Finite inputs whose results overflow ------------------------------------------------------------
 @pytest.mark.parametrize("kw", [dict(qd=np.full(N, 1e160)), dict(tau_ff=np.full(N, 1e308)),
                                 dict(f_ext=np.full((N, 6), 1e308)),
-                                dict(alpha=np.eye(6)[:, :1], beta=[1e308])])
+                                dict(alpha=np.eye(6)[:, :1], beta=[1e308]),
+                                dict(alpha=np.full((6, 2), 1e200), beta=[1.0, 2.0])])  # K overflows
 def test_overflowing_inputs_raise_instead_of_nan(kw):
     solver = vs.Solver(seven_joint_arm())
     args = dict(q=np.full(N, 0.4), qd=np.zeros(N))

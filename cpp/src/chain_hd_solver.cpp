@@ -563,7 +563,9 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
   commandFromNu(nu_, tau_cmd_);
   // Finite inputs can still overflow (|q_dot| ~ 1e160 squares to Inf): never return Inf or NaN,
   // nor results beyond kMaxResult whose products (energies, powers) would overflow.
-  bool finite = detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu_);
+  // An overflowing coupling matrix (kappa >= trace K; e.g. alfa columns of size 1e200) would be
+  // truncated to rank 0, silently dropping the task.
+  bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu_);
   for (unsigned int i = 0; finite && i < ns_; ++i) finite = detail::bounded(segs_[i].xdd);
   if (!finite)
     return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
