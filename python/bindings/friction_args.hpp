@@ -31,7 +31,8 @@ inline void checkFriction(const vereshchagin::FrictionModel& fm) {
       raise("friction.limit_tolerance must be finite and >= 0, got " + fmtDouble(fm.limit_tolerance));
     for (Eigen::Index j = 0; j < fm.lower.size() && j < fm.upper.size(); ++j)
       if (!(fm.lower(j) <= fm.upper(j)))
-        raise("friction.lower[" + std::to_string(j) + "] must be <= friction.upper[" + std::to_string(j) + "], got " +
+        raise("friction.lower[" + std::to_string(j) + "] and friction.upper[" + std::to_string(j) +
+              "] must satisfy lower <= upper, got " +
               fmtDouble(fm.lower(j)) + " > " + fmtDouble(fm.upper(j)));
   }
 }
