@@ -30,7 +30,8 @@
 //  * nu, constraint rank: as ChainHdSolver at the optimum.
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
 //    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
-//    (computed on request: one extra O(n) solve).
+//    (computed on request: one extra O(n) solve). NaN before a successful solve, or when qdd_free
+//    itself overflows (that solve fails with E_NONFINITE_RESULT).
 //  * iterations(): active-set iterations of the last solve.
 // No heap allocation in solve() or gaussValue().
 #pragma once
