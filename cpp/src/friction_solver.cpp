@@ -471,7 +471,9 @@ double FrictionSolver::gaussValue() {
     const bool resting = status_[j] != Moving;
     const double torque = tau_cmd_(j) + (resting ? friction_(j) + limit_(j) : 0.0);
     z0 += 0.5 * (qdd_(j) - free_.qdd()(j)) * torque;
-    if (resting) dissipation += fstatic_(j) * std::abs(qdd_(j));
+    // A sticking joint has qdd = 0: its round-off residual times a huge f (up to 1e308) must not
+    // overflow the sum.
+    if (resting && status_[j] != Stick) dissipation += fstatic_(j) * std::abs(qdd_(j));
   }
   return z0 + dissipation;
 }
