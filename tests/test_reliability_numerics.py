@@ -139,3 +139,20 @@ def test_chain_without_moving_joints(fixed_segments):
         res = solver.solve(np.zeros(0), np.zeros(0), **kw)
         finite(res)
         assert res.qdd.shape == (0,)
+
+
+@pytest.mark.parametrize("huge", [1e6, 1e12, 1e100])
+def test_one_huge_friction_bound_does_not_mask_the_others(huge):
+    # One huge bound next to small ones: the small ones still act in full (the QP's gradient
+    # tolerance once scaled with the largest bound; the fuzz regression solver-qp-huge-bound
+    # replays the input that exposed it).
+    chain = seven_joint_arm()
+    q, qd = np.full(7, 0.5), np.zeros(7)
+    fs = np.r_[huge, np.full(6, 0.05)]
+    res = vs.Solver(chain).solve(q, qd, friction=vs.Friction(static=fs))
+    finite(res)
+    assert res.status[0] == 1                      # the huge one sticks
+    slipping = np.isin(res.status, (2, 3))
+    assert slipping.any()                          # 0.05 N m cannot hold this arm against gravity
+    np.testing.assert_allclose(res.friction_torque[slipping], -fs[slipping] * np.sign(res.qdd[slipping]), rtol=1e-9)
+    reproduces(chain, q, qd, res, tau_ff=res.friction_torque)

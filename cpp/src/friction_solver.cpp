@@ -252,19 +252,18 @@ int FrictionSolver::boxQp(int k) {
   x.setZero();  // feasible: every box contains 0
   auto state = state_.head(k);
   state.setZero();  // 0 free, -1 at lower bound, +1 at upper bound
-  double xscale = 1e-300;  // largest finite bound
-  for (int i = 0; i < k; ++i) {
-    if (std::isfinite(hi_(i))) xscale = std::max(xscale, std::abs(hi_(i)));
-    if (std::isfinite(lo_(i))) xscale = std::max(xscale, std::abs(lo_(i)));
-  }
-  // Scale of the gradient (accelerations): the frictionless ones and what the largest friction
-  // bound can cause, at Q's physical scale (not Q's entries, which a task can make vanish).
-  gscale_ = std::max({c_.head(k).cwiseAbs().maxCoeff(), qscale_ * xscale, 1e-300});
-  const double tol_g = kGradientTolerance * gscale_;
+  // Scale of the gradient (accelerations): the frictionless ones and what the current friction
+  // iterate causes, at Q's physical scale (not Q's entries, which a task can make vanish). Not
+  // what the bounds could cause: a bound far beyond what is needed (say 1e305) made every
+  // gradient look like round-off and stopped at x = 0 (no friction on a slipping joint).
+  const double cmax = c_.head(k).cwiseAbs().maxCoeff();
+  double tol_g = 0.0;
   const int max_iterations = 50 + 20 * k;
   bool face_optimal = false;
   for (int it = 0; it < max_iterations; ++it) {
     iterations_ = it + 1;
+    gscale_ = std::max({cmax, qscale_ * x.cwiseAbs().maxCoeff(), 1e-300});
+    tol_g = kGradientTolerance * gscale_;
     grad_.head(k).noalias() = Q_.topLeftCorner(k, k) * x;
     grad_.head(k) -= c_.head(k);
     int nf = 0;
