@@ -157,3 +157,12 @@ def test_invalid_urdf_values(kw, fragments):
 def test_urdf_unknown_links_raise():
     raises(lambda: vs.Chain.from_urdf(urdf(), root="nope"), "root link 'nope'")
     raises(lambda: vs.Chain.from_urdf(urdf(), tip="nope"), "tip link 'nope'")
+
+
+def test_urdf_link_cycle_raises():
+    # Regression (fuzzing): urdfdom accepts this document (a joint whose parent and child are the
+    # same link, next to a malformed element); the loader's recursive walks never ended (stack
+    # overflow).
+    import os
+    path = os.path.join(os.path.dirname(__file__), "..", "cpp", "fuzz", "regressions", "urdf-self-loop-accepted")
+    raises(lambda: vs.Chain.from_urdf(path), "j2", "to itself")

@@ -133,7 +133,15 @@ std::string exerciseChain(const KDL::Chain& chain, ByteReader& r, const Eigen::V
         if (std::abs(qd(k)) > fm.velocity_tolerance)
           tau0(k) -= (fm.kinetic_friction.size() ? fm.kinetic_friction(k) : fm.static_friction(k)) * (qd(k) > 0 ? 1 : -1);
       ChainHdSolver free(chain, root_acc, opt);
-      if (free.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), fext, tau0) != ChainHdSolver::E_NONFINITE_RESULT)
+      const int free_rc = free.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), fext, tau0);
+      // Or the value itself is beyond the double range: its terms (friction or torque times
+      // acceleration) reach 1e300.
+      double terms = 0.0;
+      for (unsigned int k = 0; free_rc == 0 && k < n; ++k)
+        terms += (fm.static_friction(k) + std::abs(fs.commandTorques()(k)) + std::abs(fs.frictionTorques()(k)) +
+                  std::abs(fs.limitTorques()(k))) *
+                 (std::abs(fs.qdd()(k)) + std::abs(free.qdd()(k)));
+      if (free_rc != ChainHdSolver::E_NONFINITE_RESULT && std::isfinite(terms) && terms < 1e300)
         return "FrictionSolver::gaussValue non-finite after success: " + std::to_string(fs.gaussValue());
     }
     for (unsigned int k = 0; k < n; ++k) {

@@ -285,6 +285,24 @@ class Builder {
   RobotChain& out_;
 };
 
+// urdfdom accepts some documents whose joints make a link its own ancestor (e.g. a joint whose
+// parent and child are the same link): every recursive walk below would then never end.
+void checkAcyclic(const urdf::ModelInterface& model) {
+  for (const auto& entry : model.joints_) {
+    const urdf::Joint& j = *entry.second;
+    if (j.parent_link_name == j.child_link_name)
+      throw LoadError("joint '" + j.name + "' connects link '" + j.child_link_name + "' to itself");
+  }
+  const std::size_t n = model.links_.size();
+  for (const auto& entry : model.links_) {
+    std::size_t steps = 0;
+    for (urdf::LinkConstSharedPtr l = entry.second; l; l = l->getParent())
+      if (++steps > n + 1) throw LoadError("the links form a cycle through link '" + entry.first + "'");
+    for (const auto& child : entry.second->child_links)
+      if (!child || !child->parent_joint) throw LoadError("link '" + entry.first + "' has a child without a joint");
+  }
+}
+
 UrdfResult load(const std::string& xml, const std::string& root, const std::string& tip) {
   UrdfResult result;
   std::string messages;
@@ -296,6 +314,7 @@ UrdfResult load(const std::string& xml, const std::string& root, const std::stri
     return result;
   }
   try {
+    checkAcyclic(*model);
     Builder(*model, result.robot).build(root.empty() ? model->getRoot()->name : root, tip);
   } catch (const LoadError& e) {
     result.message = e.what();

@@ -197,8 +197,8 @@ class PySolver {
       py::array_t<int> st(static_cast<py::ssize_t>(nj_));
       for (unsigned int j = 0; j < nj_; ++j) st.mutable_data()[j] = friction_solver_.status()[j];
       r.status = st;
-      const double gauss = friction_solver_.gaussValue();  // NaN only if the free motion overflows
-      if (!std::isfinite(gauss)) raise("the results overflow: gauss_value's unconstrained motion is beyond 1e150");
+      const double gauss = friction_solver_.gaussValue();  // not finite only for overflowing inputs
+      if (!std::isfinite(gauss)) raise("the results overflow: gauss_value is beyond the double range");
       r.gauss_value = py::float_(gauss);
       r.iterations = py::int_(friction_solver_.iterations());
     }

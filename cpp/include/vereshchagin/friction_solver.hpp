@@ -31,7 +31,8 @@
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
 //    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
 //    (computed on request: one extra O(n) solve). NaN before a successful solve, or when qdd_free
-//    itself overflows (that solve fails with E_NONFINITE_RESULT).
+//    itself overflows (that solve fails with E_NONFINITE_RESULT); Inf when the value is beyond the
+//    double range (friction or torques times accelerations near 1e300). The Python API raises then.
 //  * iterations(): active-set iterations of the last solve.
 // No heap allocation in solve() or gaussValue().
 #pragma once
