@@ -7,6 +7,7 @@
 
 #include "articulated_step.hpp"
 #include "dense_small.hpp"
+#include "model_validation.hpp"
 
 #if defined(__GNUC__) && !defined(__clang__)
 // GCC 12 reports a false -Warray-bounds on Eigen's SSE loads of 1x1 fixed-size products.
@@ -87,6 +88,7 @@ const char* ChainHdSolver::strError(const int code) const {
     case E_TOO_MANY_CONSTRAINTS: return "More than 6 constraints on one segment";
     case E_NO_SOLUTION: return "No successful solve to take the response from";
     case E_INVALID_OPTIONS: return "Invalid solver options";
+    case E_NONFINITE_RESULT: return "The results overflow (inputs too large)";
     default: return KDL::SolverI::strError(code);
   }
 }
@@ -134,6 +136,10 @@ void ChainHdSolver::buildModel() {
     const KDL::Segment& seg = chain_.getSegment(i);
     const KDL::Joint& joint = seg.getJoint();
     Segment& s = segs_[i];
+    if (const char* why = detail::segmentGeometryProblem(seg)) {
+      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): %s", i, seg.getName().c_str(), why);
+      return;
+    }
     const KDL::RigidBodyInertia& rbi = seg.getInertia();
     const double mass = rbi.getMass();
     const KDL::Vector cog = rbi.getCOG();
@@ -354,7 +360,11 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
         e.noalias() = s.S.transpose() * A;
         U.noalias() += A.transpose() * (s.c + s.S * free);
         L.noalias() -= s.Dinv * e.transpose() * e;
-        kappa += s.Dinv * s.S.squaredNorm() * A.squaredNorm();
+        // |e_c| = |v.f_c + w.n_c| <= |v||f_c| + |w||n_c|: a bound in consistent units (the
+        // product of |S|^2 and |A_c|^2 mixes N with N m and inflates at small lengths).
+        kappa += s.Dinv * (s.S.template head<3>().norm() * A.template topRows<3>().colwise().norm() +
+                           s.S.template tail<3>().norm() * A.template bottomRows<3>().colwise().norm())
+                              .squaredNorm();
         Aproj = A;
         Aproj.noalias() -= s.Dinv * s.u * e;
       }
@@ -555,6 +565,17 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
     default: finalSweepT<6>(ff_torques); break;
   }
   commandFromNu(nu_, tau_cmd_);
+  // Finite inputs can still overflow (|q_dot| ~ 1e160 squares to Inf): never return Inf or NaN,
+  // nor results beyond kMaxResult whose products (energies, powers) would overflow.
+  // An overflowing coupling matrix (kappa >= trace K; e.g. alfa columns of size 1e200) would be
+  // truncated to rank 0, silently dropping the task.
+  bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu_);
+  for (unsigned int i = 0; finite && i < ns_; ++i) finite = detail::bounded(segs_[i].xdd);
+  if (!finite)
+    return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
+                "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
+                ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
+                f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   error = E_NOERROR;
   return E_NOERROR;

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "dense_small.hpp"
+#include "model_validation.hpp"
 
 namespace vereshchagin {
 
@@ -89,27 +90,27 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
   const Eigen::VectorXd& fs = friction.static_friction;
   const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
   if (fs.size() != n)
-    return fail(E_INVALID_FRICTION, "static friction has %ld entries, expected %ld (joints)", (long)fs.size(), n);
+    return fail(E_INVALID_FRICTION, "friction.static_friction has %ld entries, expected %ld (joints)", (long)fs.size(), n);
   if (fk.size() != n)
-    return fail(E_INVALID_FRICTION, "kinetic friction has %ld entries, expected %ld (joints) or 0", (long)fk.size(), n);
+    return fail(E_INVALID_FRICTION, "friction.kinetic_friction has %ld entries, expected %ld (joints) or 0", (long)fk.size(), n);
   if (!std::isfinite(friction.velocity_tolerance) || friction.velocity_tolerance < 0.0)
-    return fail(E_INVALID_FRICTION, "velocity tolerance must be finite and >= 0, got %g", friction.velocity_tolerance);
+    return fail(E_INVALID_FRICTION, "friction.velocity_tolerance must be finite and >= 0, got %g", friction.velocity_tolerance);
   for (long j = 0; j < n; ++j) {
     if (!std::isfinite(fs(j)) || fs(j) < 0.0)
-      return fail(E_INVALID_FRICTION, "static friction of joint %ld must be finite and >= 0, got %g", j, fs(j));
+      return fail(E_INVALID_FRICTION, "friction.static_friction(%ld) must be finite and >= 0, got %g", j, fs(j));
     if (!std::isfinite(fk(j)) || fk(j) < 0.0 || fk(j) > fs(j))
-      return fail(E_INVALID_FRICTION, "kinetic friction of joint %ld must be in [0, static = %g], got %g", j, fs(j), fk(j));
+      return fail(E_INVALID_FRICTION, "friction.kinetic_friction(%ld) must be finite and in [0, static_friction = %g], got %g", j, fs(j), fk(j));
   }
   const bool limits = friction.lower.size() != 0 || friction.upper.size() != 0;
   if (limits) {
     if (friction.lower.size() != n || friction.upper.size() != n)
-      return fail(E_INVALID_FRICTION, "joint limits need lower and upper with %ld entries each", n);
+      return fail(E_INVALID_FRICTION, "friction.lower and friction.upper must have %ld entries each (or both be empty)", n);
     if (!std::isfinite(friction.limit_tolerance) || friction.limit_tolerance < 0.0)
-      return fail(E_INVALID_FRICTION, "limit tolerance must be finite and >= 0, got %g", friction.limit_tolerance);
+      return fail(E_INVALID_FRICTION, "friction.limit_tolerance must be finite and >= 0, got %g", friction.limit_tolerance);
     for (long j = 0; j < n; ++j)
       if (std::isnan(friction.lower(j)) || std::isnan(friction.upper(j)) || friction.lower(j) > friction.upper(j))
-        return fail(E_INVALID_FRICTION, "joint %ld: limits must satisfy lower <= upper (got %g, %g)", j,
-                    friction.lower(j), friction.upper(j));
+        return fail(E_INVALID_FRICTION, "friction.lower(%ld) must be <= friction.upper(%ld), neither NaN, got %g and %g",
+                    j, j, friction.lower(j), friction.upper(j));
   }
   if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0)) {
     // Let the hybrid-dynamics solver report the size problem with its message.
@@ -193,7 +194,7 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
   link_acc_known_ = k == 0;
 
   // Friction torques and status.
-  const double acc_scale = std::max(1.0, qdd_.cwiseAbs().maxCoeff());
+  const double acc_scale = std::max(1.0, n ? qdd_.cwiseAbs().maxCoeff() : 0.0);  // (no joints: empty)
   int a = 0;
   for (long j = 0; j < n; ++j) {
     if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
@@ -213,6 +214,13 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
     const double acc = qdd_(j);
     status_[j] = std::abs(acc) <= 1e-9 * acc_scale ? Stick : (acc > 0.0 ? SlipPositive : SlipNegative);
   }
+  // The optimum is affine in finite friction bounds, but huge values can still overflow.
+  if (!(detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(friction_) && detail::bounded(limit_) &&
+        detail::bounded(nu_.head(m_keep_))))
+    return fail(ChainHdSolver::E_NONFINITE_RESULT,
+                "the results overflow (Inf/NaN or beyond 1e150): friction or other inputs too large (max static "
+                "friction %g)",
+                n ? fs.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   return ChainHdSolver::E_NOERROR;
 }
@@ -284,20 +292,16 @@ int FrictionSolver::boxQp(int k) {
   x.setZero();  // feasible: every box contains 0
   auto state = state_.head(k);
   state.setZero();  // 0 free, -1 at lower bound, +1 at upper bound
-  double xscale = 1e-300;  // largest finite bound
-  for (int i = 0; i < k; ++i) {
-    if (std::isfinite(hi_(i))) xscale = std::max(xscale, std::abs(hi_(i)));
-    if (std::isfinite(lo_(i))) xscale = std::max(xscale, std::abs(lo_(i)));
-  }
-  // Scale of the gradient (accelerations): the frictionless ones and what the largest friction
-  // bound can cause, at Q's physical scale (not Q's entries, which a task can make vanish).
-  // Also the torques acting (feed-forward, kinetic friction, the frictionless motor command)
-  // times Q's scale, and all frictionless accelerations: when a task fixes the resting joints
-  // and the friction bounds are zero or tiny, c is round-off and the bounds are no scale.
+  // Scale of the gradient (accelerations), at Q's physical scale (not Q's entries, which a task
+  // can make vanish): the frictionless accelerations, what the current friction iterate causes,
+  // and the torques acting (feed-forward, kinetic friction, the frictionless motor command). Not
+  // what the bounds could cause: a bound far beyond what is needed (say 1e305) made every
+  // gradient look like round-off and stopped at x = 0 (no friction on a slipping joint). The
+  // torques matter when a task fixes the resting joints and the bounds are zero or tiny: c is
+  // then round-off.
+  const double cmax = std::max(c_.head(k).cwiseAbs().maxCoeff(), qdd0_.cwiseAbs().maxCoeff());
   const double torque_scale = std::max(tau0_.cwiseAbs().maxCoeff(), tau_cmd0_.cwiseAbs().maxCoeff());
-  gscale_ = std::max({c_.head(k).cwiseAbs().maxCoeff(), qscale_ * xscale, qscale_ * torque_scale,
-                      qdd0_.cwiseAbs().maxCoeff(), 1e-300});
-  const double tol_g = kGradientTolerance * gscale_;
+  double tol_g = 0.0;
   // Iteration bound. Between two face-optimal points each iteration binds one more variable (a
   // blocked step) or ends on the face optimum (a full step): at most k + 1 iterations. The
   // objective never increases, and it strictly decreases from one face-optimal point to the next
@@ -314,6 +318,8 @@ int FrictionSolver::boxQp(int k) {
   free_full_rank_ = false;
   for (long it = 0; it < max_iterations; ++it) {
     iterations_ = static_cast<int>(std::min<long>(it + 1, 2147483647L));
+    gscale_ = std::max({cmax, qscale_ * x.cwiseAbs().maxCoeff(), qscale_ * torque_scale, 1e-300});
+    tol_g = kGradientTolerance * gscale_;
     grad_.head(k).noalias() = Q_.topLeftCorner(k, k).lazyProduct(x);
     grad_.head(k) -= c_.head(k);
     int nf = 0;
@@ -531,7 +537,9 @@ double FrictionSolver::gaussValue() {
     const bool resting = status_[j] != Moving;
     const double torque = tau_cmd_(j) + (resting ? friction_(j) + limit_(j) : 0.0);
     z0 += 0.5 * (qdd_(j) - free_.qdd()(j)) * torque;
-    if (resting) dissipation += fstatic_(j) * std::abs(qdd_(j));
+    // A sticking joint has qdd = 0: its round-off residual times a huge f (up to 1e308) must not
+    // overflow the sum.
+    if (resting && status_[j] != Stick) dissipation += fstatic_(j) * std::abs(qdd_(j));
   }
   return z0 + dissipation;
 }

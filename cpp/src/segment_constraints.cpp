@@ -11,6 +11,7 @@
 
 #include "articulated_step.hpp"
 #include "dense_small.hpp"
+#include "model_validation.hpp"
 
 namespace vereshchagin {
 
@@ -46,6 +47,15 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
   finalSweepGeneral(ff_torques);
   for (int k = 0; k < m; ++k) nu_user_(order_(k)) = nug_(k);
   commandFromNuGeneral(nug_.head(m), tau_cmd_);
+  // Overflow guard, as on the end-segment path.
+  bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) &&
+                detail::bounded(nu_user_.head(m));
+  for (unsigned int i = 0; finite && i < ns_; ++i) finite = detail::bounded(segs_[i].xdd);
+  if (!finite)
+    return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
+                "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
+                ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
+                f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   error = E_NOERROR;
   return E_NOERROR;
@@ -101,7 +111,10 @@ int ChainHdSolver::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
         const Vector6 bias = s.c + s.S * free;
         ug_.head(c).noalias() += A.transpose().lazyProduct(bias);
         kg_.topLeftCorner(c, c).noalias() += s.Dinv * e.lazyProduct(e.transpose());
-        kappa += s.Dinv * s.S.squaredNorm() * A.squaredNorm();
+        // The end-segment path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
+        kappa += s.Dinv * (s.S.head<3>().norm() * A.topRows<3>().colwise().norm() +
+                           s.S.tail<3>().norm() * A.bottomRows<3>().colwise().norm())
+                              .squaredNorm();
         Ap = A;
         Ap.noalias() -= (s.Dinv * s.u).lazyProduct(e.transpose());
       }

@@ -62,6 +62,19 @@ KDL::Frame toFrame(const urdf::Pose& p) {
                     KDL::Vector(p.position.x, p.position.y, p.position.z));
 }
 
+bool finitePose(const urdf::Pose& p) {
+  return std::isfinite(p.position.x) && std::isfinite(p.position.y) && std::isfinite(p.position.z) &&
+         std::isfinite(p.rotation.x) && std::isfinite(p.rotation.y) && std::isfinite(p.rotation.z) &&
+         std::isfinite(p.rotation.w);
+}
+
+// The joint's origin, validated.
+KDL::Frame jointOrigin(const urdf::Joint& j) {
+  if (!finitePose(j.parent_to_joint_origin_transform))
+    throw LoadError("joint '" + j.name + "': <origin> xyz / rpy must be finite");
+  return toFrame(j.parent_to_joint_origin_transform);
+}
+
 bool isMoving(const urdf::Joint& j) {
   return j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS ||
          j.type == urdf::Joint::PRISMATIC;
@@ -85,8 +98,8 @@ KDL::RigidBodyInertia linkInertia(const urdf::Link& link) {
   const urdf::Inertial& in = *link.inertial;
   Eigen::Matrix3d I;
   I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
-  if (!std::isfinite(in.mass) || !I.allFinite())
-    throw LoadError("link '" + link.name + "': non-finite inertial values");
+  if (!std::isfinite(in.mass) || !I.allFinite() || !finitePose(in.origin))
+    throw LoadError("link '" + link.name + "': <inertial> mass, inertia and origin must be finite");
   if (in.mass < 0.0)
     throw LoadError("link '" + link.name + "': negative mass " + std::to_string(in.mass));
   const double scale = std::max(1e-300, I.cwiseAbs().maxCoeff());
@@ -165,12 +178,12 @@ class Builder {
     if (first_moving == path.size())
       throw LoadError("no moving joint between '" + root_name + "' and '" + tip_name + "'");
     for (size_t i = 0; i < first_moving; ++i) {
-      if (i > 0) prev_tip_to_link = prev_tip_to_link * toFrame(path[i]->parent_joint->parent_to_joint_origin_transform);
+      if (i > 0) prev_tip_to_link = prev_tip_to_link * jointOrigin(*path[i]->parent_joint);
       out_.links.push_back({path[i]->name, -1, prev_tip_to_link});
       // Side branches of the base: fixed to the world, recorded for their frames only.
       for (const auto& child : path[i]->child_links) {
         if (i + 1 < path.size() && child->name == path[i + 1]->name) continue;
-        placeBaseSubtree(*child, prev_tip_to_link * toFrame(child->parent_joint->parent_to_joint_origin_transform));
+        placeBaseSubtree(*child, prev_tip_to_link * jointOrigin(*child->parent_joint));
       }
     }
     size_t k = first_moving;
@@ -184,7 +197,7 @@ class Builder {
       std::vector<KDL::Frame> in_child(end - k);
       in_child[0] = KDL::Frame::Identity();
       for (size_t i = k + 1; i < end; ++i)
-        in_child[i - k] = in_child[i - k - 1] * toFrame(path[i]->parent_joint->parent_to_joint_origin_transform);
+        in_child[i - k] = in_child[i - k - 1] * jointOrigin(*path[i]->parent_joint);
       const KDL::Frame child_to_tip = in_child[tip_index - k];
       const KDL::Frame tip_inv = child_to_tip.Inverse();
 
@@ -198,13 +211,13 @@ class Builder {
         for (const auto& child : path[i]->child_links) {
           if (i + 1 < end && child->name == path[i + 1]->name) continue;
           if (i + 1 == end && end < path.size() && child->name == path[end]->name) continue;
-          lumpSubtree(*child, link_in_tip * toFrame(child->parent_joint->parent_to_joint_origin_transform), seg_index,
+          lumpSubtree(*child, link_in_tip * jointOrigin(*child->parent_joint), seg_index,
                       inertia);
         }
       }
 
       // Joint in the previous tip frame.
-      const KDL::Frame origin = prev_tip_to_link * toFrame(j.parent_to_joint_origin_transform);
+      const KDL::Frame origin = prev_tip_to_link * jointOrigin(j);
       KDL::Vector axis(j.axis.x, j.axis.y, j.axis.z);
       const double norm = axis.Norm();
       if (!(norm > 1e-12) || !std::isfinite(norm)) throw LoadError("joint '" + j.name + "' has a zero or invalid axis");
@@ -258,19 +271,37 @@ class Builder {
     out_.links.push_back({link.name, seg, pose});
     inertia = inertia + pose * linkInertia(link);
     for (const auto& child : link.child_links)
-      lumpSubtree(*child, pose * toFrame(child->parent_joint->parent_to_joint_origin_transform), seg, inertia);
+      lumpSubtree(*child, pose * jointOrigin(*child->parent_joint), seg, inertia);
   }
 
   // Links hanging off the base (at joint positions 0): frames only, their inertia is irrelevant.
   void placeBaseSubtree(const urdf::Link& link, const KDL::Frame& pose) {
     out_.links.push_back({link.name, -1, pose});
     for (const auto& child : link.child_links)
-      placeBaseSubtree(*child, pose * toFrame(child->parent_joint->parent_to_joint_origin_transform));
+      placeBaseSubtree(*child, pose * jointOrigin(*child->parent_joint));
   }
 
   const urdf::ModelInterface& model_;
   RobotChain& out_;
 };
+
+// urdfdom accepts some documents whose joints make a link its own ancestor (e.g. a joint whose
+// parent and child are the same link): every recursive walk below would then never end.
+void checkAcyclic(const urdf::ModelInterface& model) {
+  for (const auto& entry : model.joints_) {
+    const urdf::Joint& j = *entry.second;
+    if (j.parent_link_name == j.child_link_name)
+      throw LoadError("joint '" + j.name + "' connects link '" + j.child_link_name + "' to itself");
+  }
+  const std::size_t n = model.links_.size();
+  for (const auto& entry : model.links_) {
+    std::size_t steps = 0;
+    for (urdf::LinkConstSharedPtr l = entry.second; l; l = l->getParent())
+      if (++steps > n + 1) throw LoadError("the links form a cycle through link '" + entry.first + "'");
+    for (const auto& child : entry.second->child_links)
+      if (!child || !child->parent_joint) throw LoadError("link '" + entry.first + "' has a child without a joint");
+  }
+}
 
 UrdfResult load(const std::string& xml, const std::string& root, const std::string& tip) {
   UrdfResult result;
@@ -283,6 +314,7 @@ UrdfResult load(const std::string& xml, const std::string& root, const std::stri
     return result;
   }
   try {
+    checkAcyclic(*model);
     Builder(*model, result.robot).build(root.empty() ? model->getRoot()->name : root, tip);
   } catch (const LoadError& e) {
     result.message = e.what();

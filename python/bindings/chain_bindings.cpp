@@ -27,9 +27,19 @@ PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, co
   return c;
 }
 
-void PyChain::addSegment(const std::string& name, const py::object& joint, const py::object& tip, double mass,
-                         const py::object& com, const py::object& inertia, double rotor_inertia,
-                         const std::string& joint_name) {
+void PyChain::addSegment(const std::string& name, const py::object& joint, const py::object& tip,
+                         const py::object& mass_obj, const py::object& com, const py::object& inertia,
+                         const py::object& rotor_obj, const std::string& joint_name) {
+  // Every failure names the segment and the argument: "segment 'link3': mass must be ...".
+  const std::string where = "segment '" + name + "': ";
+  const std::string jname = joint_name.empty() ? name + "_joint" : joint_name;
+  if (name.empty()) raise("name: a segment needs a non-empty name");
+  for (const std::string& other : segmentNames())
+    if (other == name) raise("name: a segment named '" + name + "' already exists (names must be unique)");
+  for (const auto& j : robot.joints)
+    if (j.name == jname) raise(where + "joint_name: a joint named '" + jname + "' already exists (names must be unique)");
+  const double mass = scalarArg(mass_obj, (where + "mass").c_str());
+  const double rotor_inertia = scalarArg(rotor_obj, (where + "rotor_inertia").c_str());
   JointSpec spec;
   if (py::isinstance<py::str>(joint)) {
     spec = jointFromString(joint.cast<std::string>());
@@ -38,28 +48,27 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   } else {
     raise("joint must be a joint-type string such as 'rot_z' or a vereshchagin.Joint");
   }
-  const KDL::Frame f_tip = tip.is_none() ? KDL::Frame::Identity() : frameFrom4x4(tip, "tip");
-  if (!std::isfinite(mass) || mass < 0.0) raise("mass must be finite and >= 0, got " + std::to_string(mass));
-  const KDL::Vector c = com.is_none() ? KDL::Vector::Zero() : vec3(com, "com");
+  const KDL::Frame f_tip = tip.is_none() ? KDL::Frame::Identity() : frameFrom4x4(tip, (where + "tip").c_str());
+  if (!std::isfinite(mass) || mass < 0.0) raise(where + "mass must be finite and >= 0, got " + fmtDouble(mass));
+  const KDL::Vector c = com.is_none() ? KDL::Vector::Zero() : vec3(com, (where + "com").c_str());
   Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
   if (!inertia.is_none()) {
-    Array a = toArray(inertia, "inertia");
+    Array a = toArray(inertia, (where + "inertia").c_str());
     if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
-      raise("inertia must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + shapeStr(a));
-    requireFinite(a, "inertia");
+      raise(where + "inertia must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + shapeStr(a));
+    requireFinite(a, (where + "inertia").c_str());
     for (int r = 0; r < 3; ++r)
       for (int k = 0; k < 3; ++k) I(r, k) = a.at(r, k);
   }
   const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
-  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) raise("inertia must be symmetric");
+  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) raise(where + "inertia must be symmetric");
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I, Eigen::EigenvaluesOnly);
   if (es.eigenvalues().minCoeff() < -1e-12 * scale)
-    raise("inertia must be positive semi-definite (smallest eigenvalue " +
+    raise(where + "inertia must be positive semi-definite (smallest eigenvalue " +
           std::to_string(es.eigenvalues().minCoeff()) + ")");
   if (!std::isfinite(rotor_inertia) || rotor_inertia < 0.0)
-    raise("rotor_inertia must be finite and >= 0, got " + std::to_string(rotor_inertia));
-  if (spec.type == KDL::Joint::Fixed && rotor_inertia != 0.0) raise("a fixed joint has no rotor inertia");
-  const std::string jname = joint_name.empty() ? name + "_joint" : joint_name;
+    raise(where + "rotor_inertia must be finite and >= 0, got " + fmtDouble(rotor_inertia));
+  if (spec.type == KDL::Joint::Fixed && rotor_inertia != 0.0) raise(where + "rotor_inertia: a fixed joint has none");
   KDL::Joint j = spec.has_axis ? KDL::Joint(jname, spec.origin, spec.axis, spec.type, 1.0, 0.0, rotor_inertia)
                                : KDL::Joint(jname, spec.type, 1.0, 0.0, rotor_inertia);
   const KDL::RotationalInertia Ic(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2));

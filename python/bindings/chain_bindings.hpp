@@ -63,8 +63,8 @@ struct PyChain {
   vereshchagin::RobotChain robot;
 
   static PyChain fromUrdf(const std::string& source, const std::string& root, const std::string& tip);
-  void addSegment(const std::string& name, const py::object& joint, const py::object& tip, double mass,
-                  const py::object& com, const py::object& inertia, double rotor_inertia,
+  void addSegment(const std::string& name, const py::object& joint, const py::object& tip, const py::object& mass,
+                  const py::object& com, const py::object& inertia, const py::object& rotor_inertia,
                   const std::string& joint_name);
   std::vector<std::string> segmentNames() const;
   std::vector<std::string> jointNames() const;

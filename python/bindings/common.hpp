@@ -43,6 +43,26 @@ inline Array toArray(const py::handle& obj, const char* name) {
   return a;
 }
 
+inline std::string fmtDouble(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// A real scalar (Python int or float, numpy scalar, 0-d array); bool and everything else raise.
+inline double scalarArg(const py::handle& obj, const char* name) {
+  if (py::isinstance<py::bool_>(obj) || py::isinstance<py::str>(obj) || py::isinstance<py::bytes>(obj) || obj.is_none())
+    raise(std::string(name) + " must be a real number, got " + std::string(py::str(py::type::of(obj).attr("__name__"))));
+  PyObject* f = PyNumber_Float(obj.ptr());
+  if (f == nullptr) {
+    PyErr_Clear();
+    raise(std::string(name) + " must be a real number, got " + std::string(py::str(py::type::of(obj).attr("__name__"))));
+  }
+  const double v = PyFloat_AsDouble(f);
+  Py_DECREF(f);
+  return v;
+}
+
 inline void requireFinite(const Array& a, const char* name) {
   const double* p = a.data();
   for (py::ssize_t k = 0; k < a.size(); ++k) {

@@ -8,6 +8,7 @@
 
 #include "chain_bindings.hpp"
 #include "common.hpp"
+#include "friction_args.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
 #include "vereshchagin/friction_solver.hpp"
 
@@ -30,7 +31,7 @@ struct SolveResult {
 
 class PySolver {
  public:
-  PySolver(const PyChain& chain, const py::object& gravity, double rcond, py::object damping)
+  PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, py::object damping)
       : chain_(chain), solver_(chain.robot.chain, KDL::Twist::Zero()), friction_solver_(chain.robot.chain, KDL::Twist::Zero()) {
     const auto nj = static_cast<Eigen::Index>(chain.robot.joints.size());
     chain_friction_ = chain_lower_ = chain_upper_ = Eigen::VectorXd::Zero(nj);
@@ -42,10 +43,10 @@ class PySolver {
     if (solver_.modelError() != ChainHdSolver::E_NOERROR) raise(std::string("invalid chain: ") + solver_.errorMessage());
     setGravity(gravity);
     vereshchagin::SolverOptions opt;
-    opt.rcond = rcond;
+    opt.rcond = scalarArg(rcond, "rcond");
     if (!damping.is_none()) {
       opt.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
-      opt.damping = damping.cast<double>();
+      opt.damping = scalarArg(damping, "damping");
     }
     if (solver_.setOptions(opt) != ChainHdSolver::E_NOERROR) raise(solver_.errorMessage());
     friction_solver_.setOptions(opt);
@@ -185,7 +186,7 @@ class PySolver {
       fm.kinetic_friction = Eigen::Map<const Eigen::VectorXd>(fk.data(), nj_);
     }
     const py::object tol = py::getattr(friction, "velocity_tolerance", py::none());
-    if (!tol.is_none()) fm.velocity_tolerance = tol.cast<double>();
+    if (!tol.is_none()) fm.velocity_tolerance = scalarArg(tol, "friction.velocity_tolerance");
     const py::object lower = py::getattr(friction, "lower", py::none()), upper = py::getattr(friction, "upper", py::none());
     if (!lower.is_none() || !upper.is_none()) {
       fm.lower = Eigen::VectorXd::Constant(nj_, -std::numeric_limits<double>::infinity());
@@ -203,10 +204,9 @@ class PySolver {
       limitArg(lower, "friction.lower", fm.lower);
       limitArg(upper, "friction.upper", fm.upper);
       const py::object ltol = py::getattr(friction, "limit_tolerance", py::none());
-      if (!ltol.is_none()) fm.limit_tolerance = ltol.cast<double>();
+      if (!ltol.is_none()) fm.limit_tolerance = scalarArg(ltol, "friction.limit_tolerance");
     }
-    for (Eigen::Index j = 0; j < fm.static_friction.size(); ++j)
-      if (fm.static_friction(j) < 0.0) raise("friction.static must be >= 0 (joint " + std::to_string(j) + ")");
+    checkFriction(fm);
     return true;
   }
 
@@ -277,7 +277,9 @@ class PySolver {
       py::array_t<int> st(static_cast<py::ssize_t>(nj_));
       for (unsigned int j = 0; j < nj_; ++j) st.mutable_data()[j] = friction_solver_.status()[j];
       r.status = st;
-      r.gauss_value = py::float_(friction_solver_.gaussValue());
+      const double gauss = friction_solver_.gaussValue();  // not finite only for overflowing inputs
+      if (!std::isfinite(gauss)) raise("the results overflow: gauss_value is beyond the double range");
+      r.gauss_value = py::float_(gauss);
       r.iterations = py::int_(friction_solver_.iterations());
     }
     return r;
@@ -448,7 +450,7 @@ void bindSolver(py::module_& mod) {
       });
 
   py::class_<PySolver>(mod, "Solver")
-      .def(py::init<const PyChain&, const py::object&, double, py::object>(), py::arg("chain"),
+      .def(py::init<const PyChain&, const py::object&, const py::object&, py::object>(), py::arg("chain"),
            py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
            py::arg("damping") = py::none())
       .def("solve", &PySolver::solve, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),

@@ -40,9 +40,10 @@
 //    (m x m, symmetric positive semi-definite, units 1/kg-like: acceleration per force).
 //
 // Singular tasks: K is inverted by eigen-decomposition. Policy TruncatedPseudoInverse (default)
-// drops eigenvalues below rcond * max(lambda_max, kappa), where kappa = sum_i D_i^-1 |S_i|^2
-// |A_i|_F^2 >= trace K is the size K would have if no projection cancelled the constraint
-// wrenches A_i felt at the joints (so a constraint that no joint can affect, e.g. along a
+// drops eigenvalues below rcond * max(lambda_max, kappa), where kappa = sum_i D_i^-1 sum_c
+// (|v_i||f_ic| + |w_i||n_ic|)^2 >= trace K (S_i = [v_i; w_i], column c of A_i = [f_ic; n_ic];
+// consistent units, so invariant to the length scale) is the size K would have if no
+// cancellation reduced the couplings S_i^T A_i of the constraint wrenches A_i felt at the joints (so a constraint that no joint can affect, e.g. along a
 // stretched arm, counts as rank 0 even when it is the only one); the rank reported counts the
 // others. DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda.
 // Both give finite outputs for any valid input. Fast path: when a Cholesky factor K = L L^T
@@ -111,6 +112,7 @@ class ChainHdSolver : public KDL::SolverI {
     E_TOO_MANY_CONSTRAINTS = -103, // alfa has more than 6 columns
     E_NO_SOLUTION = -104,          // responseColumns() called before a successful solve
     E_INVALID_OPTIONS = -105,      // rcond < 0, damping <= 0 for the damped policy, non-finite
+    E_NONFINITE_RESULT = -106,     // finite inputs whose results overflow (Inf/NaN or > 1e150)
   };
 
   // The chain is copied. root_acc: base acceleration (gravity as +9.81 along up), see above.
@@ -269,7 +271,7 @@ class ChainHdSolver : public KDL::SolverI {
   bool solved_ = false;
   VectorC U0_, nu_;
   MatrixC L0_, K_;
-  double kappa_ = 0.0;  // scale of K: sum of D_i^-1 |S_i|^2 |A_i|_F^2 (>= trace K)
+  double kappa_ = 0.0;  // scale of K: sum_i D_i^-1 sum_c (|v_i||f_ic| + |w_i||n_ic|)^2 (>= trace K)
   // K is factorised by Cholesky when it is certainly of full rank (fast path), else by a full
   // eigen-decomposition that applies the singularity policy.
   bool use_cholesky_ = false;

@@ -30,7 +30,9 @@
 //  * nu, constraint rank: as ChainHdSolver at the optimum.
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
 //    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
-//    (computed on request: one extra O(n) solve).
+//    (computed on request: one extra O(n) solve). NaN before a successful solve, or when qdd_free
+//    itself overflows (that solve fails with E_NONFINITE_RESULT); Inf when the value is beyond the
+//    double range (friction or torques times accelerations near 1e300). The Python API raises then.
 //  * iterations(): active-set iterations of the last solve (at most (k + 1) 3^k, k the resting
 //    joints with friction or on a limit; the argument is in friction_solver.cpp's boxQp()).
 //    Bland's smallest-index rule takes over if a face-optimal value fails to decrease.

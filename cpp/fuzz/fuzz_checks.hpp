@@ -1,0 +1,24 @@
+// The properties every fuzz input must satisfy, shared by the libFuzzer targets (fuzz_*.cpp) and
+// the corpus replay test (cpp/tests/test_fuzz_corpus.cpp, a plain ctest without clang):
+//  * checkUrdf: any byte string as URDF text either loads with ok = true and an empty message, or
+//    fails with a non-empty message; a loaded chain either is rejected by the solvers with an error
+//    code and a message, or solves (frictionless, one constraint, with the URDF's friction and
+//    limits) to finite outputs.
+//  * checkSolver: the bytes describe a chain (0..8 segments of any joint type, inertias, frames,
+//    rotor inertias — values anywhere from plausible to NaN) and one call of each entry point
+//    (ChainHdSolver::solve / CartToJnt / responseColumns, FrictionSolver::solve / gaussValue /
+//    linkAccelerations). Each call returns 0 with finite outputs, or an error code < 0 with a
+//    non-empty message.
+// Both return "" when the properties hold, else a description of the violation.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace fuzzutil {
+
+std::string checkUrdf(const std::uint8_t* data, std::size_t size);
+std::string checkSolver(const std::uint8_t* data, std::size_t size);
+
+}  // namespace fuzzutil
