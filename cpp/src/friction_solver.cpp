@@ -265,6 +265,11 @@ bool FrictionSolver::freeStep(int nf) {
     wmax = std::max(wmax, std::abs(v));
   }
   const bool zero_curvature = wmax > kGradientTolerance * gscale_;
+  // Entries of w at round-off level are zero: left in, a 1e-14 component of a joint with a
+  // finite bound blocks the step after a huge ratio (1e14) and hides an unbounded direction.
+  if (zero_curvature)
+    for (int i = r; i < nf; ++i)
+      if (std::abs(y(i)) <= kGradientTolerance * gscale_) y(i) = 0.0;
   // Back substitution L1^T u = rhs, rhs = -y1 (Newton step) or L2^T w (descent direction).
   auto u = eig_.head(nf);
   for (int i = 0; i < r; ++i) {
