@@ -82,6 +82,27 @@ std::string exerciseChain(const KDL::Chain& chain, ByteReader& r, const Eigen::V
     if (!bad.empty()) return bad;
   }
 
+  // Constraints on any segments: each column on a drawn segment (sometimes out of range, or more
+  // than 6 on one segment: errors), with response columns and their d(nu).
+  {
+    Eigen::VectorXi segs(m);
+    for (int c = 0; c < m; ++c) segs(c) = r.integer(-1, static_cast<int>(ns));
+    rc = hd.solve(q, qd, alfa, beta, segs, fext, ff);
+    bad = verdict("ChainHdSolver::solve(segments)", rc, hd.errorMessage(), [&] {
+      return hd.qdd().allFinite() && hd.commandTorques().allFinite() && hd.nu().allFinite() &&
+             hd.linkAccelerations().allFinite() && std::isfinite(hd.smallestSingularValue());
+    });
+    if (!bad.empty()) return bad;
+    if (rc == 0 && n > 0) {
+      const Eigen::VectorXi all = Eigen::VectorXi::LinSpaced(n, 0, static_cast<int>(n) - 1);
+      Eigen::MatrixXd dqdd(n, n), dtau(n, n), dnu(std::max(m, 1), n);
+      rc = hd.responseColumns(all, dqdd, dtau, dnu);
+      bad = verdict("responseColumns(segments)", rc, hd.errorMessage(),
+                    [&] { return dqdd.allFinite() && dtau.allFinite() && dnu.topRows(m).allFinite(); });
+      if (!bad.empty()) return bad;
+    }
+  }
+
   // The KDL entry point with the same values (only m <= 6 fits a KDL::Jacobian meaningfully).
   if (m <= 6) {
     KDL::JntArray kq(n), kqd(n), kqdd(n), kff(n), ktau(n), kbeta(m);
