@@ -196,6 +196,8 @@ void ChainHdSolver::buildModel() {
       const KDL::Vector v = Rt * t.vel, w = Rt * t.rot;
       s.S << v.x(), v.y(), v.z(), w.x(), w.y(), w.z();
       s.w_norm = s.S.tail<3>().norm();
+      s.v2 = s.S.head<3>().squaredNorm();
+      s.w2 = s.S.tail<3>().squaredNorm();
       if (!s.S.allFinite() || s.S.norm() == 0.0) {
         model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite",
                             s.joint, joint.getName().c_str());
@@ -360,11 +362,10 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
         e.noalias() = s.S.transpose() * A;
         U.noalias() += A.transpose() * (s.c + s.S * free);
         L.noalias() -= s.Dinv * e.transpose() * e;
-        // |e_c| = |v.f_c + w.n_c| <= |v||f_c| + |w||n_c|: a bound in consistent units (the
-        // product of |S|^2 and |A_c|^2 mixes N with N m and inflates at small lengths).
-        kappa += s.Dinv * (s.S.template head<3>().norm() * A.template topRows<3>().colwise().norm() +
-                           s.S.template tail<3>().norm() * A.template bottomRows<3>().colwise().norm())
-                              .squaredNorm();
+        // |e_c| = |v.f_c + w.n_c| <= |v||f_c| + |w||n_c|, so sum_c e_c^2 <= 2 (|v|^2 |F|^2 +
+        // |w|^2 |N|^2): a bound in consistent units (|S|^2 |A|^2 would mix N with N m and
+        // inflate at small lengths), without square roots in the sweep.
+        kappa += 2.0 * s.Dinv * (s.v2 * A.template topRows<3>().squaredNorm() + s.w2 * A.template bottomRows<3>().squaredNorm());
         Aproj = A;
         Aproj.noalias() -= s.Dinv * s.u * e;
       }
@@ -570,7 +571,8 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
   // An overflowing coupling matrix (kappa >= trace K; e.g. alfa columns of size 1e200) would be
   // truncated to rank 0, silently dropping the task.
   bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu_);
-  for (unsigned int i = 0; finite && i < ns_; ++i) finite = detail::bounded(segs_[i].xdd);
+  // Inf and NaN propagate outward through the link accelerations: the last one tells.
+  if (finite && ns_ > 0) finite = detail::bounded(segs_[ns_ - 1].xdd);
   if (!finite)
     return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
                 "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,

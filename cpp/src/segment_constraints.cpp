@@ -50,7 +50,8 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
   // Overflow guard, as on the end-segment path.
   bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) &&
                 detail::bounded(nu_user_.head(m));
-  for (unsigned int i = 0; finite && i < ns_; ++i) finite = detail::bounded(segs_[i].xdd);
+  // Inf and NaN propagate outward through the link accelerations: the last one tells.
+  if (finite && ns_ > 0) finite = detail::bounded(segs_[ns_ - 1].xdd);
   if (!finite)
     return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
                 "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
@@ -112,9 +113,7 @@ int ChainHdSolver::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
         ug_.head(c).noalias() += A.transpose().lazyProduct(bias);
         kg_.topLeftCorner(c, c).noalias() += s.Dinv * e.lazyProduct(e.transpose());
         // The end-segment path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
-        kappa += s.Dinv * (s.S.head<3>().norm() * A.topRows<3>().colwise().norm() +
-                           s.S.tail<3>().norm() * A.bottomRows<3>().colwise().norm())
-                              .squaredNorm();
+        kappa += 2.0 * s.Dinv * (s.v2 * A.topRows<3>().squaredNorm() + s.w2 * A.bottomRows<3>().squaredNorm());
         Ap = A;
         Ap.noalias() -= (s.Dinv * s.u).lazyProduct(e.transpose());
       }

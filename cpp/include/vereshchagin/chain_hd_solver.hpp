@@ -40,12 +40,13 @@
 //    (m x m, symmetric positive semi-definite, units 1/kg-like: acceleration per force).
 //
 // Singular tasks: K is inverted by eigen-decomposition. Policy TruncatedPseudoInverse (default)
-// drops eigenvalues below rcond * max(lambda_max, kappa), where kappa = sum_i D_i^-1 sum_c
-// (|v_i||f_ic| + |w_i||n_ic|)^2 >= trace K (S_i = [v_i; w_i], column c of A_i = [f_ic; n_ic];
-// consistent units, so invariant to the length scale) is the size K would have if no
-// cancellation reduced the couplings S_i^T A_i of the constraint wrenches A_i felt at the joints (so a constraint that no joint can affect, e.g. along a
-// stretched arm, counts as rank 0 even when it is the only one); the rank reported counts the
-// others. DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda.
+// drops eigenvalues below rcond * max(lambda_max, kappa), where kappa = 2 sum_i D_i^-1
+// (|v_i|^2 |F_i|_F^2 + |w_i|^2 |N_i|_F^2) >= sum_i D_i^-1 sum_c (|v_i||f_ic| + |w_i||n_ic|)^2 >=
+// trace K (S_i = [v_i; w_i], A_i = [F_i; N_i] with columns [f_ic; n_ic]; consistent units, so
+// invariant to the length scale) is the size K would have if no cancellation reduced the
+// couplings S_i^T A_i of the constraint wrenches A_i felt at the joints (so a constraint that no
+// joint can affect, e.g. along a stretched arm, counts as rank 0 even when it is the only one);
+// the rank reported counts the others. DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda.
 // Both give finite outputs for any valid input. Fast path: when a Cholesky factor K = L L^T
 // proves every eigenvalue above the threshold (lambda_min >= 1 / ||L^-1||_F^2 > rcond * kappa),
 // K^+ = K^-1 is applied through L: the same solution at a fraction of the cost.
@@ -206,6 +207,7 @@ class ChainHdSolver : public KDL::SolverI {
     Eigen::Matrix<double, 1, kMaxConstraints> e;  // S^T A
     double rotor = 0.0, D = 0.0, Dinv = 0.0;
     double w_norm = 0.0;    // |angular part of S| (0 for prismatic joints)
+    double v2 = 0.0, w2 = 0.0;  // |linear part of S|^2, |angular part of S|^2
     int joint = -1;         // joint index or -1 for a fixed joint
   };
 
@@ -271,7 +273,7 @@ class ChainHdSolver : public KDL::SolverI {
   bool solved_ = false;
   VectorC U0_, nu_;
   MatrixC L0_, K_;
-  double kappa_ = 0.0;  // scale of K: sum_i D_i^-1 sum_c (|v_i||f_ic| + |w_i||n_ic|)^2 (>= trace K)
+  double kappa_ = 0.0;  // scale of K: 2 sum_i D_i^-1 (|v_i|^2 |F_i|^2 + |w_i|^2 |N_i|^2) (>= trace K)
   // K is factorised by Cholesky when it is certainly of full rank (fast path), else by a full
   // eigen-decomposition that applies the singularity policy.
   bool use_cholesky_ = false;
