@@ -399,6 +399,23 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
   return E_NOERROR;
 }
 
+// Finite inputs can still overflow (|q_dot| ~ 1e160 squares to Inf): never return Inf or NaN,
+// nor results beyond kMaxResult whose products (energies, powers) would overflow. An overflowing
+// coupling matrix (kappa >= trace K; e.g. alfa columns of size 1e200) would be truncated to rank 0,
+// silently dropping the task. Inf and NaN propagate outward through the link accelerations: the
+// last one tells.
+int ChainHdSolver::checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                                const Eigen::Ref<const Eigen::VectorXd>& beta, const Eigen::Ref<const Matrix6X>& f_ext,
+                                const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu);
+  if (finite && ns_ > 0) finite = detail::bounded(segs_[ns_ - 1].xdd);
+  if (finite) return E_NOERROR;
+  return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
+              "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
+              ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
+              f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
+}
+
 int ChainHdSolver::degenerate(int i) {
   const Segment& s = segs_[i];
   return fail(E_DEGENERATE_INERTIA,
@@ -447,20 +464,11 @@ void ChainHdSolver::factorizeCoupling() {
   eig_.compute(K_);
   inv_eigen_.setZero(m);
   const auto& lam = eig_.eigenvalues();  // ascending
-  const double lmax = std::max(lam(m - 1), 0.0);
-  const double cut = options_.rcond * std::max(lmax, kappa_);
+  const double cut = options_.rcond * std::max(std::max(lam(m - 1), 0.0), kappa_);
   sigma_min_ = std::max(lam(0), 0.0);
   sigma_known_ = true;
-  for (int k = 0; k < m; ++k) {
-    const double l = std::max(lam(k), 0.0);
-    const bool kept = l > 0.0 && l > cut;
-    if (kept) ++rank_;
-    if (options_.policy == SingularityPolicy::TruncatedPseudoInverse) {
-      inv_eigen_(k) = kept ? 1.0 / l : 0.0;
-    } else {
-      inv_eigen_(k) = l / (l * l + options_.damping * options_.damping);
-    }
-  }
+  rank_ = detail::policyMultipliers(lam, inv_eigen_, cut, options_.policy == SingularityPolicy::TruncatedPseudoInverse,
+                                    options_.damping);
 }
 
 // Cholesky factor K = L L^T (into chol_), and a proof that every eigenvalue of K is above the
@@ -471,18 +479,8 @@ bool ChainHdSolver::choleskyFullRank() {
   const int m = m_;
   chol_.setZero(m, m);
   if (!detail::choleskyCertified(K_, chol_, 0.0)) return false;
-  // ||L^-1||_F^2, column by column of X = L^-1 (lower triangular) by forward substitution.
-  double frob2 = 0.0;
-  for (int c = 0; c < m; ++c) {
-    double x[kMaxConstraints];
-    for (int i = c; i < m; ++i) {
-      double v = i == c ? 1.0 : 0.0;
-      for (int k = c; k < i; ++k) v -= chol_(i, k) * x[k];
-      x[i] = v / chol_(i, i);
-      frob2 += x[i] * x[i];
-    }
-  }
-  const double lower = 1.0 / frob2;
+  VectorC x(m);
+  const double lower = 1.0 / detail::inverseFrobeniusSquared(chol_, x);
   return std::isfinite(lower) && lower > options_.rcond * kappa_;
 }
 
@@ -566,18 +564,8 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
     default: finalSweepT<6>(ff_torques); break;
   }
   commandFromNu(nu_, tau_cmd_);
-  // Finite inputs can still overflow (|q_dot| ~ 1e160 squares to Inf): never return Inf or NaN,
-  // nor results beyond kMaxResult whose products (energies, powers) would overflow.
-  // An overflowing coupling matrix (kappa >= trace K; e.g. alfa columns of size 1e200) would be
-  // truncated to rank 0, silently dropping the task.
-  bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu_);
-  // Inf and NaN propagate outward through the link accelerations: the last one tells.
-  if (finite && ns_ > 0) finite = detail::bounded(segs_[ns_ - 1].xdd);
-  if (!finite)
-    return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
-                "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
-                ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
-                f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
+  rc = checkBounded(nu_, q_dot, beta, f_ext, ff_torques);
+  if (rc != E_NOERROR) return rc;
   solved_ = true;
   error = E_NOERROR;
   return E_NOERROR;

@@ -35,6 +35,39 @@ bool choleskyCertified(const MA& A, ML& L, double min_pivot) {
   return true;
 }
 
+// ||L^-1||_F^2 of a lower-triangular L (k x k), column by column of L^-1 by forward substitution;
+// x: scratch of at least k entries. 1 / ||L^-1||_F^2 <= 1 / ||L^-1||_2^2 = lambda_min(L L^T).
+template <typename ML, typename VX>
+double inverseFrobeniusSquared(const ML& L, VX& x) {
+  const int k = static_cast<int>(L.rows());
+  double frob2 = 0.0;
+  for (int c = 0; c < k; ++c) {
+    for (int i = c; i < k; ++i) {
+      double v = i == c ? 1.0 : 0.0;
+      for (int p = c; p < i; ++p) v -= L(i, p) * x(p);
+      x(i) = v / L(i, i);
+      frob2 += x(i) * x(i);
+    }
+  }
+  return frob2;
+}
+
+// Per-eigenvalue multipliers of a symmetric positive semi-definite matrix's (pseudo-)inverse
+// under a singularity policy: truncated (1 / lambda for lambda > cut, else 0) or damped least
+// squares (lambda / (lambda^2 + damping^2)). Negative round-off eigenvalues count as 0. Returns
+// the rank: the number of eigenvalues above cut.
+template <typename VL, typename VI>
+int policyMultipliers(const VL& lam, VI& inv, double cut, bool truncate, double damping) {
+  int rank = 0;
+  for (Eigen::Index k = 0; k < lam.size(); ++k) {
+    const double l = std::max(lam(k), 0.0);
+    const bool kept = l > 0.0 && l > cut;
+    if (kept) ++rank;
+    inv(k) = truncate ? (kept ? 1.0 / l : 0.0) : l / (l * l + damping * damping);
+  }
+  return rank;
+}
+
 // Solve L L^T x = b in place (b -> x).
 template <typename ML, typename VB>
 void choleskySolve(const ML& L, VB& b) {

@@ -47,16 +47,8 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
   finalSweepGeneral(ff_torques);
   for (int k = 0; k < m; ++k) nu_user_(order_(k)) = nug_(k);
   commandFromNuGeneral(nug_.head(m), tau_cmd_);
-  // Overflow guard, as on the end-segment path.
-  bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) &&
-                detail::bounded(nu_user_.head(m));
-  // Inf and NaN propagate outward through the link accelerations: the last one tells.
-  if (finite && ns_ > 0) finite = detail::bounded(segs_[ns_ - 1].xdd);
-  if (!finite)
-    return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
-                "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
-                ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
-                f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
+  rc = checkBounded(nu_user_.head(m), q_dot, beta, f_ext, ff_torques);
+  if (rc != E_NOERROR) return rc;
   solved_ = true;
   error = E_NOERROR;
   return E_NOERROR;
@@ -149,17 +141,8 @@ void ChainHdSolver::factorizeCouplingGeneral() {
     auto L = cholg_.topLeftCorner(m, m);
     L.setZero();
     if (detail::choleskyCertified(K, L, 0.0)) {
-      double frob2 = 0.0;  // ||L^-1||_F^2 by forward substitution, column by column
       auto x = tmp_g_.head(m);
-      for (int col = 0; col < m; ++col) {
-        for (int r = col; r < m; ++r) {
-          double v = r == col ? 1.0 : 0.0;
-          for (int p = col; p < r; ++p) v -= L(r, p) * x(p);
-          x(r) = v / L(r, r);
-          frob2 += x(r) * x(r);
-        }
-      }
-      const double lower = 1.0 / frob2;
+      const double lower = 1.0 / detail::inverseFrobeniusSquared(L, x);  // <= lambda_min(K)
       if (std::isfinite(lower) && lower > options_.rcond * kappa_) {
         use_cholesky_ = true;
         rank_ = m;
@@ -172,20 +155,12 @@ void ChainHdSolver::factorizeCouplingGeneral() {
   W = K;
   detail::jacobiEigen(W, V);
   const auto lam = W.diagonal();
-  const double lmax = std::max(lam.maxCoeff(), 0.0);
-  const double cut = options_.rcond * std::max(lmax, kappa_);
+  const double cut = options_.rcond * std::max(std::max(lam.maxCoeff(), 0.0), kappa_);
   sigma_min_ = std::max(lam.minCoeff(), 0.0);
   sigma_known_ = true;
-  for (int k = 0; k < m; ++k) {
-    const double l = std::max(lam(k), 0.0);
-    const bool kept = l > 0.0 && l > cut;
-    if (kept) ++rank_;
-    if (options_.policy == SingularityPolicy::TruncatedPseudoInverse) {
-      invg_(k) = kept ? 1.0 / l : 0.0;
-    } else {
-      invg_(k) = l / (l * l + options_.damping * options_.damping);
-    }
-  }
+  auto inv = invg_.head(m);
+  rank_ = detail::policyMultipliers(lam, inv, cut, options_.policy == SingularityPolicy::TruncatedPseudoInverse,
+                                    options_.damping);
 }
 
 void ChainHdSolver::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const {

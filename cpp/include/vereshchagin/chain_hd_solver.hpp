@@ -223,6 +223,11 @@ class ChainHdSolver : public KDL::SolverI {
   // Apparent inertia and bias force of segment i > 0 added to its parent.
   inline void passToParent(int i, const Vector6& pa);
   int degenerate(int i);
+  // E_NONFINITE_RESULT (with the inputs' sizes in the message) if a result is Inf, NaN or
+  // beyond 1e150; nu in the caller's order. Inputs only for the message.
+  int checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                   const Eigen::Ref<const Eigen::VectorXd>& beta, const Eigen::Ref<const Matrix6X>& f_ext,
+                   const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   // General path (constraints on several segments), in segment_constraints.cpp.
   int sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments);
   int inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
