@@ -137,17 +137,12 @@ def test_end_alpha_combines_with_segment_constraints():
     np.testing.assert_array_equal(both.segment_nu["forearm_link"], both.nu[3:])
     assert list(dict_only.segment_nu) == ["end_effector_link", "forearm_link"]
     np.testing.assert_array_equal(dict_only.segment_nu["end_effector_link"], dict_only.nu[:3])
-    assert tool_only_is_none(solver, q, qd, a_tool, b_tool)
+    assert solver.solve(q, qd, a_tool, b_tool).segment_nu is None  # no constraints=, no split
     reordered = solver.solve(q, qd, constraints={"forearm_link": (a_elbow, b_elbow), "end_effector_link": (a_tool, b_tool)})
     np.testing.assert_allclose(reordered.nu, np.r_[dict_only.nu[3:], dict_only.nu[:3]], rtol=0, atol=1e-12)
     # the elbow constraint changes the motion (it is not ignored)
     tool_only = solver.solve(q, qd, a_tool, b_tool)
     assert np.linalg.norm(tool_only.qdd - both.qdd) > 1e-3
-
-
-def tool_only_is_none(solver, q, qd, a, b):
-    """Without constraints= there is no per-segment split."""
-    return solver.solve(q, qd, a, b).segment_nu is None
 
 
 def test_conflicting_segment_constraints_are_finite_with_rank():

@@ -242,9 +242,7 @@ bool FrictionSolver::freeStep(int nf) {
   if (detail::choleskyCertified(W, L, kZeroCurvature * qscale_)) {
     for (int a = 0; a < nf; ++a) perm(a) = a;
   } else {
-    for (int a = 0; a < nf; ++a)
-      for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
-    r = detail::pivotedCholesky(W, L, perm, kZeroCurvature * qscale_);
+    r = detail::pivotedCholesky(W, L, perm, kZeroCurvature * qscale_);  // W is still Q_FF
   }
   free_full_rank_ = r == nf;
   auto gp = tmp_.head(nf);  // g in pivot order
