@@ -104,10 +104,10 @@ void ChainHdSolver::buildModel() {
   qdd_ = Eigen::VectorXd::Zero(nj_);
   tau_cmd_ = Eigen::VectorXd::Zero(nj_);
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
-  seg_force_.assign(ns_, Matrix6X::Zero(6, nj_));
-  col_force_ = Matrix6X::Zero(6, nj_);
+  col_sdp_ = Eigen::MatrixXd::Zero(ns_, nj_);
+  col_force_ = Matrix6X::Zero(6, std::max<unsigned int>(nj_, kMaxConstraints));
   col_row_ = Eigen::VectorXd::Zero(nj_);
-  col_tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nj_);
+  col_tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, std::max<unsigned int>(nj_, kMaxConstraints));
   link_acc_ = Matrix6X::Zero(6, ns_ + 1);
   link_acc_known_ = true;  // zeros until the first solve
   f_ext_buf_ = Matrix6X::Zero(6, ns_);
@@ -651,15 +651,26 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
   const int m = m_;
   // d tau_cmd / d nu, one column per constraint; the end-segment path's S^T A rows into eg_ so
   // that both paths share the sweeps below.
-  for (int r = 0; r < m; ++r) {
-    if (general_) {
+  if (general_) {
+    for (int r = 0; r < m; ++r) {
       rhs_g_.head(m).setZero();
       rhs_g_(r) = 1.0;
       commandFromNuGeneral(rhs_g_.head(m), cmd_per_nu_.col(r));
-    } else {
-      VectorC unit = VectorC::Zero(m);
-      unit(r) = 1.0;
-      commandFromNu(unit, cmd_per_nu_.col(r));
+    }
+  } else if (m > 0) {
+    // The m wrenches -A_N carried rigidly to each joint together: row j of -J^T alfa.
+    auto F = col_force_.leftCols(m);
+    F = -segs_[ns_ - 1].A.leftCols(m);
+    for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
+      const Segment& s = segs_[i];
+      if (s.joint >= 0) cmd_per_nu_.row(s.joint).head(m).noalias() = s.S.transpose().lazyProduct(F);
+      if (i > 0) {  // f = R f', n = R n' + p x f
+        col_tmp3_.leftCols(m).noalias() = s.X.R.lazyProduct(F.topRows<3>());
+        F.topRows<3>() = col_tmp3_.leftCols(m);
+        col_tmp3_.leftCols(m).noalias() = s.X.R.lazyProduct(F.bottomRows<3>());
+        F.bottomRows<3>() = col_tmp3_.leftCols(m);
+        F.bottomRows<3>().noalias() += skew(s.X.p).lazyProduct(F.topRows<3>());
+      }
     }
   }
   if (!general_ && m > 0)
@@ -671,7 +682,6 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     const long kc = std::min<long>(nj_, k - c0);
     auto DP = col_force_.leftCols(kc);  // apparent bias-force change passed to the parent (6 x kc)
     auto DU = col_energy_.topLeftCorner(m, kc);
-    auto row = col_row_.head(kc);
     DU.setZero();
     // A unit torque at joint j changes nothing inward of... nothing distal to it: in the inward
     // pass its column is zero on segments after j's. With the joints in chain order, the columns
@@ -680,68 +690,70 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     bool ascending = true;
     for (long c = 1; c < kc; ++c)
       ascending = ascending && joint_segment_[joints(c0 + c)] >= joint_segment_[joints(c0 + c - 1)];
-    long lo = ascending ? kc : 0, lo_child = lo;
+    // Per column, fixed-size 6-vector arithmetic (robust to the compiler's inlining budget).
+    long lo = ascending ? kc : 0;
+    auto SDP = col_sdp_.leftCols(kc);  // S_i^T (apparent force change from the child), per segment
+    const int m_rows = m;
     for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
-      Segment& s = segs_[i];
+      const Segment& s = segs_[i];
+      const long lo_child = lo;
       if (ascending)
         while (lo > 0 && joint_segment_[joints(c0 + lo - 1)] >= i) --lo;
-      auto dpA_all = seg_force_[i].leftCols(kc);
-      if (i == static_cast<int>(ns_) - 1) {
-        dpA_all.setZero();
-      } else {  // child's apparent force to this frame: f = R f', n = R n' + p x f
-        dpA_all.leftCols(lo_child).setZero();
-        auto dpA_c = dpA_all.rightCols(kc - lo_child);
-        const auto DPc = DP.rightCols(kc - lo_child);
-        const Pose& X = segs_[i + 1].X;
-        dpA_c.topRows<3>().noalias() = X.R.lazyProduct(DPc.topRows<3>());
-        dpA_c.bottomRows<3>().noalias() = X.R.lazyProduct(DPc.bottomRows<3>());
-        dpA_c.bottomRows<3>().noalias() += skew(X.p).lazyProduct(dpA_c.topRows<3>());
+      const bool last = i == static_cast<int>(ns_) - 1;
+      const double* eg = eg_.col(i).data();
+      for (long c = 0; c < kc; ++c) {
+        if (c < lo) {  // not alive yet: no force change here
+          SDP(i, c) = 0.0;
+          continue;
+        }
+        Eigen::Map<Vector6> dp(DP.col(c).data());
+        if (last || c < lo_child) {
+          dp.setZero();  // becomes alive here (or the last segment)
+        } else {
+          dp = forceToParent(segs_[i + 1].X, dp);  // the child's apparent force in this frame
+        }
+        if (s.joint < 0) {
+          SDP(i, c) = 0.0;
+          continue;
+        }
+        const double sd = s.S.dot(dp);
+        SDP(i, c) = sd;
+        const double r = ((joints(c0 + c) == s.joint ? 1.0 : 0.0) - sd) * s.Dinv;  // free joint acc change
+        dp.noalias() += s.u * r;
+        double* du = DU.col(c).data();
+        for (int t = 0; t < m_rows; ++t) du[t] += eg[t] * r;
       }
-      const long na = kc - lo;  // alive columns
-      auto dpA = dpA_all.rightCols(na);
-      auto DPa = DP.rightCols(na);
-      if (s.joint >= 0) {
-        auto r = row.tail(na);
-        r.noalias() = -(s.S.transpose().lazyProduct(dpA)).transpose();
-        for (long c = lo; c < kc; ++c)
-          if (joints(c0 + c) == s.joint) row(c) += 1.0;
-        r *= s.Dinv;  // change of the free joint acceleration
-        DPa = dpA;
-        DPa.noalias() += s.u.lazyProduct(r.transpose());
-        if (m > 0) DU.rightCols(na).noalias() += eg_.col(i).head(m).lazyProduct(r.transpose());
-      } else {
-        DPa = dpA;
-      }
-      lo_child = lo;
     }
     auto DNU = col_nu_.topLeftCorner(m, kc);
+    if (use_cholesky_ && m > 0) {  // d nu = K^-1 dU, all columns through one factor
+      DNU = DU;
+      if (general_) {
+        detail::choleskySolveColumns(cholg_.topLeftCorner(m, m), DNU);
+      } else {
+        detail::choleskySolveColumns(chol_, DNU);
+      }
+    }
     for (long c = 0; c < kc; ++c) {
-      couplingSolve(DU.col(c), DNU.col(c));  // d nu = K^+ dU
+      if (!use_cholesky_) couplingSolve(DU.col(c), DNU.col(c));  // d nu = K^+ dU
       if (dnu_out)
         for (int r = 0; r < m; ++r) (*dnu_out)(general_ ? order_(r) : r, c0 + c) = DNU(r, c);
     }
-    // Outward: accelerations of all columns (6 x kc), base at rest.
+    // Outward: accelerations of all columns, base at rest.
     auto ACC = col_force_.leftCols(kc);
     ACC.setZero();
     for (unsigned int i = 0; i < ns_; ++i) {
       const Segment& s = segs_[i];
-      // motion to the child frame: w' = R^T w, v' = R^T (v - p x w)
-      auto top = ACC.topRows<3>();
-      auto bottom = ACC.bottomRows<3>();
-      top.noalias() -= skew(s.X.p).lazyProduct(bottom);
-      col_tmp3_.leftCols(kc).noalias() = s.X.R.transpose().lazyProduct(top);
-      top = col_tmp3_.leftCols(kc);
-      col_tmp3_.leftCols(kc).noalias() = s.X.R.transpose().lazyProduct(bottom);
-      bottom = col_tmp3_.leftCols(kc);
-      if (s.joint >= 0) {
-        row.noalias() = -(s.S.transpose().lazyProduct(seg_force_[i].leftCols(kc))).transpose();
-        row.noalias() -= (s.u.transpose().lazyProduct(ACC)).transpose();
-        if (m > 0) row.noalias() -= (eg_.col(i).head(m).transpose().lazyProduct(DNU)).transpose();
-        for (long c = 0; c < kc; ++c)
-          if (joints(c0 + c) == s.joint) row(c) += 1.0;
-        row *= s.Dinv;
-        dqdd.row(s.joint).segment(c0, kc) = row.transpose();
-        ACC.noalias() += s.S.lazyProduct(row.transpose());
+      const double* eg = eg_.col(i).data();
+      for (long c = 0; c < kc; ++c) {
+        Eigen::Map<Vector6> acc(ACC.col(c).data());
+        acc = motionToChild(s.X, acc);
+        if (s.joint < 0) continue;
+        double v = (joints(c0 + c) == s.joint ? 1.0 : 0.0) - SDP(i, c) - s.u.dot(acc);
+        const double* dnu = DNU.col(c).data();
+        for (int t = 0; t < m_rows; ++t) v -= eg[t] * dnu[t];
+        v *= s.Dinv;
+        dqdd(s.joint, c0 + c) = v;
+        acc.noalias() += s.S * v;
       }
     }
     // tau_cmd is linear in nu: d tau_cmd = (d tau_cmd / d nu) d nu, the m columns built once.

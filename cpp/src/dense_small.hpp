@@ -84,6 +84,30 @@ void choleskySolve(const ML& L, VB& b) {
   }
 }
 
+// Solve L L^T X = B in place for every column of B (k x c) at once: the row recursions are shared
+// by the columns (no per-column dependency chain), one reciprocal per pivot.
+template <typename ML, typename MB>
+void choleskySolveColumns(const ML& L, MB& B) {
+  const int k = static_cast<int>(L.rows());
+  const Eigen::Index nc = B.cols();
+  for (int i = 0; i < k; ++i) {
+    const double inv = 1.0 / L(i, i);
+    for (Eigen::Index c = 0; c < nc; ++c) {
+      double v = B(i, c);
+      for (int p = 0; p < i; ++p) v -= L(i, p) * B(p, c);
+      B(i, c) = v * inv;
+    }
+  }
+  for (int i = k - 1; i >= 0; --i) {
+    const double inv = 1.0 / L(i, i);
+    for (Eigen::Index c = 0; c < nc; ++c) {
+      double v = B(i, c);
+      for (int p = i + 1; p < k; ++p) v -= L(p, i) * B(p, c);
+      B(i, c) = v * inv;
+    }
+  }
+}
+
 // Pivoted (rank-revealing) Cholesky of a symmetric positive semi-definite W (k x k, overwritten
 // by its Schur complements): W(perm, perm) = L L^T with L (k x r) lower trapezoidal, stopping when
 // the largest remaining diagonal entry is <= tol. Returns the rank r.

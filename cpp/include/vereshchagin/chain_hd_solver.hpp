@@ -263,10 +263,9 @@ class ChainHdSolver : public KDL::SolverI {
   std::vector<Segment> segs_;
   std::vector<int> joint_segment_;  // segment index of each joint
   Eigen::VectorXd qdd_, tau_cmd_, zero_joints_;
-  // Workspace of responseColumns(): d tau_cmd / d nu (n_joints x m), per-segment force changes
-  // (6 x n_joints each) and column blocks.
-  Eigen::MatrixXd cmd_per_nu_, col_energy_, col_nu_;
-  std::vector<Matrix6X> seg_force_;
+  // Workspace of responseColumns(): d tau_cmd / d nu (n_joints x m), per segment and column the
+  // joint-axis component of the apparent force change (n_segments x n_joints), column blocks.
+  Eigen::MatrixXd cmd_per_nu_, col_energy_, col_nu_, col_sdp_;
   Matrix6X col_force_;
   Eigen::VectorXd col_row_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> col_tmp3_;
