@@ -738,13 +738,20 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       if (dnu_out)
         for (int r = 0; r < m; ++r) (*dnu_out)(general_ ? order_(r) : r, c0 + c) = DNU(r, c);
     }
-    // Outward: accelerations of all columns, base at rest.
+    // Outward: accelerations of all columns, base at rest. When the columns are every joint in
+    // chain order, the response G is symmetric and square: column c needs only the rows of the
+    // joints up to its own (G(j, c) for j <= c, from the segments up to joint c's); the rows
+    // below come from the columns already computed (G(j, c) = G(c, j)). The columns alive at
+    // segment i are then the suffix c >= (joints before segment i): about half the work.
+    bool symmetric = c0 == 0 && kc == static_cast<long>(nj_);
+    for (long c = 0; c < kc && symmetric; ++c) symmetric = joints(c) == c;
     auto ACC = col_force_.leftCols(kc);
     ACC.setZero();
+    long first = 0;  // first alive column
     for (unsigned int i = 0; i < ns_; ++i) {
       const Segment& s = segs_[i];
       const double* eg = eg_.col(i).data();
-      for (long c = 0; c < kc; ++c) {
+      for (long c = first; c < kc; ++c) {
         Eigen::Map<Vector6> acc(ACC.col(c).data());
         acc = motionToChild(s.X, acc);
         if (s.joint < 0) continue;
@@ -754,6 +761,10 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
         v *= s.Dinv;
         dqdd(s.joint, c0 + c) = v;
         acc.noalias() += s.S * v;
+      }
+      if (symmetric && s.joint >= 0) {
+        for (long c = s.joint + 1; c < kc; ++c) dqdd(c, s.joint) = dqdd(s.joint, c);
+        first = s.joint + 1;
       }
     }
     // tau_cmd is linear in nu: d tau_cmd = (d tau_cmd / d nu) d nu, the m columns built once.

@@ -108,6 +108,42 @@ void choleskySolveColumns(const ML& L, MB& B) {
   }
 }
 
+// Right-looking Cholesky W(perm, perm) = L L^T, L (k x r), with the pivots' reciprocals in
+// invdiag (invdiag(i) = 1 / L(i, i)). pivot = true: the largest remaining diagonal entry is the
+// next pivot (rank-revealing; stops at rank r when it is <= tol). pivot = false: columns in
+// order (perm = identity), stopping at the first pivot <= tol (returns its index: W is then
+// not proven definite). W (symmetric, k x k) is overwritten by its Schur complements.
+template <typename MW, typename ML, typename VP, typename VD>
+int choleskyReciprocal(MW& W, ML& L, VP& perm, VD& invdiag, double tol, bool pivot) {
+  const int k = static_cast<int>(W.rows());
+  for (int i = 0; i < k; ++i) perm(i) = i;
+  for (int j = 0; j < k; ++j) {
+    int p = j;
+    if (pivot)
+      for (int i = j + 1; i < k; ++i)
+        if (W(i, i) > W(p, p)) p = i;
+    if (!(W(p, p) > tol)) return j;
+    if (p != j) {  // symmetric swap of rows/columns j and p, and of L's rows built so far
+      W.row(j).swap(W.row(p));
+      W.col(j).swap(W.col(p));
+      for (int c = 0; c < j; ++c) std::swap(L(j, c), L(p, c));
+      std::swap(perm(j), perm(p));
+    }
+    const double ljj = std::sqrt(W(j, j));
+    const double inv = 1.0 / ljj;
+    L(j, j) = ljj;
+    invdiag(j) = inv;
+    for (int i = j + 1; i < k; ++i) L(i, j) = W(i, j) * inv;
+    for (int c = j + 1; c < k; ++c) {
+      const double lc = L(c, j);
+      for (int i = c; i < k; ++i) W(i, c) -= L(i, j) * lc;
+      if (pivot)
+        for (int i = c + 1; i < k; ++i) W(c, i) = W(i, c);
+    }
+  }
+  return k;
+}
+
 // Pivoted (rank-revealing) Cholesky of a symmetric positive semi-definite W (k x k, overwritten
 // by its Schur complements): W(perm, perm) = L L^T with L (k x r) lower trapezoidal, stopping when
 // the largest remaining diagonal entry is <= tol. Returns the rank r.

@@ -29,7 +29,7 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
   status_.assign(n, Moving);
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
   Gc_ = Tc_ = Q_ = work_ = L_ = V_ = N_ = B_ = Eigen::MatrixXd::Zero(n, n);
-  c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = Eigen::VectorXd::Zero(n);
+  c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = invdiag_ = Eigen::VectorXd::Zero(n);
   const int mcap = hd_.maxConstraints();
   dnu_ = Eigen::MatrixXd::Zero(mcap, n);
   nu0_ = nu_ = beta_keep_ = Eigen::VectorXd::Zero(mcap);
@@ -236,13 +236,14 @@ bool FrictionSolver::freeStep(int nf) {
     for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
   auto L = L_.topLeftCorner(nf, nf);
   auto perm = rows_.head(nf);
-  // Positive definite at the curvature tolerance (the usual case): plain Cholesky, no pivoting;
-  // otherwise the rank-revealing pivoted factorisation.
-  int r = nf;
-  if (detail::choleskyCertified(W, L, kZeroCurvature * qscale_)) {
-    for (int a = 0; a < nf; ++a) perm(a) = a;
-  } else {
-    r = detail::pivotedCholesky(W, L, perm, kZeroCurvature * qscale_);  // W is still Q_FF
+  auto inv = invdiag_.head(nf);
+  // Definite at the curvature tolerance (the usual case): no pivoting; otherwise the
+  // rank-revealing factorisation from the start (W re-gathered: the first attempt overwrote it).
+  int r = detail::choleskyReciprocal(W, L, perm, inv, kZeroCurvature * qscale_, false);
+  if (r < nf) {
+    for (int a = 0; a < nf; ++a)
+      for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
+    r = detail::choleskyReciprocal(W, L, perm, inv, kZeroCurvature * qscale_, true);
   }
   free_full_rank_ = r == nf;
   auto gp = tmp_.head(nf);  // g in pivot order
@@ -252,7 +253,7 @@ bool FrictionSolver::freeStep(int nf) {
   for (int i = 0; i < r; ++i) {
     double v = gp(i);
     for (int c = 0; c < i; ++c) v -= L(i, c) * y(c);
-    y(i) = v / L(i, i);
+    y(i) = v * inv(i);
   }
   // w = g2 - L2 y, kept in y's tail.
   double wmax = 0.0;
@@ -281,12 +282,21 @@ bool FrictionSolver::freeStep(int nf) {
   for (int i = r - 1; i >= 0; --i) {
     double v = u(i);
     for (int c = i + 1; c < r; ++c) v -= L(c, i) * u(c);
-    u(i) = v / L(i, i);
+    u(i) = v * inv(i);
   }
   for (int i = r; i < nf; ++i) u(i) = zero_curvature ? -y(i) : 0.0;
   auto out = zero_curvature ? d_.head(nf) : p_.head(nf);
   for (int a = 0; a < nf; ++a) out(perm(a)) = u(a);
   return zero_curvature;
+}
+
+// grad_ = Q x - c (the negated accelerations of the resting joints at friction x).
+void FrictionSolver::gradient(int k) {
+  for (int i = 0; i < k; ++i) {
+    double v = -c_(i);
+    for (int j = 0; j < k; ++j) v += Q_(j, i) * x_(j);  // Q symmetric: column i, contiguous
+    grad_(i) = v;
+  }
 }
 
 // Stage 1: minimise 1/2 x^T Q x - c^T x over lo <= x <= hi by a primal active-set method.
@@ -313,9 +323,20 @@ int FrictionSolver::boxQp(int k) {
   // face-optimal twice and there are at most 3^k working sets: (k + 1) 3^k iterations. When a
   // face-optimal value fails to decrease (degenerate cycling risk), releases switch to Bland's
   // smallest-index rule, the classical anti-cycling safeguard. (Observed: 2-6 iterations mean.)
+  //
+  // Primal-dual rounds (Hintermueller, Ito and Kunisch's active-set Newton step): on a face whose
+  // block is definite, the face minimiser is computed anyway; instead of stopping at the first
+  // bound on the way, the working set is re-guessed from all of its bound violations and from
+  // the multipliers' signs, and the iterate is clamped back into the box (feasible again). A
+  // round that finds no violation and no wrong-sign multiplier has found a KKT point: optimal.
+  // At most kPrimalDualRounds rounds; each may raise the objective once, so the primal
+  // argument above holds between them: at most (P + 1) (k + 1) 3^k + P iterations in all.
+  constexpr int kPrimalDualRounds = 4;
   long bound = k + 1;
   for (int i = 0; i < k && bound < 100000000L; ++i) bound *= 3;
+  bound = (kPrimalDualRounds + 1) * bound + kPrimalDualRounds;
   const long max_iterations = std::min(bound, 100000000L);
+  int rounds_left = kPrimalDualRounds;
   bool face_optimal = false, bland = false;
   double last_face_value = kInf;
   free_full_rank_ = false;
@@ -323,13 +344,31 @@ int FrictionSolver::boxQp(int k) {
     iterations_ = static_cast<int>(std::min<long>(it + 1, 2147483647L));
     gscale_ = std::max({cmax, qscale_ * x.cwiseAbs().maxCoeff(), qscale_ * torque_scale, 1e-300});
     tol_g = kGradientTolerance * gscale_;
-    grad_.head(k).noalias() = Q_.topLeftCorner(k, k).lazyProduct(x);
-    grad_.head(k) -= c_.head(k);
+    gradient(k);
     int nf = 0;
     for (int i = 0; i < k; ++i)
       if (state(i) == 0) free_idx_(nf++) = i;
     if (nf > 0 && !face_optimal) {
       const bool zero_curvature = freeStep(nf);
+      if (!zero_curvature && free_full_rank_ && rounds_left > 0) {
+        --rounds_left;
+        for (int a = 0; a < nf; ++a) x(free_idx_(a)) += p_(a);  // the face minimiser (maybe outside)
+        gradient(k);
+        bool changed = false;
+        for (int i = 0; i < k; ++i) {
+          if (state(i) == 0) {
+            if (x(i) > hi_(i)) state(i) = 1, changed = true;
+            else if (x(i) < lo_(i)) state(i) = -1, changed = true;
+          } else if ((state(i) < 0 ? -grad_(i) : grad_(i)) > tol_g) {
+            state(i) = 0, changed = true;  // wrong-sign multiplier: release
+          }
+        }
+        if (!changed) return ChainHdSolver::E_NOERROR;  // KKT point
+        for (int i = 0; i < k; ++i)
+          x(i) = state(i) > 0 ? hi_(i) : (state(i) < 0 ? lo_(i) : std::min(hi_(i), std::max(lo_(i), x(i))));
+        last_face_value = kInf;
+        continue;
+      }
       const auto dir = zero_curvature ? d_.head(nf) : p_.head(nf);
       double alpha = zero_curvature ? kInf : 1.0;
       int block = -1, side = 0;

@@ -119,6 +119,7 @@ class FrictionSolver {
   // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
+  void gradient(int k);
 
   ChainHdSolver hd_, free_;
   unsigned int nj_ = 0;
@@ -145,7 +146,7 @@ class FrictionSolver {
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;     // joint index of each resting joint
   Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_, V_, N_, B_;
-  Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_;
+  Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_, invdiag_;
   Eigen::VectorXi state_, free_idx_, rows_;
 };
 
