@@ -534,6 +534,21 @@ void ChainHdSolver::commandFromNu(const VectorC& nu, Eigen::Ref<Eigen::VectorXd>
   }
 }
 
+int ChainHdSolver::commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) {
+  if (!solved_) return fail(E_NO_SOLUTION, "commandTorquesOf() needs a successful solve() first");
+  if (nu.size() != m_ || tau_cmd.size() != nj_)
+    return fail(E_SIZE_MISMATCH, "nu has %ld entries and tau_cmd %ld, expected %d and %u", (long)nu.size(),
+                (long)tau_cmd.size(), m_, nj_);
+  if (general_) {
+    for (int c = 0; c < m_; ++c) tmp_g_(c) = nu(order_(c));  // sorted order
+    commandFromNuGeneral(tmp_g_.head(m_), tau_cmd);
+  } else {
+    const VectorC v = nu;
+    commandFromNu(v, tau_cmd);
+  }
+  return E_NOERROR;
+}
+
 int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                          const Eigen::Ref<const Matrix6X>& alfa,
@@ -641,7 +656,8 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
   if (dqdd.rows() != nj_ || dqdd.cols() != k)
     return fail(E_SIZE_MISMATCH, "dqdd is %ldx%ld, expected %ux%ld", (long)dqdd.rows(),
                 (long)dqdd.cols(), nj_, k);
-  if (dtau_cmd.rows() != nj_ || dtau_cmd.cols() != k)
+  const bool want_tau = !(dnu_out && dtau_cmd.size() == 0);  // empty beside dnu: not wanted
+  if (want_tau && (dtau_cmd.rows() != nj_ || dtau_cmd.cols() != k))
     return fail(E_SIZE_MISMATCH, "dtau_cmd is %ldx%ld, expected %ux%ld", (long)dtau_cmd.rows(),
                 (long)dtau_cmd.cols(), nj_, k);
   for (long c = 0; c < k; ++c) {
@@ -651,7 +667,9 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
   const int m = m_;
   // d tau_cmd / d nu, one column per constraint; the end-segment path's S^T A rows into eg_ so
   // that both paths share the sweeps below.
-  if (general_) {
+  if (!want_tau) {
+    // d tau_cmd / d nu not needed
+  } else if (general_) {
     for (int r = 0; r < m; ++r) {
       rhs_g_.head(m).setZero();
       rhs_g_(r) = 1.0;
@@ -768,7 +786,9 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       }
     }
     // tau_cmd is linear in nu: d tau_cmd = (d tau_cmd / d nu) d nu, the m columns built once.
-    if (m > 0) {
+    if (!want_tau) {
+      // skipped on request
+    } else if (m > 0) {
       dtau_cmd.middleCols(c0, kc).noalias() = cmd_per_nu_.leftCols(m).lazyProduct(DNU);
     } else {
       dtau_cmd.middleCols(c0, kc).setZero();

@@ -28,7 +28,7 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
   f_keep_ = ChainHdSolver::Matrix6X::Zero(6, hd_.nrOfSegments());
   status_.assign(n, Moving);
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
-  Gc_ = Tc_ = Q_ = work_ = L_ = V_ = N_ = B_ = Eigen::MatrixXd::Zero(n, n);
+  Gc_ = Q_ = work_ = L_ = V_ = N_ = B_ = Eigen::MatrixXd::Zero(n, n);
   c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = invdiag_ = Eigen::VectorXd::Zero(n);
   const int mcap = hd_.maxConstraints();
   dnu_ = Eigen::MatrixXd::Zero(mcap, n);
@@ -157,7 +157,9 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
     qdd0_ = hd_.qdd();
     tau_cmd0_ = hd_.commandTorques();
     nu0_.head(hd_.constraintCount()) = hd_.nu();
-    rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(k), dnu_.leftCols(k));
+    // d qdd and d nu per resting joint; tau_cmd follows from nu (commandTorquesOf), so its columns
+    // are not formed.
+    rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), dnu_.leftCols(k));
     if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
     for (int a = 0; a < k; ++a) {
       c_(a) = qdd0_(rest_(a));
@@ -175,11 +177,10 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
     // The outputs are affine in the friction torques: update them from the columns (no new solve).
     qdd_ = qdd0_;
     qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
-    tau_cmd_ = tau_cmd0_;
-    tau_cmd_.noalias() -= Tc_.leftCols(k) * x_.head(k);
     const int m = hd_.constraintCount();
     nu_.head(m) = nu0_.head(m);
     nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);
+    hd_.commandTorquesOf(nu_.head(m), tau_cmd_);
   } else {
     qdd_ = hd_.qdd();
     tau_cmd_ = hd_.commandTorques();
@@ -350,6 +351,9 @@ int FrictionSolver::boxQp(int k) {
       if (state(i) == 0) free_idx_(nf++) = i;
     if (nf > 0 && !face_optimal) {
       const bool zero_curvature = freeStep(nf);
+      // A singular full problem (a task fixes some accelerations) leaves nearly singular faces
+      // whose minimisers overshoot far: primal steps only then.
+      if (it == 0 && !free_full_rank_) rounds_left = 0;
       if (!zero_curvature && free_full_rank_ && rounds_left > 0) {
         --rounds_left;
         for (int a = 0; a < nf; ++a) x(free_idx_(a)) += p_(a);  // the face minimiser (maybe outside)
@@ -467,13 +471,12 @@ void FrictionSolver::leastCommand(int k) {
   }
   auto N = N_.topLeftCorner(ns, dn);
   // Target: x_St = -tau_cmd_St at the stage-1 optimum (tau_cmd = tau_cmd0 - Tc x).
+  const int m = hd_.constraintCount();
+  nu_.head(m) = nu0_.head(m);
+  nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x;
+  hd_.commandTorquesOf(nu_.head(m), tau_cmd_);  // at the stage-1 optimum
   auto t = tmp_.head(ns);
-  for (int a = 0; a < ns; ++a) {
-    const int j = rest_(rows_(a));
-    double tc = tau_cmd0_(j);
-    for (int b = 0; b < k; ++b) tc -= Tc_(j, b) * x(b);
-    t(a) = -tc;  // desired change of x_St: tau_cmd_St + change = 0
-  }
+  for (int a = 0; a < ns; ++a) t(a) = -tau_cmd_(rest_(rows_(a)));  // desired change of x_St: tau_cmd_St + change = 0
   auto z0 = d_.head(dn);
   z0.noalias() = N.transpose() * t;
   auto z = p_.head(dn);

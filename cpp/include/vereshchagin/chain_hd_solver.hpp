@@ -171,9 +171,15 @@ class ChainHdSolver : public KDL::SolverI {
   int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                       Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
   // The same, plus d(nu)/d(tau_j) into dnu (constraintCount() x k; its storage may be larger:
-  // only the top m rows are written; rows in the order of nu()).
+  // only the top m rows are written; rows in the order of nu()). Here dtau_cmd may also be empty
+  // (0 x 0): it is then not computed (commandTorquesOf(nu) gives tau_cmd for any nu).
   int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                       Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd> dnu);
+
+  // The command torques that constraint magnitudes nu (constraintCount(), the order of nu())
+  // would need at the last solve's state: tau = -sum_c J_c^T alfa_c nu_c (n_joints, linear in nu;
+  // commandTorques() is commandTorquesOf(nu())). O(n m), no allocation.
+  int commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
 
   void setRootAcceleration(const KDL::Twist& root_acc);
   int setOptions(const SolverOptions& options);

@@ -145,7 +145,7 @@ class FrictionSolver {
   Eigen::VectorXd fstatic_;  // static friction of the last solve
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;     // joint index of each resting joint
-  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_, V_, N_, B_;
+  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_, V_, N_, B_;  // Tc_ stays empty (0 x 0)
   Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_, invdiag_;
   Eigen::VectorXi state_, free_idx_, rows_;
 };
