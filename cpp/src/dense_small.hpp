@@ -108,13 +108,13 @@ void choleskySolveColumns(const ML& L, MB& B) {
   }
 }
 
-// Right-looking Cholesky W(perm, perm) = L L^T, L (k x r), with the pivots' reciprocals in
-// invdiag (invdiag(i) = 1 / L(i, i)). pivot = true: the largest remaining diagonal entry is the
-// next pivot (rank-revealing; stops at rank r when it is <= tol). pivot = false: columns in
-// order (perm = identity), stopping at the first pivot <= tol (returns its index: W is then
-// not proven definite). W (symmetric, k x k) is overwritten by its Schur complements.
+// Right-looking square-root-free factorisation W(perm, perm) = L D L^T, L (k x r) unit lower
+// trapezoidal (its unit diagonal is not stored), D = diag(1 / invdiag(0..r-1)). pivot = true: the
+// largest remaining diagonal entry is the next pivot (rank-revealing; stops at rank r when it is
+// <= tol). pivot = false: columns in order (perm = identity), stopping at the first pivot
+// <= tol (returns its index). W (symmetric, k x k) is overwritten by its Schur complements.
 template <typename MW, typename ML, typename VP, typename VD>
-int choleskyReciprocal(MW& W, ML& L, VP& perm, VD& invdiag, double tol, bool pivot) {
+int ldlReciprocal(MW& W, ML& L, VP& perm, VD& invdiag, double tol, bool pivot) {
   const int k = static_cast<int>(W.rows());
   for (int i = 0; i < k; ++i) perm(i) = i;
   for (int j = 0; j < k; ++j) {
@@ -129,14 +129,12 @@ int choleskyReciprocal(MW& W, ML& L, VP& perm, VD& invdiag, double tol, bool piv
       for (int c = 0; c < j; ++c) std::swap(L(j, c), L(p, c));
       std::swap(perm(j), perm(p));
     }
-    const double ljj = std::sqrt(W(j, j));
-    const double inv = 1.0 / ljj;
-    L(j, j) = ljj;
+    const double inv = 1.0 / W(j, j);
     invdiag(j) = inv;
     for (int i = j + 1; i < k; ++i) L(i, j) = W(i, j) * inv;
     for (int c = j + 1; c < k; ++c) {
-      const double lc = L(c, j);
-      for (int i = c; i < k; ++i) W(i, c) -= L(i, j) * lc;
+      const double wc = W(c, j);  // = L(c, j) d_j
+      for (int i = c; i < k; ++i) W(i, c) -= L(i, j) * wc;
       if (pivot)
         for (int i = c + 1; i < k; ++i) W(c, i) = W(i, c);
     }

@@ -227,10 +227,8 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
 }
 
 // Free-set step. Q_FF (nf x nf) is built in work_; p_ = a solution of Q_FF p = -g_F. Returns
-// true with a zero-curvature descent direction in d_ when g_F has a component in null(Q_FF).
-// Pivoted Cholesky Q_FF(perm, perm) = [L1; L2][L1; L2]^T of rank r; with y = L1^-1 g1 and
-// w = g2 - L2 y (zero iff g is in the range): p = -[L1^-T y; 0], or d = [L1^-T L2^T w; -w]
-// (in null(Q_FF), g^T d = -|w|^2 < 0).
+// true with a zero-curvature descent direction in d_ when g_F has a component in null(Q_FF)
+// (rank-revealing L D L^T below).
 bool FrictionSolver::freeStep(int nf) {
   auto W = work_.topLeftCorner(nf, nf);
   for (int a = 0; a < nf; ++a)
@@ -238,23 +236,27 @@ bool FrictionSolver::freeStep(int nf) {
   auto L = L_.topLeftCorner(nf, nf);
   auto perm = rows_.head(nf);
   auto inv = invdiag_.head(nf);
-  // Definite at the curvature tolerance (the usual case): no pivoting; otherwise the
-  // rank-revealing factorisation from the start (W re-gathered: the first attempt overwrote it).
-  int r = detail::choleskyReciprocal(W, L, perm, inv, kZeroCurvature * qscale_, false);
-  if (r < nf) {
+  // Definite at the curvature tolerance (the usual case): no pivoting. A failure at the last
+  // column is already rank-revealing (every accepted pivot > tol, the 1 x 1 remainder <= tol);
+  // a failure before it restarts with pivoting (W re-gathered: the attempt overwrote it).
+  const double tol = kZeroCurvature * qscale_;
+  int r = detail::ldlReciprocal(W, L, perm, inv, tol, false);
+  if (r < nf - 1) {
     for (int a = 0; a < nf; ++a)
       for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
-    r = detail::choleskyReciprocal(W, L, perm, inv, kZeroCurvature * qscale_, true);
+    r = detail::ldlReciprocal(W, L, perm, inv, tol, true);
   }
   free_full_rank_ = r == nf;
+  // Q_FF(perm, perm) = [L1; L2] D [L1; L2]^T (L1 r x r unit lower). With y = L1^-1 g1 and
+  // w = g2 - L2 y: Newton step p = -[L1^-T D^-1 y; 0]; when w != 0 the descent direction
+  // d = [L1^-T L2^T w; -w] has Q_FF d = 0 and g^T d = -|w|^2.
   auto gp = tmp_.head(nf);  // g in pivot order
   for (int a = 0; a < nf; ++a) gp(a) = grad_(free_idx_(perm(a)));
-  // y = L1^-1 g1 (forward substitution), in tmp2_.
   auto y = tmp2_.head(nf);
   for (int i = 0; i < r; ++i) {
     double v = gp(i);
     for (int c = 0; c < i; ++c) v -= L(i, c) * y(c);
-    y(i) = v * inv(i);
+    y(i) = v;
   }
   // w = g2 - L2 y, kept in y's tail.
   double wmax = 0.0;
@@ -270,10 +272,10 @@ bool FrictionSolver::freeStep(int nf) {
   if (zero_curvature)
     for (int i = r; i < nf; ++i)
       if (std::abs(y(i)) <= kGradientTolerance * gscale_) y(i) = 0.0;
-  // Back substitution L1^T u = rhs, rhs = -y1 (Newton step) or L2^T w (descent direction).
+  // Back substitution L1^T u = rhs, rhs = -D^-1 y1 (Newton step) or L2^T w (descent direction).
   auto u = eig_.head(nf);
   for (int i = 0; i < r; ++i) {
-    double v = -y(i);
+    double v = -y(i) * inv(i);
     if (zero_curvature) {
       v = 0.0;
       for (int t = r; t < nf; ++t) v += L(t, i) * y(t);
@@ -283,7 +285,7 @@ bool FrictionSolver::freeStep(int nf) {
   for (int i = r - 1; i >= 0; --i) {
     double v = u(i);
     for (int c = i + 1; c < r; ++c) v -= L(c, i) * u(c);
-    u(i) = v * inv(i);
+    u(i) = v;
   }
   for (int i = r; i < nf; ++i) u(i) = zero_curvature ? -y(i) : 0.0;
   auto out = zero_curvature ? d_.head(nf) : p_.head(nf);
