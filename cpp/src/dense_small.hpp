@@ -138,6 +138,43 @@ int pivotedCholesky(MW& W, ML& L, VP& perm, double tol) {
   return k;
 }
 
+// Left-looking pivoted Cholesky of the principal submatrix S = A(idx, idx) (k x k, symmetric
+// positive semi-definite), read in place (no copy, no Schur-complement matrix): S = V V^T + R with
+// V (k x r) in idx's order (row a of V belongs to idx(a)), lower trapezoidal in pivot order, and
+// R positive semi-definite with diagonal <= tol. Pivot j is the row of largest remaining diagonal
+// (recorded in piv(j)); column j of V reads only A's column of that pivot:
+//   V(a, j) = (S(a, p) - sum_{c<j} V(a, c) V(p, c)) / V(p, j),   V(p, j) = sqrt(d_p),
+// with d_a = S(a, a) - sum_{c<=j} V(a, c)^2 the remaining diagonal (diag: scratch of k entries).
+// Rows already pivoted get V(a, j) = 0. Returns the rank r (r columns of V written).
+template <typename MA, typename VI, typename MV, typename VD, typename VP>
+int pivotedCholeskyLeft(const MA& A, const VI& idx, int k, MV& V, VD& diag, VP& piv, double tol) {
+  constexpr double kDone = -std::numeric_limits<double>::infinity();  // marks pivoted rows
+  for (int a = 0; a < k; ++a) diag(a) = A(idx(a), idx(a));
+  for (int j = 0; j < k; ++j) {
+    int p = 0;
+    for (int a = 1; a < k; ++a)
+      if (diag(a) > diag(p)) p = a;
+    if (!(diag(p) > tol)) return j;
+    piv(j) = p;
+    const double vpp = std::sqrt(diag(p)), inv = 1.0 / vpp;
+    const int ip = idx(p);
+    for (int a = 0; a < k; ++a) {
+      if (a == p || diag(a) == kDone) {
+        V(a, j) = 0.0;
+        continue;
+      }
+      double v = A(idx(a), ip);
+      for (int c = 0; c < j; ++c) v -= V(a, c) * V(p, c);
+      v *= inv;
+      V(a, j) = v;
+      diag(a) -= v * v;
+    }
+    V(p, j) = vpp;
+    diag(p) = kDone;
+  }
+  return k;
+}
+
 // Cyclic Jacobi eigen-decomposition of a symmetric k x k matrix A: rotations J_pq zero one
 // off-diagonal pair at a time, A <- J^T A J, V <- V J. On return the diagonal of A holds the
 // eigenvalues (unsorted) and the columns of V the orthonormal eigenvectors. Stops when the

@@ -144,9 +144,15 @@ class FrictionSolver {
   Eigen::VectorXd fstatic_;  // static friction of the last solve
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;     // joint index of each resting joint
-  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_, V_, N_, B_;
+  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_;
   Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_;
   Eigen::VectorXi state_, free_idx_, rows_;
+  // Stage-2 workspace (leastCommand): Q_StSt = V V^T (V ns x r); the iterate y and target t on
+  // St; U R = V_F (column-pivoted QR of the free rows, U's columns kept at V's column index);
+  // lam_ the face multipliers of V^T y = const; side_ the working set; cols_ / piv_ pivot orders.
+  Eigen::MatrixXd V_, U_, R_;
+  Eigen::VectorXd ys_, ts_, lam_;
+  Eigen::VectorXi side_, cols_, piv_;
 };
 
 }  // namespace vereshchagin
