@@ -398,7 +398,8 @@ int FrictionSolver::boxQp(int k) {
 // g_i >= 0 at a lower bound, <= 0 at an upper one, else the worst violator is released.
 // A blocking coordinate i has d_i != 0 with d orthogonal to range(V) and to the e_j, j in W, so
 // e_i is independent of them: V_F keeps full column rank in exact arithmetic (the QR drops a
-// column only when round-off makes it dependent to 1e-9 of sqrt(Q's scale)).
+// column only when round-off makes it dependent to 1e-9 of sqrt(Q's scale)). A null space of
+// dimension 1 (ns - r = 1) is a line: closed form instead (leastOnLine).
 void FrictionSolver::leastCommand(int k) {
   // Raw column-major views of the workspace (leading dimension n; distinct buffers, no aliasing).
   const int n = static_cast<int>(nj_);
@@ -407,10 +408,11 @@ void FrictionSolver::leastCommand(int k) {
   double* __restrict grad = grad_.data();
   // Sticking rows: zero gradient Q x - c (= minus the resting joints' accelerations).
   const double gtol = 10.0 * kGradientTolerance * gscale_;
-  for (int a = 0; a < k; ++a) grad[a] = -c_(a);
-  for (int b = 0; b < k; ++b) {  // column sweeps (independent lanes, no reduction chain)
-    const double xb = x[b];
-    for (int a = 0; a < k; ++a) grad[a] += Q[a + b * n] * xb;
+  for (int a = 0; a < k; ++a) {  // Q symmetric: column a (contiguous); the rows' chains overlap
+    const double* __restrict qa = Q + a * n;
+    double g = -c_(a);
+    for (int b = 0; b < k; ++b) g += qa[b] * x[b];
+    grad[a] = g;
   }
   int* __restrict st = rows_.data();
   int ns = 0;
@@ -427,38 +429,101 @@ void FrictionSolver::leastCommand(int k) {
   const int r = detail::pivotedCholeskyLeft(Q_, rows_, ns, V_, eig_, piv_, kZeroCurvature * qscale_);
   if (r == ns) return;  // null(Q_StSt) = {0}: x* is the only optimum
 
-  const double* __restrict V = V_.data();
-  double* __restrict U = U_.data();
-  double* __restrict R = R_.data();
-  double* __restrict y = ys_.data();
-  double* __restrict t = ts_.data();
-  double* __restrict lo = p_.data();    // bounds on St
-  double* __restrict hi = eig_.data();  // (eig_ was the factorisation's scratch)
-  double* __restrict h = d_.data();     // (I - P)(y_F + t_F): the step is -h
-  double* __restrict w = tmp2_.data();  // U^T (y_F + t_F), pivot order
-  double* __restrict lam = lam_.data();
-  int* __restrict side = side_.data();  // 0 free, -1 at the lower bound, +1 at the upper bound
-  int* __restrict F = free_idx_.data();
-  int* __restrict cols = cols_.data();
-  // Target t = tau_cmd - x on St (tau_cmd = tau_cmd0 - Tc x), start y = x*_St (feasible), W empty.
-  double* __restrict tc = tmp_.data();
+  // Target t = tau_cmd - x on St (tau_cmd = tau_cmd0 - Tc x), start y = x*_St (feasible). (No
+  // restrict on what the solvers below write.)
+  double* y = ys_.data();
+  double* t = ts_.data();
+  double* lo = p_.data();    // bounds on St
+  double* hi = eig_.data();  // (eig_ was the factorisation's scratch)
   const double* __restrict Tc = Tc_.data();
-  for (int j = 0; j < n; ++j) tc[j] = tau_cmd0_(j);
-  for (int b = 0; b < k; ++b) {  // tau_cmd at x*, by column sweeps
-    const double xb = x[b];
-    for (int j = 0; j < n; ++j) tc[j] -= Tc[j + b * n] * xb;
-  }
   double yscale = 1e-300;  // torque scale of y and t (|y + t| <= |x* + t| bounds the optimum)
   for (int a = 0; a < ns; ++a) {
-    const int i = st[a];
-    const double cmd = tc[rest_(i)];
+    const int i = st[a], j = rest_(i);
+    double cmd = tau_cmd0_(j);  // tau_cmd_j at x* (the rows' chains overlap)
+    for (int b = 0; b < k; ++b) cmd -= Tc[j + b * n] * x[b];
     y[a] = x[i];
     t[a] = cmd - x[i];
     lo[a] = lo_(i);
     hi[a] = hi_(i);
-    side[a] = 0;
     yscale = std::max({yscale, std::abs(x[i]), std::abs(cmd)});
   }
+  if (r == ns - 1)
+    leastOnLine(ns, r);
+  else
+    leastActiveSet(ns, r, yscale);
+  // x_St <- y, clipped to the box (round-off overshoot of non-blocking entries); kept only if not
+  // worse than x* (a safety net: the iteration never increases the objective).
+  double v_start = 0.0, v_end = 0.0;
+  for (int a = 0; a < ns; ++a) {
+    y[a] = std::min(hi[a], std::max(lo[a], y[a]));
+    v_start += (x[st[a]] + t[a]) * (x[st[a]] + t[a]);
+    v_end += (y[a] + t[a]) * (y[a] + t[a]);
+  }
+  if (v_end <= v_start)
+    for (int a = 0; a < ns; ++a) x[st[a]] = y[a];
+}
+
+// Stage 2 when null(Q_StSt) has dimension 1 (r = ns - 1; e.g. a 1-D task on a 7-joint arm at rest):
+// y = x* + s n with V^T n = 0 is a line, the box an interval of s, so the optimum is the clipped
+// minimiser s = clip(-n^T (x* + t) / n^T n). In pivot order V = [L1; l2^T] (L1 r x r lower
+// triangular, l2 the row left out): n = [-L1^-T l2; 1]. Entries |n_a| <= 1e-12 max|n| are
+// round-off (a coordinate the equality pins): they do not bound s (any overshoot is clipped).
+void FrictionSolver::leastOnLine(int ns, int r) {
+  const int n = static_cast<int>(nj_);
+  const double* __restrict V = V_.data();
+  const int* __restrict piv = piv_.data();
+  double* __restrict y = ys_.data();
+  const double* __restrict t = ts_.data();
+  const double* __restrict lo = p_.data();
+  const double* __restrict hi = eig_.data();
+  double* __restrict nv = d_.data();
+  int q = 0;  // the row not pivoted
+  for (int a = 0; a < ns; ++a) nv[a] = 1.0;
+  for (int j = 0; j < r; ++j) nv[piv[j]] = 0.0;
+  while (nv[q] == 0.0) ++q;
+  for (int i = r - 1; i >= 0; --i) {  // L1^T u = -l2, u(i) stored at row piv(i)
+    double v = -V[q + i * n];
+    for (int c = i + 1; c < r; ++c) v -= V[piv[c] + i * n] * nv[piv[c]];
+    nv[piv[i]] = v / V[piv[i] + i * n];
+  }
+  double nn = 0.0, ng = 0.0, nmax = 0.0;
+  for (int a = 0; a < ns; ++a) {
+    nn += nv[a] * nv[a];
+    ng += nv[a] * (y[a] + t[a]);
+    nmax = std::max(nmax, std::abs(nv[a]));
+  }
+  double s_lo = -kInf, s_hi = kInf;
+  for (int a = 0; a < ns; ++a) {
+    if (!(std::abs(nv[a]) > 1e-12 * nmax)) continue;
+    const double inv = 1.0 / nv[a];
+    const double s1 = (lo[a] - y[a]) * inv, s2 = (hi[a] - y[a]) * inv;  // +-inf without a bound
+    s_lo = std::max(s_lo, std::min(s1, s2));
+    s_hi = std::min(s_hi, std::max(s1, s2));
+  }
+  const double s = std::min(s_hi, std::max(s_lo, -ng / nn));
+  for (int a = 0; a < ns; ++a) y[a] += s * nv[a];
+}
+
+// Stage 2 by the range-space primal active set (see leastCommand): on ys_ (from x*_St, feasible),
+// ts_, the St bounds in p_ / eig_ and Q_StSt = V V^T (V_, rank r).
+void FrictionSolver::leastActiveSet(int ns, int r, double yscale) {
+  // Rows of W are masked (fm = 0) rather than gathered: V_F is V with W's rows zeroed, and every
+  // loop runs over all ns rows without index indirection.
+  const int n = static_cast<int>(nj_);
+  const double* __restrict V = V_.data();
+  double* __restrict U = U_.data();
+  double* __restrict R = R_.data();
+  double* __restrict y = ys_.data();
+  const double* __restrict t = ts_.data();
+  const double* __restrict lo = p_.data();
+  const double* __restrict hi = eig_.data();
+  double* __restrict h = d_.data();     // (I - P)(y_F + t_F) on F, 0 on W: the step is -h
+  double* __restrict fm = tmp_.data();  // 1 free, 0 held at a bound
+  double* __restrict w = tmp2_.data();  // U^T (y_F + t_F), pivot order
+  double* __restrict lam = lam_.data();
+  int* __restrict side = side_.data();  // 0 free, -1 at the lower bound, +1 at the upper bound
+  int* __restrict cols = cols_.data();
+  for (int a = 0; a < ns; ++a) side[a] = 0, fm[a] = 1.0;  // W empty
   // A step entry at or below step_tol is round-off (a coordinate the equality pins): it does not
   // block; the overshoot it may cause (<= step_tol) is clipped at the end.
   const double step_tol = 1e-12 * yscale;
@@ -478,28 +543,27 @@ void FrictionSolver::leastCommand(int k) {
   bool bland = false;
   double last_face_value = kInf;
   for (long it = 0; it < max_iterations; ++it) {
-    int nf = 0;
-    double vv = 0.0, vg = 0.0;  // r = 1: v_F^T v_F, v_F^T (y_F + t_F)
-    for (int a = 0; a < ns; ++a)
-      if (side[a] == 0) {
-        const double g = y[a] + t[a];
-        vv += V[a] * V[a];
-        vg += V[a] * g;
-        h[nf] = g;
-        F[nf++] = a;
-      }
+    for (int a = 0; a < ns; ++a) h[a] = fm[a] * (y[a] + t[a]);
     int rf = 0;
     if (r == 1) {
       // One equality (the usual case under a full tool task): P g = v (v^T g) / (v^T v).
+      double vv = 0.0, vg = 0.0;
+      for (int a = 0; a < ns; ++a) {
+        const double v = fm[a] * V[a];
+        vv += v * v;
+        vg += v * h[a];
+      }
       rf = vv > col_tol2 ? 1 : 0;
       lam[0] = rf ? vg / vv : 0.0;
-      for (int b = 0; b < nf; ++b) h[b] -= V[F[b]] * lam[0];
+      for (int a = 0; a < ns; ++a) h[a] -= fm[a] * V[a] * lam[0];
     } else {
-      // Column-pivoted modified Gram-Schmidt V_F = U R, each projection applied twice (orthogonal
-      // to round-off). Column c of U and R stays at V's column index c; cols holds the pivot order.
+      // Column-pivoted modified Gram-Schmidt V_F = U R (column c of U and R stays at V's column
+      // index c; cols holds the pivot order). U R = V_F holds to round-off even where U loses some
+      // orthogonality (~1e-16 cond(V_F)); the two sweeps below make h orthogonal to range(U) =
+      // range(V_F) regardless, so the step keeps V_F^T d = 0 and R lambda = w gives V_F lambda = U w.
       for (int c = 0; c < r; ++c) {
         cols[c] = c;
-        for (int b = 0; b < nf; ++b) U[b + c * n] = V[F[b] + c * n];
+        for (int a = 0; a < ns; ++a) U[a + c * n] = fm[a] * V[a + c * n];
       }
       for (; rf < r; ++rf) {
         int best = -1;
@@ -507,7 +571,7 @@ void FrictionSolver::leastCommand(int k) {
         for (int q = rf; q < r; ++q) {
           const double* __restrict u = U + cols[q] * n;
           double s = 0.0;
-          for (int b = 0; b < nf; ++b) s += u[b] * u[b];
+          for (int a = 0; a < ns; ++a) s += u[a] * u[a];
           if (s > best_norm2) best_norm2 = s, best = q;
         }
         if (best < 0) break;  // the remaining columns are (numerically) dependent
@@ -516,17 +580,13 @@ void FrictionSolver::leastCommand(int k) {
         double* __restrict u = U + c * n;
         const double rjj = std::sqrt(best_norm2), inv = 1.0 / rjj;
         R[rf + c * n] = rjj;
-        for (int b = 0; b < nf; ++b) u[b] *= inv;
+        for (int a = 0; a < ns; ++a) u[a] *= inv;
         for (int q = rf + 1; q < r; ++q) {
           double* __restrict e = U + cols[q] * n;
-          double total = 0.0;
-          for (int pass = 0; pass < 2; ++pass) {
-            double s = 0.0;
-            for (int b = 0; b < nf; ++b) s += u[b] * e[b];
-            for (int b = 0; b < nf; ++b) e[b] -= s * u[b];
-            total += s;
-          }
-          R[rf + cols[q] * n] = total;
+          double s = 0.0;
+          for (int a = 0; a < ns; ++a) s += u[a] * e[a];
+          for (int a = 0; a < ns; ++a) e[a] -= s * u[a];
+          R[rf + cols[q] * n] = s;
         }
       }
       for (int j = 0; j < rf; ++j) w[j] = 0.0;
@@ -534,20 +594,19 @@ void FrictionSolver::leastCommand(int k) {
         for (int j = 0; j < rf; ++j) {
           const double* __restrict u = U + cols[j] * n;
           double s = 0.0;
-          for (int b = 0; b < nf; ++b) s += u[b] * h[b];
-          for (int b = 0; b < nf; ++b) h[b] -= s * u[b];
+          for (int a = 0; a < ns; ++a) s += u[a] * h[a];
+          for (int a = 0; a < ns; ++a) h[a] -= s * u[a];
           w[j] += s;
         }
     }
     double dmax = 0.0;
-    for (int b = 0; b < nf; ++b) dmax = std::max(dmax, std::abs(h[b]));
+    for (int a = 0; a < ns; ++a) dmax = std::max(dmax, std::abs(h[a]));
     if (dmax > step_tol) {
-      // Ratio test along d = -h (a division only for a new candidate).
+      // Ratio test along d = -h (a division only for a new candidate; W's entries are 0).
       double alpha = 1.0;
       int block = -1, bside = 0;
-      for (int b = 0; b < nf; ++b) {
-        const int a = F[b];
-        const double s = -h[b];
+      for (int a = 0; a < ns; ++a) {
+        const double s = -h[a];
         if (s > step_tol) {
           const double room = hi[a] - y[a];  // +inf without a bound
           if (room < alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = 1;
@@ -556,9 +615,10 @@ void FrictionSolver::leastCommand(int k) {
           if (room > alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = -1;
         }
       }
-      for (int b = 0; b < nf; ++b) y[F[b]] -= alpha * h[b];
+      for (int a = 0; a < ns; ++a) y[a] -= alpha * h[a];
       if (block >= 0) {
         side[block] = bside;
+        fm[block] = 0.0;
         y[block] = bside > 0 ? hi[block] : lo[block];
         continue;
       }
@@ -592,17 +652,8 @@ void FrictionSolver::leastCommand(int k) {
     }
     if (release < 0) break;
     side[release] = 0;
+    fm[release] = 1.0;
   }
-  // x_St <- y, clipped to the box (round-off overshoot of non-blocking entries); kept only if not
-  // worse than x* (a safety net: the iteration never increases the objective).
-  double v_start = 0.0, v_end = 0.0;
-  for (int a = 0; a < ns; ++a) {
-    y[a] = std::min(hi[a], std::max(lo[a], y[a]));
-    v_start += (x[st[a]] + t[a]) * (x[st[a]] + t[a]);
-    v_end += (y[a] + t[a]) * (y[a] + t[a]);
-  }
-  if (v_end <= v_start)
-    for (int a = 0; a < ns; ++a) x[st[a]] = y[a];
 }
 
 const ChainHdSolver::Matrix6X& FrictionSolver::linkAccelerations() {
