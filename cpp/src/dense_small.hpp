@@ -1,6 +1,7 @@
 // Small dense symmetric linear algebra on preallocated storage (no heap allocation): Cholesky
-// with a pivot threshold, and a pivoted (rank-revealing) Cholesky for the positive semi-definite
-// matrices of the friction optimisation (dimension <= number of joints).
+// with a pivot threshold and its multi-column solve, rank-revealing L D L^T and pivoted Cholesky
+// for the positive semi-definite matrices of the friction optimisation (dimension <= joints),
+// and a Jacobi eigen-decomposition.
 #pragma once
 
 #include <algorithm>
@@ -142,32 +143,39 @@ int ldlReciprocal(MW& W, ML& L, VP& perm, VD& invdiag, double tol, bool pivot) {
   return k;
 }
 
-// Pivoted (rank-revealing) Cholesky of a symmetric positive semi-definite W (k x k, overwritten
-// by its Schur complements): W(perm, perm) = L L^T with L (k x r) lower trapezoidal, stopping when
-// the largest remaining diagonal entry is <= tol. Returns the rank r.
-template <typename MW, typename ML, typename VP>
-int pivotedCholesky(MW& W, ML& L, VP& perm, double tol) {
-  const int k = static_cast<int>(W.rows());
-  for (int i = 0; i < k; ++i) perm(i) = i;
+// Left-looking pivoted Cholesky of the principal submatrix S = A(idx, idx) (k x k, symmetric
+// positive semi-definite), read in place (no copy, no Schur-complement matrix): S = V V^T + R with
+// V (k x r) in idx's order (row a of V belongs to idx(a)), lower trapezoidal in pivot order, and
+// R positive semi-definite with diagonal <= tol. Pivot j is the row of largest remaining diagonal
+// (recorded in piv(j)); column j of V reads only A's column of that pivot:
+//   V(a, j) = (S(a, p) - sum_{c<j} V(a, c) V(p, c)) / V(p, j),   V(p, j) = sqrt(d_p),
+// with d_a = S(a, a) - sum_{c<=j} V(a, c)^2 the remaining diagonal (diag: scratch of k entries).
+// Rows already pivoted get V(a, j) = 0. Returns the rank r (r columns of V written).
+template <typename MA, typename VI, typename MV, typename VD, typename VP>
+int pivotedCholeskyLeft(const MA& A, const VI& idx, int k, MV& V, VD& diag, VP& piv, double tol) {
+  constexpr double kDone = -std::numeric_limits<double>::infinity();  // marks pivoted rows
+  for (int a = 0; a < k; ++a) diag(a) = A(idx(a), idx(a));
   for (int j = 0; j < k; ++j) {
-    int p = j;
-    for (int i = j + 1; i < k; ++i)
-      if (W(i, i) > W(p, p)) p = i;
-    if (!(W(p, p) > tol)) return j;
-    if (p != j) {  // symmetric swap of rows/columns j and p, and of the rows of L built so far
-      W.row(j).swap(W.row(p));
-      W.col(j).swap(W.col(p));
-      for (int c = 0; c < j; ++c) std::swap(L(j, c), L(p, c));
-      std::swap(perm(j), perm(p));
-    }
-    const double ljj = std::sqrt(W(j, j));
-    L(j, j) = ljj;
-    for (int i = j + 1; i < k; ++i) L(i, j) = W(i, j) / ljj;
-    for (int i = j + 1; i < k; ++i)
-      for (int c = j + 1; c <= i; ++c) {
-        W(i, c) -= L(i, j) * L(c, j);
-        W(c, i) = W(i, c);
+    int p = 0;
+    for (int a = 1; a < k; ++a)
+      if (diag(a) > diag(p)) p = a;
+    if (!(diag(p) > tol)) return j;
+    piv(j) = p;
+    const double vpp = std::sqrt(diag(p)), inv = 1.0 / vpp;
+    const int ip = idx(p);
+    for (int a = 0; a < k; ++a) {
+      if (a == p || diag(a) == kDone) {
+        V(a, j) = 0.0;
+        continue;
       }
+      double v = A(idx(a), ip);
+      for (int c = 0; c < j; ++c) v -= V(a, c) * V(p, c);
+      v *= inv;
+      V(a, j) = v;
+      diag(a) -= v * v;
+    }
+    V(p, j) = vpp;
+    diag(p) = kDone;
   }
   return k;
 }

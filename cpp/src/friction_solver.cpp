@@ -28,7 +28,10 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
   f_keep_ = ChainHdSolver::Matrix6X::Zero(6, hd_.nrOfSegments());
   status_.assign(n, Moving);
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
-  Gc_ = Q_ = work_ = L_ = V_ = N_ = B_ = Eigen::MatrixXd::Zero(n, n);
+  Gc_ = Q_ = work_ = L_ = Eigen::MatrixXd::Zero(n, n);
+  V_ = U_ = R_ = Eigen::MatrixXd::Zero(n, n);
+  ys_ = ts_ = lam_ = Eigen::VectorXd::Zero(n);
+  side_ = cols_ = piv_ = Eigen::VectorXi::Zero(n);
   c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = invdiag_ = Eigen::VectorXd::Zero(n);
   const int mcap = hd_.maxConstraints();
   dnu_ = Eigen::MatrixXd::Zero(mcap, n);
@@ -423,137 +426,280 @@ int FrictionSolver::boxQp(int k) {
 }
 
 // Stage 2: among the optimal friction vectors (same qdd), the one minimising ||tau_cmd||^2.
-// On the optimal face only the sticking resting joints' mu may change, along null(Q_StSt), and
-// there tau_cmd changes by exactly the change of mu (the motion is unchanged), so the problem is
-// min ||x_St + t||^2 with t = tau_cmd at the stage-1 optimum, over x_St = x*_St + N z in the box:
-// a least-distance problem in z (N orthonormal), solved by a primal active-set method.
+// On the optimal face only the sticking resting joints' mu (set St: zero gradient) may change,
+// along null(Q_StSt), and there tau_cmd changes by exactly the change of mu while tau_cmd - mu is
+// fixed (the motion, hence the total joint torque, is unchanged). With t = (tau_cmd - x)_St at the
+// stage-1 optimum x* (constant on the face) and y = x_St, the problem is the least-distance QP
+//
+//   min_y 1/2 |y + t|^2   s.t.   lo_St <= y <= hi_St,   V^T (y - x*_St) = 0,
+//
+// with Q_StSt = V V^T (pivoted Cholesky, V ns x r of rank r; directions of curvature below the
+// zero-curvature tolerance count as null, as in stage 1). Solved in y (range-space primal active
+// set; no null-space basis): W the coordinates held at a bound, F the free ones, y feasible. The
+// face minimiser is y_F + d_F with d_F = -(I - P) (y_F + t_F), P the orthogonal projector onto
+// range(V_F) (column-pivoted QR V_F = U R), so V_F^T d_F = 0 and d_W = 0 keep the equality. Then
+// the ratio test on F (blocking coordinate joins W), or at the face optimum the multipliers
+// g_i = y_i + t_i - (V lambda)_i, i in W, with V_F lambda = P (y_F + t_F) (R lambda = U^T (y + t)):
+// g_i >= 0 at a lower bound, <= 0 at an upper one, else the worst violator is released.
+// A blocking coordinate i has d_i != 0 with d orthogonal to range(V) and to the e_j, j in W, so
+// e_i is independent of them: V_F keeps full column rank in exact arithmetic (the QR drops a
+// column only when round-off makes it dependent to 1e-9 of sqrt(Q's scale)). A null space of
+// dimension 1 (ns - r = 1) is a line: closed form instead (leastOnLine).
 void FrictionSolver::leastCommand(int k) {
-  auto x = x_.head(k);
-  grad_.head(k).noalias() = Q_.topLeftCorner(k, k).lazyProduct(x);
-  grad_.head(k) -= c_.head(k);  // = -(accelerations of the resting joints)
+  // Raw column-major views of the workspace (leading dimension n; distinct buffers, no aliasing).
+  const int n = static_cast<int>(nj_);
+  const double* __restrict Q = Q_.data();
+  double* __restrict x = x_.data();
+  double* __restrict grad = grad_.data();
+  // Sticking rows: zero gradient Q x - c (= minus the resting joints' accelerations).
+  const double gtol = 10.0 * kGradientTolerance * gscale_;
+  for (int a = 0; a < k; ++a) {  // Q symmetric: column a (contiguous); the rows' chains overlap
+    const double* __restrict qa = Q + a * n;
+    double g = -c_(a);
+    for (int b = 0; b < k; ++b) g += qa[b] * x[b];
+    grad[a] = g;
+  }
+  int* __restrict st = rows_.data();
   int ns = 0;
   for (int a = 0; a < k; ++a)
-    if (std::abs(grad_(a)) <= 10.0 * kGradientTolerance * gscale_) rows_(ns++) = a;
+    if (std::abs(grad[a]) <= gtol) st[ns++] = a;
   if (ns == 0) return;
   // Sticking joints all free at the stage-1 optimum, whose free block was positive definite:
   // Q_StSt is a principal block of it, so its null space is empty and the optimum is unique.
   if (free_full_rank_) {
     bool all_free = true;
-    for (int a = 0; a < ns && all_free; ++a) all_free = state_(rows_(a)) == 0;
+    for (int a = 0; a < ns && all_free; ++a) all_free = state_(st[a]) == 0;
     if (all_free) return;
   }
-  // Null space of Q_StSt from its pivoted Cholesky: columns [-L1^-T L2^T; I] (pivot order),
-  // orthonormalised by modified Gram-Schmidt.
-  auto W = work_.topLeftCorner(ns, ns);
-  for (int a = 0; a < ns; ++a)
-    for (int b = 0; b < ns; ++b) W(a, b) = Q_(rows_(a), rows_(b));
-  auto Lc = L_.topLeftCorner(ns, ns);
-  auto perm = state_.head(ns);  // state_ is free after stage 1
-  const int r = detail::pivotedCholesky(W, Lc, perm, kZeroCurvature * qscale_);
-  const int dn = ns - r;
-  if (dn == 0) return;
-  for (int e = 0; e < dn; ++e) {
-    auto col = tmp2_.head(ns);  // pivot order
-    col.setZero();
-    col(r + e) = 1.0;
-    // Solve L1^T v = -L2^T e_e for the first r entries.
-    for (int i = r - 1; i >= 0; --i) {
-      double v = -Lc(r + e, i);
-      for (int c = i + 1; c < r; ++c) v -= Lc(c, i) * col(c);
-      col(i) = v / Lc(i, i);
-    }
-    for (int a = 0; a < ns; ++a) N_(perm(a), e) = col(a);
-  }
-  for (int e = 0; e < dn; ++e) {
-    for (int f = 0; f < e; ++f) {
-      const double proj = N_.col(f).head(ns).dot(N_.col(e).head(ns));
-      N_.col(e).head(ns) -= proj * N_.col(f).head(ns);
-    }
-    N_.col(e).head(ns) /= N_.col(e).head(ns).norm();
-  }
-  auto N = N_.topLeftCorner(ns, dn);
-  // Target: x_St = -tau_cmd_St at the stage-1 optimum (tau_cmd = tau_cmd0 - Tc x).
+  const int r = detail::pivotedCholeskyLeft(Q_, rows_, ns, V_, eig_, piv_, kZeroCurvature * qscale_);
+  if (r == ns) return;  // null(Q_StSt) = {0}: x* is the only optimum
+
+  // Target t = tau_cmd - x on St, tau_cmd at the stage-1 optimum from its nu; start y = x*_St
+  // (feasible). (No restrict on what the solvers below write.)
   const int m = hd_.constraintCount();
   nu_.head(m) = nu0_.head(m);
-  nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x;
-  hd_.commandTorquesOf(nu_.head(m), tau_cmd_);  // at the stage-1 optimum
-  auto t = tmp_.head(ns);
-  for (int a = 0; a < ns; ++a) t(a) = -tau_cmd_(rest_(rows_(a)));  // desired change of x_St: tau_cmd_St + change = 0
-  auto z0 = d_.head(dn);
-  z0.noalias() = N.transpose() * t;
-  auto z = p_.head(dn);
-  z.setZero();
-  // Working set: rows of N (indices into St) held at a bound; side -1 lower, +1 upper.
-  int nw = 0;
-  Eigen::VectorXi& wrow = free_idx_;
-  Eigen::VectorXi& wside = state_;
-  auto lowerRoom = [&](int a) { return lo_(rows_(a)) - x(rows_(a)); };
-  auto upperRoom = [&](int a) { return hi_(rows_(a)) - x(rows_(a)); };
-  double zscale = 1e-300;  // largest finite bound, or the target's size
-  for (int i = 0; i < k; ++i) {
-    if (std::isfinite(hi_(i))) zscale = std::max(zscale, std::abs(hi_(i)));
-    if (std::isfinite(lo_(i))) zscale = std::max(zscale, std::abs(lo_(i)));
-  }
-  zscale = std::max(zscale, z0.cwiseAbs().maxCoeff());
-  for (int it = 0; it < 50 + 20 * ns; ++it) {
-    // Projection of z0 onto {z : N_W z = b_W}: zp = z0 - B^T (B B^T)^-1 (B z0 - b).
-    auto zp = tmp2_.head(dn);
-    zp = z0;
-    auto y = eig_.head(nw);
-    auto B = B_.topLeftCorner(nw, dn);
-    auto BBt = work_.topLeftCorner(nw, nw);
-    auto L = L_.topLeftCorner(nw, nw);
-    if (nw > 0) {
-      for (int w = 0; w < nw; ++w) B.row(w) = N.row(wrow(w));
-      BBt.noalias() = B * B.transpose();
-      if (!detail::choleskyCertified(BBt, L, 1e-13)) break;  // degenerate (rows of N have norm <= 1)
-      for (int w = 0; w < nw; ++w) y(w) = N.row(wrow(w)).dot(z0) - (wside(w) < 0 ? lowerRoom(wrow(w)) : upperRoom(wrow(w)));
-      detail::choleskySolve(L, y);
-      zp.noalias() -= B.transpose() * y;
-    }
-    auto step = zp - z;
-    if (step.cwiseAbs().maxCoeff() <= 1e-13 * zscale) {
-      if (nw == 0) break;
-      // Multipliers: z - z0 = B^T (sigma .* lambda), lambda >= 0 required.
-      for (int w = 0; w < nw; ++w) y(w) = B.row(w).dot(z - z0);
-      detail::choleskySolve(L, y);
-      int drop = -1;
-      double worst = -1e-12 * std::max(z0.cwiseAbs().maxCoeff(), 1e-300);
-      for (int w = 0; w < nw; ++w) {
-        const double lambda = (wside(w) < 0 ? 1.0 : -1.0) * y(w);
-        if (lambda < worst) worst = lambda, drop = w;
-      }
-      if (drop < 0) break;
-      wrow(drop) = wrow(nw - 1);
-      wside(drop) = wside(nw - 1);
-      --nw;
-      continue;
-    }
-    double alpha = 1.0;
-    int block = -1, side = 0;
-    for (int a = 0; a < ns; ++a) {
-      bool in_w = false;
-      for (int w = 0; w < nw; ++w) in_w = in_w || wrow(w) == a;
-      if (in_w) continue;
-      const double s = N.row(a).dot(step), cur = N.row(a).dot(z);
-      if (s > 1e-15) {
-        const double tt = (upperRoom(a) - cur) / s;
-        if (tt < alpha) alpha = std::max(tt, 0.0), block = a, side = 1;
-      } else if (s < -1e-15) {
-        const double tt = (lowerRoom(a) - cur) / s;
-        if (tt < alpha) alpha = std::max(tt, 0.0), block = a, side = -1;
-      }
-    }
-    z += alpha * step;
-    if (block >= 0) {
-      wrow(nw) = block;
-      wside(nw) = side;
-      ++nw;
-    }
-  }
+  nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * Eigen::Map<const Eigen::VectorXd>(x, k);
+  hd_.commandTorquesOf(nu_.head(m), tau_cmd_);
+  double* y = ys_.data();
+  double* t = ts_.data();
+  double* lo = p_.data();    // bounds on St
+  double* hi = eig_.data();  // (eig_ was the factorisation's scratch)
+  double yscale = 1e-300;  // torque scale of y and t (|y + t| <= |x* + t| bounds the optimum)
   for (int a = 0; a < ns; ++a) {
-    const int i = rows_(a);
-    x(i) = std::min(hi_(i), std::max(lo_(i), x(i) + N.row(a).dot(z)));
+    const int i = st[a], j = rest_(i);
+    const double cmd = tau_cmd_(j);  // tau_cmd_j at x*
+    y[a] = x[i];
+    t[a] = cmd - x[i];
+    lo[a] = lo_(i);
+    hi[a] = hi_(i);
+    yscale = std::max({yscale, std::abs(x[i]), std::abs(cmd)});
+  }
+  if (r == ns - 1)
+    leastOnLine(ns, r);
+  else
+    leastActiveSet(ns, r, yscale);
+  // x_St <- y, clipped to the box (round-off overshoot of non-blocking entries); kept only if not
+  // worse than x* (a safety net: the iteration never increases the objective).
+  double v_start = 0.0, v_end = 0.0;
+  for (int a = 0; a < ns; ++a) {
+    y[a] = std::min(hi[a], std::max(lo[a], y[a]));
+    v_start += (x[st[a]] + t[a]) * (x[st[a]] + t[a]);
+    v_end += (y[a] + t[a]) * (y[a] + t[a]);
+  }
+  if (v_end <= v_start)
+    for (int a = 0; a < ns; ++a) x[st[a]] = y[a];
+}
+
+// Stage 2 when null(Q_StSt) has dimension 1 (r = ns - 1; e.g. a 1-D task on a 7-joint arm at rest):
+// y = x* + s n with V^T n = 0 is a line, the box an interval of s, so the optimum is the clipped
+// minimiser s = clip(-n^T (x* + t) / n^T n). In pivot order V = [L1; l2^T] (L1 r x r lower
+// triangular, l2 the row left out): n = [-L1^-T l2; 1]. Entries |n_a| <= 1e-12 max|n| are
+// round-off (a coordinate the equality pins): they do not bound s (any overshoot is clipped).
+void FrictionSolver::leastOnLine(int ns, int r) {
+  const int n = static_cast<int>(nj_);
+  const double* __restrict V = V_.data();
+  const int* __restrict piv = piv_.data();
+  double* __restrict y = ys_.data();
+  const double* __restrict t = ts_.data();
+  const double* __restrict lo = p_.data();
+  const double* __restrict hi = eig_.data();
+  double* __restrict nv = d_.data();
+  int q = 0;  // the row not pivoted
+  for (int a = 0; a < ns; ++a) nv[a] = 1.0;
+  for (int j = 0; j < r; ++j) nv[piv[j]] = 0.0;
+  while (nv[q] == 0.0) ++q;
+  for (int i = r - 1; i >= 0; --i) {  // L1^T u = -l2, u(i) stored at row piv(i)
+    double v = -V[q + i * n];
+    for (int c = i + 1; c < r; ++c) v -= V[piv[c] + i * n] * nv[piv[c]];
+    nv[piv[i]] = v / V[piv[i] + i * n];
+  }
+  double nn = 0.0, ng = 0.0, nmax = 0.0;
+  for (int a = 0; a < ns; ++a) {
+    nn += nv[a] * nv[a];
+    ng += nv[a] * (y[a] + t[a]);
+    nmax = std::max(nmax, std::abs(nv[a]));
+  }
+  double s_lo = -kInf, s_hi = kInf;
+  for (int a = 0; a < ns; ++a) {
+    if (!(std::abs(nv[a]) > 1e-12 * nmax)) continue;
+    const double inv = 1.0 / nv[a];
+    const double s1 = (lo[a] - y[a]) * inv, s2 = (hi[a] - y[a]) * inv;  // +-inf without a bound
+    s_lo = std::max(s_lo, std::min(s1, s2));
+    s_hi = std::min(s_hi, std::max(s1, s2));
+  }
+  const double s = std::min(s_hi, std::max(s_lo, -ng / nn));
+  for (int a = 0; a < ns; ++a) y[a] += s * nv[a];
+}
+
+// Stage 2 by the range-space primal active set (see leastCommand): on ys_ (from x*_St, feasible),
+// ts_, the St bounds in p_ / eig_ and Q_StSt = V V^T (V_, rank r).
+void FrictionSolver::leastActiveSet(int ns, int r, double yscale) {
+  // Rows of W are masked (fm = 0) rather than gathered: V_F is V with W's rows zeroed, and every
+  // loop runs over all ns rows without index indirection.
+  const int n = static_cast<int>(nj_);
+  const double* __restrict V = V_.data();
+  double* __restrict U = U_.data();
+  double* __restrict R = R_.data();
+  double* __restrict y = ys_.data();
+  const double* __restrict t = ts_.data();
+  const double* __restrict lo = p_.data();
+  const double* __restrict hi = eig_.data();
+  double* __restrict h = d_.data();     // (I - P)(y_F + t_F) on F, 0 on W: the step is -h
+  double* __restrict fm = tmp_.data();  // 1 free, 0 held at a bound
+  double* __restrict w = tmp2_.data();  // U^T (y_F + t_F), pivot order
+  double* __restrict lam = lam_.data();
+  int* __restrict side = side_.data();  // 0 free, -1 at the lower bound, +1 at the upper bound
+  int* __restrict cols = cols_.data();
+  for (int a = 0; a < ns; ++a) side[a] = 0, fm[a] = 1.0;  // W empty
+  // A step entry at or below step_tol is round-off (a coordinate the equality pins): it does not
+  // block; the overshoot it may cause (<= step_tol) is clipped at the end.
+  const double step_tol = 1e-12 * yscale;
+  const double mult_tol = kGradientTolerance * yscale;
+  const double col_tol2 = 1e-18 * qscale_;  // (1e-9 sqrt(Q's scale))^2: a dependent column of V_F
+  // Iteration bound (as stage 1's): between two face optima each iteration binds one more
+  // coordinate or ends on the face optimum: at most ns + 1 iterations. The objective is strictly
+  // convex and never increases along a step; from one face optimum to the next it strictly
+  // decreases (a released coordinate has a multiplier of the wrong sign) unless a zero-length step
+  // intervenes, so no working set (3^ns with sides) is face-optimal twice: (ns + 1) 3^ns. When a
+  // face-optimal value fails to decrease, releases use Bland's smallest-index rule. At the bound
+  // the iterate is returned as is: feasible and never worse than x*. (Observed on a 7-joint arm
+  // at rest under a 6-D tool task: 3.5 iterations mean.)
+  long bound = ns + 1;
+  for (int i = 0; i < ns && bound < 100000000L; ++i) bound *= 3;
+  const long max_iterations = std::min(bound, 100000000L);
+  bool bland = false;
+  double last_face_value = kInf;
+  for (long it = 0; it < max_iterations; ++it) {
+    for (int a = 0; a < ns; ++a) h[a] = fm[a] * (y[a] + t[a]);
+    int rf = 0;
+    if (r == 1) {
+      // One equality (the usual case under a full tool task): P g = v (v^T g) / (v^T v).
+      double vv = 0.0, vg = 0.0;
+      for (int a = 0; a < ns; ++a) {
+        const double v = fm[a] * V[a];
+        vv += v * v;
+        vg += v * h[a];
+      }
+      rf = vv > col_tol2 ? 1 : 0;
+      lam[0] = rf ? vg / vv : 0.0;
+      for (int a = 0; a < ns; ++a) h[a] -= fm[a] * V[a] * lam[0];
+    } else {
+      // Column-pivoted modified Gram-Schmidt V_F = U R (column c of U and R stays at V's column
+      // index c; cols holds the pivot order). U R = V_F holds to round-off even where U loses some
+      // orthogonality (~1e-16 cond(V_F)); the two sweeps below make h orthogonal to range(U) =
+      // range(V_F) regardless, so the step keeps V_F^T d = 0 and R lambda = w gives V_F lambda = U w.
+      for (int c = 0; c < r; ++c) {
+        cols[c] = c;
+        for (int a = 0; a < ns; ++a) U[a + c * n] = fm[a] * V[a + c * n];
+      }
+      for (; rf < r; ++rf) {
+        int best = -1;
+        double best_norm2 = col_tol2;
+        for (int q = rf; q < r; ++q) {
+          const double* __restrict u = U + cols[q] * n;
+          double s = 0.0;
+          for (int a = 0; a < ns; ++a) s += u[a] * u[a];
+          if (s > best_norm2) best_norm2 = s, best = q;
+        }
+        if (best < 0) break;  // the remaining columns are (numerically) dependent
+        std::swap(cols[rf], cols[best]);
+        const int c = cols[rf];
+        double* __restrict u = U + c * n;
+        const double rjj = std::sqrt(best_norm2), inv = 1.0 / rjj;
+        R[rf + c * n] = rjj;
+        for (int a = 0; a < ns; ++a) u[a] *= inv;
+        for (int q = rf + 1; q < r; ++q) {
+          double* __restrict e = U + cols[q] * n;
+          double s = 0.0;
+          for (int a = 0; a < ns; ++a) s += u[a] * e[a];
+          for (int a = 0; a < ns; ++a) e[a] -= s * u[a];
+          R[rf + cols[q] * n] = s;
+        }
+      }
+      for (int j = 0; j < rf; ++j) w[j] = 0.0;
+      for (int pass = 0; pass < 2; ++pass)
+        for (int j = 0; j < rf; ++j) {
+          const double* __restrict u = U + cols[j] * n;
+          double s = 0.0;
+          for (int a = 0; a < ns; ++a) s += u[a] * h[a];
+          for (int a = 0; a < ns; ++a) h[a] -= s * u[a];
+          w[j] += s;
+        }
+    }
+    double dmax = 0.0;
+    for (int a = 0; a < ns; ++a) dmax = std::max(dmax, std::abs(h[a]));
+    if (dmax > step_tol) {
+      // Ratio test along d = -h (a division only for a new candidate; W's entries are 0).
+      double alpha = 1.0;
+      int block = -1, bside = 0;
+      for (int a = 0; a < ns; ++a) {
+        const double s = -h[a];
+        if (s > step_tol) {
+          const double room = hi[a] - y[a];  // +inf without a bound
+          if (room < alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = 1;
+        } else if (s < -step_tol) {
+          const double room = lo[a] - y[a];
+          if (room > alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = -1;
+        }
+      }
+      for (int a = 0; a < ns; ++a) y[a] -= alpha * h[a];
+      if (block >= 0) {
+        side[block] = bside;
+        fm[block] = 0.0;
+        y[block] = bside > 0 ? hi[block] : lo[block];
+        continue;
+      }
+    }
+    // Face optimum (full step, or none needed). lambda from R lambda = w (basic solution: columns
+    // dropped as dependent get 0; r = 1 has it already), then the working set's multipliers.
+    if (r > 1) {
+      for (int c = 0; c < r; ++c) lam[c] = 0.0;
+      for (int j = rf - 1; j >= 0; --j) {
+        const int c = cols[j];
+        double v = w[j];
+        for (int l = j + 1; l < rf; ++l) v -= R[j + cols[l] * n] * lam[cols[l]];
+        lam[c] = v / R[j + c * n];
+      }
+    }
+    double value = 0.0;
+    for (int a = 0; a < ns; ++a) value += (y[a] + t[a]) * (y[a] + t[a]);
+    if (!(value < last_face_value)) bland = true;
+    last_face_value = value;
+    int release = -1;
+    double worst = mult_tol;
+    for (int a = 0; a < ns; ++a) {
+      if (side[a] == 0) continue;
+      double g = y[a] + t[a];
+      for (int c = 0; c < r; ++c) g -= V[a + c * n] * lam[c];
+      const double violation = side[a] < 0 ? -g : g;
+      if (violation > worst) {
+        worst = violation, release = a;
+        if (bland) break;  // smallest index
+      }
+    }
+    if (release < 0) break;
+    side[release] = 0;
+    fm[release] = 1.0;
   }
 }
 

@@ -116,6 +116,10 @@ class FrictionSolver {
               const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& tau);
   int boxQp(int k);                 // stage 1 on Q_, c_, lo_, hi_ -> x_
   void leastCommand(int k);         // stage 2: tie-break on the optimal face
+  // Stage 2's solvers on the sticking set (ns joints, Q_StSt = V_ V_^T of rank r < ns), from
+  // ys_ = x*_St with target ts_ and bounds p_ / eig_ (see leastCommand).
+  void leastOnLine(int ns, int r);                        // ns - r = 1: closed form
+  void leastActiveSet(int ns, int r, double yscale);      // range-space primal active set
   // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
@@ -145,9 +149,16 @@ class FrictionSolver {
   Eigen::VectorXd fstatic_;  // static friction of the last solve
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;     // joint index of each resting joint
-  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_, V_, N_, B_;  // Tc_ stays empty (0 x 0)
+  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_;  // Tc_ stays empty (0 x 0): tau_cmd follows from nu
   Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_, invdiag_;
   Eigen::VectorXi state_, free_idx_, rows_;
+  // Stage-2 workspace (leastCommand): Q_StSt = V V^T (V ns x r); the iterate y and target t on
+  // St; U R = V_F (column-pivoted QR of V with the held rows zeroed, U's columns kept at V's
+  // column index); lam_ the face multipliers of V^T y = const; side_ the working set; cols_ / piv_
+  // the QR's and the Cholesky's pivot orders.
+  Eigen::MatrixXd V_, U_, R_;
+  Eigen::VectorXd ys_, ts_, lam_;
+  Eigen::VectorXi side_, cols_, piv_;
 };
 
 }  // namespace vereshchagin
