@@ -32,7 +32,7 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
   V_ = U_ = R_ = Eigen::MatrixXd::Zero(n, n);
   ys_ = ts_ = lam_ = Eigen::VectorXd::Zero(n);
   side_ = cols_ = piv_ = Eigen::VectorXi::Zero(n);
-  c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = invdiag_ = Eigen::VectorXd::Zero(n);
+  c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = invdiag_ = dpiv_ = Eigen::VectorXd::Zero(n);
   const int mcap = hd_.maxConstraints();
   dnu_ = Eigen::MatrixXd::Zero(mcap, n);
   nu0_ = nu_ = beta_keep_ = Eigen::VectorXd::Zero(mcap);
@@ -234,20 +234,32 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
 // (rank-revealing L D L^T below).
 bool FrictionSolver::freeStep(int nf) {
   auto W = work_.topLeftCorner(nf, nf);
-  for (int a = 0; a < nf; ++a)
-    for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
   auto L = L_.topLeftCorner(nf, nf);
   auto perm = rows_.head(nf);
   auto inv = invdiag_.head(nf);
-  // Definite at the curvature tolerance (the usual case): no pivoting. A failure at the last
-  // column is already rank-revealing (every accepted pivot > tol, the 1 x 1 remainder <= tol);
-  // a failure before it restarts with pivoting (W re-gathered: the attempt overwrote it).
   const double tol = kZeroCurvature * qscale_;
-  int r = detail::ldlReciprocal(W, L, perm, inv, tol, false);
-  if (r < nf - 1) {
+  int r = nf;
+  if (factor_valid_ && factor_n_ == nf) {  // kept up to date by factorDelete()
+    r = factor_r_;
+    for (int a = 0; a < nf; ++a) perm(a) = a;
+  } else {
     for (int a = 0; a < nf; ++a)
       for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
-    r = detail::ldlReciprocal(W, L, perm, inv, tol, true);
+    // Definite at the curvature tolerance (the usual case): no pivoting. A failure at the last
+    // column is already rank-revealing (every accepted pivot > tol, the 1 x 1 remainder <= tol);
+    // a failure before it restarts with pivoting (W re-gathered: the attempt overwrote it).
+    r = detail::ldlReciprocal(W, L, perm, inv, tol, false);
+    factor_valid_ = r >= nf - 1;  // unpivoted: can follow the blocked steps (factorDelete)
+    if (factor_valid_) {
+      factor_n_ = nf;
+      factor_r_ = r;
+      if (r == nf - 1) remainder_ = W(nf - 1, nf - 1);
+      for (int a = 0; a < r; ++a) dpiv_(a) = 1.0 / inv(a);
+    } else {
+      for (int a = 0; a < nf; ++a)
+        for (int b = 0; b < nf; ++b) W(a, b) = Q_(free_idx_(a), free_idx_(b));
+      r = detail::ldlReciprocal(W, L, perm, inv, tol, true);
+    }
   }
   free_full_rank_ = r == nf;
   // Q_FF(perm, perm) = [L1; L2] D [L1; L2]^T (L1 r x r unit lower). With y = L1^-1 g1 and
@@ -294,6 +306,57 @@ bool FrictionSolver::freeStep(int nf) {
   auto out = zero_curvature ? d_.head(nf) : p_.head(nf);
   for (int a = 0; a < nf; ++a) out(perm(a)) = u(a);
   return zero_curvature;
+}
+
+// A blocked step binds the free variable at position q of free_idx_: the unpivoted L D L^T of
+// Q_FF (nf x nf, from freeStep(); rank nf, or nf - 1 with the last pivot's remainder) becomes
+// that of Q_FF without row and column q. The rows below q receive d_q l l^T (l = L(q+1:nf, q))
+// by the rank-one update of Gill, Golub, Murray and Saunders (method C1: the pivots only grow, so
+// definite stays definite), then row and column q are dropped. O(nf^2) instead of a new
+// factorisation; the factor is marked invalid (refactorised) whenever the free set changes
+// otherwise.
+void FrictionSolver::factorDelete(int q, int nf) {
+  if (!factor_valid_ || factor_n_ != nf) {
+    factor_valid_ = false;
+    return;
+  }
+  auto L = L_.topLeftCorner(nf, nf);
+  auto z = tmp2_.head(nf);
+  const int r = factor_r_;
+  double alpha = q < r ? dpiv_(q) : 0.0;  // (the deficient last variable: nothing to pass on)
+  for (int i = q + 1; i < nf; ++i) z(i) = L(i, q);
+  for (int j = q + 1; j < nf && alpha != 0.0; ++j) {
+    const double p = z(j);
+    const double dj = j < r ? dpiv_(j) : remainder_;
+    const double dbar = dj + alpha * p * p;
+    if (j < r) {
+      dpiv_(j) = dbar;
+    } else {
+      remainder_ = dbar;
+      break;  // the last row: nothing below it
+    }
+    const double beta = p * alpha / dbar;
+    alpha = dj * alpha / dbar;
+    for (int i = j + 1; i < nf; ++i) {
+      z(i) -= p * L(i, j);
+      L(i, j) += beta * z(i);
+    }
+  }
+  // Drop row and column q.
+  for (int i = q + 1; i < nf; ++i)
+    for (int c = 0; c < q; ++c) L(i - 1, c) = L(i, c);
+  for (int c = q + 1; c < nf; ++c)
+    for (int i = c; i < nf; ++i) L(i - 1, c - 1) = L(i, c);
+  for (int j = q + 1; j < nf; ++j) dpiv_(j - 1) = dpiv_(j);
+  const int n1 = nf - 1;
+  int r1 = q < r ? r - 1 : n1;  // deleting the deficient last variable leaves a definite factor
+  if (r1 == n1 - 1 && remainder_ > kZeroCurvature * qscale_) {
+    dpiv_(r1) = remainder_;  // the update made the last pivot definite
+    r1 = n1;
+  }
+  factor_n_ = n1;
+  factor_r_ = r1;
+  for (int a = 0; a < r1; ++a) invdiag_(a) = 1.0 / dpiv_(a);
 }
 
 // grad_ = Q x - c (the negated accelerations of the resting joints at friction x).
@@ -346,6 +409,7 @@ int FrictionSolver::boxQp(int k) {
   bool face_optimal = false, bland = false;
   double last_face_value = kInf;
   free_full_rank_ = false;
+  factor_valid_ = false;
   for (long it = 0; it < max_iterations; ++it) {
     iterations_ = static_cast<int>(std::min<long>(it + 1, 2147483647L));
     gscale_ = std::max({cmax, qscale_ * x.cwiseAbs().maxCoeff(), qscale_ * torque_scale, 1e-300});
@@ -373,6 +437,7 @@ int FrictionSolver::boxQp(int k) {
           }
         }
         if (!changed) return ChainHdSolver::E_NOERROR;  // KKT point
+        factor_valid_ = false;
         for (int i = 0; i < k; ++i)
           x(i) = state(i) > 0 ? hi_(i) : (state(i) < 0 ? lo_(i) : std::min(hi_(i), std::max(lo_(i), x(i))));
         last_face_value = kInf;
@@ -380,16 +445,16 @@ int FrictionSolver::boxQp(int k) {
       }
       const auto dir = zero_curvature ? d_.head(nf) : p_.head(nf);
       double alpha = zero_curvature ? kInf : 1.0;
-      int block = -1, side = 0;
+      int block = -1, side = 0, block_pos = -1;
       for (int a = 0; a < nf; ++a) {
         const int i = free_idx_(a);
         const double s = dir(a);
         if (s > 0.0 && hi_(i) < kInf) {
           const double t = (hi_(i) - x(i)) / s;
-          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = 1;
+          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = 1, block_pos = a;
         } else if (s < 0.0 && lo_(i) > -kInf) {
           const double t = (lo_(i) - x(i)) / s;
-          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = -1;
+          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = -1, block_pos = a;
         }
       }
       if (!std::isfinite(alpha))
@@ -399,6 +464,7 @@ int FrictionSolver::boxQp(int k) {
       if (block >= 0) {
         state(block) = side;
         x(block) = side > 0 ? hi_(block) : lo_(block);
+        factorDelete(block_pos, nf);
         face_optimal = false;
         continue;
       }
@@ -420,6 +486,7 @@ int FrictionSolver::boxQp(int k) {
     }
     if (release < 0) return ChainHdSolver::E_NOERROR;
     state(release) = 0;
+    factor_valid_ = false;
     face_optimal = false;
   }
   return fail(E_NOT_CONVERGED, "friction optimisation did not converge in %ld active-set iterations", max_iterations);

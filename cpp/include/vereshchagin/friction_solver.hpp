@@ -124,6 +124,7 @@ class FrictionSolver {
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
   void gradient(int k);
+  void factorDelete(int q, int nf);
 
   ChainHdSolver hd_, free_;
   unsigned int nj_ = 0;
@@ -150,7 +151,12 @@ class FrictionSolver {
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;     // joint index of each resting joint
   Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_;  // Tc_ stays empty (0 x 0): tau_cmd follows from nu
-  Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_, invdiag_;
+  Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_, invdiag_, dpiv_;
+  // Free-set factor L D L^T kept across blocked steps (freeStep / factorDelete): valid for the
+  // free set of size factor_n_, rank factor_r_ (n or n - 1, then remainder_ is the last pivot).
+  bool factor_valid_ = false;
+  int factor_n_ = 0, factor_r_ = 0;
+  double remainder_ = 0.0;
   Eigen::VectorXi state_, free_idx_, rows_;
   // Stage-2 workspace (leastCommand): Q_StSt = V V^T (V ns x r); the iterate y and target t on
   // St; U R = V_F (column-pivoted QR of V with the held rows zeroed, U's columns kept at V's
