@@ -26,7 +26,7 @@ using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 int main() {
   testutil::Checker ck("test_affine");
   int fd_samples = 0, dense_samples = 0, skipped = 0, columns = 0;
-  double worst_fd = 0.0, worst_dense = 0.0;
+  double worst_fd = 0.0, worst_dense = 0.0, worst_sym = 0.0;
 
   for (int s = 0; s < 400; ++s) {
     const unsigned long long seed = 15485863ULL * static_cast<unsigned long long>(s) + 5ULL;
@@ -73,6 +73,44 @@ int main() {
                  solver.linkAccelerations() == acc0,
              tag + ": responseColumns changed the solve results");
     columns += k;
+
+    // Every joint in chain order takes the symmetric path (half the outward pass, the rest
+    // mirrored); the same columns requested in reverse order take the general one.
+    Eigen::VectorXi all(n), rev(n);
+    for (int j = 0; j < n; ++j) all(j) = j, rev(j) = n - 1 - j;
+    Eigen::MatrixXd g_all(n, n), t_all(n, n), g_rev(n, n), t_rev(n, n);
+    Eigen::MatrixXd nu_all = Eigen::MatrixXd::Constant(6, n, NAN), nu_rev(6, n), nu_skip(6, n);
+    rc = solver.responseColumns(all, g_all, t_all, nu_all) + solver.responseColumns(rev, g_rev, t_rev, nu_rev);
+    if (!ck.check(rc == 0, tag + ": all-joint responseColumns failed: " + solver.errorMessage())) continue;
+    Eigen::MatrixXd g_back(n, n), t_back(n, n), nu_back(nc, n);
+    for (int j = 0; j < n; ++j) {
+      g_back.col(j) = g_rev.col(n - 1 - j);
+      t_back.col(j) = t_rev.col(n - 1 - j);
+      nu_back.col(j) = nu_rev.col(n - 1 - j).head(nc);
+    }
+    const double e_sym = std::max(relErrCols(g_all, g_back), relErrCols(t_all, t_back));
+    worst_sym = std::max(worst_sym, e_sym);
+    ck.check(e_sym <= 1e-12 && g_all == g_all.transpose(),
+             tag + ": symmetric all-joint response vs reverse order, rel err " + str(e_sym));
+    ck.check(relErrCols(nu_all.topRows(nc), nu_back) <= 1e-12, tag + ": all-joint d nu vs reverse order");
+    // dtau_cmd may be skipped (empty) beside dnu: the other outputs are unchanged, bit for bit.
+    Eigen::MatrixXd g_skip(n, n), none(0, 0);
+    rc = solver.responseColumns(all, g_skip, none, nu_skip);
+    ck.check(rc == 0 && g_skip == g_all && nu_skip.topRows(nc) == nu_all.topRows(nc),
+             tag + ": responseColumns without dtau_cmd differs");
+    // commandTorquesOf: commandTorques() for nu(), linear in nu (the columns of dtau_cmd).
+    Eigen::VectorXd tau_of(n);
+    rc = solver.commandTorquesOf(nu0, tau_of);
+    ck.check(rc == 0 && tau_of == tau0, tag + ": commandTorquesOf(nu()) != commandTorques()");
+    for (int j = 0; j < n && nc > 0; ++j) {
+      const Eigen::VectorXd nu_j = nu0 + nu_all.col(j).head(nc);
+      solver.commandTorquesOf(nu_j, tau_of);
+      const double scale = std::max({1.0, tau0.cwiseAbs().maxCoeff(), t_all.col(j).cwiseAbs().maxCoeff()});
+      ck.check((tau_of - tau0 - t_all.col(j)).cwiseAbs().maxCoeff() <= 1e-12 * scale,
+               tag + ": commandTorquesOf(nu + dnu) - tau_cmd != dtau_cmd, joint " + str(j));
+    }
+    ck.check(solver.commandTorquesOf(Eigen::VectorXd::Zero(nc + 1), tau_of) == KDL::SolverI::E_SIZE_MISMATCH,
+             tag + ": commandTorquesOf accepted a wrong-size nu");
 
     // (a) central differences of full solves, step h.
     const double h = 1.0;
@@ -140,11 +178,16 @@ int main() {
              "empty-request setup solve");
     Eigen::MatrixXd a(4, 0), b(4, 0);
     ck.check(solver.responseColumns(Eigen::VectorXi(0), a, b) == 0, "responseColumns with no joints");
+    Eigen::VectorXd tau(4);
+    vereshchagin::ChainHdSolver fresh(chain, KDL::Twist::Zero());
+    ck.check(fresh.commandTorquesOf(Eigen::VectorXd(0), tau) == vereshchagin::ChainHdSolver::E_NO_SOLUTION,
+             "commandTorquesOf before a solve");
+    ck.check(solver.commandTorquesOf(Eigen::VectorXd(0), tau) == 0 && tau.isZero(), "commandTorquesOf with m = 0");
   }
 
   ck.check(fd_samples >= 350 && dense_samples >= 250 && skipped * 10 <= dense_samples,
            "too few samples: fd " + str(fd_samples) + ", dense " + str(dense_samples) + ", skipped " + str(skipped));
   return ck.finish(str(fd_samples) + " samples vs finite differences, " + str(dense_samples) + " vs dense formulas (" +
                    str(skipped) + " ill-conditioned skipped), " + str(columns) + " columns; worst rel err fd " +
-                   str(worst_fd) + ", dense " + str(worst_dense));
+                   str(worst_fd) + ", dense " + str(worst_dense) + ", symmetric path " + str(worst_sym));
 }

@@ -151,6 +151,8 @@ int main() {
     Eigen::MatrixXd dq(n, n), dt(n, n), dn(M, n);
     rc = ours.responseColumns(joints, dq, dt, dn);
     ck.check(rc == 0, tag + ": responseColumns " + str(rc));
+    Eigen::VectorXd tau_of(n);
+    ck.check(ours.commandTorquesOf(nu, tau_of) == 0 && tau_of == tau, tag + ": commandTorquesOf(nu()) != commandTorques()");
     vereshchagin::ChainHdSolver other(chain, root_acc);
     for (int j = 0; j < n; j += 3) {
       Eigen::VectorXd ff2 = ff.data;

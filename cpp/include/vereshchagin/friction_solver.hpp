@@ -12,11 +12,14 @@
 // joints get the kinetic (Coulomb) friction -fk_j sign(qd_j) as a feed-forward torque.
 //
 // Method: one full solve, the response columns of the resting joints (O(n) each, no
-// refactorisation), then the k x k box QP by a primal active-set method (exact: complementarity
-// holds to round-off; singular Q handled through zero-curvature directions). When several mu
-// give the same qdd* (the task fixes some resting joints' accelerations), the one minimising the
-// motor command ||tau_cmd||^2 is chosen (a least-distance problem on the optimal face): static
-// friction holds what it can and the motors add only the rest.
+// refactorisation; half the outward work when every joint rests, G being symmetric), then the
+// k x k box QP by an active-set method (exact: complementarity holds to round-off; singular Q
+// handled through zero-curvature directions): a few primal-dual working-set rounds on definite
+// faces, then primal steps whose free-set L D L^T follows each newly bound variable by a
+// rank-one update. When several mu give the same qdd* (the task fixes some resting joints'
+// accelerations), the one minimising the motor command ||tau_cmd||^2 is chosen (a least-distance
+// problem on the optimal face, solved in the range space of Q_StSt): static friction holds what
+// it can and the motors add only the rest.
 //
 // Units and frames are those of ChainHdSolver. Outputs after solve():
 //  * qdd (n): joint accelerations.
@@ -33,9 +36,9 @@
 //    (computed on request: one extra O(n) solve). NaN before a successful solve, or when qdd_free
 //    itself overflows (that solve fails with E_NONFINITE_RESULT); Inf when the value is beyond the
 //    double range (friction or torques times accelerations near 1e300). The Python API raises then.
-//  * iterations(): active-set iterations of the last solve (at most (k + 1) 3^k, k the resting
-//    joints with friction or on a limit; the argument is in friction_solver.cpp's boxQp()).
-//    Bland's smallest-index rule takes over if a face-optimal value fails to decrease.
+//  * iterations(): active-set iterations of the last solve (at most 5 (k + 1) 3^k + 4, k the
+//    resting joints with friction or on a limit; the argument is in friction_solver.cpp's
+//    boxQp()). Bland's smallest-index rule takes over if a face-optimal value fails to decrease.
 // No heap allocation in solve() or gaussValue().
 #pragma once
 
