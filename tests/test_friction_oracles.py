@@ -470,8 +470,9 @@ def test_random_chains(seed, m, rest):
     _check_chain_case(case, res, f"seed {seed} n {n} m {m} rest {rest} f {case['static']}")
 
 
-TIE_CASES = [("hold", "all", 1), ("hold", "all", 2), ("hold", "all", 3), ("partial", "all", 2),
-             ("partial", "all", 3), ("hold", "one", 2), ("hold", "one", 3), ("partial", "one", 3)]
+TIE_CASES = [("hold", "all", 1), ("hold", "all", 2), ("hold", "all", 3), ("hold", "all", 4), ("hold", "all", 5),
+             ("partial", "all", 2), ("partial", "all", 3), ("partial", "all", 4), ("partial", "all", 5),
+             ("hold", "one", 2), ("hold", "one", 3), ("hold", "one", 4), ("partial", "one", 3), ("partial", "one", 4)]
 
 
 @pytest.mark.parametrize("tie", TIE_CASES, ids=lambda t: "-".join(map(str, t)))
