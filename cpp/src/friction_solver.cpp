@@ -176,6 +176,7 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
       qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_.articulatedInertia(static_cast<unsigned int>(rest_(a)))});
     rc = boxQp(k);
     if (rc != ChainHdSolver::E_NOERROR) return rc;
+    tau_cmd_known_ = false;
     leastCommand(k);
     // The outputs are affine in the friction torques: update them from the columns (no new solve).
     qdd_ = qdd0_;
@@ -183,7 +184,7 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
     const int m = hd_.constraintCount();
     nu_.head(m) = nu0_.head(m);
     nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);
-    hd_.commandTorquesOf(nu_.head(m), tau_cmd_);
+    if (!tau_cmd_known_) hd_.commandTorquesOf(nu_.head(m), tau_cmd_);  // (else kept by leastCommand)
   } else {
     qdd_ = hd_.qdd();
     tau_cmd_ = hd_.commandTorques();
@@ -573,8 +574,14 @@ void FrictionSolver::leastCommand(int k) {
     v_start += (x[st[a]] + t[a]) * (x[st[a]] + t[a]);
     v_end += (y[a] + t[a]) * (y[a] + t[a]);
   }
+  // On the optimal face the motion is unchanged, so tau_cmd - x stays fixed: tau_cmd moves by the
+  // change of x on St (and not elsewhere) without another pass over the chain.
   if (v_end <= v_start)
-    for (int a = 0; a < ns; ++a) x[st[a]] = y[a];
+    for (int a = 0; a < ns; ++a) {
+      tau_cmd_(rest_(st[a])) += y[a] - x[st[a]];
+      x[st[a]] = y[a];
+    }
+  tau_cmd_known_ = true;
 }
 
 // Stage 2 when null(Q_StSt) has dimension 1 (r = ns - 1; e.g. a 1-D task on a 7-joint arm at rest):

@@ -158,6 +158,7 @@ class FrictionSolver {
   // Free-set factor L D L^T kept across blocked steps (freeStep / factorDelete): valid for the
   // free set of size factor_n_, rank factor_r_ (n or n - 1, then remainder_ is the last pivot).
   bool factor_valid_ = false;
+  bool tau_cmd_known_ = false;  // leastCommand() left tau_cmd_ at the final x
   int factor_n_ = 0, factor_r_ = 0;
   double remainder_ = 0.0;
   Eigen::VectorXi state_, free_idx_, rows_;
