@@ -292,10 +292,12 @@ def random_friction(rng, n, kind="mixed", scale=5.0):
 # ------------------------------------------------------------------------------------------------
 # Exact linear algebra
 # ------------------------------------------------------------------------------------------------
-def equality_qp_batch(P, p, C, d, rcond=1e-11, feas_rtol=1e-9):
+def equality_qp_batch(P, p, C, d, rcond=1e-11, feas_rtol=1e-9, atol=0.0):
     """Columnwise argmin 1/2 x^T P x + p_k^T x  s.t. C x = d_k  (P symmetric positive definite).
 
     p: (nx, K), d: (mc, K). Null-space method with one SVD of C (any rank): x is affine in (p, d).
+    Singular values of C up to max(rcond * largest, atol) count as zero (atol: when C's scale is
+    known, e.g. rows of an orthonormal basis, a C made only of round-off has rank 0).
     Returns (X (nx, K), feasible (K,) bool); a column is infeasible if C x = d_k has no solution
     (relative residual above feas_rtol)."""
     nx, K = P.shape[0], p.shape[1]
@@ -306,7 +308,7 @@ def equality_qp_batch(P, p, C, d, rcond=1e-11, feas_rtol=1e-9):
     if mc == 0:
         return -np.linalg.solve(P, p), np.ones(K, bool)
     U, s, Vt = np.linalg.svd(C, full_matrices=True)
-    r = int(np.sum(s > rcond * max(s[0], 1e-300))) if s.size else 0
+    r = int(np.sum(s > max(rcond * max(s[0], 1e-300), atol))) if s.size else 0
     xp = Vt[:r].T @ ((U[:, :r].T @ d) / s[:r, None])
     res = np.linalg.norm(C @ xp - d, axis=0)
     feasible = res <= feas_rtol * np.maximum.reduce([np.ones(K), dn, s[0] * np.linalg.norm(xp, axis=0)])
@@ -419,8 +421,10 @@ def tie_break(prob, qdd, zero_tol=None):
             continue
         base = np.repeat(c[:, None], K, axis=1)  # (n, K)
         base[Zj[bnd], :] += vals_b
+        # N is orthonormal: a direction of N_Z^T below 1e-10 does not constrain mu_Z (its effect on
+        # N^T tau is below the 1e-9 tscale check), however small the whole of N_Z is.
         X, ok = equality_qp_batch(np.eye(free.size), base[Zj[free], :], N[Zj[free], :].T, -N.T @ base,
-                                  feas_rtol=1e-10)
+                                  feas_rtol=1e-10, atol=1e-10)
         slack_hi = np.where(np.isfinite(hi[free]), np.abs(hi[free]) * 1e-12, 0.0)[:, None] + 1e-14 * tscale
         slack_lo = np.where(np.isfinite(lo[free]), np.abs(lo[free]) * 1e-12, 0.0)[:, None] + 1e-14 * tscale
         ok &= np.all(X <= hi[free, None] + slack_hi, axis=0)
