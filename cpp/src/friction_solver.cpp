@@ -400,7 +400,10 @@ int FrictionSolver::boxQp(int k) {
   // the multipliers' signs, and the iterate is clamped back into the box (feasible again). A
   // round that finds no violation and no wrong-sign multiplier has found a KKT point: optimal.
   // At most kPrimalDualRounds rounds; each may raise the objective once, so the primal
-  // argument above holds between them: at most (P + 1) (k + 1) 3^k + P iterations in all.
+  // argument above holds between them: at most (P + 1) (k + 1) 3^k + P iterations in all. No
+  // rounds when the whole Q is singular (a task fixes accelerations): its nearly singular faces
+  // have minimisers far outside the box, and the rounds then cost more than the primal steps.
+  // (The free-set factor updates of factorDelete() change how a step is computed, not which.)
   constexpr int kPrimalDualRounds = 4;
   long bound = k + 1;
   for (int i = 0; i < k && bound < 100000000L; ++i) bound *= 3;
