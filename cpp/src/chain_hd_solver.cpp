@@ -105,6 +105,7 @@ void ChainHdSolver::buildModel() {
   tau_cmd_ = Eigen::VectorXd::Zero(nj_);
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
   col_sdp_ = Eigen::MatrixXd::Zero(ns_, nj_);
+  col_s0_ = col_u0_ = Matrix6X::Zero(6, ns_);
   col_force_ = Matrix6X::Zero(6, std::max<unsigned int>(nj_, kMaxConstraints));
   col_row_ = Eigen::VectorXd::Zero(nj_);
   col_tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, std::max<unsigned int>(nj_, kMaxConstraints));
@@ -693,6 +694,28 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
   }
   if (!general_ && m > 0)
     for (unsigned int i = 0; i < ns_; ++i) eg_.col(i).head(m) = segs_[i].e.leftCols(m).transpose();
+  // Joint axes S and u = IA S of every segment in the base frame, about the base origin (Pluecker
+  // coordinates about one fixed point: a spatial motion or force vector is then the same vector
+  // on every body). Motion: w0 = R w, v0 = R v + p x w0; force: f0 = R f, n0 = R n + p x f0, with
+  // R, p the tip frame's orientation and origin in the base frame.
+  {
+    Vector3 p = Vector3::Zero();
+    Matrix3 R_parent = Matrix3::Identity();
+    for (unsigned int i = 0; i < ns_; ++i) {
+      const Segment& s = segs_[i];
+      p.noalias() += R_parent * s.X.p;
+      R_parent = s.R_base;
+      if (s.joint < 0) continue;
+      auto S0 = col_s0_.col(i);
+      auto u0 = col_u0_.col(i);
+      S0.tail<3>().noalias() = s.R_base * s.S.tail<3>();
+      S0.head<3>().noalias() = s.R_base * s.S.head<3>();
+      S0.head<3>() += p.cross(Vector3(S0.tail<3>()));
+      u0.head<3>().noalias() = s.R_base * s.u.head<3>();
+      u0.tail<3>().noalias() = s.R_base * s.u.tail<3>();
+      u0.tail<3>() += p.cross(Vector3(u0.head<3>()));
+    }
+  }
   // All columns at once (coefficient-wise products: no GEMM workspace on the heap), in chunks of
   // at most n_joints (the workspace width): a unit torque at
   // joint joints(c) changes only the force part of the sweeps; bodies distal to it feel nothing.
@@ -708,7 +731,9 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     bool ascending = true;
     for (long c = 1; c < kc; ++c)
       ascending = ascending && joint_segment_[joints(c0 + c)] >= joint_segment_[joints(c0 + c - 1)];
-    // Per column, fixed-size 6-vector arithmetic (robust to the compiler's inlining budget).
+    // Per column, fixed-size 6-vector arithmetic (robust to the compiler's inlining budget), in
+    // the base frame about its origin (S0, u0 above): force and motion changes pass between
+    // segments unchanged, no per-column change of frame.
     long lo = ascending ? kc : 0;
     auto SDP = col_sdp_.leftCols(kc);  // S_i^T (apparent force change from the child), per segment
     const int m_rows = m;
@@ -719,25 +744,22 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
         while (lo > 0 && joint_segment_[joints(c0 + lo - 1)] >= i) --lo;
       const bool last = i == static_cast<int>(ns_) - 1;
       const double* eg = eg_.col(i).data();
+      const Eigen::Map<const Vector6> S0(col_s0_.col(i).data()), u0(col_u0_.col(i).data());
       for (long c = 0; c < kc; ++c) {
         if (c < lo) {  // not alive yet: no force change here
           SDP(i, c) = 0.0;
           continue;
         }
         Eigen::Map<Vector6> dp(DP.col(c).data());
-        if (last || c < lo_child) {
-          dp.setZero();  // becomes alive here (or the last segment)
-        } else {
-          dp = forceToParent(segs_[i + 1].X, dp);  // the child's apparent force in this frame
-        }
+        if (last || c < lo_child) dp.setZero();  // becomes alive here (or the last segment)
         if (s.joint < 0) {
           SDP(i, c) = 0.0;
           continue;
         }
-        const double sd = s.S.dot(dp);
+        const double sd = S0.dot(dp);
         SDP(i, c) = sd;
         const double r = ((joints(c0 + c) == s.joint ? 1.0 : 0.0) - sd) * s.Dinv;  // free joint acc change
-        dp.noalias() += s.u * r;
+        dp.noalias() += u0 * r;
         double* du = DU.col(c).data();
         for (int t = 0; t < m_rows; ++t) du[t] += eg[t] * r;
       }
@@ -768,17 +790,17 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     long first = 0;  // first alive column
     for (unsigned int i = 0; i < ns_; ++i) {
       const Segment& s = segs_[i];
+      if (s.joint < 0) continue;  // a rigid attachment: the same spatial acceleration (base frame)
       const double* eg = eg_.col(i).data();
+      const Eigen::Map<const Vector6> S0(col_s0_.col(i).data()), u0(col_u0_.col(i).data());
       for (long c = first; c < kc; ++c) {
         Eigen::Map<Vector6> acc(ACC.col(c).data());
-        acc = motionToChild(s.X, acc);
-        if (s.joint < 0) continue;
-        double v = (joints(c0 + c) == s.joint ? 1.0 : 0.0) - SDP(i, c) - s.u.dot(acc);
+        double v = (joints(c0 + c) == s.joint ? 1.0 : 0.0) - SDP(i, c) - u0.dot(acc);
         const double* dnu = DNU.col(c).data();
         for (int t = 0; t < m_rows; ++t) v -= eg[t] * dnu[t];
         v *= s.Dinv;
         dqdd(s.joint, c0 + c) = v;
-        acc.noalias() += s.S * v;
+        acc.noalias() += S0 * v;
       }
       if (symmetric && s.joint >= 0) {
         for (long c = s.joint + 1; c < kc; ++c) dqdd(c, s.joint) = dqdd(s.joint, c);
