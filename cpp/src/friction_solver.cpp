@@ -517,19 +517,11 @@ int FrictionSolver::boxQp(int k) {
 // column only when round-off makes it dependent to 1e-9 of sqrt(Q's scale)). A null space of
 // dimension 1 (ns - r = 1) is a line: closed form instead (leastOnLine).
 void FrictionSolver::leastCommand(int k) {
-  // Raw column-major views of the workspace (leading dimension n; distinct buffers, no aliasing).
-  const int n = static_cast<int>(nj_);
-  const double* __restrict Q = Q_.data();
-  double* __restrict x = x_.data();
-  double* __restrict grad = grad_.data();
   // Sticking rows: zero gradient Q x - c (= minus the resting joints' accelerations).
+  gradient(k);
+  double* __restrict x = x_.data();  // raw views of the workspace (distinct buffers, no aliasing)
+  const double* __restrict grad = grad_.data();
   const double gtol = 10.0 * kGradientTolerance * gscale_;
-  for (int a = 0; a < k; ++a) {  // Q symmetric: column a (contiguous); the rows' chains overlap
-    const double* __restrict qa = Q + a * n;
-    double g = -c_(a);
-    for (int b = 0; b < k; ++b) g += qa[b] * x[b];
-    grad[a] = g;
-  }
   int* __restrict st = rows_.data();
   int ns = 0;
   for (int a = 0; a < k; ++a)
