@@ -106,6 +106,7 @@ void ChainHdSolver::buildModel() {
   zero_joints_ = Eigen::VectorXd::Zero(nj_);
   col_sdp_ = Eigen::MatrixXd::Zero(ns_, nj_);
   col_s0_ = col_u0_ = Matrix6X::Zero(6, ns_);
+  col_offset_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, ns_);
   col_force_ = Matrix6X::Zero(6, std::max<unsigned int>(nj_, kMaxConstraints));
   col_row_ = Eigen::VectorXd::Zero(nj_);
   col_tmp3_ = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, std::max<unsigned int>(nj_, kMaxConstraints));
@@ -694,26 +695,24 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
   }
   if (!general_ && m > 0)
     for (unsigned int i = 0; i < ns_; ++i) eg_.col(i).head(m) = segs_[i].e.leftCols(m).transpose();
-  // Joint axes S and u = IA S of every segment in the base frame, about the base origin (Pluecker
-  // coordinates about one fixed point: a spatial motion or force vector is then the same vector
-  // on every body). Motion: w0 = R w, v0 = R v + p x w0; force: f0 = R f, n0 = R n + p x f0, with
-  // R, p the tip frame's orientation and origin in the base frame.
+  // Joint axes S and u = IA S of every segment in base axes (about the segment's own tip origin),
+  // and each tip origin's offset from its parent's, in base axes: the column sweeps then change
+  // only the reference point between segments (a cross product), never the axes. (About one fixed
+  // point, the base origin, even that would go, but moments grow with the chain's distance from
+  // it and square in the products: precision is lost and a 1e150 m chain overflows.)
   {
-    Vector3 p = Vector3::Zero();
     Matrix3 R_parent = Matrix3::Identity();
     for (unsigned int i = 0; i < ns_; ++i) {
       const Segment& s = segs_[i];
-      p.noalias() += R_parent * s.X.p;
+      col_offset_.col(i).noalias() = R_parent * s.X.p;
       R_parent = s.R_base;
       if (s.joint < 0) continue;
       auto S0 = col_s0_.col(i);
       auto u0 = col_u0_.col(i);
-      S0.tail<3>().noalias() = s.R_base * s.S.tail<3>();
       S0.head<3>().noalias() = s.R_base * s.S.head<3>();
-      S0.head<3>() += p.cross(Vector3(S0.tail<3>()));
+      S0.tail<3>().noalias() = s.R_base * s.S.tail<3>();
       u0.head<3>().noalias() = s.R_base * s.u.head<3>();
       u0.tail<3>().noalias() = s.R_base * s.u.tail<3>();
-      u0.tail<3>() += p.cross(Vector3(u0.head<3>()));
     }
   }
   // All columns at once (coefficient-wise products: no GEMM workspace on the heap), in chunks of
@@ -732,8 +731,7 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     for (long c = 1; c < kc; ++c)
       ascending = ascending && joint_segment_[joints(c0 + c)] >= joint_segment_[joints(c0 + c - 1)];
     // Per column, fixed-size 6-vector arithmetic (robust to the compiler's inlining budget), in
-    // the base frame about its origin (S0, u0 above): force and motion changes pass between
-    // segments unchanged, no per-column change of frame.
+    // base axes (S0, u0 above): between segments only the reference point moves.
     long lo = ascending ? kc : 0;
     auto SDP = col_sdp_.leftCols(kc);  // S_i^T (apparent force change from the child), per segment
     const int m_rows = m;
@@ -743,6 +741,7 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       if (ascending)
         while (lo > 0 && joint_segment_[joints(c0 + lo - 1)] >= i) --lo;
       const bool last = i == static_cast<int>(ns_) - 1;
+      const Vector3 offset_child = last ? Vector3::Zero() : Vector3(col_offset_.col(i + 1));
       const double* eg = eg_.col(i).data();
       const Eigen::Map<const Vector6> S0(col_s0_.col(i).data()), u0(col_u0_.col(i).data());
       for (long c = 0; c < kc; ++c) {
@@ -750,16 +749,26 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
           SDP(i, c) = 0.0;
           continue;
         }
-        Eigen::Map<Vector6> dp(DP.col(c).data());
-        if (last || c < lo_child) dp.setZero();  // becomes alive here (or the last segment)
-        if (s.joint < 0) {
-          SDP(i, c) = 0.0;
-          continue;
+        // Force part f and moment part n as separate 3-vectors: a 6-vector updated in its top half
+        // and reloaded whole stalls on store forwarding.
+        double* dp = DP.col(c).data();
+        Vector3 f = Vector3::Zero(), n = Vector3::Zero();  // becomes alive here (or the last segment)
+        if (!(last || c < lo_child)) {  // the child's apparent force about this tip origin: n += d x f
+          f = Vector3(dp[0], dp[1], dp[2]);
+          n = Vector3(dp[3], dp[4], dp[5]) + offset_child.cross(f);
         }
-        const double sd = S0.dot(dp);
-        SDP(i, c) = sd;
-        const double r = ((joints(c0 + c) == s.joint ? 1.0 : 0.0) - sd) * s.Dinv;  // free joint acc change
-        dp.noalias() += u0 * r;
+        double r = 0.0;
+        if (s.joint >= 0) {
+          const double sd = S0.head<3>().dot(f) + S0.tail<3>().dot(n);
+          SDP(i, c) = sd;
+          r = ((joints(c0 + c) == s.joint ? 1.0 : 0.0) - sd) * s.Dinv;  // free joint acc change
+          f += u0.head<3>() * r;
+          n += u0.tail<3>() * r;
+        } else {
+          SDP(i, c) = 0.0;
+        }
+        for (int t = 0; t < 3; ++t) dp[t] = f(t), dp[3 + t] = n(t);
+        if (s.joint < 0) continue;
         double* du = DU.col(c).data();
         for (int t = 0; t < m_rows; ++t) du[t] += eg[t] * r;
       }
@@ -790,17 +799,23 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
     long first = 0;  // first alive column
     for (unsigned int i = 0; i < ns_; ++i) {
       const Segment& s = segs_[i];
-      if (s.joint < 0) continue;  // a rigid attachment: the same spatial acceleration (base frame)
+      const Vector3 offset = col_offset_.col(i);
       const double* eg = eg_.col(i).data();
       const Eigen::Map<const Vector6> S0(col_s0_.col(i).data()), u0(col_u0_.col(i).data());
       for (long c = first; c < kc; ++c) {
-        Eigen::Map<Vector6> acc(ACC.col(c).data());
-        double v = (joints(c0 + c) == s.joint ? 1.0 : 0.0) - SDP(i, c) - u0.dot(acc);
+        double* acc = ACC.col(c).data();  // linear part a, angular part w (see the inward pass)
+        const Vector3 w(acc[3], acc[4], acc[5]);
+        Vector3 a = Vector3(acc[0], acc[1], acc[2]) + w.cross(offset);  // about this tip origin
+        if (s.joint < 0) {
+          for (int t = 0; t < 3; ++t) acc[t] = a(t);
+          continue;
+        }
+        double v = (joints(c0 + c) == s.joint ? 1.0 : 0.0) - SDP(i, c) - u0.head<3>().dot(a) - u0.tail<3>().dot(w);
         const double* dnu = DNU.col(c).data();
         for (int t = 0; t < m_rows; ++t) v -= eg[t] * dnu[t];
         v *= s.Dinv;
         dqdd(s.joint, c0 + c) = v;
-        acc.noalias() += S0 * v;
+        for (int t = 0; t < 3; ++t) acc[t] = a(t) + S0(t) * v, acc[3 + t] = w(t) + S0(3 + t) * v;
       }
       if (symmetric && s.joint >= 0) {
         for (long c = s.joint + 1; c < kc; ++c) dqdd(c, s.joint) = dqdd(s.joint, c);

@@ -272,7 +272,8 @@ class ChainHdSolver : public KDL::SolverI {
   // Workspace of responseColumns(): d tau_cmd / d nu (n_joints x m), per segment and column the
   // joint-axis component of the apparent force change (n_segments x n_joints), column blocks.
   Eigen::MatrixXd cmd_per_nu_, col_energy_, col_nu_, col_sdp_;
-  Matrix6X col_s0_, col_u0_;  // joint axes S and IA S in the base frame, about its origin
+  Matrix6X col_s0_, col_u0_;  // joint axes S and IA S in base axes, about each tip origin
+  Eigen::Matrix<double, 3, Eigen::Dynamic> col_offset_;  // tip origin - parent's tip origin, base axes
   Matrix6X col_force_;
   Eigen::VectorXd col_row_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> col_tmp3_;
