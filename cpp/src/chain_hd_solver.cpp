@@ -715,16 +715,15 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
       u0.tail<3>().noalias() = s.R_base * s.u.tail<3>();
     }
   }
-  // All columns at once (coefficient-wise products: no GEMM workspace on the heap), in chunks of
-  // at most n_joints (the workspace width): a unit torque at
+  // All columns at once, in chunks of at most n_joints (the workspace width): a unit torque at
   // joint joints(c) changes only the force part of the sweeps; bodies distal to it feel nothing.
   for (long c0 = 0; c0 < k; c0 += nj_) {
     const long kc = std::min<long>(nj_, k - c0);
     auto DP = col_force_.leftCols(kc);  // apparent bias-force change passed to the parent (6 x kc)
     auto DU = col_energy_.topLeftCorner(m, kc);
     DU.setZero();
-    // A unit torque at joint j changes nothing inward of... nothing distal to it: in the inward
-    // pass its column is zero on segments after j's. With the joints in chain order, the columns
+    // A unit torque at joint j changes nothing distal to it: in the inward pass its column is
+    // zero on segments after j's. With the joints in chain order, the columns
     // alive at segment i are a suffix [lo, kc) that grows towards the base (the friction solver
     // asks in that order); otherwise every column is processed everywhere.
     bool ascending = true;
