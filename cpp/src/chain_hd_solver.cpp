@@ -426,29 +426,14 @@ int ChainHdSolver::degenerate(int i) {
               s.joint, chain_.getSegment(i).getJoint().getName().c_str(), s.D);
 }
 
-// Final outward sweep: joint and link accelerations, given the constraint magnitudes nu_.
+// Final outward sweep of the end-segment path: the constraint forces through S^T A_i = e_i.
 template <int M>
 void ChainHdSolver::finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  const bool has_tau = ff_torques.size() != 0;
   Eigen::Matrix<double, M, 1> nu;
   if (M > 0) nu = nu_;
-  Vector6 xdd_parent = root_acc_;
-  link_acc_known_ = false;
-  for (unsigned int i = 0; i < ns_; ++i) {
-    Segment& s = segs_[i];
-    Vector6 a = motionToChild(s.X, xdd_parent);
-    a += s.c;
-    if (s.joint >= 0) {
-      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
-      double f = s.S.dot(s.pA) + s.u.dot(a);  // S^T IA a = u^T a (IA symmetric)
-      if (M > 0) f += s.e.template leftCols<M>().dot(nu.transpose());
-      const double qdd = s.Dinv * (tau - f);
-      qdd_(s.joint) = qdd;
-      a += s.S * qdd;
-    }
-    s.xdd = a;
-    xdd_parent = a;
-  }
+  finalSweep(ff_torques, [&nu](int, const Segment& s) {
+    return M > 0 ? s.e.template leftCols<M>().dot(nu.transpose()) : 0.0;
+  });
 }
 
 void ChainHdSolver::factorizeCoupling() {

@@ -184,26 +184,12 @@ void ChainHdSolver::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, 
   out.head(m).noalias() = V.lazyProduct(tmp_g_.head(m));
 }
 
+// Final outward sweep of the several-segment path: the active columns felt by segment i.
 void ChainHdSolver::finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  const bool has_tau = ff_torques.size() != 0;
-  Vector6 xdd_parent = root_acc_;
-  link_acc_known_ = false;
-  for (unsigned int i = 0; i < ns_; ++i) {
-    Segment& s = segs_[i];
-    Vector6 a = motionToChild(s.X, xdd_parent);
-    a += s.c;
-    if (s.joint >= 0) {
-      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
-      double f = s.S.dot(s.pA) + s.u.dot(a);
-      const int c = active_[i];
-      if (c > 0) f += eg_.col(i).head(c).dot(nug_.head(c));
-      const double qdd = s.Dinv * (tau - f);
-      qdd_(s.joint) = qdd;
-      a += s.S * qdd;
-    }
-    s.xdd = a;
-    xdd_parent = a;
-  }
+  finalSweep(ff_torques, [this](int i, const Segment&) {
+    const int c = active_[i];
+    return c > 0 ? eg_.col(i).head(c).dot(nug_.head(c)) : 0.0;
+  });
 }
 
 // tau_cmd = -sum_c J_c^T alfa_c nu_c: each segment adds the wrenches -alfa nu of its own columns

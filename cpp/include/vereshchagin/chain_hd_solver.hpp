@@ -228,6 +228,10 @@ class ChainHdSolver : public KDL::SolverI {
   inline bool articulate(Segment& s, double tau, Vector6& pa, double& free) const;
   // Apparent inertia and bias force of segment i > 0 added to its parent.
   inline void passToParent(int i, const Vector6& pa);
+  // Final outward sweep shared by both paths (articulated_step.hpp); constraint_force(i, s) gives
+  // segment i's S^T A nu.
+  template <typename ConstraintForce>
+  inline void finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const ConstraintForce& constraint_force);
   int degenerate(int i);
   // E_NONFINITE_RESULT (with the inputs' sizes in the message) if a result is Inf, NaN or
   // beyond 1e150; nu in the caller's order. Inputs only for the message.
