@@ -298,6 +298,14 @@ def fext_to_pinocchio(rc, data, q, f_ext):
     return fext
 
 
+def well_conditioned_task(A, Minv, ratio=1e-4):
+    """True if the task rows A (m x n) couple through the inverse inertia Minv with every
+    eigenvalue of A Minv A^T above ratio x the largest: a near-singular task would make a
+    comparison measure its conditioning, not the solver."""
+    ev = np.linalg.eigvalsh(A @ Minv @ A.T)
+    return ev.min() >= ratio * ev.max()
+
+
 def frame_jacobian(rc, data, q, segment=-1):
     """(6, n) LOCAL_WORLD_ALIGNED Jacobian of a segment's tip frame (Pinocchio returns (6,) if n == 1)."""
     J = pin.computeFrameJacobian(rc.model, data, q, rc.tip_frames[segment], pin.LOCAL_WORLD_ALIGNED)

@@ -38,6 +38,7 @@ from chains import (
     random_alpha,
     random_chain,
     random_f_ext,
+    well_conditioned_task,
 )
 from friction_oracles import (
     SLIP_NEG,
@@ -204,8 +205,7 @@ def make_case(rng, chain, model, fid, q_range, m, *, friction, task="random", p_
             J = np.reshape(pin.computeFrameJacobian(model, data, pq, fid, LWA), (6, n))
             A = alpha.T @ J
             Minv = np.linalg.inv(pinocchio_problem(model, data, pq, qd, static=np.zeros(n)).H)
-            ev = np.linalg.eigvalsh(A @ Minv @ A.T)
-            if ev.min() < 1e-4 * ev.max():
+            if not well_conditioned_task(A, Minv):
                 continue
         if not m:
             beta = None

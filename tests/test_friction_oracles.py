@@ -37,6 +37,7 @@ from chains import (
     random_chain,
     random_f_ext,
     random_state,
+    well_conditioned_task,
 )
 from friction_oracles import (
     MOVING,
@@ -394,8 +395,7 @@ def random_chain_case(rng, n, m, *, rest="all", friction="mixed", fext=True, cap
         if m:
             A = alpha.T @ J
             Minv = np.linalg.inv(pinocchio_problem(rc.model, data, q, qd, static=np.zeros(n)).H)
-            ev = np.linalg.eigvalsh(A @ Minv @ A.T)
-            if ev.min() < 1e-4 * ev.max():
+            if not well_conditioned_task(A, Minv):
                 continue
         if not m:
             beta = None
@@ -659,8 +659,7 @@ def _robot_case(name, rng, m, rest, friction, task="random", accept=None, **kw):
         if m:
             J = pin.computeFrameJacobian(model, data, pq, fid, LWA)
             A = alpha.T @ J
-            ev = np.linalg.eigvalsh(A @ np.linalg.inv(pinocchio_problem(model, data, pq, qd, static=np.zeros(n)).H) @ A.T)
-            if ev.min() < 1e-4 * ev.max():
+            if not well_conditioned_task(A, np.linalg.inv(pinocchio_problem(model, data, pq, qd, static=np.zeros(n)).H)):
                 continue
         if not m:
             beta = None
