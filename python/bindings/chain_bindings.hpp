@@ -63,6 +63,9 @@ struct PyChain {
   vereshchagin::RobotChain robot;
 
   static PyChain fromUrdf(const std::string& source, const std::string& root, const std::string& tip);
+  // Pickle state: every segment (joint, tip frame, inertia bit for bit), joint and link metadata.
+  py::tuple getState() const;
+  static PyChain fromState(const py::tuple& state);
   void addSegment(const std::string& name, const py::object& joint, const py::object& tip, const py::object& mass,
                   const py::object& com, const py::object& inertia, const py::object& rotor_inertia,
                   const std::string& joint_name);
@@ -71,8 +74,20 @@ struct PyChain {
   py::array_t<double> jointField(double vereshchagin::JointInfo::*field) const;
   py::array_t<double> rotorInertia() const;
   void setRotorInertia(const py::object& values);
-  // Segment index and the pose of the named link (or the segment tip) in that segment's tip frame.
-  int resolveSegment(const py::object& which, KDL::Frame& link_in_tip) const;
+  // One addressing rule for every call that names a frame (fk, jacobian, twist, segment_index,
+  // constraints=, f_ext dicts): a segment name, a link merged into a segment by fixed joints
+  // (link_in_tip: its pose in that segment's tip frame), the base link by its own name
+  // (segment -1), or an int index (negative from the end). `label` starts error messages.
+  struct Target {
+    int segment = -1;
+    KDL::Frame link_in_tip = KDL::Frame::Identity();
+    bool merged = false;  // a merged link away from the tip: moments must be moved
+  };
+  Target resolveTarget(PyObject* which, const std::string& label) const;
+  // The same for calls that need a moving segment: the base raises.
+  Target resolveMoving(PyObject* which, const std::string& label) const;
+  // Joint index from a joint name or an int index (negative from the end).
+  int resolveJoint(PyObject* which, const std::string& label) const;
   py::array_t<double> fk(const py::object& q, const py::object& segment) const;
   py::array_t<double> jacobian(const py::object& q, const py::object& segment) const;
   py::array_t<double> twist(const py::object& q, const py::object& qd, const py::object& segment) const;

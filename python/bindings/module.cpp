@@ -8,11 +8,13 @@
 namespace vsbind {
 void bindChain(py::module_& mod);
 void bindSolver(py::module_& mod);
+void bindResultType(py::module_& mod);
 }  // namespace vsbind
 
 PYBIND11_MODULE(_core, mod) {
   mod.doc() = "C++ core of vereshchagin (Popov-Vereshchagin hybrid dynamics on KDL chains).";
   pybind11::register_exception<vsbind::SolverError>(mod, "SolverError", PyExc_ValueError);
   vsbind::bindChain(mod);
+  vsbind::bindResultType(mod);
   vsbind::bindSolver(mod);
 }

@@ -6,10 +6,31 @@ from typing import Optional
 
 import numpy as np
 
+from ._core import SolverError
+
+
+def _frozen_vector(value, name: str, allow_inf: bool = False) -> Optional[np.ndarray]:
+    """A read-only float64 copy of a 1-D real array (None stays None)."""
+    if value is None:
+        return None
+    a = np.asarray(value)
+    if a.dtype.kind not in "iuf":
+        raise SolverError(f"friction.{name} must hold real numbers (int or float), got dtype {a.dtype}")
+    if a.ndim != 1:
+        raise SolverError(f"friction.{name} must be a 1-D array (one value per joint), got shape {a.shape}")
+    a = np.array(a, dtype=np.float64)
+    if np.isnan(a).any() or (not allow_inf and not np.isfinite(a).all()):
+        raise SolverError(f"friction.{name} contains {'NaN' if allow_inf else 'NaN or Inf'}")
+    a.setflags(write=False)
+    return a
+
 
 @dataclass(frozen=True)
 class Friction:
     """Per-joint friction for ``Solver.solve(..., friction=Friction(...))``.
+
+    Immutable: the arrays are stored as read-only float64 copies, so a solver may reuse a parsed
+    ``Friction`` across calls (pass the same object in a control loop).
 
     Parameters
     ----------
@@ -26,6 +47,12 @@ class Friction:
         ``friction=True`` uses the chain's URDF limits.
     limit_tolerance : float
         Distance to a limit (rad or m) at which the joint counts as on it.
+
+    Raises
+    ------
+    SolverError
+        Non-numeric or non-1-D arrays, NaN (or Inf in ``static``/``kinetic``). Sizes and signs
+        are checked against the chain by the solve.
     """
 
     static: np.ndarray
@@ -34,3 +61,14 @@ class Friction:
     lower: Optional[np.ndarray] = None
     upper: Optional[np.ndarray] = None
     limit_tolerance: float = 1e-9
+
+    def __post_init__(self):
+        object.__setattr__(self, "static", _frozen_vector(self.static, "static"))
+        object.__setattr__(self, "kinetic", _frozen_vector(self.kinetic, "kinetic"))
+        object.__setattr__(self, "lower", _frozen_vector(self.lower, "lower", allow_inf=True))
+        object.__setattr__(self, "upper", _frozen_vector(self.upper, "upper", allow_inf=True))
+
+    def __reduce__(self):
+        # Rebuilt through the constructor, so copies and unpickled objects stay read-only.
+        return (Friction, (self.static, self.kinetic, self.velocity_tolerance, self.lower, self.upper,
+                           self.limit_tolerance))

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
@@ -10,16 +11,37 @@ from . import _core
 
 @dataclass(frozen=True)
 class BatchResult:
-    """Results of :meth:`Solver.solve_batch`, one row per input row.
+    """Results of :meth:`Solver.solve_batch`: the fields of :class:`SolveResult` with a leading row axis.
+
+    Row ``b`` equals ``Solver.solve`` of row ``b``'s arguments bit for bit.
 
     Attributes
     ----------
-    qdd, tau_command : ndarray, shape (B, n)
-    nu : ndarray, shape (B, m_max)
-        Rows with fewer constraints are padded with NaN.
+    qdd : ndarray, shape (B, n)
+        Joint accelerations, rad/s^2 or m/s^2.
+    tau_command : ndarray, shape (B, n)
+        Motor torques added to ``tau_ff`` that realise ``qdd`` (N m or N).
+    nu : ndarray, shape (B, m)
+        Constraint magnitudes (end-segment ``alpha`` columns first, then each ``constraints``
+        entry's).
     link_acc : ndarray, shape (B, n_segments + 1, 6)
-    constraint_rank : ndarray of int, shape (B,)
+        Spatial accelerations ``[linear, angular]`` of the base and each segment tip (base axes,
+        tip origins, including ``-gravity``).
+    constraint_rank : ndarray of int32, shape (B,)
+        Rank of each row's coupling matrix.
     smallest_singular_value : ndarray, shape (B,)
+        Smallest eigenvalue of each row's coupling matrix.
+    friction_torque, limit_torque : ndarray, shape (B, n), or None
+        With ``friction``: physical friction torques and joint-limit reactions (NaN in rows
+        solved without friction). None when no row has friction.
+    status : ndarray of int32, shape (B, n), or None
+        0 moving, 1 sticking, 2 slipping +, 3 slipping - (-1 in rows without friction).
+    gauss_value : ndarray, shape (B,), or None
+        Gauss' function at each row's optimum (NaN in rows without friction).
+    iterations : ndarray of int32, shape (B,), or None
+        Iterations of each row's friction max-min (-1 in rows without friction).
+    segment_nu : dict or None
+        ``{key: (B, m_i) view of nu}`` for each ``constraints`` key.
     """
 
     qdd: np.ndarray
@@ -28,6 +50,12 @@ class BatchResult:
     link_acc: np.ndarray
     constraint_rank: np.ndarray
     smallest_singular_value: np.ndarray
+    friction_torque: Optional[np.ndarray] = None
+    limit_torque: Optional[np.ndarray] = None
+    status: Optional[np.ndarray] = None
+    gauss_value: Optional[np.ndarray] = None
+    iterations: Optional[np.ndarray] = None
+    segment_nu: Optional[dict] = None
 
 
 class Solver(_core.Solver):
@@ -41,74 +69,87 @@ class Solver(_core.Solver):
         Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``). Internally the base
         accelerates by ``-gravity``, so ``beta`` and ``link_acc`` include that acceleration.
     rcond : float
-        Eigenvalues of the constraint coupling matrix below ``rcond`` times the largest are
+        Eigenvalues of the constraint coupling matrix below ``rcond`` times its scale are
         treated as zero (truncated pseudo-inverse; the rank is reported).
     damping : float, optional
         If given, use damped least squares ``lambda / (lambda^2 + damping^2)`` instead.
 
     Notes
     -----
-    ``solve(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None)`` returns a
-    :class:`SolveResult`:
+    :meth:`solve` solves one state and returns a :class:`SolveResult`; :meth:`solve_batch`
+    solves many (optionally on several threads); :meth:`response_columns` gives the affine
+    response of the last solve to feed-forward torques.
 
-    - ``q``, ``qd``: (n,) joint positions (rad or m) and velocities.
-    - ``alpha``: (6, m), m <= 6, unit constraint wrenches on the last segment, rows
-      ``[force; moment]``, base-frame axes, moment about the last segment's tip origin.
-    - ``beta``: (m,) acceleration set-points ``alpha.T @ a_N`` where ``a_N`` is the last segment's
-      spatial acceleration (base axes, tip origin) *including* ``-gravity``: holding the tip still
-      along z needs ``beta = 9.81``, not 0.
-    - ``f_ext``: (n_segments, 6) wrench ``[force, moment]`` applied to each segment by the
-      environment, base-frame axes, moment about that segment's tip origin (N, N m).
-    - ``tau_ff``: (n,) feed-forward joint torques (N m or N).
-    - ``constraints``: ``{segment: (alpha_i (6, m_i), beta_i (m_i,))}`` acceleration constraints on
-      any segments (Shakhimardanov's extension), keyed by segment name or index (negative counts
-      from the end), with the end-segment conventions at that segment: base-frame axes, moment
-      about *that segment's* tip origin, ``beta_i`` including ``-gravity``. At most 6 columns per
-      segment; any number of segments. Combines with ``alpha``/``beta`` (the last segment).
-
-    Result fields: ``qdd`` (n,); ``tau_command`` (n,) the torques the motors must add to
-    ``tau_ff`` to realise ``qdd`` (``-sum_i J_i^T alpha_i nu_i`` over constrained segments);
-    ``nu`` (m,) constraint magnitudes (the wrench on the last segment is ``-alpha @ nu``), with
-    ``constraints`` the end-segment ``alpha`` columns first, then each entry's in dict order
-    (``segment_nu`` maps each ``constraints`` key to its own part); ``link_acc`` (n_segments + 1, 6) spatial
-    accelerations ``[linear, angular]`` of the base and each segment's tip (base axes, tip
-    origin, including ``-gravity``); ``constraint_rank``; ``smallest_singular_value``.
-
-    ``friction=Friction(...)`` (or ``True`` for the chain's URDF values) adds static friction:
-    the exact max-min of report 000. Then also ``friction_torque`` (physical, opposes motion),
-    ``limit_torque`` (reactions of joint limits), ``status`` (0 moving, 1 stick, 2 slip +,
-    3 slip -), ``gauss_value`` (Z0(qdd) + sum f |qdd| over resting joints) and ``iterations``;
-    ``tau_command`` is what the motors add to ``tau_ff`` with friction acting, and the least such
-    command when friction could hold in several ways.
-    The GIL is released while solving; use one solver per thread for parallel work.
+    Conventions (those of Orocos KDL's ``ChainHdSolver_Vereshchagin``): spatial vectors are
+    ``[linear; angular]`` and wrenches ``[force; moment]``, in base-frame axes with moments and
+    accelerations about each segment's tip origin; ``beta`` includes ``-gravity``; ``f_ext`` is one
+    row per segment. Segments are addressed by segment name, by the name of a link merged into a
+    segment by fixed joints (tool frames), or by index (negative from the end); the base only by
+    its link name. Solvers, chains and results pickle and deep-copy. The GIL is released while
+    solving.
     """
 
-    def solve_batch(self, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None) -> BatchResult:
-        """Solve B states at once.
+    def solve_batch(self, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None,
+                    threads=1) -> BatchResult:
+        """Solve B states at once (each row exactly as :meth:`solve` would).
+
+        Every argument is either shared by all rows (the shape :meth:`solve` takes) or has a
+        leading batch axis of B rows; arguments without a batch axis are broadcast.
 
         Parameters
         ----------
-        q, qd : array_like, shape (B, n)
-        alpha, beta, f_ext, tau_ff : array_like, optional
-            Either one value for all rows (shapes as in :meth:`solve`) or with a leading axis B.
+        q, qd : array_like, shape (B, n) or (n,)
+        alpha : array_like, shape (B, 6, m), (6, m) or (6,), optional
+        beta : array_like, shape (B, m) or (m,); for m = 1 also (B,) or a float
+        f_ext : array_like, shape (B, n_segments, 6) or (n_segments, 6), or dict, optional
+            A dict maps segments (names, merged link names or indices) to ``(6,)`` or ``(B, 6)``
+            wrenches.
+        tau_ff : array_like, shape (B, n) or (n,), optional
+        friction : None, bool, Friction, or a sequence of B of them, optional
+        constraints : dict, optional
+            ``{segment: (alpha_i, beta_i)}`` with ``alpha_i`` (6, m_i) or (B, 6, m_i) and
+            ``beta_i`` (m_i,) or (B, m_i).
+        threads : int
+            Rows are split into ``threads`` contiguous chunks solved in parallel with the GIL
+            released (0: one per core). Results do not depend on it.
 
         Returns
         -------
         BatchResult
-        """
-        return BatchResult(**super().solve_batch(q, qd, alpha, beta, f_ext, tau_ff))
 
-    def response_columns(self, joints):
-        """Affine response of the last solve to unit joint torques.
+        Raises
+        ------
+        SolverError
+            Shapes that do not fit (the message names the argument and its batch axis), or the
+            first failing row (``"batch row 3: ..."``).
+        """
+        return BatchResult(**super().solve_batch(q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, threads))
+
+    def response_columns(self, joints, hold_sticking=True):
+        """Affine response of the last solve to unit feed-forward joint torques.
+
+        ``qdd`` and ``tau_command`` are affine in ``tau_ff``; column c is the change of each per
+        unit of ``tau_ff`` at joint ``joints[c]`` (columns of the constrained inverse inertia
+        ``G = H^-1 - H^-1 A^T K^+ A H^-1``, ``A = alpha^T J``), computed in O(n) per column.
+
+        After a friction-aware solve, by default the joints that stick (``status == 1``) are
+        held: a small change of torque is absorbed by their static friction (or limit reaction),
+        so their ``qdd`` stays 0 and the others respond as in the arm with those joints locked,
+        ``G - G[:, S] G[S, S]^+ G[S, :]``. This is the linearisation a controller needs around a
+        sticking state (valid while the friction stays inside its bound). Moving and slipping
+        joints keep their friction torque fixed. ``hold_sticking=False`` gives the columns of
+        the frictionless problem at that state (friction torques as fixed inputs).
 
         Parameters
         ----------
-        joints : sequence of int, length k
+        joints : sequence of int or str, length k
+            Joint indices (negative from the end) or joint names.
+        hold_sticking : bool
+            Hold the sticking joints of the last friction-aware solve (no effect after a solve
+            without friction).
 
         Returns
         -------
         dqdd, dtau_command : ndarray, shape (n, k)
-            Column c is the change of ``qdd`` and of ``tau_command`` per unit of ``tau_ff`` at
-            joint ``joints[c]`` (columns of the constrained inverse inertia G).
         """
-        return super().response_columns(joints)
+        return super().response_columns(joints, hold_sticking)

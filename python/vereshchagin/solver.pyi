@@ -1,5 +1,5 @@
 from dataclasses import dataclass
-from typing import Optional, Sequence
+from typing import Mapping, Optional, Sequence, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -14,6 +14,12 @@ class BatchResult:
     link_acc: NDArray[np.float64]
     constraint_rank: NDArray[np.int32]
     smallest_singular_value: NDArray[np.float64]
+    friction_torque: Optional[NDArray[np.float64]] = None
+    limit_torque: Optional[NDArray[np.float64]] = None
+    status: Optional[NDArray[np.int32]] = None
+    gauss_value: Optional[NDArray[np.float64]] = None
+    iterations: Optional[NDArray[np.int32]] = None
+    segment_nu: Optional[dict] = None
 
 class Solver(_core.Solver):
     def solve_batch(  # type: ignore[override]
@@ -24,7 +30,10 @@ class Solver(_core.Solver):
         beta: Optional[ArrayLike] = None,
         f_ext: Optional[ArrayLike] = None,
         tau_ff: Optional[ArrayLike] = None,
+        friction: object = None,
+        constraints: Optional[Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]] = None,
+        threads: int = 1,
     ) -> BatchResult: ...
-    def response_columns(
-        self, joints: Sequence[int]
+    def response_columns(  # type: ignore[override]
+        self, joints: Sequence[Union[int, str]], hold_sticking: bool = True
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...

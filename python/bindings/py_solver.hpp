@@ -1,0 +1,85 @@
+// The Python Solver: argument parsing (argument-naming messages), the engines that solve, and the
+// result type. Solver.solve is a METH_FASTCALL entry point (solver_bindings.cpp); solve_batch runs
+// rows on one engine per thread with the GIL released (solve_batch.cpp).
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "chain_bindings.hpp"
+#include "common.hpp"
+#include "engine.hpp"
+#include "numpy_fast.hpp"
+#include "result_type.hpp"
+
+namespace vsbind {
+
+// The arguments of one solve, checked: views into the caller's arrays plus the blocks, wrenches
+// and friction model that RowInputs points at.
+struct ParsedSolve {
+  F64View q, qd, alpha, beta, f_ext, tau;
+  std::vector<F64View> block_views;   // alpha_i, beta_i of constraints= entries (kept alive)
+  std::vector<ConstraintBlock> blocks;
+  std::vector<py::object> block_keys;  // constraints= keys, in order (for segment_nu)
+  std::vector<double> f_ext_dense;     // f_ext given as a dict: (n_segments, 6)
+  std::vector<LinkWrench> link_wrenches;
+  py::object friction_owner;           // keeps a parsed friction's arrays alive
+  vereshchagin::FrictionModel friction_model;
+  const vereshchagin::FrictionModel* friction = nullptr;
+  RowInputs row;
+  void clear();
+};
+
+class PySolver {
+ public:
+  PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping);
+
+  // Parses solve()'s arguments (objects may be null for "not given") into `p`.
+  void parse(PyObject* q, PyObject* qd, PyObject* alpha, PyObject* beta, PyObject* f_ext, PyObject* tau_ff,
+             PyObject* friction, PyObject* constraints, ParsedSolve& p);
+  // Solves the parsed row on engine 0 with the GIL released; raises SolverError on failure.
+  void runParsed(const ParsedSolve& p);
+  // The result of the last runParsed(): new arrays, or written into `out` (a SolveResult).
+  py::object result(const ParsedSolve& p, PyObject* out);
+
+  py::dict solveBatch(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
+                      const py::object& f_ext, const py::object& tau_ff, const py::object& friction,
+                      const py::object& constraints, const py::object& threads);
+  py::tuple responseColumns(const py::object& joints, bool hold_sticking);
+  double timeCpp(const ParsedSolve& p, long reps);
+
+  void setGravity(const py::object& gravity);
+  py::array gravity() const;
+  py::tuple getState() const;
+
+  // Locks the solver; waits with the GIL released if another thread holds it.
+  std::unique_lock<std::mutex> lock();
+
+  const PyChain& chain() const { return chain_; }
+  unsigned int nj = 0, ns = 0;
+  ParsedSolve parsed;  // scratch of solve(), reused under the lock
+
+ private:
+  friend struct BatchRunner;
+  void parseFExt(PyObject* f_ext, ParsedSolve& p) const;
+  void parseConstraints(PyObject* constraints, ParsedSolve& p) const;
+  bool parseFriction(PyObject* friction, ParsedSolve& p);
+  Engine& engine(std::size_t k);
+
+  PyChain chain_;
+  KDL::Vector gravity_;
+  vereshchagin::SolverOptions options_;
+  py::object damping_arg_;
+  std::vector<std::unique_ptr<Engine>> engines_;
+  vereshchagin::FrictionModel chain_friction_;  // friction=True
+  py::object friction_cache_key_;               // the last vereshchagin.Friction parsed
+  vereshchagin::FrictionModel friction_cache_;
+  std::mutex mutex_;
+};
+
+// Checked alpha: (6, m) or (6,) (one column), m <= 6, finite.
+F64View alphaView(PyObject* obj, const std::string& name);
+
+}  // namespace vsbind

@@ -1,0 +1,329 @@
+#include "result_type.hpp"
+
+#include <pybind11/numpy.h>
+
+#include <string>
+
+#include "common.hpp"
+#include "docstrings.hpp"
+
+namespace vsbind {
+
+namespace {
+
+enum View { kQdd, kTau, kNu, kLinkAcc, kFriction, kLimit, kStatus, kNumViews };
+
+struct ResultObject {
+  PyObject_HEAD
+  PyObject* buffer;             // 1-D float64 array: every numeric output
+  PyObject* views[kNumViews];   // cached views of the buffer (NULL until first access)
+  PyObject* segment_keys;       // tuple or NULL: constraints= keys
+  PyObject* segment_starts;     // tuple of int: first entry of each key's part of nu
+  PyObject* segment_counts;     // tuple of int: its length
+  PyObject* segment_nu;         // cached dict or NULL
+  ResultLayout layout;
+  int rank;
+  double smin;
+  double gauss;
+  int iterations;
+};
+
+PyTypeObject* g_type = nullptr;
+
+Py_ssize_t bufferDoubles(const ResultLayout& l) {
+  Py_ssize_t n = 2 * l.nj + l.m + 6 * (l.ns + 1);
+  if (l.friction) n += 2 * l.nj + (l.nj + 1) / 2;  // friction, limit torques; int32 status
+  return n;
+}
+
+ResultObject* self(PyObject* o) { return reinterpret_cast<ResultObject*>(o); }
+
+double* base(PyObject* o) { return reinterpret_cast<double*>(py::detail::array_proxy(self(o)->buffer)->data); }
+
+void clearViews(ResultObject* r) {
+  for (auto& v : r->views) Py_CLEAR(v);
+  Py_CLEAR(r->segment_nu);
+}
+
+void dealloc(PyObject* o) {
+  ResultObject* r = self(o);
+  clearViews(r);
+  Py_CLEAR(r->buffer);
+  Py_CLEAR(r->segment_keys);
+  Py_CLEAR(r->segment_starts);
+  Py_CLEAR(r->segment_counts);
+  PyTypeObject* tp = Py_TYPE(o);
+  tp->tp_free(o);
+  Py_DECREF(tp);
+}
+
+PyObject* allocate(const ResultLayout& layout, PyObject* buffer) {
+  ResultObject* r = PyObject_New(ResultObject, g_type);
+  if (r == nullptr) throw py::error_already_set();
+  r->buffer = buffer;
+  for (auto& v : r->views) v = nullptr;
+  r->segment_keys = r->segment_starts = r->segment_counts = r->segment_nu = nullptr;
+  r->layout = layout;
+  r->rank = 0;
+  r->smin = r->gauss = 0.0;
+  r->iterations = 0;
+  return reinterpret_cast<PyObject*>(r);
+}
+
+PyObject* newBuffer(Py_ssize_t n) {
+  const auto& api = py::detail::npy_api::get();
+  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(py::detail::npy_api::NPY_DOUBLE_),
+                                          1, &n, nullptr, nullptr, 0, nullptr);
+  if (a == nullptr) throw py::error_already_set();
+  return a;
+}
+
+// A view of `count` entries at `offset` doubles, shaped `dims`, based on the buffer.
+PyObject* makeView(ResultObject* r, Py_ssize_t offset_doubles, int nd, const Py_ssize_t* dims, int type_num) {
+  const auto& api = py::detail::npy_api::get();
+  constexpr int flags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_ |
+                        py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  void* data = base(reinterpret_cast<PyObject*>(r)) + offset_doubles;
+  PyObject* v = api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(type_num), nd, dims, nullptr,
+                                          data, flags, nullptr);
+  if (v == nullptr) return nullptr;
+  Py_INCREF(r->buffer);
+  if (api.PyArray_SetBaseObject_(v, r->buffer) != 0) {
+    Py_DECREF(v);
+    return nullptr;
+  }
+  return v;
+}
+
+Py_ssize_t offsetOf(const ResultLayout& l, int which) {
+  const Py_ssize_t nj = l.nj, link = 6 * (l.ns + 1);
+  switch (which) {
+    case kQdd: return 0;
+    case kTau: return nj;
+    case kNu: return 2 * nj;
+    case kLinkAcc: return 2 * nj + l.m;
+    case kFriction: return 2 * nj + l.m + link;
+    case kLimit: return 3 * nj + l.m + link;
+    default: return 4 * nj + l.m + link;  // kStatus
+  }
+}
+
+PyObject* getView(PyObject* o, void* closure) {
+  ResultObject* r = self(o);
+  const int which = static_cast<int>(reinterpret_cast<intptr_t>(closure));
+  if (which >= kFriction && !r->layout.friction) Py_RETURN_NONE;
+  if (r->views[which] == nullptr) {
+    const ResultLayout& l = r->layout;
+    Py_ssize_t dims[2] = {l.nj, 0};
+    int nd = 1;
+    if (which == kNu) dims[0] = l.m;
+    if (which == kLinkAcc) {
+      dims[0] = l.ns + 1;
+      dims[1] = 6;
+      nd = 2;
+    }
+    const int type = which == kStatus ? py::detail::npy_api::NPY_INT_ : py::detail::npy_api::NPY_DOUBLE_;
+    r->views[which] = makeView(r, offsetOf(l, which), nd, dims, type);
+    if (r->views[which] == nullptr) return nullptr;
+  }
+  Py_INCREF(r->views[which]);
+  return r->views[which];
+}
+
+PyObject* getRank(PyObject* o, void*) { return PyLong_FromLong(self(o)->rank); }
+PyObject* getSmin(PyObject* o, void*) { return PyFloat_FromDouble(self(o)->smin); }
+PyObject* getGauss(PyObject* o, void*) {
+  if (!self(o)->layout.friction) Py_RETURN_NONE;
+  return PyFloat_FromDouble(self(o)->gauss);
+}
+PyObject* getIterations(PyObject* o, void*) {
+  if (!self(o)->layout.friction) Py_RETURN_NONE;
+  return PyLong_FromLong(self(o)->iterations);
+}
+
+PyObject* getSegmentNu(PyObject* o, void*) {
+  ResultObject* r = self(o);
+  if (r->segment_keys == nullptr) Py_RETURN_NONE;
+  if (r->segment_nu == nullptr) {
+    try {
+      py::object nu = py::reinterpret_steal<py::object>(getView(o, reinterpret_cast<void*>(kNu)));
+      if (!nu) throw py::error_already_set();
+      py::dict d;
+      const py::tuple keys = py::reinterpret_borrow<py::tuple>(r->segment_keys);
+      const py::tuple starts = py::reinterpret_borrow<py::tuple>(r->segment_starts);
+      const py::tuple counts = py::reinterpret_borrow<py::tuple>(r->segment_counts);
+      for (std::size_t k = 0; k < keys.size(); ++k) {
+        const Py_ssize_t a = starts[k].cast<Py_ssize_t>(), c = counts[k].cast<Py_ssize_t>();
+        d[keys[k]] = nu[py::slice(a, a + c, 1)];
+      }
+      r->segment_nu = d.release().ptr();
+    } catch (py::error_already_set& e) {
+      e.restore();
+      return nullptr;
+    }
+  }
+  Py_INCREF(r->segment_nu);
+  return r->segment_nu;
+}
+
+PyObject* repr(PyObject* o) {
+  const ResultObject* r = self(o);
+  const std::string s = "<vereshchagin.SolveResult n_joints=" + std::to_string(r->layout.nj) + " m=" +
+                        std::to_string(r->layout.m) + " rank=" + std::to_string(r->rank) +
+                        (r->layout.friction ? " friction" : "") + ">";
+  return PyUnicode_FromString(s.c_str());
+}
+
+PyObject* stateTuple(PyObject* o, bool copy_buffer) {
+  const ResultObject* r = self(o);
+  PyObject* buf = copy_buffer ? py::detail::npy_api::get().PyArray_NewCopy_(r->buffer, 0) : (Py_INCREF(r->buffer), r->buffer);
+  if (buf == nullptr) return nullptr;
+  auto orNone = [](PyObject* x) { PyObject* v = x ? x : Py_None; Py_INCREF(v); return v; };
+  return Py_BuildValue("(iiiiddiiNNNN)", r->layout.nj, r->layout.ns, r->layout.m, static_cast<int>(r->layout.friction),
+                       r->smin, r->gauss, r->rank, r->iterations, buf, orNone(r->segment_keys),
+                       orNone(r->segment_starts), orNone(r->segment_counts));
+}
+
+PyObject* fromState(PyObject*, PyObject* args) {
+  try {
+    const py::tuple t = py::reinterpret_borrow<py::tuple>(args);
+    if (t.size() != 12) throw SolverError("SolveResult state must have 12 entries");
+    ResultLayout l;
+    l.nj = t[0].cast<int>();
+    l.ns = t[1].cast<int>();
+    l.m = t[2].cast<int>();
+    l.friction = t[3].cast<int>() != 0;
+    py::array_t<double, py::array::c_style | py::array::forcecast> buf(t[8]);
+    if (buf.ndim() != 1 || buf.size() != bufferDoubles(l)) throw SolverError("SolveResult state: buffer of the wrong size");
+    PyObject* own = py::detail::npy_api::get().PyArray_NewCopy_(buf.ptr(), 0);
+    if (own == nullptr) throw py::error_already_set();
+    PyObject* o = allocate(l, own);
+    ResultObject* r = self(o);
+    r->smin = t[4].cast<double>();
+    r->gauss = t[5].cast<double>();
+    r->rank = t[6].cast<int>();
+    r->iterations = t[7].cast<int>();
+    if (!t[9].is_none()) {
+      r->segment_keys = t[9].cast<py::tuple>().release().ptr();
+      r->segment_starts = t[10].cast<py::tuple>().release().ptr();
+      r->segment_counts = t[11].cast<py::tuple>().release().ptr();
+    }
+    return o;
+  } catch (const SolverError& e) {
+    PyErr_SetString(PyExc_ValueError, e.what());
+  } catch (py::error_already_set& e) {
+    e.restore();
+  } catch (const std::exception& e) {
+    PyErr_SetString(PyExc_ValueError, e.what());
+  }
+  return nullptr;
+}
+
+PyObject* g_from_state = nullptr;
+
+PyObject* reduce(PyObject* o, PyObject*) {
+  PyObject* state = stateTuple(o, false);
+  if (state == nullptr) return nullptr;
+  return Py_BuildValue("(ON)", g_from_state, state);
+}
+
+PyObject* copyResult(PyObject* o, PyObject*) {
+  PyObject* state = stateTuple(o, true);
+  if (state == nullptr) return nullptr;
+  PyObject* r = fromState(nullptr, state);
+  Py_DECREF(state);
+  return r;
+}
+
+PyObject* deepcopyResult(PyObject* o, PyObject*) { return copyResult(o, nullptr); }
+
+PyGetSetDef g_getset[] = {
+    {"qdd", getView, nullptr, docs::kQdd, reinterpret_cast<void*>(kQdd)},
+    {"tau_command", getView, nullptr, docs::kTauCommand, reinterpret_cast<void*>(kTau)},
+    {"nu", getView, nullptr, docs::kNu, reinterpret_cast<void*>(kNu)},
+    {"link_acc", getView, nullptr, docs::kLinkAcc, reinterpret_cast<void*>(kLinkAcc)},
+    {"constraint_rank", getRank, nullptr, docs::kConstraintRank, nullptr},
+    {"smallest_singular_value", getSmin, nullptr, docs::kSmallestSingularValue, nullptr},
+    {"friction_torque", getView, nullptr, docs::kFrictionTorque, reinterpret_cast<void*>(kFriction)},
+    {"limit_torque", getView, nullptr, docs::kLimitTorque, reinterpret_cast<void*>(kLimit)},
+    {"status", getView, nullptr, docs::kStatus, reinterpret_cast<void*>(kStatus)},
+    {"gauss_value", getGauss, nullptr, docs::kGaussValue, nullptr},
+    {"iterations", getIterations, nullptr, docs::kIterations, nullptr},
+    {"segment_nu", getSegmentNu, nullptr, docs::kSegmentNu, nullptr},
+    {nullptr, nullptr, nullptr, nullptr, nullptr}};
+
+PyMethodDef g_methods[] = {
+    {"__reduce__", reduce, METH_NOARGS, "Pickle support."},
+    {"__copy__", copyResult, METH_NOARGS, "An independent copy (its own buffer)."},
+    {"__deepcopy__", deepcopyResult, METH_O, "An independent copy (its own buffer)."},
+    {nullptr, nullptr, 0, nullptr}};
+
+PyMethodDef g_from_state_def = {"_result_from_state", fromState, METH_VARARGS, "Unpickle a SolveResult."};
+
+}  // namespace
+
+void bindResultType(py::module_& mod) {
+  static PyType_Slot slots[] = {{Py_tp_dealloc, reinterpret_cast<void*>(dealloc)},
+                                {Py_tp_repr, reinterpret_cast<void*>(repr)},
+                                {Py_tp_getset, g_getset},
+                                {Py_tp_methods, g_methods},
+                                {Py_tp_doc, const_cast<char*>(docs::kSolveResult)},
+                                {0, nullptr}};
+  static PyType_Spec spec = {"vereshchagin._core.SolveResult", sizeof(ResultObject), 0, Py_TPFLAGS_DEFAULT, slots};
+  PyObject* type = PyType_FromSpec(&spec);
+  if (type == nullptr) throw py::error_already_set();
+  g_type = reinterpret_cast<PyTypeObject*>(type);
+  mod.add_object("SolveResult", py::reinterpret_borrow<py::object>(type));
+  g_from_state = PyCFunction_NewEx(&g_from_state_def, nullptr, mod.attr("__name__").ptr());
+  if (g_from_state == nullptr) throw py::error_already_set();
+  mod.add_object("_result_from_state", py::reinterpret_borrow<py::object>(g_from_state));
+}
+
+py::object newResult(const ResultLayout& layout, PyObject* out) {
+  if (out == nullptr) return py::reinterpret_steal<py::object>(allocate(layout, newBuffer(bufferDoubles(layout))));
+  if (Py_TYPE(out) != g_type)
+    throw SolverError("out must be a SolveResult returned by an earlier solve(), got " +
+                      std::string(Py_TYPE(out)->tp_name));
+  ResultObject* r = self(out);
+  const ResultLayout& l = r->layout;
+  if (l.nj != layout.nj || l.ns != layout.ns || l.m != layout.m || l.friction != layout.friction)
+    throw SolverError("out does not fit this solve: it holds m = " + std::to_string(l.m) + (l.friction ? " with" : " without") +
+                      " friction, this solve has m = " + std::to_string(layout.m) +
+                      (layout.friction ? " with" : " without") + " friction");
+  Py_CLEAR(r->segment_nu);
+  Py_CLEAR(r->segment_keys);
+  Py_CLEAR(r->segment_starts);
+  Py_CLEAR(r->segment_counts);
+  return py::reinterpret_borrow<py::object>(out);
+}
+
+ResultPointers resultPointers(PyObject* o) {
+  const ResultLayout& l = self(o)->layout;
+  double* b = base(o);
+  ResultPointers p;
+  p.qdd = b + offsetOf(l, kQdd);
+  p.tau_command = b + offsetOf(l, kTau);
+  p.nu = b + offsetOf(l, kNu);
+  p.link_acc = b + offsetOf(l, kLinkAcc);
+  p.friction_torque = l.friction ? b + offsetOf(l, kFriction) : nullptr;
+  p.limit_torque = l.friction ? b + offsetOf(l, kLimit) : nullptr;
+  p.status = l.friction ? reinterpret_cast<int*>(b + offsetOf(l, kStatus)) : nullptr;
+  return p;
+}
+
+void setResultScalars(PyObject* o, int rank, double smin, double gauss, int iterations) {
+  ResultObject* r = self(o);
+  r->rank = rank;
+  r->smin = smin;
+  r->gauss = gauss;
+  r->iterations = iterations;
+}
+
+void setSegmentLayout(PyObject* o, py::tuple keys, py::tuple starts, py::tuple counts) {
+  ResultObject* r = self(o);
+  r->segment_keys = keys.release().ptr();
+  r->segment_starts = starts.release().ptr();
+  r->segment_counts = counts.release().ptr();
+}
+
+}  // namespace vsbind
