@@ -8,11 +8,15 @@
 namespace vsbind {
 void bindChain(py::module_& mod);
 void bindSolver(py::module_& mod);
+void bindDynamics(py::module_& mod);
+void bindSegmentSpec(py::module_& mod);
 }  // namespace vsbind
 
 PYBIND11_MODULE(_core, mod) {
   mod.doc() = "C++ core of vereshchagin (Popov-Vereshchagin hybrid dynamics on KDL chains).";
   pybind11::register_exception<vsbind::SolverError>(mod, "SolverError", PyExc_ValueError);
   vsbind::bindChain(mod);
+  vsbind::bindDynamics(mod);      // adds methods to Chain
+  vsbind::bindSegmentSpec(mod);   // adds Chain.segment_spec
   vsbind::bindSolver(mod);
 }
