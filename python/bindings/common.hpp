@@ -115,5 +115,16 @@ inline py::array_t<double> copyVector(const double* p, py::ssize_t n) {
   return a;
 }
 
+// A KDL frame as a row-major 4x4 homogeneous transform written to out[0..15].
+inline void writeHomogeneous(const KDL::Frame& f, double* out) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out[4 * r + c] = r < 3 ? (c < 3 ? f.M(r, c) : f.p(r)) : (c == 3 ? 1.0 : 0.0);
+}
+
+inline py::array_t<double> homogeneous(const KDL::Frame& f) {
+  py::array_t<double> T({4, 4});
+  writeHomogeneous(f, T.mutable_data());
+  return T;
+}
 
 }  // namespace vsbind

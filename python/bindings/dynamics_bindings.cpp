@@ -152,12 +152,7 @@ py::array_t<double> fkAll(const PyChain& c, const py::object& q_obj) {
   const KDL::Chain& chain = c.robot.chain;
   const std::vector<KDL::Frame> tips = tipFrames(chain, jointVector(q_obj, "q", chain.getNrOfJoints()));
   py::array_t<double> out({static_cast<py::ssize_t>(tips.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
-  auto o = out.mutable_unchecked<3>();
-  for (size_t i = 0; i < tips.size(); ++i) {
-    const KDL::Frame& f = tips[i];
-    for (int r = 0; r < 4; ++r)
-      for (int k = 0; k < 4; ++k) o(i, r, k) = r < 3 ? (k < 3 ? f.M(r, k) : f.p(r)) : (k == 3 ? 1.0 : 0.0);
-  }
+  for (size_t i = 0; i < tips.size(); ++i) writeHomogeneous(tips[i], out.mutable_data() + 16 * i);
   return out;
 }
 

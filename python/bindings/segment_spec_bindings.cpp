@@ -26,14 +26,6 @@ const char* jointTypeName(KDL::Joint::JointType type) {
 
 py::array_t<double> vector3(const KDL::Vector& v) { return copyVector(v.data, 3); }
 
-py::array_t<double> frame4x4(const KDL::Frame& f) {
-  py::array_t<double> T({4, 4});
-  auto t = T.mutable_unchecked<2>();
-  for (int r = 0; r < 4; ++r)
-    for (int k = 0; k < 4; ++k) t(r, k) = r < 3 ? (k < 3 ? f.M(r, k) : f.p(r)) : (k == 3 ? 1.0 : 0.0);
-  return T;
-}
-
 // KDL keeps the rotational inertia about the tip origin; add_segment takes it about the centre of
 // mass: I_com = I_tip - m (|c|^2 E - c c^T) (parallel-axis theorem).
 py::array_t<double> inertiaAboutCom(const KDL::RigidBodyInertia& body) {
@@ -64,7 +56,7 @@ py::dict segmentSpec(const PyChain& c, const py::object& which) {
   d["axis"] = fixed ? py::object(py::none()) : py::object(vector3(j.JointAxis()));
   d["origin"] = with_axis ? vector3(j.JointOrigin()) : vector3(KDL::Vector::Zero());
   d["joint_name"] = j.getName();
-  d["tip"] = frame4x4(s.getFrameToTip());
+  d["tip"] = homogeneous(s.getFrameToTip());
   d["mass"] = s.getInertia().getMass();
   d["com"] = vector3(s.getInertia().getCOG());
   d["inertia"] = inertiaAboutCom(s.getInertia());
