@@ -46,7 +46,11 @@ def _members(cls):
 def _field_documented(cls, field: str) -> bool:
     """A dataclass field is documented in its class's 'Attributes' or 'Parameters' section."""
     doc = inspect.getdoc(cls) or ""
-    return any(line.strip().startswith(field) for line in doc.splitlines())
+    for line in doc.splitlines():
+        head = line.split(" : ")[0] if " : " in line else line.rstrip(":")
+        if field in (name.strip() for name in head.split(",")):
+            return True
+    return False
 
 
 def _walk():

@@ -181,6 +181,13 @@ PyChain::Target PyChain::resolveTarget(PyObject* which, const std::string& label
   return t;
 }
 
+PyChain::Target PyChain::resolveOptional(const py::object& which, const std::string& label) const {
+  if (!which.is_none()) return resolveTarget(which.ptr(), label);
+  Target t;
+  t.segment = static_cast<int>(robot.chain.getNrOfSegments()) - 1;
+  return t;
+}
+
 PyChain::Target PyChain::resolveMoving(PyObject* which, const std::string& label) const {
   Target t = resolveTarget(which, label);
   if (t.segment < 0)
@@ -215,20 +222,12 @@ KDL::JntArray jointArray(const py::object& obj, const char* name, unsigned int n
   return q;
 }
 
-py::array_t<double> toMatrix4(const KDL::Frame& f) {
-  py::array_t<double> T({4, 4});
-  auto t = T.mutable_unchecked<2>();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) t(r, c) = r < 3 ? (c < 3 ? f.M(r, c) : f.p(r)) : (c == 3 ? 1.0 : 0.0);
-  return T;
-}
 
 }  // namespace
 
 py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segment) const {
   const KDL::JntArray q = jointArray(q_obj, "q", robot.chain.getNrOfJoints());
-  const Target t = segment.is_none() ? Target{static_cast<int>(robot.chain.getNrOfSegments()) - 1}
-                                     : resolveTarget(segment.ptr(), "segment");
+  const Target t = resolveOptional(segment, "segment");
   const int seg = t.segment;
   const KDL::Frame& link_in_tip = t.link_in_tip;
   KDL::Frame f = KDL::Frame::Identity();
@@ -236,14 +235,13 @@ py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segme
     KDL::ChainFkSolverPos_recursive solver(robot.chain);
     if (solver.JntToCart(q, f, seg + 1) < 0) raise("forward kinematics failed");
   }
-  return toMatrix4(f * link_in_tip);
+  return homogeneous(f * link_in_tip);
 }
 
 py::array_t<double> PyChain::jacobian(const py::object& q_obj, const py::object& segment) const {
   const unsigned int n = robot.chain.getNrOfJoints();
   const KDL::JntArray q = jointArray(q_obj, "q", n);
-  const Target t = segment.is_none() ? Target{static_cast<int>(robot.chain.getNrOfSegments()) - 1}
-                                     : resolveTarget(segment.ptr(), "segment");
+  const Target t = resolveOptional(segment, "segment");
   const int seg = t.segment;
   const KDL::Frame& link_in_tip = t.link_in_tip;
   KDL::Jacobian J(n);

@@ -86,6 +86,8 @@ struct PyChain {
   Target resolveTarget(PyObject* which, const std::string& label) const;
   // The same for calls that need a moving segment: the base raises.
   Target resolveMoving(PyObject* which, const std::string& label) const;
+  // resolveTarget, with None meaning the last segment (the default of fk, jacobian, ...).
+  Target resolveOptional(const py::object& which, const std::string& label) const;
   // Joint index from a joint name or an int index (negative from the end).
   int resolveJoint(PyObject* which, const std::string& label) const;
   py::array_t<double> fk(const py::object& q, const py::object& segment) const;

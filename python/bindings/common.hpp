@@ -34,11 +34,22 @@ inline std::string shapeStr(const py::array& a) {
   return s.str();
 }
 
+// A float64 C-contiguous array of a real argument: int and float dtypes (and nested sequences of
+// numbers) are converted; bool, complex, string and object values raise naming `name`.
 inline Array toArray(const py::handle& obj, const char* name) {
-  Array a = Array::ensure(obj);
-  if (!a) {
+  if (PyBool_Check(obj.ptr())) raise(std::string(name) + " must be a real number or array, got bool");
+  py::array any = py::array::ensure(obj);
+  if (!any) {
     PyErr_Clear();
     raise(std::string(name) + " must be a numeric array-like of floats");
+  }
+  const char kind = any.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    raise(std::string(name) + " must hold real numbers (int or float), got dtype " + std::string(py::str(any.dtype())));
+  Array a = Array::ensure(any);
+  if (!a) {
+    PyErr_Clear();
+    raise(std::string(name) + " could not be converted to float64");
   }
   return a;
 }
@@ -115,5 +126,16 @@ inline py::array_t<double> copyVector(const double* p, py::ssize_t n) {
   return a;
 }
 
+// A KDL frame as a row-major 4x4 homogeneous transform written to out[0..15].
+inline void writeHomogeneous(const KDL::Frame& f, double* out) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out[4 * r + c] = r < 3 ? (c < 3 ? f.M(r, c) : f.p(r)) : (c == 3 ? 1.0 : 0.0);
+}
+
+inline py::array_t<double> homogeneous(const KDL::Frame& f) {
+  py::array_t<double> T({4, 4});
+  writeHomogeneous(f, T.mutable_data());
+  return T;
+}
 
 }  // namespace vsbind

@@ -9,6 +9,8 @@ namespace vsbind {
 void bindChain(py::module_& mod);
 void bindSolver(py::module_& mod);
 void bindResultType(py::module_& mod);
+void bindDynamics(py::module_& mod);
+void bindSegmentSpec(py::module_& mod);
 }  // namespace vsbind
 
 PYBIND11_MODULE(_core, mod) {
@@ -16,5 +18,7 @@ PYBIND11_MODULE(_core, mod) {
   pybind11::register_exception<vsbind::SolverError>(mod, "SolverError", PyExc_ValueError);
   vsbind::bindChain(mod);
   vsbind::bindResultType(mod);
+  vsbind::bindDynamics(mod);      // adds methods to Chain
+  vsbind::bindSegmentSpec(mod);   // adds Chain.segment_spec
   vsbind::bindSolver(mod);
 }

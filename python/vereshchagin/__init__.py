@@ -9,6 +9,10 @@ from ._core import Chain, Joint, SolveResult, SolverError
 from . import robots, task
 from .friction import Friction
 from .solver import BatchResult, Solver
+from .kdl_interop import chain_from_kdl as _chain_from_kdl, chain_to_kdl as _chain_to_kdl
+
+Chain.from_kdl = staticmethod(_chain_from_kdl)  # PyKDL interoperability (kdl_interop.py)
+Chain.to_kdl = _chain_to_kdl
 
 __all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
 __version__ = "0.1.0"

@@ -1,6 +1,6 @@
 """Type stubs of the compiled module vereshchagin._core."""
 import os
-from typing import Mapping, Optional, Sequence, Union, final
+from typing import Any, Mapping, Optional, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -72,6 +72,25 @@ class Chain:
     def twist(
         self, q: ArrayLike, qd: ArrayLike, segment: str | int | None = None
     ) -> NDArray[np.float64]: ...
+    def inverse_dynamics(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        f_ext: Optional[ArrayLike] = None,
+        gravity: ArrayLike = ...,
+    ) -> NDArray[np.float64]: ...
+    def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
+    def gravity_torques(self, q: ArrayLike, gravity: ArrayLike = ...) -> NDArray[np.float64]: ...
+    def coriolis_torques(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]: ...
+    def jacobian_dot_times_qd(
+        self, q: ArrayLike, qd: ArrayLike, segment: str | int | None = None
+    ) -> NDArray[np.float64]: ...
+    def fk_all(self, q: ArrayLike) -> NDArray[np.float64]: ...
+    def segment_spec(self, segment: str | int) -> dict[str, Any]: ...
+    @staticmethod
+    def from_kdl(kdl_chain: Any) -> Chain: ...
+    def to_kdl(self) -> Any: ...
 
 @final
 class SolveResult:

@@ -1,0 +1,265 @@
+// Dynamics companions of the Python Chain: thin wrappers of KDL's ChainIdSolver_RNE (inverse
+// dynamics), ChainDynParam (mass matrix, gravity and Coriolis torques), ChainJntToJacDotSolver
+// (Jdot qd) and ChainFkSolverPos_recursive (every segment's pose), in the conventions of the
+// hybrid solver: physical gravity in the base frame, external wrenches in base-frame axes with the
+// moment about each segment's tip origin, applied ON the segment BY the environment.
+#include <pybind11/stl.h>
+
+#include <vector>
+
+#include <kdl/chaindynparam.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainfksolvervel_recursive.hpp>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/chainjnttojacdotsolver.hpp>
+#include <kdl/jntarrayvel.hpp>
+#include <kdl/jntspaceinertiamatrix.hpp>
+
+#include "chain_bindings.hpp"
+
+namespace vsbind {
+
+namespace {
+
+const std::vector<double> kEarthGravity{0.0, 0.0, -9.81};
+
+KDL::JntArray jointVector(const py::object& obj, const char* name, unsigned int n) {
+  const Array a = vectorArg(obj, name, n);
+  KDL::JntArray out(n);
+  for (unsigned int k = 0; k < n; ++k) out(k) = a.at(k);
+  return out;
+}
+
+// Results of finite inputs can still overflow (e.g. |qd| = 1e160); never hand back Inf or NaN.
+void requireFiniteResult(const double* p, size_t n, const char* what) {
+  for (size_t k = 0; k < n; ++k)
+    if (!std::isfinite(p[k])) raise(std::string(what) + ": the result overflows the double range");
+}
+
+py::array_t<double> jointTorques(const KDL::JntArray& tau, const char* what) {
+  requireFiniteResult(tau.data.data(), tau.rows(), what);
+  return copyVector(tau.data.data(), tau.rows());
+}
+
+// Tip frame of every segment in the base frame (empty for a chain without segments).
+std::vector<KDL::Frame> tipFrames(const KDL::Chain& chain, const KDL::JntArray& q) {
+  std::vector<KDL::Frame> frames(chain.getNrOfSegments());
+  if (frames.empty()) return frames;
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  if (fk.JntToCart(q, frames) < 0) raise("forward kinematics failed");
+  return frames;
+}
+
+// Our f_ext (n_segments, 6): rows [force, moment], base-frame axes, moment about the segment's tip
+// origin, applied ON the segment. KDL's RNE wants the same wrench (same sign: it subtracts f_ext
+// from the wrench the segment needs) in the segment's tip-frame axes: rotate both halves.
+KDL::Wrenches externalWrenches(const py::object& f_ext, const KDL::Chain& chain, const KDL::JntArray& q) {
+  const unsigned int ns = chain.getNrOfSegments();
+  KDL::Wrenches out(ns, KDL::Wrench::Zero());
+  if (f_ext.is_none()) return out;
+  const Array f = toArray(f_ext, "f_ext");
+  if (f.ndim() != 2 || f.shape(0) != static_cast<py::ssize_t>(ns) || f.shape(1) != 6)
+    raise("f_ext must have shape (" + std::to_string(ns) + ", 6), got " + shapeStr(f));
+  requireFinite(f, "f_ext");
+  const std::vector<KDL::Frame> tips = tipFrames(chain, q);
+  for (unsigned int i = 0; i < ns; ++i) {
+    const KDL::Wrench base_axes(KDL::Vector(f.at(i, 0), f.at(i, 1), f.at(i, 2)),
+                                KDL::Vector(f.at(i, 3), f.at(i, 4), f.at(i, 5)));
+    out[i] = tips[i].M.Inverse(base_axes);
+  }
+  return out;
+}
+
+py::array_t<double> inverseDynamics(const PyChain& c, const py::object& q_obj, const py::object& qd_obj,
+                                    const py::object& qdd_obj, const py::object& f_ext, const py::object& gravity) {
+  const KDL::Chain& chain = c.robot.chain;
+  const unsigned int n = chain.getNrOfJoints();
+  const KDL::JntArray q = jointVector(q_obj, "q", n);
+  const KDL::JntArray qd = jointVector(qd_obj, "qd", n);
+  const KDL::JntArray qdd = jointVector(qdd_obj, "qdd", n);
+  const KDL::Vector g = vec3(gravity, "gravity");
+  const KDL::Wrenches wrenches = externalWrenches(f_ext, chain, q);
+  KDL::JntArray tau(n);
+  KDL::ChainIdSolver_RNE rne(chain, g);  // KDL takes physical gravity here (base accelerates by -g)
+  if (rne.CartToJnt(q, qd, qdd, wrenches, tau) < 0) raise("inverse dynamics failed: " + std::string(rne.strError(rne.getError())));
+  return jointTorques(tau, "inverse_dynamics");
+}
+
+py::array_t<double> massMatrix(const PyChain& c, const py::object& q_obj) {
+  const KDL::Chain& chain = c.robot.chain;
+  const unsigned int n = chain.getNrOfJoints();
+  const KDL::JntArray q = jointVector(q_obj, "q", n);
+  KDL::JntSpaceInertiaMatrix H(n);
+  KDL::ChainDynParam dyn(chain, KDL::Vector::Zero());
+  if (dyn.JntToMass(q, H) < 0) raise("mass matrix computation failed: " + std::string(dyn.strError(dyn.getError())));
+  requireFiniteResult(H.data.data(), static_cast<size_t>(H.data.size()), "mass_matrix");
+  py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(n)});
+  auto o = out.mutable_unchecked<2>();
+  for (unsigned int r = 0; r < n; ++r)
+    for (unsigned int k = 0; k < n; ++k) o(r, k) = H(r, k);
+  return out;
+}
+
+py::array_t<double> gravityTorques(const PyChain& c, const py::object& q_obj, const py::object& gravity) {
+  const KDL::Chain& chain = c.robot.chain;
+  const KDL::JntArray q = jointVector(q_obj, "q", chain.getNrOfJoints());
+  KDL::JntArray tau(chain.getNrOfJoints());
+  KDL::ChainDynParam dyn(chain, vec3(gravity, "gravity"));
+  if (dyn.JntToGravity(q, tau) < 0) raise("gravity torques failed: " + std::string(dyn.strError(dyn.getError())));
+  return jointTorques(tau, "gravity_torques");
+}
+
+py::array_t<double> coriolisTorques(const PyChain& c, const py::object& q_obj, const py::object& qd_obj) {
+  const KDL::Chain& chain = c.robot.chain;
+  const unsigned int n = chain.getNrOfJoints();
+  const KDL::JntArray q = jointVector(q_obj, "q", n);
+  const KDL::JntArray qd = jointVector(qd_obj, "qd", n);
+  KDL::JntArray tau(n);
+  KDL::ChainDynParam dyn(chain, KDL::Vector::Zero());
+  if (dyn.JntToCoriolis(q, qd, tau) < 0) raise("Coriolis torques failed: " + std::string(dyn.strError(dyn.getError())));
+  return jointTorques(tau, "coriolis_torques");
+}
+
+// d/dt(J) qd of the (6, n) base-axes Jacobian of a segment tip or merged link origin: [classical
+// linear acceleration of that point; angular acceleration] at qdd = 0, gravity not included.
+py::array_t<double> jacobianDotTimesQd(const PyChain& c, const py::object& q_obj, const py::object& qd_obj,
+                                       const py::object& segment) {
+  const KDL::Chain& chain = c.robot.chain;
+  const unsigned int n = chain.getNrOfJoints();
+  const KDL::JntArrayVel state(jointVector(q_obj, "q", n), jointVector(qd_obj, "qd", n));
+  const PyChain::Target target = c.resolveOptional(segment, "segment");
+  const int seg = target.segment;
+  const KDL::Frame& link_in_tip = target.link_in_tip;
+  py::array_t<double> out(6);
+  std::fill(out.mutable_data(), out.mutable_data() + 6, 0.0);
+  if (seg < 0) return out;  // a base link does not move
+  KDL::ChainJntToJacDotSolver jdot(chain);  // HYBRID: base axes, reference point the tip origin
+  KDL::Twist at_tip;
+  if (jdot.JntToJacDot(state, at_tip, seg + 1) < 0) raise("Jdot qd failed: " + std::string(jdot.strError(jdot.getError())));
+  KDL::ChainFkSolverVel_recursive fkv(chain);
+  KDL::FrameVel tip;
+  if (fkv.JntToCart(state, tip, seg + 1) < 0) raise("forward velocity kinematics failed");
+  // A point fixed at r from the tip origin: d/dt (v + w x r) = dv + dw x r + w x (w x r).
+  const KDL::Vector r = tip.M.R * link_in_tip.p;
+  const KDL::Vector w = tip.GetTwist().rot;
+  const KDL::Vector lin = at_tip.vel + at_tip.rot * r + w * (w * r);
+  const double values[6] = {lin.x(), lin.y(), lin.z(), at_tip.rot.x(), at_tip.rot.y(), at_tip.rot.z()};
+  requireFiniteResult(values, 6, "jacobian_dot_times_qd");
+  std::copy(values, values + 6, out.mutable_data());
+  return out;
+}
+
+py::array_t<double> fkAll(const PyChain& c, const py::object& q_obj) {
+  const KDL::Chain& chain = c.robot.chain;
+  const std::vector<KDL::Frame> tips = tipFrames(chain, jointVector(q_obj, "q", chain.getNrOfJoints()));
+  py::array_t<double> out({static_cast<py::ssize_t>(tips.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
+  for (size_t i = 0; i < tips.size(); ++i) writeHomogeneous(tips[i], out.mutable_data() + 16 * i);
+  return out;
+}
+
+}  // namespace
+
+void bindDynamics(py::module_& mod) {
+  auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
+  chain.def("inverse_dynamics", &inverseDynamics, py::arg("q"), py::arg("qd"), py::arg("qdd"),
+            py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity, R"doc(Joint torques that realise ``qdd`` (recursive Newton-Euler, KDL's ChainIdSolver_RNE).
+
+``tau = M(q) qdd + C(q, qd) qd + g(q) - sum_i J_i(q)^T f_ext[i]``, rotor inertia included
+(``rotor_inertia * qdd`` on each joint's diagonal).
+
+Parameters
+----------
+q, qd, qdd : array_like, shape (n_joints,)
+    Joint positions (rad or m), velocities (rad/s or m/s) and accelerations (rad/s^2 or m/s^2).
+f_ext : array_like, shape (n_segments, 6), optional
+    Wrench ``[force, moment]`` (N, N m) applied ON each segment BY the environment, base-frame
+    axes, moment about that segment's tip origin (the solver's convention; converted to KDL's
+    tip-frame axes internally). ``J_i`` above is the base-axes Jacobian of segment i's tip.
+gravity : array_like, shape (3,)
+    Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
+
+Returns
+-------
+ndarray, shape (n_joints,)
+    Joint torques / forces, N m or N.
+)doc");
+  chain.def("mass_matrix", &massMatrix, py::arg("q"), R"doc(Joint-space mass matrix ``M(q)`` (KDL's ChainDynParam::JntToMass).
+
+Parameters
+----------
+q : array_like, shape (n_joints,)
+    Joint positions, rad or m.
+
+Returns
+-------
+ndarray, shape (n_joints, n_joints)
+    Symmetric positive definite, kg m^2 / kg m / kg; ``rotor_inertia`` is included on the diagonal
+    (Pinocchio's ``armature``).
+)doc");
+  chain.def("gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
+            R"doc(Generalised gravity ``g(q)``: the torques that hold the chain still (KDL's ChainDynParam::JntToGravity).
+
+Parameters
+----------
+q : array_like, shape (n_joints,)
+    Joint positions, rad or m.
+gravity : array_like, shape (3,)
+    Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
+
+Returns
+-------
+ndarray, shape (n_joints,)
+    ``inverse_dynamics(q, 0, 0, gravity=gravity)``, N m or N.
+)doc");
+  chain.def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"),
+            R"doc(Coriolis and centrifugal torques ``C(q, qd) qd`` (KDL's ChainDynParam::JntToCoriolis).
+
+Parameters
+----------
+q, qd : array_like, shape (n_joints,)
+    Joint positions (rad or m) and velocities (rad/s or m/s).
+
+Returns
+-------
+ndarray, shape (n_joints,)
+    ``inverse_dynamics(q, qd, 0, gravity=[0, 0, 0])``, N m or N.
+)doc");
+  chain.def("jacobian_dot_times_qd", &jacobianDotTimesQd, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
+            R"doc(Time derivative of the Jacobian times the joint velocities, ``(d/dt J(q)) qd``.
+
+``J`` is :meth:`jacobian`: the (6, n) base-axes Jacobian ``[linear; angular]`` of the segment's
+tip origin (or of a merged link's origin). The result is the acceleration of that point at
+``qdd = 0`` without gravity: rows 0-2 the *classical* linear acceleration of the point (not the
+spatial one: it includes ``omega x v``), rows 3-5 the angular acceleration, base-frame axes, so
+that ``a = J qdd + jacobian_dot_times_qd(q, qd)``. Pinocchio: ``getFrameJacobianTimeVariation(...,
+LOCAL_WORLD_ALIGNED) @ v``. Computed by KDL's ChainJntToJacDotSolver (HYBRID representation), the
+reference point then moved to the link origin.
+
+Parameters
+----------
+q, qd : array_like, shape (n_joints,)
+    Joint positions (rad or m) and velocities (rad/s or m/s).
+segment : str or int, optional
+    As in :meth:`fk`: a segment name or index (negative from the end), or a merged link's name;
+    default the last segment. A base link gives zeros.
+
+Returns
+-------
+ndarray, shape (6,)
+    m/s^2 and rad/s^2.
+)doc");
+  chain.def("fk_all", &fkAll, py::arg("q"), R"doc(Pose of every segment's tip frame in the base frame.
+
+Parameters
+----------
+q : array_like, shape (n_joints,)
+    Joint positions, rad or m.
+
+Returns
+-------
+ndarray, shape (n_segments, 4, 4)
+    ``fk_all(q)[i] == fk(q, i)``: homogeneous transforms, metres.
+)doc");
+}
+
+}  // namespace vsbind
