@@ -217,6 +217,28 @@ class MujocoGen3:
             out[env] = (force + float(self._f6[0]), who)
         return out
 
+    def joint_friction_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """The plant's dry joint friction at the last step: who sticks, and its torque.
+
+        Returns
+        -------
+        stick : ndarray of bool, shape (n,)
+            Joint j's friction torque stayed inside its bound, |torque| < (1 - 1e-3) f_j: friction
+            held the joint (a sliding joint gets exactly f_j). False for joints without friction.
+            (MuJoCo's ``efc_state`` of ``frictionloss`` rows is no stick flag: held joints with
+            |torque| well below f_j are often labelled linear.)
+        torque : ndarray, shape (n,)
+            Friction torque on each joint (N m, acting on the joint like a motor torque; MuJoCo's
+            ``efc_force`` of the joint's ``frictionloss`` row).
+        """
+        d, m = self.data, self.model
+        torque = np.zeros(self.n_joints)
+        rows = np.flatnonzero(d.efc_type[:d.nefc] == mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
+        torque[d.efc_id[rows]] = d.efc_force[rows]
+        bound = m.dof_frictionloss[:self.n_joints]
+        stick = (bound > 0.0) & (np.abs(torque) < (1.0 - 1e-3) * bound)
+        return stick, torque
+
     def mass_matrix(self, q) -> np.ndarray:
         """Joint-space mass matrix (n, n) at ``q`` (MuJoCo's ``mj_fullM``, armature included)."""
         d = mujoco.MjData(self.model)
