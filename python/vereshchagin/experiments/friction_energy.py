@@ -189,7 +189,8 @@ class Log:
     plant_friction : (T, n)
         The plant's friction torque on each joint (N m).
     model_stick : (T, n) bool
-        The solver's max-min status "stick" (``maxmin`` only; False otherwise).
+        The max-min holds the joint with friction: at rest with zero commanded acceleration (status
+        stick, or slip at the friction bound with ``qdd_j`` = 0 to 1e-9), ``maxmin`` only.
     inputs : list of dict
         The solver's inputs per cycle (only with ``keep_inputs``).
     """
@@ -214,8 +215,8 @@ def _recorder(robot: MujocoGen3, total: int, n: int, keep_inputs: bool):
         log.model_command[k] = res.tau_command
         log.error[k] = info.error
         log.plant_stick[k], log.plant_friction[k] = robot.joint_friction_state()
-        if res.status is not None:
-            log.model_stick[k] = np.asarray(res.status) == 1
+        if res.status is not None:  # at rest and no commanded acceleration: friction (partly) holds it
+            log.model_stick[k] = (np.asarray(res.status) != 0) & (np.abs(np.asarray(res.qdd)) <= 1e-9)
         if keep_inputs:
             log.inputs.append(info.inputs)
     return log, on_cycle
@@ -277,7 +278,7 @@ def outcome(run: Run) -> dict:
     directions; RMS over the run, and at its end), ``rms_rot`` (rad, rotational error RMS),
     ``drift`` (m: tool displacement over the hold phase; for the partial task its x-y part, the
     free directions), ``stick_plant`` / ``stick_model`` (mean number of joints the plant's friction
-    holds / the max-min predicts sticking), ``friction_share`` (mean over the hold phase of
+    holds / the max-min holds with friction, :class:`Log`), ``friction_share`` (mean over the hold phase of
     sum |plant friction torque| / sum |motor + friction torque|: the share of the holding torque that
     friction supplied), ``saturated`` (fraction of samples with a command beyond the effort limits).
     """
