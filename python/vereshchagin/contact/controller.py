@@ -183,6 +183,7 @@ class CascadedController:
         self.extra_constraints = None  # dict for segment constraints (solver API of issue 5)
         self.support_share = None  # callable(result, q) -> torque the environment supplies
         self._all = list(range(n))
+        self._alpha = {}  # constraint directions per tuple of names
 
     # -- task state ------------------------------------------------------------------------------
     def set_goal(self, T_goal) -> None:
@@ -228,7 +229,10 @@ class CascadedController:
         v_lin = _saturate(gains.k_pos[0] * e[:3], cfg.v_max)
         v_ang = _saturate(gains.k_pos[1] * e[3:], cfg.w_max)
         a_des = np.concatenate([gains.k_vel[0] * (v_lin - tw[:3]), gains.k_vel[1] * (v_ang - tw[3:])])
-        alpha = directions(CONTACT_DIRECTIONS if self.in_contact else cfg.free_directions)
+        names = CONTACT_DIRECTIONS if self.in_contact else cfg.free_directions
+        if names not in self._alpha:
+            self._alpha[names] = directions(names)
+        alpha = self._alpha[names]
         if cfg.hold_band is not None:
             e_task = alpha @ (alpha.T @ e)  # the error along the constrained directions
             if np.linalg.norm(e_task[:3]) < cfg.hold_band[0] and np.linalg.norm(e_task[3:]) < cfg.hold_band[1]:

@@ -176,6 +176,7 @@ class MujocoGen3:
             if gid >= 0:
                 self._env[gid] = name
         self._f6 = np.zeros(6)
+        self._frictionloss = model.dof_frictionloss[:self.n_joints].copy()
 
     def read(self) -> JointState:
         d = self.data
@@ -231,11 +232,13 @@ class MujocoGen3:
             Friction torque on each joint (N m, acting on the joint like a motor torque; MuJoCo's
             ``efc_force`` of the joint's ``frictionloss`` row).
         """
-        d, m = self.data, self.model
+        d = self.data
         torque = np.zeros(self.n_joints)
-        rows = np.flatnonzero(d.efc_type[:d.nefc] == mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
-        torque[d.efc_id[rows]] = d.efc_force[rows]
-        bound = m.dof_frictionloss[:self.n_joints]
+        rows = slice(d.ne, d.ne + d.nf)  # MuJoCo orders the rows: equality, friction, limits, contacts
+        dof = d.efc_id[rows]
+        mine = d.efc_type[rows] == mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF
+        torque[dof[mine]] = d.efc_force[rows][mine]
+        bound = self._frictionloss
         stick = (bound > 0.0) & (np.abs(torque) < (1.0 - 1e-3) * bound)
         return stick, torque
 

@@ -58,12 +58,20 @@ def _select(results, task: str, scale: float) -> dict:
 
 
 # -- context: friction against gravity ----------------------------------------------------------------
+def ideal_saving(g, f) -> float:
+    """Share of the holding ∫τ² friction ``f`` (n,) could take over against gravity torques ``g`` (n,).
+
+    ``1 - sum max(|g_j| - f_j, 0)^2 / sum g_j^2``: every joint held by friction at its bound.
+    """
+    g = np.asarray(g, float)
+    return float(1.0 - np.sum(np.maximum(np.abs(g) - np.asarray(f, float), 0.0) ** 2) / np.sum(g ** 2))
+
+
 def context(quick: bool) -> tuple[list, list, list]:
     """Per joint at the held poses: gravity torque, friction, their ratio; and the ideal holding saving.
 
-    The ideal saving is what the least-command rule promises when every joint sticks: motors supply
-    ``max(|g_j| - f_j, 0)`` instead of ``|g_j|``, so the integral of tau^2 drops by
-    ``1 - sum max(|g_j| - f_j, 0)^2 / sum g_j^2``.
+    The ideal saving (:func:`ideal_saving`) is what the least-command rule promises when every joint
+    sticks: motors supply ``max(|g_j| - f_j, 0)`` instead of ``|g_j|``.
 
     Returns
     -------
@@ -80,7 +88,7 @@ def context(quick: bool) -> tuple[list, list, list]:
             ratio = f[j] / abs(g[j]) if abs(g[j]) > 1e-6 else float("inf")
             rows.append([task.name, f"joint_{j + 1}", f"{g[j]:.3f}", f"{f[j]:.2f}",
                          "inf" if not np.isfinite(ratio) else f"{ratio:.3f}"])
-        ideal = {s: 1.0 - np.sum(np.maximum(np.abs(g) - s * f, 0.0) ** 2) / np.sum(g ** 2) for s in fe.FRICTION_SCALES}
+        ideal = {s: ideal_saving(g, s * f) for s in fe.FRICTION_SCALES}
         big = np.argsort(-np.abs(g))[:3]
         lines.append(
             f"- {task.name}: gravity torques {', '.join(f'joint_{j + 1} {abs(g[j]):.2f}' for j in big)} N m "
@@ -181,23 +189,26 @@ def findings(results) -> list[str]:
     lines = []
     mm, band = hold["maxmin"]["outcome"], hold["maxmin_band"]["outcome"]
     base = hold[BASE]["outcome"]
+    ideal = ideal_saving(*fe.gravity_torques(fe.tasks()[0], fe.tasks()[0].q0))
     lines.append(
-        f"- Holding, the exact max-min alone changes ∫τ² by {_pct(mm['tau2'], base['tau2']):+.1f} %: it lets friction hold "
-        "only joints whose commanded acceleration is exactly zero; the P loop's corrections never are, so it "
-        f"let friction hold on average {mm['stick_model']:.1f} of 7 joints and added the full friction towards each "
-        "correction to the others, the naive scheme's command. With the hold band (zero acceleration asked inside "
-        f"0.05 mm / 0.5 mrad) it let friction hold {band['stick_model']:.1f} and changed ∫τ² by "
-        f"{_pct(band['tau2'], base['tau2']):+.1f} % at an RMS error of {1e3 * band['rms_error']:.3f} mm "
-        f"(unaware {1e3 * base['rms_error']:.3f} mm); the ideal with every joint stuck is in the context list above.")
+        f"- Holding, the exact max-min alone changes ∫τ² by {_pct(mm['tau2'], base['tau2']):+.1f} % (the ideal with "
+        f"every joint held by friction: {-100 * ideal:+.1f} %): it lets friction hold only joints whose commanded "
+        "acceleration is exactly zero; the P loop's corrections never are, so it let friction hold on average "
+        f"{mm['stick_model']:.1f} of 7 joints and added the full friction towards each correction to the others, "
+        "the naive scheme's command (the torques chatter by ±f). With the hold band (zero acceleration asked inside "
+        f"0.05 mm / 0.5 mrad) ∫τ² changes by {_pct(band['tau2'], base['tau2']):+.1f} % at an RMS error of "
+        f"{1e3 * band['rms_error']:.3f} mm (unaware {1e3 * base['rms_error']:.3f} mm): inside the band it commands "
+        "the least torque, which asks friction for its full breakaway value; the plant's friction then sits at its "
+        "bound, the joints creep out of the band, and each correction from rest pays +f again (figure).")
     stalls = [t.name for t in fe.tasks() if t.name != "partial" and t.name in {r["task"] for r in results}
               and not _completes(_select(results, t.name, 1.0)[BASE]["outcome"])]
     if stalls:
         lines.append(
             f"- The friction-unaware controller does not complete the moving tasks ({', '.join(stalls)}). With the "
-            "desired twist "
-            "saturated, the cascaded P asks for at most k_vel v_max (1.5 m/s^2, 20 rad/s^2): on the light wrist "
-            "and at the shoulder that is less torque than static friction, so those joints stay stuck and the "
-            "error grows; every friction-aware command breaks them free.")
+            "desired twist saturated, the cascaded P asks for at most k_vel v_max = 1.5 m/s^2 (slow task) and "
+            "k_vel w_max = 20 rad/s^2 in rotation: at the shoulder (joint_2, slow task) and the last wrist joint "
+            "(joint_7, reach) that is less torque than static friction, so the joint stays stuck and the error "
+            "grows; every friction-aware command breaks it free.")
     part = _select(results, "partial", 1.0)
     if part:
         pm, pb = part["maxmin"]["outcome"], part[BASE]["outcome"]
@@ -241,6 +252,7 @@ def plot_task(path: Path, results, task: fe.TaskSpec) -> None:
     if base["work"] > WORK_FLOOR:
         flat[7].bar(x + 0.2, [_pct(runs[c]["outcome"]["work"], base["work"]) for c in others], 0.4, label="∫|τ q̇|")
     flat[7].axhline(0.0, color="k", lw=0.8)
+    flat[7].set_yscale("symlog", linthresh=10.0)  # ±10 % linear, larger changes logarithmic
     flat[7].set_xticks(x, [fe.CONTROLLERS[c].replace(" ", "\n", 2) for c in others], fontsize=6)
     flat[7].set_ylabel("change vs friction-unaware [%] (< 0: saves)")
     flat[7].legend(fontsize=7)
