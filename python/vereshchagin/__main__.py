@@ -15,6 +15,16 @@ def _rel(path: Path, root: Path) -> str:
     return Path(os.path.relpath(path, root)).as_posix()
 
 
+def _section(label: str, run, out: Path, quick: bool, index: list) -> bool:
+    """Run one experiment section: ``run(out, quick=, progress=)`` returns ``index`` (Markdown lines,
+    appended to ``index``), ``ok`` and ``seconds``. Returns ``ok``."""
+    _say(f"[reproduce] {label}{' (quick)' if quick else ''}")
+    res = run(out, quick=quick, progress=_say)
+    index += res["index"]
+    _say(f"[reproduce] {label}: {'ok' if res['ok'] else 'FAILED'} ({res['seconds']:.1f} s)")
+    return bool(res["ok"])
+
+
 def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     """Run the selected experiments, write their outputs and ``index.md`` into ``out_dir``.
 
@@ -75,19 +85,11 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     if case in ("contact", "all"):
         from .contact.report import run as run_contact
 
-        _say(f"[reproduce] report 003 contact use cases (MuJoCo plant){' (quick)' if quick else ''}")
-        res = run_contact(out, quick=quick, progress=_say)
-        ok &= bool(res["ok"])
-        index += res["index"]
-        _say(f"[reproduce] contact checks: {'ok' if res['ok'] else 'FAILED'} ({res['seconds']:.1f} s)")
+        ok &= _section("report 003 contact use cases (MuJoCo plant)", run_contact, out, quick, index)
     if case in ("friction-energy", "all"):
         from .experiments.friction_energy_report import run as run_energy
 
-        _say(f"[reproduce] friction-energy experiment (MuJoCo Gen3){' (quick)' if quick else ''}")
-        res = run_energy(out, quick=quick, progress=_say)
-        ok &= bool(res["ok"])
-        index += res["index"]
-        _say(f"[reproduce] friction-energy: {'ok' if res['ok'] else 'FAILED'} ({res['seconds']:.1f} s)")
+        ok &= _section("friction-energy experiment (MuJoCo Gen3)", run_energy, out, quick, index)
     index_path = out / "index.md"
     index_path.write_text("\n".join(index), encoding="utf-8")
     _say(f"[reproduce] wrote {index_path}")
