@@ -83,7 +83,7 @@ def _expected_command(run, k: int, solver, friction) -> np.ndarray:
 @pytest.mark.parametrize("controller", list(fe.CONTROLLERS))
 def test_commands_follow_each_controllers_definition(controller):
     """Max-min: the command is the solver's tau_command with friction (+ the posture term) at every step."""
-    task = next(t for t in fe.tasks(True) if t.name == "slow")  # moving and resting joints
+    task = fe.task_named("slow", quick=True)  # moving and resting joints
     run = fe.simulate(task, controller, keep_inputs=True)
     log, chain = run.info["log"], run.info["chain"]
     solver = vs.Solver(chain, gravity=[0.0, 0.0, -9.81])
@@ -145,3 +145,7 @@ def test_bad_controller_names_are_rejected():
         CascadedController(chain, vs.Solver(chain), ControllerConfig(friction_mode="coulomb"))
     with pytest.raises(ValueError, match="controller"):
         fe.simulate(fe.tasks(True)[0], "coulomb")
+    with pytest.raises(ValueError, match="unknown task"):
+        fe.task_named("wave")
+    with pytest.raises(ValueError, match="joint_friction"):
+        fe.simulate(fe.tasks(True)[0], "none", friction_scale=-1.0)

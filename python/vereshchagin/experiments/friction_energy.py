@@ -50,7 +50,8 @@ from ..contact.mujoco_plant import MujocoGen3, Scene, build_model
 from ..contact.use_cases import Phase, Run, gen3_model, run_loop
 from ..solver import Solver
 
-__all__ = ["CONTROLLERS", "FRICTION_SCALES", "PAYLOAD", "REST_TOLERANCE", "Log", "TaskSpec", "simulate", "tasks"]
+__all__ = ["CONTROLLERS", "FRICTION_SCALES", "HOLD_BAND", "PARTIAL_POSE", "PAYLOAD", "REST_TOLERANCE", "Log", "TaskSpec",
+           "gravity_torques", "outcome", "run_all", "run_case", "simulate", "task_named", "tasks"]
 
 CONTROLLERS = {
     "none": "friction-unaware",
@@ -170,6 +171,14 @@ def tasks(quick: bool = False) -> list[TaskSpec]:
         TaskSpec("reach", "(d) fast reach, 20 cm in 1 s (minimum jerk, peak 0.375 m/s), then hold", reach,
                  v_max=0.5),
     ]
+
+
+def task_named(name: str, quick: bool = False) -> TaskSpec:
+    """The task of :func:`tasks` called ``name``; ValueError if there is none."""
+    for task in tasks(quick):
+        if task.name == name:
+            return task
+    raise ValueError(f"unknown task {name!r}; use one of {[t.name for t in tasks(quick)]}")
 
 
 @dataclass
@@ -325,8 +334,7 @@ def run_case(task_name: str, controller: str, friction_scale: float, quick: bool
         ``task``, ``controller``, ``scale``, ``outcome`` (:func:`outcome`), ``trace`` (figure data),
         ``held_q`` (joint angles at the end, rad), ``simulated`` (s).
     """
-    task = next(t for t in tasks(quick) if t.name == task_name)
-    run = simulate(task, controller, friction_scale)
+    run = simulate(task_named(task_name, quick), controller, friction_scale)
     return dict(task=task_name, controller=controller, scale=friction_scale, outcome=outcome(run),
                 trace=_trace(run), held_q=run.q[-1].copy(), simulated=float(run.t[-1] - run.t[0]))
 
