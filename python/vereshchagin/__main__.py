@@ -15,6 +15,16 @@ def _rel(path: Path, root: Path) -> str:
     return Path(os.path.relpath(path, root)).as_posix()
 
 
+def _section(label: str, run, out: Path, quick: bool, index: list) -> bool:
+    """Run one experiment section: ``run(out, quick=, progress=)`` returns ``index`` (Markdown lines,
+    appended to ``index``), ``ok`` and ``seconds``. Returns ``ok``."""
+    _say(f"[reproduce] {label}{' (quick)' if quick else ''}")
+    res = run(out, quick=quick, progress=_say)
+    index += res["index"]
+    _say(f"[reproduce] {label}: {'ok' if res['ok'] else 'FAILED'} ({res['seconds']:.1f} s)")
+    return bool(res["ok"])
+
+
 def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     """Run the selected experiments, write their outputs and ``index.md`` into ``out_dir``.
 
@@ -23,8 +33,10 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     out_dir : str or Path
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
-    case : {"friction", "demo", "contact", "all"}
-        ``contact``: report 003's three use cases in MuJoCo (:mod:`vereshchagin.contact.report`).
+    case : {"friction", "demo", "contact", "friction-energy", "all"}
+        ``contact``: report 003's three use cases in MuJoCo (:mod:`vereshchagin.contact.report`);
+        ``friction-energy``: the motor effort exact static friction saves on the Gen3
+        (:mod:`vereshchagin.experiments.friction_energy_report`).
 
     Returns
     -------
@@ -73,11 +85,11 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     if case in ("contact", "all"):
         from .contact.report import run as run_contact
 
-        _say(f"[reproduce] report 003 contact use cases (MuJoCo plant){' (quick)' if quick else ''}")
-        res = run_contact(out, quick=quick, progress=_say)
-        ok &= bool(res["ok"])
-        index += res["index"]
-        _say(f"[reproduce] contact checks: {'ok' if res['ok'] else 'FAILED'} ({res['seconds']:.1f} s)")
+        ok &= _section("report 003 contact use cases (MuJoCo plant)", run_contact, out, quick, index)
+    if case in ("friction-energy", "all"):
+        from .experiments.friction_energy_report import run as run_energy
+
+        ok &= _section("friction-energy experiment (MuJoCo Gen3)", run_energy, out, quick, index)
     index_path = out / "index.md"
     index_path.write_text("\n".join(index), encoding="utf-8")
     _say(f"[reproduce] wrote {index_path}")
@@ -88,11 +100,11 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="vereshchagin", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("demo", help="solve three tasks on a 7-joint arm and print the results")
-    rep = sub.add_parser("reproduce", help="reproduce report 000's friction figures, the demo and report 003's contact "
-                         "use cases into a folder")
+    rep = sub.add_parser("reproduce", help="reproduce report 000's friction figures, the demo, report 003's contact "
+                         "use cases and the friction-energy experiment into a folder")
     rep.add_argument("--out", default="results", help="output folder (default: ./results)")
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
-    rep.add_argument("--case", choices=("friction", "demo", "contact", "all"), default="all",
+    rep.add_argument("--case", choices=("friction", "demo", "contact", "friction-energy", "all"), default="all",
                      help="which experiments to run (default: all)")
     args = parser.parse_args(argv)
     if args.command == "demo":

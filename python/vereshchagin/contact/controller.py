@@ -22,6 +22,10 @@ One cycle (:meth:`CascadedController.command`):
    makes resting joints get the max-min static friction and moving ones Coulomb friction, so
    ``tau_command`` is the motor torque with friction acting (friction compensation).
    The motor torque sent is ``tau_command`` + the motor-side part of ``tau_ff``.
+   ``ControllerConfig.friction_mode`` selects how joint friction enters (the friction-energy
+   experiment compares them): ``"maxmin"`` (the above, default), ``"none"`` (plain solve, friction
+   left to feedback), ``"sign"`` (plain solve + ``f_j sign(qd_j)``, at rest the sign of the
+   commanded ``qdd_j``), ``"smooth"`` (plain solve + ``f_j tanh(qd_j / eps_v)``).
 
 Contact detection: |v_z| of the end-effector below ``contact_threshold`` for
 ``contact_samples`` (10) consecutive samples, armed once the tool has moved (|v_z| above twice
@@ -30,13 +34,14 @@ the threshold). On contact the gains switch to the contact set and the direction
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Optional
 
 import numpy as np
 
 from ..friction import Friction
 from ..task import beta_for, directions, pose_error
 
-__all__ = ["CONTACT_GAINS", "FREE_GAINS", "CascadedController", "ControllerConfig", "Gains"]
+__all__ = ["CONTACT_GAINS", "FREE_GAINS", "FRICTION_MODES", "CascadedController", "ControllerConfig", "Gains"]
 
 G = 9.81
 
@@ -67,6 +72,11 @@ with k_vel = 4. The quick mode (5 cm descent) completes with 4.
 """
 
 
+FRICTION_MODES = ("maxmin", "none", "sign", "smooth")
+FREE_DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+CONTACT_DIRECTIONS = ("x", "y", "rx", "ry", "rz")
+
+
 @dataclass(frozen=True)
 class ControllerConfig:
     """Controller settings (SI units).
@@ -84,8 +94,14 @@ class ControllerConfig:
         The tool's contact point in the end-effector frame (m), for ``f_ext``.
     mu_estimate : float
         Surface friction coefficient assumed in ``f_ext`` (0: no friction compensation).
-    use_friction : bool
-        Pass the chain's joint friction to the solver (friction compensation).
+    friction_mode : {"maxmin", "none", "sign", "smooth"}
+        How the chain's joint friction ``f`` (static = kinetic, N m) enters the command:
+        ``"maxmin"``: passed to the solver (exact max-min, least command; friction compensation);
+        ``"none"``: ignored (plain solve; feedback alone fights friction); ``"sign"``: plain solve
+        plus ``f_j sign(qd_j)``, and for a joint at rest (|qd_j| <= ``friction_velocity_tolerance``)
+        ``f_j sign(qdd_j)`` of the commanded motion (classical Coulomb compensation);
+        ``"smooth"``: plain solve plus ``f_j tanh(qd_j / friction_velocity_tolerance)`` (the
+        usual chatter-free variant: about no compensation at rest).
     friction_velocity_tolerance : float
         |qd| (rad/s) at or below which a joint counts as resting for the friction solver. Above
         the plant's creep: MuJoCo's dry friction is a soft constraint that lets a held joint creep
@@ -96,6 +112,13 @@ class ControllerConfig:
         ``(K, D)`` of a motor-side joint posture term ``K (q_ref - q) - D qd`` in ``tau_ff``;
         the solver realises the task regardless, so it only acts in the unconstrained
         directions (self-motion, released z). (0, 0): off, as in the report (tau_ff = 0).
+    free_directions : tuple of str
+        Constrained directions in free space (names of :func:`vereshchagin.task.directions`,
+        base axes); default all six. Fewer leave the rest of the motion to the dynamics.
+    hold_band : (float, float) or None
+        ``(m, rad)``: while the translational and rotational pose errors along the constrained
+        directions are both inside, the task asks for zero acceleration (``a_des = 0``: "stay", so resting joints may stick)
+        instead of the P correction. None (default): no band.
     """
 
     free_gains: Gains = FREE_GAINS
@@ -106,13 +129,11 @@ class ControllerConfig:
     contact_samples: int = 10
     contact_point: tuple = (0.0, 0.0, 0.0)
     mu_estimate: float = 0.3
-    use_friction: bool = True
+    friction_mode: str = "maxmin"
     friction_velocity_tolerance: float = 1e-2
     posture_gains: tuple = (20.0, 3.0)
-
-
-FREE_DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
-CONTACT_DIRECTIONS = ("x", "y", "rx", "ry", "rz")
+    free_directions: tuple = FREE_DIRECTIONS
+    hold_band: Optional[tuple] = None
 
 
 @dataclass
@@ -125,6 +146,9 @@ class CycleInfo:
     normal_force_estimate: float
     contact: bool
     result: object = field(repr=False, default=None)
+    inputs: dict = field(repr=False, default_factory=dict)
+    """The solve's arguments (``q, qd, alpha, beta, f_ext, tau_ff`` and segment ``constraints``,
+    without ``friction``) and ``motor_ff``, the motor-side part of ``tau_ff`` added to the command."""
 
 
 class CascadedController:
@@ -145,9 +169,11 @@ class CascadedController:
         n = chain.n_joints
         self.n = n
         self.damping = np.asarray(chain.damping, float)
-        self.friction = Friction(static=np.asarray(chain.friction, float),
-                                 velocity_tolerance=config.friction_velocity_tolerance) \
-            if config.use_friction and np.any(np.asarray(chain.friction) > 0) else None
+        if config.friction_mode not in FRICTION_MODES:
+            raise ValueError(f"friction_mode must be one of {FRICTION_MODES}, got {config.friction_mode!r}")
+        self.joint_friction = np.asarray(chain.friction, float)
+        self.friction = Friction(static=self.joint_friction, velocity_tolerance=config.friction_velocity_tolerance) \
+            if config.friction_mode == "maxmin" and np.any(self.joint_friction > 0) else None
         self.goal = None
         self.in_contact = False
         self.detect = False
@@ -157,6 +183,7 @@ class CascadedController:
         self.extra_constraints = None  # dict for segment constraints (solver API of issue 5)
         self.support_share = None  # callable(result, q) -> torque the environment supplies
         self._all = list(range(n))
+        self._alpha = {}  # constraint directions per tuple of names
 
     # -- task state ------------------------------------------------------------------------------
     def set_goal(self, T_goal) -> None:
@@ -202,7 +229,14 @@ class CascadedController:
         v_lin = _saturate(gains.k_pos[0] * e[:3], cfg.v_max)
         v_ang = _saturate(gains.k_pos[1] * e[3:], cfg.w_max)
         a_des = np.concatenate([gains.k_vel[0] * (v_lin - tw[:3]), gains.k_vel[1] * (v_ang - tw[3:])])
-        alpha = directions(CONTACT_DIRECTIONS if self.in_contact else FREE_DIRECTIONS)
+        names = CONTACT_DIRECTIONS if self.in_contact else cfg.free_directions
+        if names not in self._alpha:
+            self._alpha[names] = directions(names)
+        alpha = self._alpha[names]
+        if cfg.hold_band is not None:
+            e_task = alpha @ (alpha.T @ e)  # the error along the constrained directions
+            if np.linalg.norm(e_task[:3]) < cfg.hold_band[0] and np.linalg.norm(e_task[3:]) < cfg.hold_band[1]:
+                a_des[:] = 0.0
         beta = beta_for(alpha, a_des, tw, self.solver.gravity)
 
         tau_motor_ff = np.zeros(self.n)
@@ -237,11 +271,22 @@ class CascadedController:
             f_ext = np.zeros((self.chain.n_segments, 6))
             f_ext[-1] = np.concatenate([F, np.cross(r, F)])
         res = self.solver.solve(q, qd, alpha, beta, f_ext=f_ext, tau_ff=tau_ff, friction=self.friction, **kw)
-        tau = np.asarray(res.tau_command) + tau_motor_ff
+        tau = np.asarray(res.tau_command) + tau_motor_ff + self._friction_feedforward(qd, res.qdd)
         if self.support_share is not None:
             tau = tau - self.support_share(res, q)
+        inputs = dict(q=q, qd=qd, alpha=alpha, beta=beta, f_ext=f_ext, tau_ff=tau_ff, motor_ff=tau_motor_ff, **kw)
         return tau, CycleInfo(pose=T, twist=tw, error=e, normal_force_estimate=N, contact=self.in_contact,
-                              result=res)
+                              result=res, inputs=inputs)
+
+    def _friction_feedforward(self, qd, qdd) -> np.ndarray:
+        """Torque added for joint friction by the ``"sign"`` and ``"smooth"`` modes (zero otherwise)."""
+        mode, eps = self.config.friction_mode, self.config.friction_velocity_tolerance
+        if mode == "sign":
+            moving = np.abs(qd) > eps
+            return self.joint_friction * np.where(moving, np.sign(qd), np.sign(qdd))
+        if mode == "smooth":
+            return self.joint_friction * np.tanh(qd / eps)
+        return np.zeros(self.n)
 
     def _without_push(self, q, qd, alpha, beta, tau_ff, tau_motor_ff, w, kw):
         """``tau_ff`` with the motor posture part's effect on the released direction ``w`` removed."""

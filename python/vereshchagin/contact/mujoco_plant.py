@@ -176,6 +176,7 @@ class MujocoGen3:
             if gid >= 0:
                 self._env[gid] = name
         self._f6 = np.zeros(6)
+        self._frictionloss = model.dof_frictionloss[:self.n_joints].copy()
 
     def read(self) -> JointState:
         d = self.data
@@ -216,6 +217,30 @@ class MujocoGen3:
             who.add(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, arm) or f"geom{arm}")
             out[env] = (force + float(self._f6[0]), who)
         return out
+
+    def joint_friction_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """The plant's dry joint friction at the last step: who sticks, and its torque.
+
+        Returns
+        -------
+        stick : ndarray of bool, shape (n,)
+            Joint j's friction torque stayed inside its bound, |torque| < (1 - 1e-3) f_j: friction
+            held the joint (a sliding joint gets exactly f_j). False for joints without friction.
+            (MuJoCo's ``efc_state`` of ``frictionloss`` rows is no stick flag: held joints with
+            |torque| well below f_j are often labelled linear.)
+        torque : ndarray, shape (n,)
+            Friction torque on each joint (N m, acting on the joint like a motor torque; MuJoCo's
+            ``efc_force`` of the joint's ``frictionloss`` row).
+        """
+        d = self.data
+        torque = np.zeros(self.n_joints)
+        rows = slice(d.ne, d.ne + d.nf)  # MuJoCo orders the rows: equality, friction, limits, contacts
+        dof = d.efc_id[rows]
+        mine = d.efc_type[rows] == mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF
+        torque[dof[mine]] = d.efc_force[rows][mine]
+        bound = self._frictionloss
+        stick = (bound > 0.0) & (np.abs(torque) < (1.0 - 1e-3) * bound)
+        return stick, torque
 
     def mass_matrix(self, q) -> np.ndarray:
         """Joint-space mass matrix (n, n) at ``q`` (MuJoCo's ``mj_fullM``, armature included)."""

@@ -19,7 +19,7 @@ from . import metrics
 from .elbow import VARIANTS as ELBOW_VARIANTS, elbow
 from .use_cases import JOINT_DAMPING, JOINT_FRICTION, grasp, writing
 
-__all__ = ["REPORT_003", "run"]
+__all__ = ["REPORT_003", "md_table", "run", "write_csv"]
 
 REPORT_003 = {
     # Table 6.2, average torque (N m) per joint 0..6: contact, contactless
@@ -40,13 +40,15 @@ def _bar(frac: float, width: int = 24) -> str:
     return "[" + "#" * k + "-" * (width - k) + f"] {100 * frac:5.1f} %"
 
 
-def _md_table(header, rows) -> list[str]:
+def md_table(header, rows) -> list[str]:
+    """Lines of a Markdown table with ``header`` (strings) and ``rows`` (sequences, shown with str)."""
     out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
     out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
     return out
 
 
-def _write_csv(path: Path, header, rows) -> None:
+def write_csv(path: Path, header, rows) -> None:
+    """Write ``header`` and ``rows`` to the CSV file ``path`` (UTF-8)."""
     with open(path, "w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
         w.writerow(header)
@@ -221,14 +223,14 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     oc, on = metrics.grasp_outcome(gc), metrics.grasp_outcome(gn)
     e_c, e_n = metrics.effort(gc, gc.window("slide")), metrics.effort(gn, gn.window("slide"))
     header, rows = _effort_rows({"contact": e_c, "contactless": e_n})
-    _write_csv(out / "grasp_effort.csv", header, rows)
+    write_csv(out / "grasp_effort.csv", header, rows)
     p1, p2 = out / "grasp_torque_power.png", out / "grasp_trajectories.png"
     _plot_effort(p1, {"contact": gc, "contactless": gn}, "slide", "Use case 1, slide: torque and power")
     _plot_trajectories(p2, {"contact": gc, "contactless": gn}, "Use case 1: tool position")
     grasp_ok = (oc["contact_detected"] and abs(oc["distance_x"] - 0.10) <= 0.005 and oc["contact_fraction"] > 0.95
                 and not gn.table_touch and not metrics.grasp_outcome(gn)["contact_detected"])
     ok &= grasp_ok
-    (out / "grasp_effort.md").write_text("\n".join(_md_table(header, rows)) + "\n", encoding="utf-8")
+    (out / "grasp_effort.md").write_text("\n".join(md_table(header, rows)) + "\n", encoding="utf-8")
     idx += ["### Use case 1: grasp by sliding (cf. report Tables 6.1, 6.2)", "",
             f"Contact: detected at t = {oc['contact_time']:.3f} s; slid {1e3 * oc['distance_x']:.1f} mm along x "
             f"in contact for {100 * oc['contact_fraction']:.1f} % of the slide (mean normal force "
@@ -237,7 +239,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
             f"table touched: {'yes (' + ', '.join(gn.table_touch) + ')' if gn.table_touch else 'never'}. "
             f"Checks: {'ok' if grasp_ok else 'FAILED'}.", "",
             "Per joint over the slide (avg torque signed as in Table 6.2; power = τ q̇ is mechanical, the "
-            "report's Table 6.1 is electrical V·I):", "", *_md_table(header, rows), "",
+            "report's Table 6.1 is electrical V·I):", "", *md_table(header, rows), "",
             f"CSV: [{rel(out / 'grasp_effort.csv')}]({rel(out / 'grasp_effort.csv')}); figures: "
             f"[{rel(p1)}]({rel(p1)}), [{rel(p2)}]({rel(p2)})", "",
             "How contact changes torque and energy, next to the report's measurements (section 6.2):", "",
@@ -260,17 +262,17 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
               f"{100 * ac['contact_fraction']:.1f} %", *map(str, REPORT_003["writing_contact"])],
              ["Contactless", f"{an['max_displacement']:.8f}", f"{an['mean_displacement']:.8f}", f"{an['length']:.4f}",
               f"{100 * an['contact_fraction']:.1f} %", *map(str, REPORT_003["writing_contactless"])]]
-    _write_csv(out / "writing_accuracy.csv", wh, wrows)
-    (out / "writing_accuracy.md").write_text("\n".join(_md_table(wh, wrows)) + "\n", encoding="utf-8")
+    write_csv(out / "writing_accuracy.csv", wh, wrows)
+    (out / "writing_accuracy.md").write_text("\n".join(md_table(wh, wrows)) + "\n", encoding="utf-8")
     ew_c, ew_n = metrics.effort(wc, wc.window("write")), metrics.effort(wn, wn.window("write"))
     wheader, wrows2 = _effort_rows({"contact": ew_c, "contactless": ew_n})
-    _write_csv(out / "writing_effort.csv", wheader, wrows2)
+    write_csv(out / "writing_effort.csv", wheader, wrows2)
     p3, p4 = out / "writing_line.png", out / "writing_torque_power.png"
     _plot_trajectories(p3, {"contact": wc, "contactless": wn}, "Use case 2: pen tip", y_mm=True)
     _plot_effort(p4, {"contact": wc, "contactless": wn}, "write", "Use case 2, writing: torque and power")
     less_accurate = ac["max_displacement"] > an["max_displacement"]
     idx += ["### Use case 2: writing a 10 cm line (cf. report Table 6.3)", "",
-            *_md_table(wh, wrows), "",
+            *md_table(wh, wrows), "",
             f"Pen on the paper for {100 * ac['contact_fraction']:.1f} % of the drawn line; contactless pen "
             f"{'touched the table' if wn.table_touch else 'never touched the table'}. Checks: {'ok' if w_ok else 'FAILED'}.",
             "",
@@ -290,7 +292,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     ee = {v: metrics.effort(r, r.window("slide")) for v, r in er.items()}
     eo = {v: metrics.elbow_outcome(r) for v, r in er.items()}
     eheader, erows = _effort_rows(ee)
-    _write_csv(out / "elbow_effort.csv", eheader, erows)
+    write_csv(out / "elbow_effort.csv", eheader, erows)
     p5 = out / "elbow_torque_power.png"
     _plot_effort(p5, er, "slide", "Use case 3, resting elbow: torque and power")
     lines3 = []
@@ -331,7 +333,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
             "unsupported (no box; a segment constraint on forearm_link holds the elbow's height, the motors carry "
             "everything), plant (box; the controller does not know it and leaves the self-motion to nature), "
             "constraint (box; the same segment constraint, its upward share -J_eᵀ α_e ν_e left to the box).", "",
-            *_md_table(eheader, erows), "", *lines3, "", f"Checks: {'ok' if elbow_ok else 'FAILED'}.", "",
+            *md_table(eheader, erows), "", *lines3, "", f"Checks: {'ok' if elbow_ok else 'FAILED'}.", "",
             f"CSV: [{rel(out / 'elbow_effort.csv')}]({rel(out / 'elbow_effort.csv')}); figure: [{rel(p5)}]({rel(p5)})",
             ""]
     secs = time.perf_counter() - t_start

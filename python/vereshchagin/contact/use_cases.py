@@ -29,7 +29,8 @@ from ..solver import Solver
 from .controller import CascadedController, ControllerConfig
 from .mujoco_plant import MujocoGen3, Scene, build_model, pen_tip
 
-__all__ = ["JOINT_FRICTION", "JOINT_DAMPING", "Phase", "Run", "grasp", "run_loop", "writing"]
+__all__ = ["JOINT_FRICTION", "JOINT_DAMPING", "Phase", "Run", "gen3_model", "grasp", "run_loop", "with_tool_link",
+           "writing"]
 
 JOINT_FRICTION = (0.5, 0.5, 0.5, 0.5, 0.3, 0.3, 0.3)
 """Static (breakaway) joint friction, N m (Kinova publishes none; plausible harmonic-drive values)."""
@@ -42,17 +43,44 @@ CLEARANCE = 0.03  # m, tool above the table in the contactless grasp
 PEN_DIRECTION_WORLD = (0.0, 0.0, -1.0)
 
 
-def gen3_model():
-    """URDF text and chain of the Gen3 with the rigid gripper, friction and damping above."""
-    urdf = robots.gen3_urdf(gripper=True, joint_friction=JOINT_FRICTION, joint_damping=JOINT_DAMPING)
+def gen3_model(friction_scale: float = 1.0, payload: Optional[tuple] = None):
+    """URDF text and chain of the Gen3 with the rigid gripper, friction and damping above.
+
+    Parameters
+    ----------
+    friction_scale : float
+        Factor on :data:`JOINT_FRICTION` (>= 0).
+    payload : (float, (3,)) or None
+        ``(mass kg, position m in the end-effector frame)`` of a solid sphere (radius
+        :data:`PAYLOAD_RADIUS`) held rigidly by the gripper (:func:`with_tool_link`); the plant
+        and the chain both carry it (a known payload).
+    """
+    friction = tuple(friction_scale * f for f in JOINT_FRICTION)
+    urdf = robots.gen3_urdf(gripper=True, joint_friction=friction, joint_damping=JOINT_DAMPING)
+    if payload is not None:
+        urdf = with_tool_link(urdf, "payload", payload[1], mass=payload[0], radius=PAYLOAD_RADIUS)
     return urdf, Chain.from_urdf(urdf, root="base_link", tip=robots.GEN3_TIP_LINK)
 
 
-def with_tool_link(urdf: str, name: str, xyz) -> str:
-    """The URDF with a massless link ``name`` fixed to the end-effector link at ``xyz`` (m)."""
+PAYLOAD_RADIUS = 0.04
+"""m, the payload sphere of :func:`gen3_model` (inertia 2/5 m r^2 about its centre)."""
+
+
+def with_tool_link(urdf: str, name: str, xyz, mass: float = 0.0, radius: float = 0.0) -> str:
+    """The URDF with a link ``name`` fixed to the end-effector link at ``xyz`` (m).
+
+    Massless by default; with ``mass`` (kg) > 0 the link is a solid sphere of that mass and
+    ``radius`` (m) centred at its origin (inertial only, no collision shape).
+    """
+    inertial = ""
+    if mass > 0.0:
+        i = 0.4 * mass * radius ** 2
+        inertial = (f'    <inertial>\n      <origin xyz="0 0 0" rpy="0 0 0"/>\n      <mass value="{mass!r}"/>\n'
+                    f'      <inertia ixx="{i!r}" ixy="0" ixz="0" iyy="{i!r}" iyz="0" izz="{i!r}"/>\n'
+                    '    </inertial>\n')
     link = (f'  <joint name="{name}_joint" type="fixed">\n    <parent link="{robots.GEN3_TIP_LINK}"/>\n'
             f'    <child link="{name}"/>\n    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="0 0 0"/>\n'
-            f'  </joint>\n  <link name="{name}"/>\n')
+            f'  </joint>\n  <link name="{name}">\n{inertial}  </link>\n')
     return urdf.replace("</robot>", link + "</robot>")
 
 
@@ -60,9 +88,11 @@ def with_tool_link(urdf: str, name: str, xyz) -> str:
 class Phase:
     """One step of a task: drive the end-effector to ``goal`` for at most ``duration`` s.
 
-    ``goal`` is a 4x4 pose or a callable ``goal(log_so_far, pose_now) -> 4x4`` evaluated when the
-    phase starts. ``detect``: end the phase when contact is detected. ``contact``: directions
-    with z released (None: keep the current mode). ``gripper``: command at the phase start.
+    ``goal`` is a 4x4 pose or a callable ``goal(pose_now) -> 4x4`` evaluated when the
+    phase starts. ``path``: optional ``path(goal, t) -> 4x4``, the goal at ``t`` s into the phase
+    (set every cycle; a moving reference). ``detect``: end the phase when contact is detected.
+    ``contact``: directions with z released (None: keep the current mode). ``gripper``: command
+    at the phase start.
     """
 
     name: str
@@ -71,6 +101,7 @@ class Phase:
     detect: bool = False
     contact: Optional[bool] = None
     gripper: Optional[float] = None
+    path: Optional[Callable] = None
 
 
 @dataclass
@@ -110,11 +141,14 @@ def _shifted(T, dx=0.0, dy=0.0, dz=0.0, R=None):
 
 
 def run_loop(robot, controller: CascadedController, phases, case: str, variant: str, tool_point,
-             progress: Optional[Callable[[float], None]] = None) -> Run:
+             progress: Optional[Callable[[float], None]] = None,
+             on_cycle: Optional[Callable[[int, np.ndarray, object], None]] = None) -> Run:
     """Run the phases on ``robot`` (any :class:`~.robot_interface.RobotInterface`).
 
     ``tool_point`` is the contact point in the end-effector frame (logged as ``tool``).
-    ``progress(fraction)`` is called now and then.
+    ``progress(fraction)`` is called now and then. ``on_cycle(k, command, cycle_info)`` is called
+    after each step with the sample index, the torque written and the controller's
+    :class:`~.controller.CycleInfo` (extra logging).
     """
     dt = robot.period
     total = int(round(sum(p.duration for p in phases) / dt)) + len(phases)
@@ -131,14 +165,17 @@ def run_loop(robot, controller: CascadedController, phases, case: str, variant: 
     for i, p in enumerate(phases):
         s = robot.read()
         T_now = np.asarray(controller.chain.fk(s.q))
-        controller.set_goal(p.goal(T_now) if callable(p.goal) else p.goal)
+        goal = p.goal(T_now) if callable(p.goal) else p.goal
+        controller.set_goal(goal)
         if p.contact is not None:
             controller.set_contact(p.contact)
         controller.arm_contact_detection(p.detect)
         if p.gripper is not None:
             robot.set_gripper(p.gripper)
         steps = int(round(p.duration / dt))
-        for _ in range(steps):
+        for step in range(steps):
+            if p.path is not None:
+                controller.set_goal(p.path(goal, step * dt))
             s = robot.read()
             cmd, ci = controller.command(s.q, s.qd)
             robot.write(cmd)
@@ -148,6 +185,8 @@ def run_loop(robot, controller: CascadedController, phases, case: str, variant: 
             tip[k] = ci.pose[:3, 3]
             tool[k] = (ci.pose @ tp)[:3]
             ph[k], cm[k] = i, controller.in_contact
+            if on_cycle is not None:
+                on_cycle(k, cmd, ci)
             if diag is not None:
                 forces = diag()
                 if "table" in forces:
