@@ -11,4 +11,4 @@ from .friction import Friction
 from .solver import BatchResult, Solver
 
 __all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
-__version__ = "0.1.0"
+from ._version import __version__ as __version__  # written once: CMakeLists.txt
