@@ -82,7 +82,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "friction solve: %s\n", friction_solver.errorMessage());
       return 1;
     }
-    std::printf("tool held still, breakaway friction %4.1f N m on every joint:\n", f);
+    std::printf("tool held still, breakaway friction %4.1f N m on every joint (rank %d):\n", f,
+                friction_solver.constraintRank());
     print("tau_command [N m]", friction_solver.commandTorques());
     print("friction torque [N m]", friction_solver.frictionTorques());
   }
