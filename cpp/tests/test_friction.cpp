@@ -14,7 +14,7 @@ namespace {
 using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 using testutil::str;
 
-// Report 000, sec. 6: 1 kg, 1 m link, COM at 0.5 m, joint-axis inertia 2.25 kg m^2, about z.
+// Vukcevic 2018, sec. 6: 1 kg, 1 m link, COM at 0.5 m, joint-axis inertia 2.25 kg m^2, about z.
 KDL::Chain oneDof() {
   KDL::Chain ch;
   ch.addSegment(KDL::Segment("link", KDL::Joint("j", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
