@@ -8,6 +8,7 @@ commands and the vertical constraint force over time.
 
 Run: ``python examples/batch_trajectory.py [out_dir]`` (writes batch_trajectory.png; about 2 s).
 """
+
 import sys
 import time
 from pathlib import Path
@@ -43,8 +44,10 @@ def main(out_dir="."):
     t_loop = time.perf_counter() - start
     np.testing.assert_allclose(batch.qdd, [r.qdd for r in loop], rtol=1e-12, atol=1e-12)
     print(f"{len(t)} states: solve_batch {t_batch * 1e3:.1f} ms, loop of solve {t_loop * 1e3:.1f} ms")
-    print(f"largest |tau_command| {np.abs(batch.tau_command).max():.2f} N m, "
-          f"constraint force {(-batch.nu[:, 0]).min():.2f} .. {(-batch.nu[:, 0]).max():.2f} N")
+    print(
+        f"largest |tau_command| {np.abs(batch.tau_command).max():.2f} N m, "
+        f"constraint force {(-batch.nu[:, 0]).min():.2f} .. {(-batch.nu[:, 0]).max():.2f} N"
+    )
 
     fig, (ax_tau, ax_nu) = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
     ax_tau.plot(t, batch.tau_command)

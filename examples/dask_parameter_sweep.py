@@ -11,6 +11,7 @@ Run: ``python examples/dask_parameter_sweep.py [out_dir] [scheduler_address]``
 (writes dask_parameter_sweep.png; about 5 s including the cluster start; needs ``dask`` and
 ``distributed``).
 """
+
 import sys
 from pathlib import Path
 
@@ -20,8 +21,8 @@ from dask.distributed import Client, LocalCluster
 
 import vereshchagin as vs
 
-FRICTION = np.linspace(0.0, 20.0, 11)          # breakaway friction of every joint, N m
-SHOULDER = np.linspace(-1.0, 1.0, 9)           # offset of joint 2 from the start pose, rad
+FRICTION = np.linspace(0.0, 20.0, 11)  # breakaway friction of every joint, N m
+SHOULDER = np.linspace(-1.0, 1.0, 9)  # offset of joint 2 from the start pose, rad
 
 
 def holding_command(shoulder_offset, friction):
@@ -63,8 +64,13 @@ def main(out_dir=".", address=None):
         held = FRICTION[row < 1e-9]
         print(f"  {s:+.2f}: {'more than ' + str(FRICTION[-1]) if held.size == 0 else f'{held[0]:.0f}'}")
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    image = ax.imshow(table, origin="lower", aspect="auto", cmap="viridis",
-                      extent=[FRICTION[0], FRICTION[-1], SHOULDER[0], SHOULDER[-1]])
+    image = ax.imshow(
+        table,
+        origin="lower",
+        aspect="auto",
+        cmap="viridis",
+        extent=[FRICTION[0], FRICTION[-1], SHOULDER[0], SHOULDER[-1]],
+    )
     fig.colorbar(image, label="|tau_command| to hold the tool [N m]")
     ax.set_xlabel("breakaway friction of every joint [N m]")
     ax.set_ylabel("shoulder (joint 2) offset [rad]")

@@ -8,19 +8,20 @@ in, so nobody has to remember that holding the height against gravity needs ``be
 
 Run: ``python examples/free_fall_vs_held_tool.py`` (prints a table, about 1 s).
 """
+
 import numpy as np
 
 import vereshchagin as vs
 
 
 def main():
-    chain = vs.robots.gen3()                     # 7 joints, base_link -> end_effector_link
+    chain = vs.robots.gen3()  # 7 joints, base_link -> end_effector_link
     solver = vs.Solver(chain, gravity=[0.0, 0.0, -9.81])
-    q = np.array(vs.robots.GEN3_START_POSE)      # rad
-    qd = np.zeros(chain.n_joints)                # rad/s
+    q = np.array(vs.robots.GEN3_START_POSE)  # rad
+    qd = np.zeros(chain.n_joints)  # rad/s
 
     free = solver.solve(q, qd)
-    hold_z = vs.task.Task("z")                   # one constraint: tool z, base axes
+    hold_z = vs.task.Task("z")  # one constraint: tool z, base axes
     held = hold_z.solve(solver, chain, q, qd, a_desired=np.zeros(6))
     hold_pose = vs.task.Task(["x", "y", "z", "rx", "ry", "rz"])
     fixed = hold_pose.solve(solver, chain, q, qd, a_desired=np.zeros(6))
@@ -33,8 +34,10 @@ def main():
         # link_acc includes the base acceleration -gravity: subtract it for the classical value.
         a_z = res.link_acc[-1, 2] - 9.81
         print(f"{name:26s} {a_z:20.3f} {np.linalg.norm(res.qdd):16.3f}  {res.tau_command}")
-    print(f"\nbeta used for the held height: {vs.task.beta_for(hold_z.alpha, np.zeros(6), chain.twist(q, qd))} "
-          "(= +g: the base accelerates upwards by g in the solver's convention)")
+    print(
+        f"\nbeta used for the held height: {vs.task.beta_for(hold_z.alpha, np.zeros(6), chain.twist(q, qd))} "
+        "(= +g: the base accelerates upwards by g in the solver's convention)"
+    )
     print(f"constraint force on the tool when held: {-held.nu[0]:.2f} N along z")
     assert abs(held.link_acc[-1, 2] - 9.81) < 1e-9 and free.link_acc[-1, 2] < 9.81
 

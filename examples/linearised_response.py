@@ -9,6 +9,7 @@ correction it wants; the script checks the prediction against fresh solves.
 
 Run: ``python examples/linearised_response.py`` (about 1 s).
 """
+
 import numpy as np
 
 import vereshchagin as vs
@@ -21,10 +22,10 @@ def main():
     q = np.array(vs.robots.GEN3_START_POSE)
     qd = rng.normal(scale=0.3, size=chain.n_joints)
     tau_ff = rng.normal(scale=2.0, size=chain.n_joints)
-    task = vs.task.Task("z")                                   # the tool keeps its height
+    task = vs.task.Task("z")  # the tool keeps its height
     base = task.solve(solver, chain, q, qd, np.zeros(6), tau_ff=tau_ff)
     joints = list(range(chain.n_joints))
-    G, dcmd = solver.response_columns(joints)                  # both (n, n), per N m of tau_ff
+    G, dcmd = solver.response_columns(joints)  # both (n, n), per N m of tau_ff
 
     dt = 1e-3
     np.set_printoptions(precision=4, suppress=True, linewidth=120)
@@ -32,7 +33,7 @@ def main():
     print(f"eigenvalues of G: {np.linalg.eigvalsh(G)}  (one zero: the task's direction)\n")
     worst = 0.0
     for k in range(3):
-        d = rng.normal(scale=1.0, size=chain.n_joints)         # a candidate correction, N m
+        d = rng.normal(scale=1.0, size=chain.n_joints)  # a candidate correction, N m
         predicted_qdd = base.qdd + G @ d
         predicted_cmd = base.tau_command + dcmd @ d
         exact = task.solve(solver, chain, q, qd, np.zeros(6), tau_ff=tau_ff + d)

@@ -9,6 +9,7 @@ support force and the motor commands, and checks that the elbow does not acceler
 
 Run: ``python examples/segment_constraints.py`` (about 1 s).
 """
+
 import numpy as np
 
 import vereshchagin as vs
@@ -21,18 +22,21 @@ def main():
     solver = vs.Solver(chain, gravity=[0.0, 0.0, -G])
     q = np.array(vs.robots.GEN3_START_POSE)
     qd = np.zeros(chain.n_joints)
-    elbow = "forearm_link"                                   # segment 4 (index 3)
+    elbow = "forearm_link"  # segment 4 (index 3)
 
-    tool_alpha = vs.task.directions(["z", "rx", "ry", "rz"])   # tool: height and orientation
+    tool_alpha = vs.task.directions(["z", "rx", "ry", "rz"])  # tool: height and orientation
     tool_beta = vs.task.beta_for(tool_alpha, np.zeros(6), chain.twist(q, qd))
-    elbow_alpha = vs.task.directions("z")                      # elbow: no vertical acceleration
+    elbow_alpha = vs.task.directions("z")  # elbow: no vertical acceleration
     elbow_beta = vs.task.beta_for(elbow_alpha, np.zeros(6), chain.twist(q, qd, elbow))
 
     cases = {
         "tool task only": {"alpha": tool_alpha, "beta": tool_beta},
         "elbow support only": {"constraints": {elbow: (elbow_alpha, elbow_beta)}},
-        "tool task + elbow support": {"alpha": tool_alpha, "beta": tool_beta,
-                                      "constraints": {elbow: (elbow_alpha, elbow_beta)}},
+        "tool task + elbow support": {
+            "alpha": tool_alpha,
+            "beta": tool_beta,
+            "constraints": {elbow: (elbow_alpha, elbow_beta)},
+        },
     }
     np.set_printoptions(precision=3, suppress=True, linewidth=120)
     elbow_index = chain.segment_index(elbow)

@@ -12,6 +12,7 @@ stick/slip status over time (semi-implicit Euler, 2 ms steps).
 
 Run: ``python examples/static_friction_hold.py [out_dir]`` (writes static_friction_hold.png; about 2 s).
 """
+
 import sys
 from pathlib import Path
 

@@ -8,6 +8,7 @@ checked against the task by finite differences of the forward kinematics.
 
 Run: ``python examples/urdf_partial_task.py`` (needs ``pip install example-robot-data``; about 1 s).
 """
+
 import numpy as np
 
 import vereshchagin as vs
@@ -26,10 +27,10 @@ def main():
     for note in chain.notes:
         print(f"note: {note}")
 
-    solver = vs.Solver(chain)                        # gravity [0, 0, -9.81] by default
+    solver = vs.Solver(chain)  # gravity [0, 0, -9.81] by default
     q = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.6, 0.8])
     qd = np.array([0.3, -0.2, 0.1, 0.4, -0.1, 0.2, 0.0])
-    task = vs.task.Task(["x", "z", "rx", "ry", "rz"])   # y stays free
+    task = vs.task.Task(["x", "z", "rx", "ry", "rz"])  # y stays free
     a_desired = np.array([0.5, 0.0, 0.0, 0.0, 0.0, 0.0])
     res = task.solve(solver, chain, q, qd, a_desired)
 

@@ -5,6 +5,7 @@ Blocks of one file run in order in one namespace (a page is a tutorial), in a fr
 with a non-interactive matplotlib backend and a temporary working directory. A block fenced as
 ``python`` is executed; output-only or illustrative text uses ``text`` or ``pycon``.
 """
+
 import os
 import re
 import subprocess
@@ -36,16 +37,22 @@ def test_readme_has_the_tour():
 def test_code_blocks_run(page, tmp_path):
     script = "\n\n".join(f"# --- block {k + 1} of {page.name}\n{b}" for k, b in enumerate(python_blocks(page)))
     env = dict(os.environ, MPLBACKEND="Agg")
-    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, env=env, capture_output=True,
-                          text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    )
     assert proc.returncode == 0, f"{page.name}:\n{proc.stdout[-2000:]}\n{proc.stderr[-4000:]}"
 
 
 def test_sphinx_builds_without_warnings(tmp_path):
     """``sphinx-build -W``: any warning (a broken reference, a bad docstring) fails."""
-    proc = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
-                           str(DOCS), str(tmp_path / "html")], cwd=ROOT, capture_output=True, text=True,
-                          timeout=600, env=dict(os.environ, MPLBACKEND="Agg"))
+    proc = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html", str(DOCS), str(tmp_path / "html")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env=dict(os.environ, MPLBACKEND="Agg"),
+    )
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-6000:]
     index = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
     assert "vereshchagin" in index

@@ -4,6 +4,7 @@ Each runs in a fresh interpreter (as a user would run it) with a non-interactive
 backend and a temporary folder as the working and output directory. The C++ example is built
 and run by .ci/test against the installed library (it needs the install prefix).
 """
+
 import os
 import subprocess
 import sys
@@ -26,8 +27,9 @@ def test_examples_exist():
 def test_example_runs(script, tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
     start = time.perf_counter()
-    proc = subprocess.run([sys.executable, str(script), str(tmp_path)], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, str(script), str(tmp_path)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120
+    )
     elapsed = time.perf_counter() - start
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     assert proc.stdout.strip(), "an example must print something a person would look at"

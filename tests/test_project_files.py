@@ -1,4 +1,5 @@
 """Project files stay consistent: one version, lint clean, license shipped, no paths outside the repo."""
+
 import re
 import subprocess
 import sys
@@ -21,7 +22,7 @@ def test_version_is_written_once():
     version = _cmake_version()
     assert vs.__version__ == version
     assert metadata.version("vereshchagin") == version
-    assert re.search(r'^version\s*=', (ROOT / "pyproject.toml").read_text(encoding="utf-8"), re.M) is None
+    assert re.search(r"^version\s*=", (ROOT / "pyproject.toml").read_text(encoding="utf-8"), re.M) is None
     init = (ROOT / "python" / "vereshchagin" / "__init__.py").read_text(encoding="utf-8")
     assert version not in init
     assert f"## [{version}]" in (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
@@ -29,8 +30,12 @@ def test_version_is_written_once():
 
 def test_ruff_lint_clean():
     """The lint rules of pyproject.toml's [tool.ruff.lint] hold on every Python file of the repository."""
-    proc = subprocess.run([sys.executable, "-m", "ruff", "check", "python", "tests", "benchmarks", "examples", "docs"],
-                          cwd=ROOT, capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ruff", "check", "python", "tests", "benchmarks", "examples", "docs"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 

@@ -3,6 +3,7 @@
 Drawn from the package's own forward kinematics (``Chain.fk``), so the figure shows what the
 solver means by each frame. ``draw(path)`` writes a PNG.
 """
+
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -15,8 +16,14 @@ def _arm():
     for k, length in enumerate((0.5, 0.4, 0.2)):
         tip = np.eye(4)
         tip[0, 3] = length
-        chain.add_segment(name=f"link{k + 1}", joint="rot_y", tip=tip, mass=1.0, com=[-length / 2, 0, 0],
-                          inertia=np.diag([1e-3, 1e-2, 1e-2]))
+        chain.add_segment(
+            name=f"link{k + 1}",
+            joint="rot_y",
+            tip=tip,
+            mass=1.0,
+            com=[-length / 2, 0, 0],
+            inertia=np.diag([1e-3, 1e-2, 1e-2]),
+        )
     return chain
 
 
@@ -25,8 +32,12 @@ def _axes(ax, T, label, scale=0.12, color="k"):
     o = T[:3, 3]
     for col, name in ((0, "x"), (2, "z")):
         d = T[:3, col] * scale
-        ax.annotate("", xy=(o[0] + d[0], o[2] + d[2]), xytext=(o[0], o[2]),
-                    arrowprops=dict(arrowstyle="->", color=color, lw=1.4))
+        ax.annotate(
+            "",
+            xy=(o[0] + d[0], o[2] + d[2]),
+            xytext=(o[0], o[2]),
+            arrowprops=dict(arrowstyle="->", color=color, lw=1.4),
+        )
         ax.text(o[0] + 1.15 * d[0], o[2] + 1.15 * d[2], name, color=color, fontsize=8, ha="center", va="center")
     ax.text(o[0] - 0.02, o[2] - 0.05, label, fontsize=8, ha="right", va="top", color=color)
 
@@ -43,18 +54,43 @@ def draw(path):
     for k in range(1, len(poses)):
         _axes(ax, poses[k], f"tip of segment {k - 1}\n'{chain.segment_names[k - 1]}'\n(link_acc row {k})")
     tool = poses[-1][:3, 3]
-    ax.annotate("", xy=(tool[0], tool[2] + 0.22), xytext=(tool[0], tool[2]),
-                arrowprops=dict(arrowstyle="-|>", color="tab:red", lw=2))
-    ax.text(tool[0] + 0.12, tool[2] + 0.12, "alpha = z: unit force along base z\nat the last tip origin;\n"
-            "hold height: beta = +9.81", color="tab:red", fontsize=8, va="top")
+    ax.annotate(
+        "",
+        xy=(tool[0], tool[2] + 0.22),
+        xytext=(tool[0], tool[2]),
+        arrowprops=dict(arrowstyle="-|>", color="tab:red", lw=2),
+    )
+    ax.text(
+        tool[0] + 0.12,
+        tool[2] + 0.12,
+        "alpha = z: unit force along base z\nat the last tip origin;\nhold height: beta = +9.81",
+        color="tab:red",
+        fontsize=8,
+        va="top",
+    )
     ax.annotate("", xy=(-0.25, 0.25), xytext=(-0.25, 0.5), arrowprops=dict(arrowstyle="-|>", color="tab:green", lw=2))
-    ax.text(-0.23, 0.45, "gravity = [0, 0, -9.81]\n(solver: base accelerates\nby -gravity = +9.81 z)",
-            color="tab:green", fontsize=8, va="top")
+    ax.text(
+        -0.23,
+        0.45,
+        "gravity = [0, 0, -9.81]\n(solver: base accelerates\nby -gravity = +9.81 z)",
+        color="tab:green",
+        fontsize=8,
+        va="top",
+    )
     mid = poses[2][:3, 3]
-    ax.annotate("", xy=(mid[0] + 0.18, mid[2]), xytext=(mid[0], mid[2]),
-                arrowprops=dict(arrowstyle="-|>", color="tab:purple", lw=2))
-    ax.text(mid[0] + 0.2, mid[2] + 0.02, "f_ext of segment 1:\nbase axes, moment\nabout its tip origin",
-            color="tab:purple", fontsize=8)
+    ax.annotate(
+        "",
+        xy=(mid[0] + 0.18, mid[2]),
+        xytext=(mid[0], mid[2]),
+        arrowprops=dict(arrowstyle="-|>", color="tab:purple", lw=2),
+    )
+    ax.text(
+        mid[0] + 0.2,
+        mid[2] + 0.02,
+        "f_ext of segment 1:\nbase axes, moment\nabout its tip origin",
+        color="tab:purple",
+        fontsize=8,
+    )
     ax.text(0.3, -0.25, "joints rotate about y (into the page); q > 0 turns x towards -z", fontsize=8)
     ax.set_aspect("equal")
     ax.set_xlim(-0.35, 1.45)

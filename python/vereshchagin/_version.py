@@ -4,6 +4,7 @@ An installed package (wheel or ``pip install .``) has it in its metadata, which 
 fills from CMakeLists.txt at build time. A source or build tree that is imported without being
 installed reads CMakeLists.txt directly; anything else reports ``0+unknown``.
 """
+
 from __future__ import annotations
 
 import re
