@@ -51,7 +51,12 @@ nitpicky = False
 html_theme = "alabaster"
 html_title = f"vereshchagin {release}"
 html_static_path = []
-html_theme_options = {"description": "Constrained hybrid dynamics with static joint friction", "page_width": "1100px"}
+html_theme_options = {
+    "description": "Constrained hybrid dynamics with static joint friction",
+    "page_width": "1280px",
+    "sidebar_width": "230px",
+    "body_max_width": "none",
+}
 
 
 def _regenerate_figures(app):
