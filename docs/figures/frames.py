@@ -42,6 +42,17 @@ def _axes(ax, T, label, scale=0.12, color="k"):
     ax.text(o[0] - 0.02, o[2] - 0.05, label, fontsize=8, ha="right", va="top", color=color)
 
 
+def _arrow(ax, start, delta, color, text_offset, text):
+    """A thick arrow from ``start`` by ``delta`` (x, z) and a label at ``start + text_offset``."""
+    ax.annotate(
+        "",
+        xy=(start[0] + delta[0], start[1] + delta[1]),
+        xytext=start,
+        arrowprops=dict(arrowstyle="-|>", color=color, lw=2),
+    )
+    ax.text(start[0] + text_offset[0], start[1] + text_offset[1], text, color=color, fontsize=8, va="top")
+
+
 def draw(path):
     """Write the figure to ``path`` (PNG)."""
     chain = _arm()
@@ -53,43 +64,30 @@ def draw(path):
     _axes(ax, poses[0], "base frame\n(segment index -,\nlink_acc row 0)", color="tab:blue")
     for k in range(1, len(poses)):
         _axes(ax, poses[k], f"tip of segment {k - 1}\n'{chain.segment_names[k - 1]}'\n(link_acc row {k})")
-    tool = poses[-1][:3, 3]
-    ax.annotate(
-        "",
-        xy=(tool[0], tool[2] + 0.22),
-        xytext=(tool[0], tool[2]),
-        arrowprops=dict(arrowstyle="-|>", color="tab:red", lw=2),
-    )
-    ax.text(
-        tool[0] + 0.12,
-        tool[2] + 0.12,
+    tool, mid = poses[-1][:3, 3], poses[2][:3, 3]
+    _arrow(
+        ax,
+        (tool[0], tool[2]),
+        (0.0, 0.22),
+        "tab:red",
+        (0.2, 0.12),
         "alpha = z: unit force along base z\nat the last tip origin;\nhold height: beta = +9.81",
-        color="tab:red",
-        fontsize=8,
-        va="top",
     )
-    ax.annotate("", xy=(-0.25, 0.25), xytext=(-0.25, 0.5), arrowprops=dict(arrowstyle="-|>", color="tab:green", lw=2))
-    ax.text(
-        -0.23,
-        0.45,
+    _arrow(
+        ax,
+        (-0.25, 0.5),
+        (0.0, -0.25),
+        "tab:green",
+        (0.02, -0.05),
         "gravity = [0, 0, -9.81]\n(solver: base accelerates\nby -gravity = +9.81 z)",
-        color="tab:green",
-        fontsize=8,
-        va="top",
     )
-    mid = poses[2][:3, 3]
-    ax.annotate(
-        "",
-        xy=(mid[0] + 0.18, mid[2]),
-        xytext=(mid[0], mid[2]),
-        arrowprops=dict(arrowstyle="-|>", color="tab:purple", lw=2),
-    )
-    ax.text(
-        mid[0] + 0.2,
-        mid[2] + 0.02,
+    _arrow(
+        ax,
+        (mid[0], mid[2]),
+        (0.18, 0.0),
+        "tab:purple",
+        (0.2, 0.1),
         "f_ext of segment 1:\nbase axes, moment\nabout its tip origin",
-        color="tab:purple",
-        fontsize=8,
     )
     ax.text(0.3, -0.25, "joints rotate about y (into the page); q > 0 turns x towards -z", fontsize=8)
     ax.set_aspect("equal")
