@@ -2,7 +2,7 @@
 // with all joints at rest, against
 //  * plain     our frictionless solve, vereshchagin::ChainHdSolver::solve, same inputs;
 //  * KDL       KDL 1.5.1's frictionless ChainHdSolver_Vereshchagin::CartToJnt, same inputs;
-//  * vertices  the report's vertex enumeration (report 000, sec. 5.6): for each of the 2^7 sign
+//  * vertices  the report's vertex enumeration (Vukcevic 2018, sec. 5.6): for each of the 2^7 sign
 //              vectors mu = +-f, one KDL CartToJnt solve with ff - mu and the Gauss function
 //              g(mu) = Z0 + mu^T qdd, keeping the best vertex.
 //
@@ -11,7 +11,7 @@
 // qdd_free one KDL nc = 0 solve under ff (per state) and tau_cmd = -J^T alfa nu, J the base-frame
 // tip Jacobian (KDL::ChainJntToJacSolver, once per state) and nu from KDL's
 // getContraintForceMagnitude. (KDL's own constraint_torques output is not that command: see
-// /work/shared/reference/kdl-1.5.1-vereshchagin.md, defect 1.) The vertex timing includes the
+// docs/kdl-pinocchio.md, "KDL 1.5.1's solver".) The vertex timing includes the
 // free solve and the Jacobian.
 //
 // Chains: the Kinova Gen3 7-DoF chain and the seeded random 7-joint chain of bench_solver.cpp
@@ -429,7 +429,7 @@ int main(int argc, char** argv) {
        << " | " << fmt("%.1e", r.max_plain_dqdd) << " |\n";
   md << "\nThe vertex answer is right only when the optimum is at a vertex (every resting joint slips, or the task "
      << "fixes its acceleration); whenever a joint sticks with the task leaving it free, the optimum is inside the "
-     << "box and the best vertex moves a joint that friction holds (report 000, sec. 5.6).\n";
+     << "box and the best vertex moves a joint that friction holds (Vukcevic 2018, sec. 5.6).\n";
   const int violations = [&] {
     int v = 0;
     for (const Row& r : rows) v += r.g_violations;

@@ -76,9 +76,9 @@ def rpy(roll, pitch, yaw):
                      [-sp, cp * sr, cp * cr]])
 
 
-def frame(R=np.eye(3), p=(0.0, 0.0, 0.0)):
+def frame(R=None, p=(0.0, 0.0, 0.0)):
     T = np.eye(4)
-    T[:3, :3], T[:3, 3] = R, p
+    T[:3, :3], T[:3, 3] = np.eye(3) if R is None else R, p
     return T
 
 
@@ -237,7 +237,7 @@ def bench_case(label, segs, seed, batches, batch_s):
         worst = max(rel_diff(g[i], expected[i]) for g in got.values() for i in range(N_STATES))
 
         variants = {"ours solve": per_state(solver.solve, ours_args),
-                    "ours batch": lambda reps: [solver.solve_batch(*batch_args) for _ in range(reps)],
+                    "ours batch": lambda reps, args=batch_args: [solver.solve_batch(*args) for _ in range(reps)],
                     "pin FD": per_state(pin_fd, pin_args)}
         if m:
             variants["pin pipeline"] = per_state(pipeline, [(q, qd, tau, *s[m]) for q, qd, tau, s in states])

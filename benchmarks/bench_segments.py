@@ -160,7 +160,7 @@ def bench_robot(label, build, names, seed, batches, batch_s):
         def ours(q, qd, tau, c):
             return solver.solve(q, qd, tau_ff=tau, constraints=c)
 
-        def pipeline(pq, qd, tau, alpha_t, b):
+        def pipeline(pq, qd, tau, alpha_t, b, fids=fids, up=up):
             pin.computeAllTerms(model, data, pq, qd)
             J = np.vstack([pin.getFrameJacobian(model, data, f, LWA) for f in fids])
             acc = np.concatenate([pin.getFrameAcceleration(model, data, f, LWA).vector for f in fids])

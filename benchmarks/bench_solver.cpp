@@ -4,7 +4,7 @@
 //
 // Chains:
 //  * "7 (Gen3)": a Kinova Gen3 7-DoF arm (no vision module, no gripper). Joint origins, axes and
-//    link inertias transcribed by hand from /work/shared/reference/robots/kinova_gen3_7dof.json,
+//    link inertias transcribed by hand from python/vereshchagin/robots/data/kinova_gen3_7dof.json,
 //    which was itself expanded from Kinovarobotics/ros2_kortex
 //    kortex_description/arms/gen3/7dof/urdf/gen3_macro.xacro. The fixed end-effector frame is left
 //    out because KDL's Vereshchagin solver does not support a fixed last segment.

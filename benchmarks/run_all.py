@@ -113,7 +113,7 @@ def friction_section(fr_file, fr_rc, frpy_file, frpy_rc):
     md = [
         "## Static friction",
         "",
-        "Issue targets for the friction-aware solve (`vereshchagin::FrictionSolver`, the exact max-min of report 000 "
+        "Issue targets for the friction-aware solve (`vereshchagin::FrictionSolver`, the exact max-min of Vukcevic 2018 "
         "by one solve, the response columns of the resting joints and a box QP by an active-set method) on a 7-joint "
         "arm with every joint at rest, m = 0, 1, 6: at most 2.5x our plain solve (`ChainHdSolver::solve`, same "
         "inputs, no friction) and faster than one KDL plain solve (`ChainHdSolver_Vereshchagin::CartToJnt`); at "

@@ -1,4 +1,4 @@
-"""Independent oracles for static joint friction (see /work/shared/reference/friction-maxmin.md).
+"""Independent oracles for static joint friction (the max-min stated in docs/friction.md).
 
 Nothing here calls vereshchagin's solver. The problem is stated in Pinocchio's quantities:
 
@@ -40,7 +40,7 @@ Oracles:
     tolerance 0 and the noslip post-processor (unregularised projected Gauss-Seidel on the friction
     rows) iterated to convergence. Only for tasks without alpha.
 
-Joint position limits (friction-maxmin.md sec. 2, report 000 sec. 5.2). A resting joint flagged
+Joint position limits (docs/friction.md, "Joint limits"; Vukcevic 2018, sec. 5.2). A resting joint flagged
 ``at_lower`` (``at_upper``) may not accelerate further into its limit: the primal gains the one-sided
 constraint qdd_j >= 0 (qdd_j <= 0); both flags: qdd_j = 0. The objective is unchanged (the limit does
 no work). In the stationarity condition the limit's multiplier joins mu_j, whose bounds open on one

@@ -206,7 +206,7 @@ def test_hold_weight_with_vertical_slider():
 def _loop(solver, Q, QD, alpha=None, beta=None, f=None, tau=None, per_row=()):
     out = []
     for b in range(len(Q)):
-        pick = lambda name, x: (x[b] if name in per_row else x) if x is not None else None  # noqa: E731
+        pick = lambda name, x, b=b: (x[b] if name in per_row else x) if x is not None else None  # noqa: E731
         out.append(solver.solve(Q[b], QD[b], pick("alpha", alpha), pick("beta", beta), pick("f", f), pick("tau", tau)))
     return out
 

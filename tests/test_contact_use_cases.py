@@ -1,4 +1,4 @@
-"""Report 003's contact use cases in MuJoCo (vereshchagin.contact), quick mode: physical outcomes.
+"""The contact use cases of Lau (2023) in MuJoCo (vereshchagin.contact), quick mode: physical outcomes.
 
 The plant is MuJoCo (independent physics); the checks are on what it reports -- contact forces
 on the table, which arm geoms touched it, where the tool went -- not on controller internals.

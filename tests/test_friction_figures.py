@@ -1,4 +1,4 @@
-"""Report 000's friction figures and table (vereshchagin.experiments), and the slow references in
+"""The friction figures and table of Vukcevic (2018) (vereshchagin.experiments), and the slow references in
 vereshchagin.experiments.gauss (the Gauss function g(mu) by frictionless solves, grid sampling,
 vertex enumeration) against the exact friction-aware solve.
 

@@ -439,7 +439,7 @@ def test_solver_raises_iff_primal_infeasible(seed):
 # Known solver bug (reported; C++ not changed here): small friction on a limit held by the task
 # ------------------------------------------------------------------------------------------------
 def _arm_1dof():
-    """Report 000's 1-DOF arm: joint-axis inertia 2.25 kg m^2, revolute about z, no gravity."""
+    """The 1-DOF arm of Vukcevic (2018): joint-axis inertia 2.25 kg m^2, revolute about z, no gravity."""
     chain = vs.Chain()
     tip = np.eye(4)
     tip[0, 3] = 1.0

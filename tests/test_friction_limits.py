@@ -1,6 +1,6 @@
 """Joint position limits as a one-sided dissipative force in the friction optimisation.
 
-Expected values are worked out by hand for report 000's 1-DOF arm (joint-axis inertia 2.25 kg m^2,
+Expected values are worked out by hand for the 1-DOF arm of Vukcevic 2018, ch. 6 (joint-axis inertia 2.25 kg m^2,
 no gravity, f = 2 N m here): a joint resting on its limit and pushed further stays (the limit
 reaction takes what friction cannot hold); pushed away it slips as usual.
 """

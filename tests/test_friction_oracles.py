@@ -1,4 +1,4 @@
-"""Static joint friction (Vereshchagin's max-min, /work/shared/reference/friction-maxmin.md) against
+"""Static joint friction (Vereshchagin's max-min, docs/friction.md) against
 independent oracles (tests/friction_oracles.py; none of them calls our solver):
 
 (a) SLSQP on the primal  min Z0(qdd) + sum_{resting j} f_j |qdd_j|  s.t.  A qdd = b, polished to
@@ -150,7 +150,7 @@ def both_oracles(prob):
 
 
 # ------------------------------------------------------------------------------------------------
-# The 1-DOF arm of report 000: mass 1, length 1, COM 0.5, joint-axis inertia 2.25, revolute about z
+# The 1-DOF arm of Vukcevic 2018, ch. 6: mass 1, length 1, COM 0.5, joint-axis inertia 2.25, revolute about z
 # ------------------------------------------------------------------------------------------------
 def arm_1dof():
     seg = SegmentSpec("rot_z", np.array([0.0, 0.0, 1.0]), np.zeros(3), homogeneous(None, [1.0, 0.0, 0.0]),
@@ -759,5 +759,5 @@ def test_velocity_tolerance_boundary(tol):
         res = vs.Solver(rc.chain, gravity=g).solve(q, qd, friction=friction_arg(static, kinetic, tol))
         assert res.status[0] != MOVING
         assert (res.status[1] == MOVING) == (abs(qd[1]) > tol)
-        check_against_oracles(res, prob, lambda a: pin.rnea(rc.model, data, q, qd, a),
+        check_against_oracles(res, prob, lambda a, data=data, qd=qd: pin.rnea(rc.model, data, q, qd, a),
                               oracles=both_oracles(prob), what=f"qd {qd}")

@@ -59,7 +59,7 @@ def test_unknown_segment_names_raise():
     chain = seven_joint_arm()
     q = np.zeros(7)
     for fn in (chain.fk, chain.jacobian):
-        raises(lambda: fn(q, "link9"), "segment", "'link9'")
+        raises(lambda fn=fn: fn(q, "link9"), "segment", "'link9'")
     raises(lambda: chain.twist(q, q, "nope"), "segment", "'nope'")
     raises(lambda: chain.segment_index("nope"), "segment", "'nope'")
 

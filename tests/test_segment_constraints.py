@@ -216,7 +216,7 @@ def test_friction_with_mid_chain_constraints_vs_oracles(seed):
         prob = FrictionProblem(H, qdd_free, A, np.concatenate(betas) - drift, np.ones(r.chain.n_joints, bool), static,
                                extra=dict(tau_ff=tau))
         oracles = {"scipy": scipy_oracle(prob), "enumeration": enumeration_oracle(prob)}
-        check_against_oracles(res, prob, lambda a: pin.rnea(r.model, data, pq, qd, a), oracles=oracles,
+        check_against_oracles(res, prob, lambda a, pq=pq, qd=qd: pin.rnea(r.model, data, pq, qd, a), oracles=oracles,
                               what=f"{r.name} {names} seed {seed}")
         return
     raise AssertionError("no well-conditioned sample found")

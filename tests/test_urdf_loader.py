@@ -68,7 +68,7 @@ def combine(bodies):
     return m, c, Ic
 
 
-def about_point(m, c, Ic, p=np.zeros(3)):
+def about_point(m, c, Ic, p=(0.0, 0.0, 0.0)):
     d = np.asarray(c) - p
     return Ic + m * (d @ d * E3 - np.outer(d, d))
 

@@ -1,4 +1,4 @@
-// FrictionSolver: report 000's 1-DOF numbers, holding by friction, and on random chains the
+// FrictionSolver: the 1-DOF numbers of Vukcevic 2018 (ch. 6), holding by friction, and on random chains the
 // physics of the result checked with KDL's forward dynamics (ff + tau_cmd + friction reproduces
 // qdd) and the stick/slip complementarity conditions.
 #include <cmath>
@@ -14,7 +14,7 @@ namespace {
 using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 using testutil::str;
 
-// Report 000, sec. 6: 1 kg, 1 m link, COM at 0.5 m, joint-axis inertia 2.25 kg m^2, about z.
+// Vukcevic 2018, sec. 6: 1 kg, 1 m link, COM at 0.5 m, joint-axis inertia 2.25 kg m^2, about z.
 KDL::Chain oneDof() {
   KDL::Chain ch;
   ch.addSegment(KDL::Segment("link", KDL::Joint("j", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
@@ -148,6 +148,6 @@ int main() {
   int compared = 0;
   randomChains(ck, compared);
   ck.check(compared >= 250, "too few random trials solved: " + str(compared));
-  return ck.finish("report 000's 1-DOF numbers and holding; " + str(compared) +
+  return ck.finish("the 1-DOF numbers of Vukcevic 2018 and holding; " + str(compared) +
                    " random chains checked with KDL's FD and complementarity");
 }

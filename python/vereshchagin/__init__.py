@@ -15,4 +15,4 @@ Chain.from_kdl = staticmethod(_chain_from_kdl)  # PyKDL interoperability (kdl_in
 Chain.to_kdl = _chain_to_kdl
 
 __all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
-__version__ = "0.1.0"
+from ._version import __version__ as __version__  # written once: CMakeLists.txt

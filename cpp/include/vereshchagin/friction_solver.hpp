@@ -1,7 +1,7 @@
 // Popov-Vereshchagin hybrid dynamics with static (breakaway) joint friction, solved exactly.
 //
-// Problem (report 000, Vereshchagin's max-min; the precise statement is in the project's
-// reference friction-maxmin.md): joints at rest (|qd_j| <= velocity_tolerance) with breakaway
+// Problem (Vereshchagin's max-min as in D. Vukcevic, TR 03-2018, H-BRS 2018; stated in full in
+// docs/friction.md): joints at rest (|qd_j| <= velocity_tolerance) with breakaway
 // friction f_j > 0 get the friction torque -mu_j, |mu_j| <= f_j, that maximises the dissipation:
 //
 //   qdd* = argmin_qdd  Z0(qdd) + sum_{j at rest} f_j |qdd_j|   subject to the task,
@@ -54,7 +54,7 @@ struct FrictionModel {
   Eigen::VectorXd static_friction;   // f_j >= 0 per joint (N m or N)
   Eigen::VectorXd kinetic_friction;  // 0 <= fk_j <= f_j per joint; empty: equal to static_friction
   double velocity_tolerance = 1e-6;  // |qd_j| at or below this: the joint is at rest
-  // Joint position limits (report 000, sec. 5.2: a second dissipative force). A joint at rest
+  // Joint position limits (Vukcevic 2018, sec. 5.2: a second dissipative force). A joint at rest
   // with q_j <= lower_j + limit_tolerance (or >= upper_j - limit_tolerance) gets, in the same
   // optimisation, a one-sided reaction that stops it from moving further into the limit (no
   // bound on its size). Empty vectors: no limits; +-infinity entries: no limit on that side.

@@ -1,4 +1,4 @@
-"""Report 000's friction experiments on the 1-DOF arm (figures 5.2, 5.5, 6.2-6.7) and their optimum.
+"""The friction experiments of Vukcevic (2018) on the 1-DOF arm (figures 5.2, 5.5, 6.2-6.7) and their optimum.
 
 The arm (report sec. 6.1): one revolute joint about z, link length 1 m, mass 1 kg, centre of mass
 at 0.5 m, joint-axis inertia 2.25 kg m^2 (2.0 about the centre of mass), no gravity, at rest,
@@ -312,11 +312,11 @@ def _write_tables(rows: list, out: Path) -> tuple:
             w.writerow({k: ("" if r[k] is None else repr(r[k]) if isinstance(r[k], float) else r[k])
                         for k in _CSV_FIELDS})
     md = [
-        "# Static friction on the 1-DOF arm of report 000: the optimum",
+        "# Static friction on the 1-DOF arm of Vukcevic (2018): the optimum",
         "",
         "Arm: rot_z, 1 m, 1 kg, COM 0.5 m, joint-axis inertia 2.25 kg m^2, no gravity, at rest; "
         f"breakaway friction f = {F_BREAKAWAY:g} N m. Optimum from `Solver.solve(..., friction=...)`; "
-        "\"report\" columns are report 000's published values (— not published). Friction torque is the "
+        "\"report\" columns are the report's published values (— not published). Friction torque is the "
         "physical one, −μ (μ: Vereshchagin's multiplier). Net torque = external load + friction + motor "
         "command (= H qdd here). g(μ*) reference: `experiments.gauss.gauss_function` (one frictionless "
         "solve); grid: the report's sampling; vertex: the best of the box vertices ±f.",
@@ -358,7 +358,7 @@ def expected_figures() -> list:
 
 
 def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None) -> dict:
-    """Reproduce report 000's friction figures and tabulate the optimum.
+    """Reproduce the friction figures of Vukcevic (2018) and tabulate the optimum.
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Reference evaluations of Vereshchagin's max-min for static joint friction (report 000, ch. 5).
+"""Reference evaluations of Vereshchagin's max-min for static joint friction (Vukcevic 2018, ch. 5; docs/friction.md).
 
 The friction-aware solve ``Solver.solve(..., friction=...)`` finds the optimum exactly (one solve,
 response columns, a small box QP). The functions here are the slow references it is checked

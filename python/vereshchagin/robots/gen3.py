@@ -55,7 +55,7 @@ GEN3_TIP_LINK = "end_effector_link"
 """Link used as the chain tip by :func:`gen3` (the Kinova end-effector frame on the bracelet)."""
 
 GEN3_START_POSE_REPORTED = (6.28318, 0.261895, 3.14159, 4.01417, 0.0, 0.959856, 0.57079)
-"""Use-case-1 start pose of report 003 as written there (rad; Kortex reports angles in 0..2 pi)."""
+"""Use-case-1 start pose of Lau 2023 as written there (rad; Kortex reports angles in 0..2 pi)."""
 
 GEN3_START_POSE = tuple(math.remainder(q, 2.0 * math.pi) for q in GEN3_START_POSE_REPORTED)
 """The same pose with each angle wrapped to [-pi, pi] (rad).

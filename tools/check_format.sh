@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Formatting and lint checks, as the test command runs them (.ci/test).
+#
+#   bash tools/check_format.sh          ruff check (lint rules in pyproject.toml [tool.ruff.lint])
+#   bash tools/check_format.sh --all    also clang-format --dry-run --Werror and ruff format --check
+#
+# The formatters' checks are wired but gated until the repository's one formatting commit (listed
+# in .git-blame-ignore-revs) has been made; after it, .ci/test calls this script with --all.
+# To format: clang-format-14 -i <files>  and  ruff format python tests benchmarks examples docs.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY_DIRS="python tests benchmarks examples docs"
+echo "[format] ruff check $PY_DIRS"
+python3 -m ruff check $PY_DIRS
+if [ "${1:-}" = "--all" ]; then
+  echo "[format] ruff format --check $PY_DIRS"
+  python3 -m ruff format --check $PY_DIRS
+  CLANG_FORMAT="${CLANG_FORMAT:-clang-format-14}"
+  echo "[format] $CLANG_FORMAT --dry-run --Werror on the C++ sources"
+  git ls-files -- '*.cpp' '*.hpp' | xargs "$CLANG_FORMAT" --dry-run --Werror
+fi
