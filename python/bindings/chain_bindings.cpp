@@ -371,15 +371,30 @@ PyChain PyChain::fromState(const py::tuple& state) {
 }
 
 void bindChain(py::module_& mod) {
-  py::class_<JointSpec>(mod, "Joint")
+  py::class_<JointSpec>(mod, "Joint", R"doc(A joint type for :meth:`Chain.add_segment`, made by the static methods.
+
+``Joint.revolute(axis, origin)`` and ``Joint.prismatic(axis, origin)`` give a rotation about, or
+a translation along, the line through ``origin`` along ``axis`` (root-frame coordinates, m);
+``Joint.fixed()`` a rigid connection. The strings ``'rot_x'`` ... ``'trans_z'`` and ``'fixed'``
+name the axis-aligned cases.
+)doc")
       .def_static("revolute", [](const py::object& axis, const py::object& origin) {
-        return makeAxisJoint(KDL::Joint::RotAxis, axis, origin); }, py::arg("axis"), py::arg("origin") = py::none())
+        return makeAxisJoint(KDL::Joint::RotAxis, axis, origin); }, py::arg("axis"), py::arg("origin") = py::none(),
+        "Rotation about the line through ``origin`` (3,), m, along ``axis`` (3,), normalised; root-frame coordinates.")
       .def_static("prismatic", [](const py::object& axis, const py::object& origin) {
-        return makeAxisJoint(KDL::Joint::TransAxis, axis, origin); }, py::arg("axis"), py::arg("origin") = py::none())
-      .def_static("fixed", []() { return JointSpec(); })
+        return makeAxisJoint(KDL::Joint::TransAxis, axis, origin); }, py::arg("axis"), py::arg("origin") = py::none(),
+        "Translation along ``axis`` (3,), normalised, root-frame coordinates (``origin`` only places the axis line).")
+      .def_static("fixed", []() { return JointSpec(); }, "A rigid connection (no joint variable).")
       .def("__repr__", &JointSpec::repr);
 
-  py::class_<PyChain>(mod, "Chain")
+  py::class_<PyChain>(mod, "Chain", R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
+
+Build it segment by segment with :meth:`add_segment`, or from a URDF with :meth:`from_urdf`
+(fixed joints merged into their parent links). Joint metadata (limits, friction, damping, rotor
+inertia) and the names of merged links are kept. Frames are addressed by segment name, merged link
+name, or index (negative from the end); the base only by its link name (:attr:`root_link`).
+Chains pickle and copy.
+)doc")
       .def(py::init<>())
       .def("add_segment", &PyChain::addSegment, R"doc(Append a segment (a joint followed by a rigid body).
 
@@ -420,42 +435,108 @@ segment's tip frame is the ``tip`` link's frame. Defaults: the URDF's root link 
 leaf. Raises SolverError for malformed XML, unknown links, tip not below root, floating, planar
 or mimic joints on the path, negative mass or a non-PSD inertia.
 )doc")
-      .def_property_readonly("n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); })
-      .def_property_readonly("n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); })
-      .def_property_readonly("segment_names", &PyChain::segmentNames)
-      .def_property_readonly("joint_names", &PyChain::jointNames)
-      .def_property_readonly("lower", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::lower); })
-      .def_property_readonly("upper", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::upper); })
-      .def_property_readonly("velocity_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::velocity_limit); })
-      .def_property_readonly("effort_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::effort_limit); })
-      .def_property_readonly("friction", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::friction); })
-      .def_property_readonly("damping", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::damping); })
-      .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia)
+      .def_property_readonly("n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); }, "int: number of moving joints n (the length of q, qd, tau_ff).")
+      .def_property_readonly("n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); }, "int: number of segments (moving joints plus fixed-joint segments; rows of f_ext).")
+      .def_property_readonly("segment_names", &PyChain::segmentNames, "list of str: segment names, base to tip (a URDF segment is named after its link).")
+      .def_property_readonly("joint_names", &PyChain::jointNames, "list of str: moving joint names in q order.")
+      .def_property_readonly("lower", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::lower); }, "ndarray (n,): lower position limits, rad or m (-inf: none; URDF continuous joints have none).")
+      .def_property_readonly("upper", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::upper); }, "ndarray (n,): upper position limits, rad or m (+inf: none).")
+      .def_property_readonly("velocity_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::velocity_limit); }, "ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver.")
+      .def_property_readonly("effort_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::effort_limit); }, "ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver.")
+      .def_property_readonly("friction", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::friction); }, "ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>); used by friction=True.")
+      .def_property_readonly("damping", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::damping); }, "ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not applied by the solver.")
+      .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia, "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg (settable; added to the joint's articulated inertia).")
       .def_property_readonly("joint_types", [](const PyChain& c) {
         std::vector<std::string> t;
         for (const auto& j : c.robot.joints) t.push_back(j.type);
-        return t; })
+        return t; }, "list of str: 'revolute', 'continuous' or 'prismatic' per moving joint.")
       .def_property_readonly("segment_masses", [](const PyChain& c) {
         py::array_t<double> m(static_cast<py::ssize_t>(c.robot.chain.getNrOfSegments()));
         for (unsigned int i = 0; i < c.robot.chain.getNrOfSegments(); ++i)
           m.mutable_data()[i] = c.robot.chain.getSegment(i).getInertia().getMass();
-        return m; })
-      .def_property_readonly("root_link", [](const PyChain& c) { return c.robot.root_link; })
-      .def_property_readonly("notes", [](const PyChain& c) { return c.robot.notes; })
+        return m; }, "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.")
+      .def_property_readonly("root_link", [](const PyChain& c) { return c.robot.root_link; }, "str: name of the base link (the base frame); the base is addressed by this name only.")
+      .def_property_readonly("notes", [](const PyChain& c) { return c.robot.notes; }, "list of str: approximations made while building the chain (lumped branches, merged links).")
       .def_property_readonly("link_names", [](const PyChain& c) {
         std::vector<std::string> t;
         for (const auto& l : c.robot.links) t.push_back(l.link);
-        return t; })
+        return t; }, "list of str: every URDF link folded into the chain (segments, merged links, base links); segment and merged link names address frames in fk, jacobian, twist, constraints= and f_ext dicts; base links only in fk, jacobian and twist.")
       .def("segment_index", [](const PyChain& c, const py::object& which) {
-        return c.resolveMoving(which.ptr(), "segment_index").segment; }, py::arg("name"))
+        return c.resolveMoving(which.ptr(), "segment_index").segment; }, py::arg("name"), R"doc(Index of a segment.
+
+Parameters
+----------
+name : str or int
+    A segment name, the name of a link merged into a segment by fixed joints (its segment's
+    index), or an index (negative from the end).
+
+Returns
+-------
+int
+    In ``0 .. n_segments - 1``.
+
+Raises
+------
+SolverError
+    Unknown names, indices out of range, and the base link (it is no segment; ``fk``,
+    ``jacobian`` and ``twist`` accept it by name).
+)doc")
       .def("joint_index", [](const PyChain& c, const py::object& which) {
-        return c.resolveJoint(which.ptr(), "joint_index"); }, py::arg("name"))
-      .def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(),
-           "4x4 pose of a segment tip (index or name; default the last) or of a merged link, base frame.")
-      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(),
-           "(6, n) Jacobian [linear; angular] of a segment tip or link origin, base-frame axes.")
-      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
-           "(6,) twist [v; omega] of a segment tip or link origin, base-frame axes.")
+        return c.resolveJoint(which.ptr(), "joint_index"); }, py::arg("name"), R"doc(Index of a moving joint in q.
+
+Parameters
+----------
+name : str or int
+    A joint name or an index (negative from the end).
+
+Returns
+-------
+int
+    In ``0 .. n_joints - 1``.
+)doc")
+      .def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(), R"doc(Pose of a frame in the base frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+    Joint positions, rad or m.
+segment : str or int, optional
+    Segment name or index (negative from the end; default: the last segment's tip), a link
+    merged into a segment (its own frame), or the base link's name (identity).
+
+Returns
+-------
+ndarray, shape (4, 4)
+    Homogeneous transform of the frame in the base frame (m).
+)doc")
+      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(), R"doc(Geometric Jacobian of a frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+segment : str or int, optional
+    As in :meth:`fk` (default: the last segment's tip).
+
+Returns
+-------
+ndarray, shape (6, n)
+    Rows ``[linear; angular]``: the velocity of the frame's origin and the angular velocity,
+    base-frame axes, per unit joint velocity (zero for the base).
+)doc")
+      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(), R"doc(Velocity of a frame.
+
+Parameters
+----------
+q, qd : array_like, shape (n,)
+segment : str or int, optional
+    As in :meth:`fk` (default: the last segment's tip).
+
+Returns
+-------
+ndarray, shape (6,)
+    ``[v; omega]``: linear velocity of the frame's origin (m/s) and angular velocity (rad/s),
+    base-frame axes; ``jacobian(q, segment) @ qd``.
+)doc")
       .def(py::pickle([](const PyChain& c) { return c.getState(); },
                       [](const py::tuple& t) { return PyChain::fromState(t); }))
       .def("__copy__", [](const PyChain& c) { return c; })

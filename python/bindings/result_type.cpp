@@ -2,6 +2,8 @@
 
 #include <pybind11/numpy.h>
 
+#include <cstddef>
+#include <cstring>
 #include <string>
 
 #include "common.hpp"
@@ -13,19 +15,20 @@ namespace {
 
 enum View { kQdd, kTau, kNu, kLinkAcc, kFriction, kLimit, kStatus, kNumViews };
 
+// Every numeric output lives in `data` (allocated with the object: one allocation per solve).
+// Array fields are views of it whose base is the result; they are not cached (a cache would be a
+// reference cycle), so each attribute access makes a new view of the same memory.
 struct ResultObject {
-  PyObject_HEAD
-  PyObject* buffer;             // 1-D float64 array: every numeric output
-  PyObject* views[kNumViews];   // cached views of the buffer (NULL until first access)
+  PyObject_VAR_HEAD
   PyObject* segment_keys;       // tuple or NULL: constraints= keys
   PyObject* segment_starts;     // tuple of int: first entry of each key's part of nu
   PyObject* segment_counts;     // tuple of int: its length
-  PyObject* segment_nu;         // cached dict or NULL
   ResultLayout layout;
   int rank;
   double smin;
   double gauss;
   int iterations;
+  double data[1];               // bufferDoubles(layout) entries
 };
 
 PyTypeObject* g_type = nullptr;
@@ -38,17 +41,10 @@ Py_ssize_t bufferDoubles(const ResultLayout& l) {
 
 ResultObject* self(PyObject* o) { return reinterpret_cast<ResultObject*>(o); }
 
-double* base(PyObject* o) { return reinterpret_cast<double*>(py::detail::array_proxy(self(o)->buffer)->data); }
-
-void clearViews(ResultObject* r) {
-  for (auto& v : r->views) Py_CLEAR(v);
-  Py_CLEAR(r->segment_nu);
-}
+double* base(PyObject* o) { return self(o)->data; }
 
 void dealloc(PyObject* o) {
   ResultObject* r = self(o);
-  clearViews(r);
-  Py_CLEAR(r->buffer);
   Py_CLEAR(r->segment_keys);
   Py_CLEAR(r->segment_starts);
   Py_CLEAR(r->segment_counts);
@@ -57,12 +53,10 @@ void dealloc(PyObject* o) {
   Py_DECREF(tp);
 }
 
-PyObject* allocate(const ResultLayout& layout, PyObject* buffer) {
-  ResultObject* r = PyObject_New(ResultObject, g_type);
+PyObject* allocate(const ResultLayout& layout) {
+  ResultObject* r = PyObject_NewVar(ResultObject, g_type, bufferDoubles(layout));
   if (r == nullptr) throw py::error_already_set();
-  r->buffer = buffer;
-  for (auto& v : r->views) v = nullptr;
-  r->segment_keys = r->segment_starts = r->segment_counts = r->segment_nu = nullptr;
+  r->segment_keys = r->segment_starts = r->segment_counts = nullptr;
   r->layout = layout;
   r->rank = 0;
   r->smin = r->gauss = 0.0;
@@ -70,25 +64,17 @@ PyObject* allocate(const ResultLayout& layout, PyObject* buffer) {
   return reinterpret_cast<PyObject*>(r);
 }
 
-PyObject* newBuffer(Py_ssize_t n) {
-  const auto& api = py::detail::npy_api::get();
-  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(py::detail::npy_api::NPY_DOUBLE_),
-                                          1, &n, nullptr, nullptr, 0, nullptr);
-  if (a == nullptr) throw py::error_already_set();
-  return a;
-}
-
-// A view of `count` entries at `offset` doubles, shaped `dims`, based on the buffer.
+// A view at `offset_doubles` into the result's data, shaped `dims`; its base is the result.
 PyObject* makeView(ResultObject* r, Py_ssize_t offset_doubles, int nd, const Py_ssize_t* dims, int type_num) {
   const auto& api = py::detail::npy_api::get();
   constexpr int flags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_ |
                         py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  void* data = base(reinterpret_cast<PyObject*>(r)) + offset_doubles;
+  void* data = r->data + offset_doubles;
   PyObject* v = api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(type_num), nd, dims, nullptr,
                                           data, flags, nullptr);
   if (v == nullptr) return nullptr;
-  Py_INCREF(r->buffer);
-  if (api.PyArray_SetBaseObject_(v, r->buffer) != 0) {
+  Py_INCREF(r);
+  if (api.PyArray_SetBaseObject_(v, reinterpret_cast<PyObject*>(r)) != 0) {
     Py_DECREF(v);
     return nullptr;
   }
@@ -112,22 +98,17 @@ PyObject* getView(PyObject* o, void* closure) {
   ResultObject* r = self(o);
   const int which = static_cast<int>(reinterpret_cast<intptr_t>(closure));
   if (which >= kFriction && !r->layout.friction) Py_RETURN_NONE;
-  if (r->views[which] == nullptr) {
-    const ResultLayout& l = r->layout;
-    Py_ssize_t dims[2] = {l.nj, 0};
-    int nd = 1;
-    if (which == kNu) dims[0] = l.m;
-    if (which == kLinkAcc) {
-      dims[0] = l.ns + 1;
-      dims[1] = 6;
-      nd = 2;
-    }
-    const int type = which == kStatus ? py::detail::npy_api::NPY_INT_ : py::detail::npy_api::NPY_DOUBLE_;
-    r->views[which] = makeView(r, offsetOf(l, which), nd, dims, type);
-    if (r->views[which] == nullptr) return nullptr;
+  const ResultLayout& l = r->layout;
+  Py_ssize_t dims[2] = {l.nj, 0};
+  int nd = 1;
+  if (which == kNu) dims[0] = l.m;
+  if (which == kLinkAcc) {
+    dims[0] = l.ns + 1;
+    dims[1] = 6;
+    nd = 2;
   }
-  Py_INCREF(r->views[which]);
-  return r->views[which];
+  const int type = which == kStatus ? py::detail::npy_api::NPY_INT_ : py::detail::npy_api::NPY_DOUBLE_;
+  return makeView(r, offsetOf(l, which), nd, dims, type);
 }
 
 PyObject* getRank(PyObject* o, void*) { return PyLong_FromLong(self(o)->rank); }
@@ -144,7 +125,7 @@ PyObject* getIterations(PyObject* o, void*) {
 PyObject* getSegmentNu(PyObject* o, void*) {
   ResultObject* r = self(o);
   if (r->segment_keys == nullptr) Py_RETURN_NONE;
-  if (r->segment_nu == nullptr) {
+  {
     try {
       py::object nu = py::reinterpret_steal<py::object>(getView(o, reinterpret_cast<void*>(kNu)));
       if (!nu) throw py::error_already_set();
@@ -156,14 +137,12 @@ PyObject* getSegmentNu(PyObject* o, void*) {
         const Py_ssize_t a = starts[k].cast<Py_ssize_t>(), c = counts[k].cast<Py_ssize_t>();
         d[keys[k]] = nu[py::slice(a, a + c, 1)];
       }
-      r->segment_nu = d.release().ptr();
+      return d.release().ptr();
     } catch (py::error_already_set& e) {
       e.restore();
       return nullptr;
     }
   }
-  Py_INCREF(r->segment_nu);
-  return r->segment_nu;
 }
 
 PyObject* repr(PyObject* o) {
@@ -174,9 +153,10 @@ PyObject* repr(PyObject* o) {
   return PyUnicode_FromString(s.c_str());
 }
 
-PyObject* stateTuple(PyObject* o, bool copy_buffer) {
+PyObject* stateTuple(PyObject* o) {
   const ResultObject* r = self(o);
-  PyObject* buf = copy_buffer ? py::detail::npy_api::get().PyArray_NewCopy_(r->buffer, 0) : (Py_INCREF(r->buffer), r->buffer);
+  PyObject* buf = PyBytes_FromStringAndSize(reinterpret_cast<const char*>(r->data),
+                                            static_cast<Py_ssize_t>(sizeof(double)) * bufferDoubles(r->layout));
   if (buf == nullptr) return nullptr;
   auto orNone = [](PyObject* x) { PyObject* v = x ? x : Py_None; Py_INCREF(v); return v; };
   return Py_BuildValue("(iiiiddiiNNNN)", r->layout.nj, r->layout.ns, r->layout.m, static_cast<int>(r->layout.friction),
@@ -193,12 +173,12 @@ PyObject* fromState(PyObject*, PyObject* args) {
     l.ns = t[1].cast<int>();
     l.m = t[2].cast<int>();
     l.friction = t[3].cast<int>() != 0;
-    py::array_t<double, py::array::c_style | py::array::forcecast> buf(t[8]);
-    if (buf.ndim() != 1 || buf.size() != bufferDoubles(l)) throw SolverError("SolveResult state: buffer of the wrong size");
-    PyObject* own = py::detail::npy_api::get().PyArray_NewCopy_(buf.ptr(), 0);
-    if (own == nullptr) throw py::error_already_set();
-    PyObject* o = allocate(l, own);
+    const std::string buf = t[8].cast<std::string>();
+    if (l.nj < 0 || l.ns < 0 || l.m < 0 || buf.size() != sizeof(double) * static_cast<std::size_t>(bufferDoubles(l)))
+      throw SolverError("SolveResult state: data of the wrong size");
+    PyObject* o = allocate(l);
     ResultObject* r = self(o);
+    std::memcpy(r->data, buf.data(), buf.size());
     r->smin = t[4].cast<double>();
     r->gauss = t[5].cast<double>();
     r->rank = t[6].cast<int>();
@@ -222,13 +202,13 @@ PyObject* fromState(PyObject*, PyObject* args) {
 PyObject* g_from_state = nullptr;
 
 PyObject* reduce(PyObject* o, PyObject*) {
-  PyObject* state = stateTuple(o, false);
+  PyObject* state = stateTuple(o);
   if (state == nullptr) return nullptr;
   return Py_BuildValue("(ON)", g_from_state, state);
 }
 
 PyObject* copyResult(PyObject* o, PyObject*) {
-  PyObject* state = stateTuple(o, true);
+  PyObject* state = stateTuple(o);
   if (state == nullptr) return nullptr;
   PyObject* r = fromState(nullptr, state);
   Py_DECREF(state);
@@ -254,8 +234,8 @@ PyGetSetDef g_getset[] = {
 
 PyMethodDef g_methods[] = {
     {"__reduce__", reduce, METH_NOARGS, "Pickle support."},
-    {"__copy__", copyResult, METH_NOARGS, "An independent copy (its own buffer)."},
-    {"__deepcopy__", deepcopyResult, METH_O, "An independent copy (its own buffer)."},
+    {"__copy__", copyResult, METH_NOARGS, "An independent copy (its own data)."},
+    {"__deepcopy__", deepcopyResult, METH_O, "An independent copy (its own data)."},
     {nullptr, nullptr, 0, nullptr}};
 
 PyMethodDef g_from_state_def = {"_result_from_state", fromState, METH_VARARGS, "Unpickle a SolveResult."};
@@ -269,7 +249,8 @@ void bindResultType(py::module_& mod) {
                                 {Py_tp_methods, g_methods},
                                 {Py_tp_doc, const_cast<char*>(docs::kSolveResult)},
                                 {0, nullptr}};
-  static PyType_Spec spec = {"vereshchagin._core.SolveResult", sizeof(ResultObject), 0, Py_TPFLAGS_DEFAULT, slots};
+  static PyType_Spec spec = {"vereshchagin._core.SolveResult", static_cast<int>(offsetof(ResultObject, data)),
+                             static_cast<int>(sizeof(double)), Py_TPFLAGS_DEFAULT, slots};
   PyObject* type = PyType_FromSpec(&spec);
   if (type == nullptr) throw py::error_already_set();
   g_type = reinterpret_cast<PyTypeObject*>(type);
@@ -280,7 +261,7 @@ void bindResultType(py::module_& mod) {
 }
 
 py::object newResult(const ResultLayout& layout, PyObject* out) {
-  if (out == nullptr) return py::reinterpret_steal<py::object>(allocate(layout, newBuffer(bufferDoubles(layout))));
+  if (out == nullptr) return py::reinterpret_steal<py::object>(allocate(layout));
   if (Py_TYPE(out) != g_type)
     throw SolverError("out must be a SolveResult returned by an earlier solve(), got " +
                       std::string(Py_TYPE(out)->tp_name));
@@ -290,7 +271,6 @@ py::object newResult(const ResultLayout& layout, PyObject* out) {
     throw SolverError("out does not fit this solve: it holds m = " + std::to_string(l.m) + (l.friction ? " with" : " without") +
                       " friction, this solve has m = " + std::to_string(layout.m) +
                       (layout.friction ? " with" : " without") + " friction");
-  Py_CLEAR(r->segment_nu);
   Py_CLEAR(r->segment_keys);
   Py_CLEAR(r->segment_starts);
   Py_CLEAR(r->segment_counts);

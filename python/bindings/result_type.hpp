@@ -1,7 +1,6 @@
-// vereshchagin.SolveResult: a small CPython type holding every numeric output of one solve in one
-// float64 buffer. Its array fields are views of that buffer, made on first access and cached, so
-// a solve allocates two objects (result and buffer) whatever the number of outputs, and
-// `out=` reuses both.
+// vereshchagin.SolveResult: a small CPython type holding every numeric output of one solve in
+// float64 storage allocated with the object. Its array fields are views of that storage made on
+// access, so a solve allocates one object whatever the number of outputs, and `out=` reuses it.
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -24,7 +23,7 @@ struct ResultPointers {
 // Registers the type on `mod` (as SolveResult) and _result_from_state for unpickling.
 void bindResultType(py::module_& mod);
 
-// A new result for `layout` (buffer uninitialised), or `out` after checking that it is a
+// A new result for `layout` (data uninitialised), or `out` after checking that it is a
 // SolveResult of the same layout (raises SolverError otherwise). Returns a new reference.
 py::object newResult(const ResultLayout& layout, PyObject* out);
 ResultPointers resultPointers(PyObject* result);

@@ -235,6 +235,20 @@ void bindArguments(const char* fname, PyObject* const* args, Py_ssize_t nargs, P
   }
 }
 
+// The PySolver of a Solver instance (the method descriptor guarantees the type; a subclass whose
+// __init__ did not call the base one has no value yet).
+PySolver& solverOf(PyObject* self) {
+  auto* inst = reinterpret_cast<py::detail::instance*>(self);
+  void* value = nullptr;
+  if (inst->simple_layout) {
+    if (inst->simple_holder_constructed) value = inst->simple_value_holder[0];
+  } else {
+    value = inst->get_value_and_holder().value_ptr();
+  }
+  if (value == nullptr) throw py::type_error("Solver.__init__ was not called on this instance");
+  return *static_cast<PySolver*>(value);
+}
+
 // Runs `body`, turning C++ exceptions into Python ones (SolverError for our messages).
 template <typename Body>
 PyObject* guarded(Body&& body) {
@@ -258,7 +272,7 @@ PyObject* solveEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, Py
   return guarded([&]() -> py::object {
     PyObject* a[kNumSolveParams] = {};
     bindArguments("solve", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    PySolver& s = py::handle(self).cast<PySolver&>();
+    PySolver& s = solverOf(self);
     auto lk = s.lock();
     s.parse(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], s.parsed);
     s.runParsed(s.parsed);
@@ -275,7 +289,7 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
     const long reps = py::handle(args[0]).cast<long>();
     PyObject* a[kNumSolveParams] = {};
     bindArguments("_time_cpp", args + 1, nargs - 1, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    PySolver& s = py::handle(self).cast<PySolver&>();
+    PySolver& s = solverOf(self);
     auto lk = s.lock();
     ParsedSolve p;
     s.parse(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], p);

@@ -7,12 +7,13 @@ feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL
 """
 from ._core import Chain, Joint, SolveResult, SolverError
 from . import robots, task
+from ._version import __version__ as __version__  # written once: CMakeLists.txt
 from .friction import Friction
-from .solver import BatchResult, Solver
 from .kdl_interop import chain_from_kdl as _chain_from_kdl, chain_to_kdl as _chain_to_kdl
+from .solver import BatchResult, Solver
 
-Chain.from_kdl = staticmethod(_chain_from_kdl)  # PyKDL interoperability (kdl_interop.py)
-Chain.to_kdl = _chain_to_kdl
+# PyKDL interoperability (kdl_interop.py), attached to the compiled class.
+setattr(Chain, "from_kdl", staticmethod(_chain_from_kdl))
+setattr(Chain, "to_kdl", _chain_to_kdl)
 
 __all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
-from ._version import __version__ as __version__  # written once: CMakeLists.txt

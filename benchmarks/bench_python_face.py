@@ -1,0 +1,200 @@
+#!/usr/bin/env python3
+"""Python benchmark: the cost of the Python face over the C++ solve, and batch throughput.
+
+Chains and states as in bench_pinocchio.py (the Kinova Gen3 7-DoF table and a seeded random 7-joint
+chain; 64 seeded states; m = 0, 1, 6 orthonormal constraint columns on the last segment). Friction
+cases: the same states with joints 2, 4, 6 (1-based: every second joint) at rest and static
+friction 0.5-2 N m, m = 0 and 1.
+
+Timed per call, all in one process, interleaved batches (A B C A B C ...), medians:
+  C++ solve        Solver._time_cpp: the C++ Engine::run + reading every output solve() returns
+                   (link accelerations; with friction also friction/limit torques, status,
+                   gauss_value), looped in C++ with the GIL released
+  py solve         solver.solve(q, qd, alpha=alpha, beta=beta, tau_ff=tau) with keyword arguments as
+                   the README writes them (m = 0: solver.solve(q, qd, tau_ff=tau))
+  py solve + qdd   the same and reading res.qdd (result arrays are views made on first access)
+  py out=          solver.solve(..., out=res): the result reused in place
+  pin              m = 0: pin.aba(model, data, q, v, tau); m > 0: the Pinocchio pipeline of
+                   bench_pinocchio.py (computeAllTerms, frame Jacobian and acceleration,
+                   forwardDynamics); friction rows: none (Pinocchio has no exact max-min)
+  batch            solve_batch over 1024 rows (the 64 states 16 times), per row, threads=1 and 2
+
+Usage: python benchmarks/bench_python_face.py [--out FILE] [--batches N] [--batch-ms MS]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+import pinocchio as pin
+
+import vereshchagin as vs
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_pinocchio import (LWA, N_STATES, UP, build_ours, build_pinocchio, gen3_segments,  # noqa: E402
+                             make_states, paired_ratio, random_segments, time_group)
+
+BATCH_ROWS = 1024
+
+
+def case_rows(label, segs, seed, batches, batch_s):
+    solver = build_ours(segs)
+    model, fid = build_pinocchio(segs)
+    data = model.createData()
+    n = model.nv
+    states = make_states(n, seed)
+    rng = np.random.default_rng(seed + 7)
+    static = rng.uniform(0.5, 2.0, n)
+    friction = vs.Friction(static=static)
+    rest = np.zeros(n, bool)
+    rest[1::2] = True
+    rows = []
+    cases = [(m, False) for m in (0, 1, 6)] + [(m, True) for m in (0, 1)]
+    for m, with_friction in cases:
+        calls = []
+        for q, qd, tau, tasks in states:
+            qd = np.where(rest, 0.0, qd) if with_friction else qd
+            kw = dict(tau_ff=tau)
+            if m:
+                kw.update(alpha=tasks[m][0], beta=tasks[m][1])
+            if with_friction:
+                kw["friction"] = friction
+            calls.append((q, qd, kw, tasks.get(m), tau))
+        outs = [solver.solve(q, qd, **kw) for q, qd, kw, _, _ in calls]
+
+        def cpp(reps):
+            for q, qd, kw, _, _ in calls:
+                solver._time_cpp(reps, q, qd, **kw)
+
+        def py(reps):
+            for _ in range(reps):
+                for q, qd, kw, _, _ in calls:
+                    solver.solve(q, qd, **kw)
+
+        def py_read(reps):
+            for _ in range(reps):
+                for q, qd, kw, _, _ in calls:
+                    solver.solve(q, qd, **kw).qdd
+
+        def py_out(reps):
+            for _ in range(reps):
+                for (q, qd, kw, _, _), out in zip(calls, outs):
+                    solver.solve(q, qd, out=out, **kw)
+
+        variants = {"cpp": cpp, "py": py, "py+qdd": py_read, "out": py_out}
+        if not with_friction:
+            if m == 0:
+                pin_args = [(model, data, q, qd, tau) for q, qd, _, _, tau in calls]
+
+                def pin_run(reps):
+                    for _ in range(reps):
+                        for a in pin_args:
+                            pin.aba(*a)
+            else:
+                def pipeline(q, qd, tau, alpha, beta):
+                    pin.computeAllTerms(model, data, q, qd)
+                    J = alpha.T @ pin.getFrameJacobian(model, data, fid, LWA)
+                    gamma = alpha.T @ (pin.getFrameAcceleration(model, data, fid, LWA).vector + UP) - beta
+                    return pin.forwardDynamics(model, data, tau, J, gamma)
+
+                def pin_run(reps):
+                    for _ in range(reps):
+                        for q, qd, _, task, tau in calls:
+                            pipeline(q, qd, tau, *task)
+            variants["pin"] = pin_run
+        print(f"timing {label}, m {m}{' friction' if with_friction else ''} ...", file=sys.stderr, flush=True)
+        us = time_group(variants, batches, batch_s)
+        med = {k: statistics.median(v) for k, v in us.items()}
+        row = dict(label=label, m=m, friction=with_friction, **med,
+                   overhead=statistics.median(p - c for p, c in zip(us["py"], us["cpp"])),
+                   overhead_read=statistics.median(p - c for p, c in zip(us["py+qdd"], us["cpp"])))
+        if "pin" in us:
+            row["r_pin"] = paired_ratio(us["py+qdd"], us["pin"])
+        row.update(batch_rows(solver, calls, batches))
+        rows.append(row)
+    return rows
+
+
+def batch_rows(solver, calls, batches):
+    """solve_batch per row (threads 1 and 2) and its ratio to the C++ single solve."""
+    reps = BATCH_ROWS // len(calls)
+    Q = np.tile(np.array([c[0] for c in calls]), (reps, 1))
+    QD = np.tile(np.array([c[1] for c in calls]), (reps, 1))
+    kw0 = calls[0][2]
+    kw = dict(tau_ff=np.tile(np.array([c[2]["tau_ff"] for c in calls]), (reps, 1)))
+    if "alpha" in kw0:
+        kw["alpha"] = np.tile(np.array([c[2]["alpha"] for c in calls]), (reps, 1, 1))
+        kw["beta"] = np.tile(np.array([c[2]["beta"] for c in calls]), (reps, 1))
+    if "friction" in kw0:
+        kw["friction"] = kw0["friction"]
+    t1, t2 = [], []
+    for _ in range(max(5, batches // 3)):
+        for threads, sink in ((1, t1), (2, t2)):
+            t0 = time.perf_counter()
+            solver.solve_batch(Q, QD, threads=threads, **kw)
+            sink.append((time.perf_counter() - t0) * 1e6 / len(Q))
+    return {"batch1": statistics.median(t1), "batch2": statistics.median(t2),
+            "speedup": statistics.median(a / b for a, b in zip(t1, t2))}
+
+
+def report(rows, batches, batch_s, wall):
+    out = ["## Python face: overhead over the C++ solve, batch throughput", ""]
+    out.append(f"Python {sys.version.split()[0]}, numpy {np.__version__}, pinocchio {pin.__version__}, "
+               f"{os.cpu_count()} cores, load average {' '.join(open('/proc/loadavg').read().split()[:3])} at the "
+               f"end. {N_STATES} seeded states per chain; {batches} interleaved batches of about "
+               f"{batch_s * 1e3:.0f} ms per variant, medians; overhead = median over batches of (Python - C++) in "
+               f"the same batch round. Run time {wall:.0f} s.")
+    out.append("")
+    out.append("Columns (microseconds per call): `C++` = the C++ solve and reading every output `solve()` returns, "
+               "looped in C++ (`Solver._time_cpp`); `py` = `solver.solve(q, qd, alpha=alpha, beta=beta, "
+               "tau_ff=tau)` (keywords as in the README); `py + qdd` = the same and reading `.qdd`; `out=` = "
+               "the result reused in place; `pin` = `pin.aba` (m = 0) or the Pinocchio pipeline (m > 0, see "
+               "the Pinocchio section); `batch` = `solve_batch` per row over 1024 rows with `threads=1` and `2`; "
+               "`speedup` = threads=1 time / threads=2 time.")
+    out.append("")
+    out.append("| chain | m | friction | C++ us | py us | py + qdd us | out= us | overhead us | overhead + qdd us | "
+               "pin us | py + qdd / pin | batch/row t=1 us | batch t=1 / C++ | batch t=2 us | speedup t=2 |")
+    out.append("|---|---|---|" + "---:|" * 12)
+    for r in rows:
+        pin_us = f"{r['pin']:.2f}" if "pin" in r else "-"
+        ratio = f"{r['r_pin']:.2f}" if "r_pin" in r else "-"
+        out.append(f"| {r['label']} | {r['m']} | {'yes' if r['friction'] else 'no'} | {r['cpp']:.2f} | {r['py']:.2f} | "
+                   f"{r['py+qdd']:.2f} | {r['out']:.2f} | {r['overhead']:.2f} | {r['overhead_read']:.2f} | {pin_us} | "
+                   f"{ratio} | {r['batch1']:.2f} | {r['batch1'] / r['cpp']:.2f} | {r['batch2']:.2f} | "
+                   f"{r['speedup']:.2f} |")
+    out.append("")
+    worst = max(r["overhead_read"] for r in rows)
+    aba = [r["r_pin"] for r in rows if r["m"] == 0 and "r_pin" in r]
+    m6 = [r["r_pin"] for r in rows if r["m"] == 6 and "r_pin" in r]
+    batch = max(r["batch1"] / r["cpp"] for r in rows)
+    speed = min(r["speedup"] for r in rows)
+    out.append(f"Targets: overhead (with reading qdd) <= 1.0 us: worst {worst:.2f} us; solve at m = 0 / pin.aba <= 1.0: "
+               f"{', '.join(f'{x:.2f}' for x in aba)}; m = 6 / Pinocchio pipeline <= 0.5: "
+               f"{', '.join(f'{x:.2f}' for x in m6)}; batch row / C++ solve <= 1.15: worst {batch:.2f}; threads=2 "
+               f">= 1.7x: worst {speed:.2f}.")
+    return "\n".join(out) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out")
+    ap.add_argument("--batches", type=int, default=21)
+    ap.add_argument("--batch-ms", type=float, default=10.0)
+    args = ap.parse_args()
+    t0 = time.perf_counter()
+    rows = case_rows("7 (Gen3)", gen3_segments(), 1000, args.batches, args.batch_ms * 1e-3)
+    rows += case_rows("7 (random)", random_segments(7, 0x5EED0000 + 7), 1007, args.batches, args.batch_ms * 1e-3)
+    text = report(rows, args.batches, args.batch_ms * 1e-3, time.perf_counter() - t0)
+    print(text)
+    if args.out:
+        with open(args.out, "w") as f:
+            f.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
