@@ -422,3 +422,33 @@ def test_pickle_and_deepcopy_round_trip_and_solve_in_a_child_process(panda):
     for k, v in fields(ref).items():  # the same numbers, bit for bit, in another process
         np.testing.assert_array_equal(fields(a)[k], v, err_msg=k)
     assert_same(fields(b), fields(vs.Solver(chain).solve(*args, friction=fr)))
+
+
+# ------------------------------------------------------------------------------------------------
+# Optional parts: the CLI names the extra to install instead of a traceback
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("case,module,extra", [("contact", "mujoco", "experiments"),
+                                               ("friction", "matplotlib", "experiments"),
+                                               ("all", "mujoco", "experiments")])
+def test_cli_names_the_extra_when_an_optional_package_is_missing(case, module, extra, tmp_path):
+    import subprocess
+    import sys
+
+    # A child interpreter in which `module` cannot be found (a meta-path finder that refuses it).
+    code = (
+        "import sys, importlib.abc\n"
+        "class Block(importlib.abc.MetaPathFinder):\n"
+        f"    def find_spec(self, name, path=None, target=None):\n"
+        f"        if name == {module!r} or name.startswith({module!r} + '.'):\n"
+        "            raise ModuleNotFoundError(name)\n"
+        "        return None\n"
+        "sys.meta_path.insert(0, Block())\n"
+        "import importlib.util\n"
+        "_orig = importlib.util.find_spec\n"
+        f"importlib.util.find_spec = lambda n, *a: None if n == {module!r} else _orig(n, *a)\n"
+        "from vereshchagin.__main__ import main\n"
+        f"sys.exit(main(['reproduce', '--quick', '--case', {case!r}, '--out', {str(tmp_path)!r}]))\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    assert f"vereshchagin[{extra}]" in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+    assert not any(tmp_path.iterdir()), "nothing is run or written when a dependency is missing"

@@ -113,6 +113,13 @@ def main(argv=None) -> int:
         run()
         return 0
     if args.command == "reproduce":
+        from ._optional import CASE_NEEDS, missing_message
+
+        cases = CASE_NEEDS if args.case == "all" else {args.case: CASE_NEEDS[args.case]}
+        message = missing_message(sorted({m for needs in cases.values() for m in needs}))
+        if message:
+            print(f"vereshchagin reproduce --case {args.case}: {message}", file=sys.stderr)
+            return 2
         return reproduce(args.out, quick=args.quick, case=args.case)
     return 2  # pragma: no cover
 
