@@ -13,7 +13,7 @@ from .kdl_interop import chain_from_kdl as _chain_from_kdl, chain_to_kdl as _cha
 from .solver import BatchResult, Solver
 
 # PyKDL interoperability (kdl_interop.py), attached to the compiled class.
-setattr(Chain, "from_kdl", staticmethod(_chain_from_kdl))
-setattr(Chain, "to_kdl", _chain_to_kdl)
+Chain.from_kdl = staticmethod(_chain_from_kdl)  # type: ignore[method-assign]
+Chain.to_kdl = _chain_to_kdl  # type: ignore[method-assign,assignment]
 
 __all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
