@@ -161,7 +161,7 @@ PyChain::Target PyChain::resolveTarget(PyObject* which, const std::string& label
       if (l.link == name) {
         t.segment = l.segment;  // -1: a link of the base
         t.link_in_tip = l.in_segment_tip;
-        t.merged = l.segment >= 0 && !KDL::Equal(l.in_segment_tip.p, KDL::Vector::Zero(), 0.0);
+        t.merged = l.segment >= 0 && l.in_segment_tip.p.Norm() != 0.0;
         return t;
       }
     }

@@ -38,6 +38,7 @@ inline std::string shapeStr(const py::array& a) {
 // numbers) are converted; bool, complex, string and object values raise naming `name`.
 inline Array toArray(const py::handle& obj, const char* name) {
   if (PyBool_Check(obj.ptr())) raise(std::string(name) + " must be a real number or array, got bool");
+  if (obj.is_none()) raise(std::string(name) + " must be a real array, got None");
   py::array any = py::array::ensure(obj);
   if (!any) {
     PyErr_Clear();

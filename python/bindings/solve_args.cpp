@@ -127,7 +127,7 @@ void PySolver::parseConstraints(PyObject* constraints, ParsedSolve& p) const {
     const PyChain::Target t = chain_.resolveMoving(key, label);
     for (std::size_t k = 0; k < p.block_keys.size(); ++k) {
       const ConstraintBlock& other = p.blocks[p.blocks.size() - p.block_keys.size() + k];
-      if (other.segment == t.segment && KDL::Equal(other.offset, t.link_in_tip.p, 0.0))
+      if (other.segment == t.segment && (other.offset - t.link_in_tip.p).Norm() == 0.0)
         raise(label + ": the same frame as constraints[" + keyRepr(p.block_keys[k].ptr()) +
               "] (one entry per frame: put all its columns in one alpha)");
     }

@@ -187,7 +187,7 @@ struct BatchRunner {
       const PyChain::Target t = s.chain_.resolveMoving(key, label);
       for (std::size_t k = 0; k < key_block.size(); ++k) {
         const ConstraintBlock& other = block_template[key_block[k]];
-        if (other.segment == t.segment && KDL::Equal(other.offset, t.link_in_tip.p, 0.0))
+        if (other.segment == t.segment && (other.offset - t.link_in_tip.p).Norm() == 0.0)
           raise(label + ": the same frame as constraints[" + py::repr(block_keys[k]).cast<std::string>() + "]");
       }
       if ((!PyTuple_Check(value) && !PyList_Check(value)) || PySequence_Size(value) != 2)

@@ -13,7 +13,10 @@ def _frozen_vector(value, name: str, allow_inf: bool = False) -> Optional[np.nda
     """A read-only float64 copy of a 1-D real array (None stays None)."""
     if value is None:
         return None
-    a = np.asarray(value)
+    try:
+        a = np.asarray(value)
+    except (ValueError, TypeError) as e:  # ragged nested sequences and the like
+        raise SolverError(f"friction.{name} must be a 1-D array of real numbers: {e}") from None
     if a.dtype.kind not in "iuf":
         raise SolverError(f"friction.{name} must hold real numbers (int or float), got dtype {a.dtype}")
     if a.ndim != 1:
