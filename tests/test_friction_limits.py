@@ -17,7 +17,7 @@ def arm():
     chain = vs.Chain()
     tip = np.eye(4)
     tip[0, 3] = 1.0
-    chain.add_segment("link", "rot_z", tip=tip, mass=1.0, com=[-0.5, 0, 0], inertia=np.diag([0, 0, 2.0]))
+    chain.add_segment("link", "rot_z", tip=tip, mass=1.0, com=[-0.5, 0, 0], inertia=np.diag([1.0, 1.0, 2.0]))
     return vs.Solver(chain, gravity=[0, 0, 0])
 
 

@@ -122,8 +122,10 @@ def robot(*parts):
 
 def inertia_matrix(rng):
     """A random valid (PSD, triangle inequality) inertia tensor with products of inertia."""
-    a, b, c = rng.uniform(0.02, 0.2, 3)
-    c = min(c, a + b - 1e-3)
+    while True:  # principal moments with every triangle inequality (a margin of 1e-3)
+        a, b, c = rng.uniform(0.02, 0.2, 3)
+        if min(a + b - c, b + c - a, a + c - b) >= 1e-3:
+            break
     Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     I = Q @ np.diag([a, b, c]) @ Q.T
     return 0.5 * (I + I.T)

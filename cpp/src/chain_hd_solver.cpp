@@ -66,8 +66,13 @@ int ChainHdSolver::setOptions(const SolverOptions& options) {
                 "options.damping must be finite and > 0 for the damped least-squares policy, got %g",
                 options.damping);
   }
+  const bool rebuild = options.inertia_check != options_.inertia_check;
   options_ = options;
   solved_ = false;
+  if (rebuild) {
+    buildModel();
+    return model_error_;
+  }
   return E_NOERROR;
 }
 
@@ -116,6 +121,10 @@ void ChainHdSolver::buildModel() {
   zero_f_ext_ = Matrix6X::Zero(6, ns_);
   alfa_buf_.setZero();
   mcap_ = std::max<int>(kMaxConstraints, kMaxConstraints * static_cast<int>(ns_));
+  pt_f_ = pt_t_ = pt_energy_ = pt_tmp_ = Eigen::VectorXd::Zero(mcap_);
+  pt_free_ = Eigen::VectorXd::Zero(nj_);
+  pt_m_ = -1;  // weights are per column of a model: cleared with it
+  pt_f_any_ = pt_t_any_ = pt_used_ = false;
   general_ = false;
   order_ = Eigen::VectorXi::Zero(mcap_);
   seg_count_ = Eigen::VectorXi::Zero(ns_);
@@ -148,35 +157,21 @@ void ChainHdSolver::buildModel() {
     const KDL::RotationalInertia Io = rbi.getRotationalInertia();  // about the tip origin
     Vector3 c(cog.x(), cog.y(), cog.z());
     Matrix3 I_origin = Eigen::Map<const Matrix3>(Io.data);
-    if (!std::isfinite(mass) || !c.allFinite() || !I_origin.allFinite()) {
+    if (!c.allFinite()) {
       model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): non-finite inertial parameters", i,
                           seg.getName().c_str());
       return;
     }
-    if (mass < 0.0) {
-      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): mass must be >= 0, got %g", i,
-                          seg.getName().c_str(), mass);
-      return;
-    }
-    // Rotational inertia about the centre of mass must be symmetric positive semi-definite.
+    // Rotational inertia about the centre of mass, checked as options_.inertia_check says.
     const Matrix3 Sc = skew(c);
     const Matrix3 I_com = I_origin + mass * Sc * Sc;
-    const double tol = 1e-12 * std::max(1.0, I_com.cwiseAbs().maxCoeff());
-    if ((I_com - I_com.transpose()).cwiseAbs().maxCoeff() > tol) {
-      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): rotational inertia is not symmetric",
-                          i, seg.getName().c_str());
-      return;
-    }
-    Eigen::SelfAdjointEigenSolver<Matrix3> es(I_com, Eigen::EigenvaluesOnly);
-    if (es.eigenvalues().minCoeff() < -tol) {
-      model_error_ = fail(E_INVALID_MODEL,
-                          "segment %u ('%s'): rotational inertia about the centre of mass is not "
-                          "positive semi-definite (smallest eigenvalue %g)",
-                          i, seg.getName().c_str(), es.eigenvalues().minCoeff());
+    std::array<char, 320> why_buf{};
+    if (const char* why = detail::inertiaProblem(mass, I_com, options_.inertia_check, why_buf.data(), why_buf.size())) {
+      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): %s", i, seg.getName().c_str(), why);
       return;
     }
     s.I = rigidInertia(mass, c, 0.5 * (I_origin + I_origin.transpose()));
-    scale += I_com.trace() + mass * (c.squaredNorm() + seg.getFrameToTip().p.Norm() *
+    scale += I_com.cwiseAbs().trace() + mass * (c.squaredNorm() + seg.getFrameToTip().p.Norm() *
                                                            seg.getFrameToTip().p.Norm());
     s.X0 = toPose(seg.pose(0.0));
     if (joint.getType() == KDL::Joint::Fixed) {
@@ -420,10 +415,17 @@ int ChainHdSolver::checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu, con
 
 int ChainHdSolver::degenerate(int i) {
   const Segment& s = segs_[i];
+  const char* name = chain_.getSegment(i).getJoint().getName().c_str();
+  if (options_.inertia_check == InertiaCheck::JointSpace && s.D < 0.0)
+    return fail(E_DEGENERATE_INERTIA,
+                "joint %d ('%s') has articulated inertia D = %g <= 0 at this configuration: the model's "
+                "joint-space inertia matrix is not positive definite here (inertia_check = joint_space "
+                "accepts non-physical link inertias only where it is)",
+                s.joint, name, s.D);
   return fail(E_DEGENERATE_INERTIA,
               "joint %d ('%s') has zero articulated inertia (%g): the bodies it moves have no "
               "mass or inertia about its axis and it has no rotor inertia",
-              s.joint, chain_.getSegment(i).getJoint().getName().c_str(), s.D);
+              s.joint, name, s.D);
 }
 
 // Final outward sweep of the end-segment path: the constraint forces through S^T A_i = e_i.
@@ -549,11 +551,14 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
   outwardSweep(q, q_dot, f_ext);
   rc = inwardSweep(alfa, ff_torques);
   if (rc != E_NOERROR) return rc;
+  rc = passThroughEnergy(f_ext, ff_torques);
+  if (rc != E_NOERROR) return rc;
 
   // Balance of acceleration energy at the base: A_0^T Xdd_0 + U_0 + L_0 nu = beta.
   factorizeCoupling();
   const int m = m_;
   VectorC rhs = U0_ - beta;  // nu = L0^-1 (beta - U0) = K^+ (U0 - beta), K = -L0
+  if (pt_used_) rhs -= pt_energy_.head(m);  // the drivers' parts that pass through
   applyCouplingInverse(rhs, nu_);
 
   switch (m) {
@@ -612,6 +617,23 @@ const ChainHdSolver::Matrix6X& ChainHdSolver::linkAccelerations() const {
   }
   return link_acc_;
 }
+
+namespace {
+KDL::Twist toTwist(const Vector6& v) {
+  return KDL::Twist(KDL::Vector(v(0), v(1), v(2)), KDL::Vector(v(3), v(4), v(5)));
+}
+}  // namespace
+
+KDL::Frame ChainHdSolver::linkLocalPose(unsigned int i) const {
+  const Pose& X = segs_[i].X;
+  return KDL::Frame(KDL::Rotation(X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0),
+                                  X.R(2, 1), X.R(2, 2)),
+                    KDL::Vector(X.p(0), X.p(1), X.p(2)));
+}
+
+KDL::Twist ChainHdSolver::linkLocalVelocity(unsigned int i) const { return toTwist(segs_[i].v); }
+
+KDL::Twist ChainHdSolver::linkLocalAcceleration(unsigned int i) const { return toTwist(segs_[i].xdd); }
 
 void ChainHdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot) const {
   x_dotdot.resize(ns_ + 1);

@@ -23,7 +23,7 @@ FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_a
     : hd_(chain, root_acc, options), free_(chain, root_acc, options) {
   nj_ = hd_.nrOfJoints();
   const int n = static_cast<int>(nj_);
-  qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = Eigen::VectorXd::Zero(n);
+  qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = ff_driver_ = Eigen::VectorXd::Zero(n);
   q_keep_ = qd_keep_ = fstatic_ = Eigen::VectorXd::Zero(n);
   f_keep_ = ChainHdSolver::Matrix6X::Zero(6, hd_.nrOfSegments());
   status_.assign(n, Moving);
@@ -44,6 +44,14 @@ int FrictionSolver::setOptions(const SolverOptions& options) {
   const int rc = hd_.setOptions(options);
   if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
   free_.setOptions(options);
+  return rc;
+}
+
+int FrictionSolver::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
+                                   const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
+  const int rc = hd_.setPassThrough(f_ext_pass_through, ff_pass_through);
+  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  solved_ = false;
   return rc;
 }
 
@@ -79,7 +87,12 @@ int FrictionSolver::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
                             const Eigen::Ref<const Eigen::VectorXi>* segments,
                             const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
                             const Eigen::Ref<const Eigen::VectorXd>& tau) {
-  return segments ? hd_.solve(q, q_dot, alfa, beta, *segments, f_ext, tau) : hd_.solve(q, q_dot, alfa, beta, f_ext, tau);
+  // The pass-through's feed-forward driver is ff_torques alone, not the friction in tau.
+  hd_.pt_driver_ = &ff_driver_;
+  const int rc =
+      segments ? hd_.solve(q, q_dot, alfa, beta, *segments, f_ext, tau) : hd_.solve(q, q_dot, alfa, beta, f_ext, tau);
+  hd_.pt_driver_ = nullptr;
+  return rc;
 }
 
 int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
@@ -134,7 +147,7 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
   }
   int k = 0;
   for (long j = 0; j < n; ++j) {
-    tau0_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
+    tau0_(j) = ff_driver_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
     if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
       tau0_(j) -= fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
       continue;

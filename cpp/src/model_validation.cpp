@@ -1,7 +1,11 @@
 // Geometric validity of a KDL segment. See model_validation.hpp.
 #include "model_validation.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+
+#include <Eigen/Eigenvalues>
 
 namespace vereshchagin {
 namespace detail {
@@ -37,6 +41,36 @@ const char* segmentGeometryProblem(const KDL::Segment& segment) {
   if (joint.getType() == KDL::Joint::RotAxis || joint.getType() == KDL::Joint::TransAxis) {
     if (!finite(joint.JointOrigin())) return "joint origin is not finite";
     if (!finite(joint.JointAxis())) return "joint axis is not finite";
+  }
+  return nullptr;
+}
+
+const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaCheck check, char* buf,
+                           std::size_t size) {
+  if (!std::isfinite(mass) || !I_com.allFinite()) return "inertial parameters are not finite";
+  if (mass < 0.0) {
+    std::snprintf(buf, size, "negative mass %g (must be >= 0)", mass);
+    return buf;
+  }
+  const double tol = 1e-12 * std::max(1.0, I_com.cwiseAbs().maxCoeff());
+  if ((I_com - I_com.transpose()).cwiseAbs().maxCoeff() > tol) return "rotational inertia is not symmetric";
+  if (check == InertiaCheck::JointSpace) return nullptr;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (I_com + I_com.transpose()), Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d I = es.eigenvalues();  // ascending
+  if (I(0) < -tol) {
+    std::snprintf(buf, size,
+                  "rotational inertia about the centre of mass is not positive semi-definite (principal "
+                  "moments %g, %g, %g); identified models are accepted with inertia_check = joint_space",
+                  I(0), I(1), I(2));
+    return buf;
+  }
+  if (I(0) + I(1) < I(2) - 1e-6 * I(2)) {
+    std::snprintf(buf, size,
+                  "principal moments of inertia about the centre of mass (%g, %g, %g) violate the triangle "
+                  "inequality I1 + I2 >= I3: no rigid body has them; identified models are accepted with "
+                  "inertia_check = joint_space",
+                  I(0), I(1), I(2));
+    return buf;
   }
   return nullptr;
 }

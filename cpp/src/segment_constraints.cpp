@@ -40,9 +40,15 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
     general_ = false;
     return rc;
   }
+  rc = passThroughEnergy(f_ext, ff_torques);
+  if (rc != E_NOERROR) {
+    general_ = false;
+    return rc;
+  }
   factorizeCouplingGeneral();
   const int m = m_;
   for (int k = 0; k < m; ++k) rhs_g_(k) = ug_(k) - beta(order_(k));  // nu = K^+ (U - beta)
+  if (pt_used_) rhs_g_.head(m) -= pt_energy_.head(m);  // the drivers' parts that pass through
   couplingSolve(rhs_g_.head(m), nug_.head(m));
   finalSweepGeneral(ff_torques);
   for (int k = 0; k < m; ++k) nu_user_(order_(k)) = nug_(k);

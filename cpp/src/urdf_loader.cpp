@@ -11,6 +11,8 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include "model_validation.hpp"
+
 namespace vereshchagin {
 
 namespace {
@@ -92,21 +94,16 @@ const char* typeName(int type) {
   }
 }
 
-// The link's own inertia in its link frame (zero if it has none), validated.
-KDL::RigidBodyInertia linkInertia(const urdf::Link& link) {
+// The link's own inertia in its link frame (zero if it has none), validated as `check` says.
+KDL::RigidBodyInertia linkInertia(const urdf::Link& link, InertiaCheck check) {
   if (!link.inertial) return KDL::RigidBodyInertia::Zero();
   const urdf::Inertial& in = *link.inertial;
-  Eigen::Matrix3d I;
+  Eigen::Matrix3d I;  // about the centre of mass, inertial-frame axes
   I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
-  if (!std::isfinite(in.mass) || !I.allFinite() || !finitePose(in.origin))
-    throw LoadError("link '" + link.name + "': <inertial> mass, inertia and origin must be finite");
-  if (in.mass < 0.0)
-    throw LoadError("link '" + link.name + "': negative mass " + std::to_string(in.mass));
-  const double scale = std::max(1e-300, I.cwiseAbs().maxCoeff());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I, Eigen::EigenvaluesOnly);
-  if (es.eigenvalues().minCoeff() < -1e-12 * scale)
-    throw LoadError("link '" + link.name + "': inertia tensor is not positive semi-definite (smallest eigenvalue " +
-                    std::to_string(es.eigenvalues().minCoeff()) + ")");
+  if (!finitePose(in.origin)) throw LoadError("link '" + link.name + "': <inertial> origin must be finite");
+  char buf[320];
+  if (const char* why = detail::inertiaProblem(in.mass, I, check, buf, sizeof buf))
+    throw LoadError("link '" + link.name + "': " + why);
   const KDL::Frame T = toFrame(in.origin);  // inertial frame in the link frame
   // Rotate the tensor to link axes: R I R^T.
   Eigen::Matrix3d R;
@@ -125,7 +122,8 @@ void collectLeaves(const urdf::Link& link, std::vector<std::string>& leaves) {
 
 class Builder {
  public:
-  Builder(const urdf::ModelInterface& model, RobotChain& out) : model_(model), out_(out) {}
+  Builder(const urdf::ModelInterface& model, RobotChain& out, InertiaCheck check)
+      : model_(model), out_(out), check_(check) {}
 
   void build(const std::string& root_name, const std::string& tip_name_in) {
     urdf::LinkConstSharedPtr root = model_.getLink(root_name);
@@ -206,7 +204,7 @@ class Builder {
       for (size_t i = k; i < end; ++i) {
         const KDL::Frame link_in_tip = tip_inv * in_child[i - k];
         out_.links.push_back({path[i]->name, seg_index, link_in_tip});
-        inertia = inertia + link_in_tip * linkInertia(*path[i]);
+        inertia = inertia + link_in_tip * linkInertia(*path[i], check_);
         // Side branches of this path link.
         for (const auto& child : path[i]->child_links) {
           if (i + 1 < end && child->name == path[i + 1]->name) continue;
@@ -269,7 +267,7 @@ class Builder {
       out_.notes.push_back("side branch through moving joint '" + j.name + "' lumped rigidly at position 0 into segment " +
                            std::to_string(seg));
     out_.links.push_back({link.name, seg, pose});
-    inertia = inertia + pose * linkInertia(link);
+    inertia = inertia + pose * linkInertia(link, check_);
     for (const auto& child : link.child_links)
       lumpSubtree(*child, pose * jointOrigin(*child->parent_joint), seg, inertia);
   }
@@ -283,6 +281,7 @@ class Builder {
 
   const urdf::ModelInterface& model_;
   RobotChain& out_;
+  InertiaCheck check_;
 };
 
 // urdfdom accepts some documents whose joints make a link its own ancestor (e.g. a joint whose
@@ -303,7 +302,7 @@ void checkAcyclic(const urdf::ModelInterface& model) {
   }
 }
 
-UrdfResult load(const std::string& xml, const std::string& root, const std::string& tip) {
+UrdfResult load(const std::string& xml, const std::string& root, const std::string& tip, const UrdfOptions& options) {
   UrdfResult result;
   std::string messages;
   urdf::ModelInterfaceSharedPtr model = parse(xml, messages);
@@ -315,7 +314,7 @@ UrdfResult load(const std::string& xml, const std::string& root, const std::stri
   }
   try {
     checkAcyclic(*model);
-    Builder(*model, result.robot).build(root.empty() ? model->getRoot()->name : root, tip);
+    Builder(*model, result.robot, options.inertia_check).build(root.empty() ? model->getRoot()->name : root, tip);
   } catch (const LoadError& e) {
     result.message = e.what();
     result.robot = RobotChain();
@@ -327,11 +326,13 @@ UrdfResult load(const std::string& xml, const std::string& root, const std::stri
 
 }  // namespace
 
-UrdfResult chainFromUrdfString(const std::string& xml, const std::string& root, const std::string& tip) {
-  return load(xml, root, tip);
+UrdfResult chainFromUrdfString(const std::string& xml, const std::string& root, const std::string& tip,
+                               const UrdfOptions& options) {
+  return load(xml, root, tip, options);
 }
 
-UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root, const std::string& tip) {
+UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root, const std::string& tip,
+                             const UrdfOptions& options) {
   std::ifstream in(path);
   if (!in) {
     UrdfResult r;
@@ -340,7 +341,7 @@ UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root, c
   }
   std::stringstream ss;
   ss << in.rdbuf();
-  return load(ss.str(), root, tip);
+  return load(ss.str(), root, tip, options);
 }
 
 }  // namespace vereshchagin

@@ -15,10 +15,11 @@ using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 using testutil::str;
 
 // Vukcevic 2018, sec. 6: 1 kg, 1 m link, COM at 0.5 m, joint-axis inertia 2.25 kg m^2, about z.
+// (Only the z moment matters; x and y are set so that the body is a rigid body: 1 + 1 >= 2.)
 KDL::Chain oneDof() {
   KDL::Chain ch;
   ch.addSegment(KDL::Segment("link", KDL::Joint("j", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
-                             KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(0, 0, 2.0, 0, 0, 0))));
+                             KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(1.0, 1.0, 2.0, 0, 0, 0))));
   return ch;
 }
 

@@ -9,6 +9,7 @@
 #include "test_common.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
 #include "vereshchagin/friction_solver.hpp"
+#include "vereshchagin/kdl_compat.hpp"
 
 
 namespace {
@@ -188,6 +189,59 @@ int main() {
     ck.check(g1.news == g0.news && g1.mallocs == g0.mallocs,
              "segment-constraint solves allocated: operator new " + str(g1.news - g0.news) + ", malloc " +
                  str(g1.mallocs - g0.mallocs));
+  }
+
+  // Driver pass-through (both paths, friction on top) and the KDL drop-in class (zero columns,
+  // driver weights, every getter with outputs of the right size).
+  {
+    vereshchagin::ChainHdSolver pt(chain, grav);
+    vereshchagin::FrictionSolver fpt(chain, grav);
+    vereshchagin::FrictionModel fm;
+    fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
+    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+    const Eigen::VectorXd w3 = Eigen::VectorXd::LinSpaced(3, 0.0, 1.0), w6 = Eigen::VectorXd::LinSpaced(6, 1.0, 0.2);
+    Eigen::VectorXi segs3(3);
+    segs3 << 2, static_cast<int>(ns) - 1, 4;
+    vereshchagin::kdl_compat::ChainHdSolver_Vereshchagin compat(chain, grav, 6);
+    KDL::Jacobian alfa_zero = alfa[6];
+    alfa_zero.data.col(2).setZero();
+    alfa_zero.data.col(4).setZero();
+    std::vector<KDL::Twist> tw(ns + 1), tw_n(ns);
+    std::vector<KDL::Frame> fr(ns);
+    Eigen::VectorXd nu6(6);
+    KDL::JntArray total(n);
+    ck.check(pt.setPassThrough(w3, w3.reverse()) == 0 && fpt.setPassThrough(w3, w3) == 0 &&
+                 compat.setDriverWeights(w6, w6.reverse()) == 0,
+             "pass-through weights accepted");
+    pt.solve(q[0].data, qd[0].data, alfa_m[3], beta[3].data, fext_m[0], ff[0].data);
+    fpt.solve(q[0].data, rest, alfa_m[3], beta[3].data, fext_m[0], ff[0].data, fm);
+    compat.CartToJnt(q[0], qd[0], qdd, alfa_zero, beta[6], fext[0], ff[0], tau);
+    double psum = 0.0;
+    int pfail = 0;
+    const Counts p0 = now();
+    for (int it = 0; it < 500; ++it) {
+      const int s = it % kSets;
+      if (pt.solve(q[s].data, qd[s].data, alfa_m[3], beta[3].data, fext_m[s], ff[s].data) != 0) ++pfail;
+      psum += pt.qdd()(0) + pt.nu()(1);
+      if (pt.solve(q[s].data, qd[s].data, alfa_m[3], beta[3].data, segs3, fext_m[s], ff[s].data) != 0) ++pfail;
+      psum += pt.qdd()(1);
+      if (fpt.solve(q[s].data, rest, alfa_m[3], beta[3].data, segs3, fext_m[s], ff[s].data, fm) != 0) ++pfail;
+      psum += fpt.qdd()(2);
+      if (compat.CartToJnt(q[s], qd[s], qdd, it % 2 ? alfa_zero : alfa[6], beta[6], fext[s], ff[s], tau) != 0) ++pfail;
+      compat.getTransformedLinkAcceleration(tw);
+      compat.getTotalTorque(total);
+      compat.getContraintForceMagnitude(nu6);
+      compat.getLinkCartesianPose(fr);
+      compat.getLinkCartesianVelocity(tw_n);
+      compat.getLinkAcceleration(tw_n);
+      psum += qdd(0) + tw[ns].vel.z() + total(0) + nu6(5) + fr[1].p.x() + tw_n[2].rot.x();
+    }
+    const Counts p1 = now();
+    ck.check(pfail == 0, "pass-through / drop-in solves failed: " + str(pfail));
+    ck.check(std::isfinite(psum), "non-finite pass-through results");
+    ck.check(p1.news == p0.news && p1.mallocs == p0.mallocs,
+             "pass-through / drop-in solves allocated: operator new " + str(p1.news - p0.news) + ", malloc " +
+                 str(p1.mallocs - p0.mallocs));
   }
 
   return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves + 2000 with segment constraints on a 7-joint chain, nc 0..6 (malloc counted too: ") +

@@ -67,6 +67,21 @@
 // tau_cmd = -sum_c J_{segments(c)}^T alfa_c nu_c. Rank and singularity policy as above (a full
 // Jacobi eigen-decomposition replaces Eigen's when K is not certified by Cholesky).
 //
+// Driver pass-through (Shakhimardanov, KU Leuven 2015, sec. 3.5.3, eq. 3.42: how much of each
+// driver's own acceleration energy the constraint balance credits): the constraint magnitudes
+// solve K nu = U - beta with U = a_nature + a_fext + a_ff the acceleration energy along the
+// constraint columns of the unconstrained arm, split by driver (a_nature: gravity as root_acc and
+// velocity products; a_fext: f_ext alone; a_ff: ff_torques alone, each with the others zero and
+// q_dot = 0 for the last two). setPassThrough(p_f, p_t) replaces it by
+//     K nu = a_nature + (1 - p_f) .* a_fext + (1 - p_t) .* a_ff - beta,
+// p in [0, 1] per column in the order of nu(): 0 (default) = the constraint compensates that
+// driver along that column (KDL's behaviour; results bit for bit as without weights); 1 = the
+// driver's own effect along that column passes through, alfa_c^T Xdd = beta_c + a_driver,c (a
+// commanded press of f_ext on a table, a support, feed-forward torques that should act along a
+// constrained direction); in between, linear. qdd, nu and the command torques follow from this nu
+// with all drivers acting, as always. responseColumns() is the response to joint torques that the
+// constraints compensate (pass-through 0, e.g. friction), whatever the weights.
+//
 // Real-time use: construction allocates everything; solve(), CartToJnt() and responseColumns()
 // allocate no heap memory and do bounded work. One instance is not thread-safe; use one per thread.
 #pragma once
@@ -83,6 +98,7 @@
 #include <kdl/solveri.hpp>
 #include <kdl/chainidsolver.hpp>  // KDL::Wrenches
 
+#include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/spatial.hpp"
 
 namespace vereshchagin {
@@ -95,6 +111,11 @@ struct SolverOptions {
   double rcond = 1e-12;
   // Damping of the damped-least-squares policy, in the eigenvalues' units (> 0 for that policy).
   double damping = 1e-6;
+  // Which inertial parameters the chain may have (inertia_check.hpp): Physical (default) checks
+  // every segment's rigid-body inertia when the model is built; JointSpace accepts identified
+  // models and instead requires every articulated joint inertia D_j > 0 at each solve.
+  // Changing it through setOptions() rebuilds the model.
+  InertiaCheck inertia_check = InertiaCheck::Physical;
 };
 
 class ChainHdSolver : public KDL::SolverI {
@@ -108,8 +129,9 @@ class ChainHdSolver : public KDL::SolverI {
   // Error codes in addition to KDL::SolverI's (E_SIZE_MISMATCH = -4, E_OUT_OF_RANGE = -6, ...).
   enum {
     E_NONFINITE_INPUT = -100,      // NaN or Inf in an input
-    E_INVALID_MODEL = -101,        // negative mass, non-PSD inertia, negative rotor inertia, ...
-    E_DEGENERATE_INERTIA = -102,   // a joint's articulated inertia is zero: no unique motion
+    E_INVALID_MODEL = -101,        // negative mass, inertia failing options.inertia_check, negative rotor inertia, ...
+    E_DEGENERATE_INERTIA = -102,   // a joint's articulated inertia D_j <= 0: no unique motion (zero),
+                                   // or H(q) not positive definite here (inertia_check JointSpace)
     E_TOO_MANY_CONSTRAINTS = -103, // alfa has more than 6 columns
     E_NO_SOLUTION = -104,          // responseColumns() called before a successful solve
     E_INVALID_OPTIONS = -105,      // rcond < 0, damping <= 0 for the damped policy, non-finite
@@ -154,6 +176,13 @@ class ChainHdSolver : public KDL::SolverI {
   }
   const Matrix6X& linkAccelerations() const;  // computed on first request after a solve
   int constraintCount() const { return m_; }
+  // Segment i's state at the last successful solve (i < nrOfSegments(), unchecked; unspecified before):
+  // the pose of its tip frame in its parent's tip frame (the base for i = 0), and its spatial
+  // velocity and acceleration (the latter including root_acc) in its own tip axes about its own
+  // tip origin. (KDL's getLinkPose / getLinkVelocity / getLinkAcceleration.)
+  KDL::Frame linkLocalPose(unsigned int i) const;
+  KDL::Twist linkLocalVelocity(unsigned int i) const;
+  KDL::Twist linkLocalAcceleration(unsigned int i) const;
   // Articulated inertia D_j of joint j (its own rotor plus everything it moves, with its parent
   // held) at the last solve: a lower bound of the unconstrained (H^-1)_jj is 1 / D_j.
   double articulatedInertia(unsigned int joint) const { return segs_[joint_segment_[joint]].D; }
@@ -181,7 +210,21 @@ class ChainHdSolver : public KDL::SolverI {
   // commandTorques() is commandTorquesOf(nu())). O(n m), no allocation.
   int commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
 
+  // Driver pass-through weights (see above), kept for the following solves: f_ext_pass_through
+  // and ff_pass_through (m entries each in [0, 1], the order of nu(), or empty: all 0). m is then
+  // the number of constraint columns every solve must have (else E_SIZE_MISMATCH) until
+  // clearPassThrough() or new weights. Returns E_OUT_OF_RANGE (weights unchanged) for entries
+  // outside [0, 1] or NaN, E_SIZE_MISMATCH for sizes (different non-zero sizes, or more than
+  // maxConstraints()). All-zero weights are the same as none. Rebuilding the model
+  // (updateInternalDataStructures(), setOptions() changing inertia_check) clears them.
+  int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
+                     const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
+  void clearPassThrough();
+  // Number of constraint columns the weights are for (-1: no weights set).
+  int passThroughColumns() const { return pt_m_; }
+
   void setRootAcceleration(const KDL::Twist& root_acc);
+  // Returns E_INVALID_OPTIONS (options unchanged) or, when inertia_check changed, modelError().
   int setOptions(const SolverOptions& options);
   const SolverOptions& options() const { return options_; }
 
@@ -199,6 +242,8 @@ class ChainHdSolver : public KDL::SolverI {
   void updateInternalDataStructures() override;
 
  private:
+  friend class FrictionSolver;  // sets pt_driver_ (its ff_torques carry friction too)
+
   struct Segment {
     Pose X0;                // pose of this tip frame in the parent tip frame at q = 0
     Pose X;                 // the same at the current q
@@ -233,6 +278,17 @@ class ChainHdSolver : public KDL::SolverI {
   template <typename ConstraintForce>
   inline void finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const ConstraintForce& constraint_force);
   int degenerate(int i);
+  // Pass-through (see above), after an inward sweep of either path: E_SIZE_MISMATCH if weights
+  // are set for another column count; else, when a weight is non-zero, writes
+  // p_f .* a_fext + p_t .* a_ff (m_, the path's column order) into pt_energy_ and sets pt_used_.
+  int passThroughEnergy(const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  // Joint accelerations one driver alone gives (f_ext or joint torques tau, either may be empty),
+  // each joint with its parent at rest and no constraint, through the last sweep's articulated
+  // inertias: free_j = (tau_j - S_j^T p_j) / D_j, p the driver's articulated bias force.
+  void driverFree(const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& tau);
+  // Acceleration energy along the constraint columns (m_, the path's order) of driverFree()'s
+  // accelerations: sum_j e_j^T free_j, into out.
+  void driverEnergy(Eigen::Ref<Eigen::VectorXd> out) const;
   // E_NONFINITE_RESULT (with the inputs' sizes in the message) if a result is Inf, NaN or
   // beyond 1e150; nu in the caller's order. Inputs only for the message.
   int checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
@@ -314,6 +370,17 @@ class ChainHdSolver : public KDL::SolverI {
   Eigen::MatrixXd kg_, cholg_, vg_;  // coupling matrix, its Cholesky factor or eigenvectors
   Eigen::VectorXd invg_;             // policy multiplier per eigenvalue
   mutable Eigen::MatrixXd work_g_, work_v_;  // Jacobi workspace for the smallest singular value
+
+  // Driver pass-through (storage sized at construction).
+  Eigen::VectorXd pt_f_, pt_t_;      // weights per caller's column (mcap)
+  int pt_m_ = -1;                    // columns they are for; -1: none
+  bool pt_f_any_ = false, pt_t_any_ = false;  // some weight is non-zero
+  bool pt_used_ = false;             // the last solve applied pt_energy_
+  Eigen::VectorXd pt_free_;          // driverFree() per joint (n_joints)
+  Eigen::VectorXd pt_energy_, pt_tmp_;  // p_f .* a_fext + p_t .* a_ff, and one driver's a (mcap)
+  // The feed-forward driver when ff_torques also carry forces the constraints always compensate
+  // (FrictionSolver's friction); nullptr: ff_torques.
+  const Eigen::VectorXd* pt_driver_ = nullptr;
 };
 
 }  // namespace vereshchagin

@@ -103,6 +103,12 @@ class FrictionSolver {
   const char* errorMessage() const { return message_.data(); }
   int modelError() const { return hd_.modelError(); }
   void setRootAcceleration(const KDL::Twist& root_acc) { hd_.setRootAcceleration(root_acc); free_.setRootAcceleration(root_acc); }
+  // Driver pass-through weights as ChainHdSolver::setPassThrough: they weight f_ext and
+  // ff_torques only; friction (kinetic and the max-min's static) is always compensated along the
+  // constraints. Returns ChainHdSolver's codes (message in errorMessage()).
+  int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
+                     const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
+  void clearPassThrough() { hd_.clearPassThrough(); }
   int setOptions(const SolverOptions& options);
 
  private:
@@ -133,6 +139,7 @@ class FrictionSolver {
   unsigned int nj_ = 0;
   std::array<char, 512> message_{};
   Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;
+  Eigen::VectorXd ff_driver_;  // ff_torques of the last solve (zero if empty): hd_'s pass-through driver
   Eigen::MatrixXd dnu_;
   ChainHdSolver::Matrix6X alfa_keep_;  // 6 x maxConstraints() storage
   Eigen::VectorXd beta_keep_;

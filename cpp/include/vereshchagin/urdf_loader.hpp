@@ -15,6 +15,7 @@
 
 #include <string>
 
+#include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/robot_chain.hpp"
 
 namespace vereshchagin {
@@ -25,11 +26,19 @@ struct UrdfResult {
   RobotChain robot;
 };
 
+struct UrdfOptions {
+  // How each link's <inertial> is checked (inertia_check.hpp): Physical (default) rejects links
+  // that are no rigid body (the message names the joint_space option); JointSpace accepts any
+  // symmetric inertia with mass >= 0 (identified models) and leaves the check of the joint-space
+  // inertia to the solver (whose SolverOptions::inertia_check must then be JointSpace too).
+  InertiaCheck inertia_check = InertiaCheck::Physical;
+};
+
 // xml: the URDF document. root / tip: link names; empty root = the URDF's root link, empty tip =
 // the single leaf below root (an error names the leaves when the tree branches).
 UrdfResult chainFromUrdfString(const std::string& xml, const std::string& root = "",
-                               const std::string& tip = "");
+                               const std::string& tip = "", const UrdfOptions& options = UrdfOptions());
 UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root = "",
-                             const std::string& tip = "");
+                             const std::string& tip = "", const UrdfOptions& options = UrdfOptions());
 
 }  // namespace vereshchagin

@@ -1,0 +1,29 @@
+// Which inertial parameters a model may have: the choice shared by ChainHdSolver (SolverOptions)
+// and the URDF loader (UrdfOptions).
+#pragma once
+
+namespace vereshchagin {
+
+enum class InertiaCheck {
+  // Every body must be a rigid body: mass >= 0 and a rotational inertia about its centre of mass
+  // that is symmetric, positive semi-definite and whose principal moments obey the triangle
+  // inequality I1 + I2 >= I3 (to 1e-6 of the largest, for rounded model files; a PSD tensor such
+  // as diag(0.1, 0.01, 0.01) belongs to no mass distribution). Checked once, when the model is
+  // built. The default of this library's own classes.
+  Physical,
+  // Identified models (parameters fitted on the real arm, e.g. the KUKA LWR 4 of Jubien, Gautier
+  // and Janot, IFAC 2014) often have link inertias that are not positive semi-definite; only the
+  // joint-space inertia matrix H(q) is positive definite. Accepted: mass >= 0 and any symmetric
+  // rotational inertia. At each solve every joint's articulated inertia D_j must be > 0 (which
+  // holds exactly when H(q) is positive definite), else the solve fails with
+  // ChainHdSolver::E_DEGENERATE_INERTIA and a message naming the joint. KDL's behaviour, minus
+  // its NaNs.
+  JointSpace,
+};
+
+// "physical" / "joint_space" (the Python spelling), for messages.
+inline const char* inertiaCheckName(InertiaCheck check) {
+  return check == InertiaCheck::Physical ? "physical" : "joint_space";
+}
+
+}  // namespace vereshchagin

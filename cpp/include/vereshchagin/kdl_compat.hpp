@@ -1,0 +1,139 @@
+// Drop-in replacement for Orocos KDL 1.5.1's KDL::ChainHdSolver_Vereshchagin: change
+//     #include <kdl/chainhdsolver_vereshchagin.hpp>     KDL::ChainHdSolver_Vereshchagin
+// to  #include <vereshchagin/kdl_compat.hpp>            vereshchagin::kdl_compat::ChainHdSolver_Vereshchagin
+// and nothing else. Same constructor, CartToJnt and getters, same frames, signs and units (see
+// chain_hd_solver.hpp: alfa columns are unit constraint wrenches in base axes about the last tip's
+// origin, beta = alfa^T Xdd_N including root_acc, root_acc is the base acceleration with gravity
+// as +9.81 up, f_ext[i] in base axes about segment i's tip origin).
+//
+// Accepted as in KDL wherever the solve is well defined:
+//  * identified robot models: inertias are checked with InertiaCheck::JointSpace (every
+//    articulated joint inertia D_j > 0 at each solve, i.e. the joint-space inertia is positive
+//    definite there; a clear error naming the joint, never NaN, where KDL returns NaN);
+//  * zero columns of alfa disable those constraints (their nu entries are 0), as in KDL;
+//  * fixed joints anywhere, and a massless distal body with rotor inertia.
+//
+// Documented differences, only where KDL 1.5.1 is wrong:
+//  * constraint_torques (the output of CartToJnt) are the command torques -J^T alfa nu: added to
+//    ff_torques and applied to the unconstrained arm (forward dynamics with the same f_ext and
+//    gravity) they reproduce q_dotdot. KDL's entries are the articulated-body torques felt at each
+//    joint, which do not (only the last joint's entry agrees).
+//  * getTotalTorque() = ff_torques + constraint_torques: the total joint torque the motors apply.
+//    (KDL's is D_j * q_dotdot_j, the articulated inertia times the acceleration, not a torque any
+//    joint sees.)
+//  * The chain is copied (KDL keeps a reference, which dangles for a temporary chain);
+//    updateInternalDataStructures() re-reads the chain given to the constructor, which must then
+//    still exist (as KDL requires always).
+//  * Errors are reported, not asserted or computed as NaN: sizes (E_SIZE_MISMATCH, as KDL), and
+//    ChainHdSolver's codes (E_NONFINITE_INPUT, E_INVALID_MODEL, E_DEGENERATE_INERTIA, ...); the
+//    message is in errorMessage(). CartToJnt allocates no heap memory (KDL's does, when nc > 0).
+//  * A rank-deficient constraint set is pseudo-inverted relative to the coupling matrix's scale
+//    (ChainHdSolver's TruncatedPseudoInverse), not with KDL's absolute 1e-14 SVD cut-off.
+//
+// Getters of KDL's internal recursion quantities, absent here: getLinkUnitForceAccelerationEnergy,
+// getLinkBiasForceAcceleratoinEnergy, getLinkUnitForceMatrix, getLinkBiasForceMatrix and
+// getJointBiasAcceleration are declared by KDL 1.5.1's header but defined only inside a comment
+// (any call fails to link), and their commented-out bodies return the last segment's values,
+// which are zero for M and G by construction. This implementation keeps no per-segment copy of
+// those quantities (its sweeps hold them in fixed-size per-segment blocks in another row order and
+// frame), so there is nothing equivalent to return. The public ChainHdSolver (solver()) gives the
+// useful equivalents: constraintRank(), smallestSingularValue(), responseColumns().
+//
+// Beyond KDL: setDriverWeights() (driver pass-through, see below), solver() for the full
+// vereshchagin::ChainHdSolver API, and errorMessage().
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <kdl/chain.hpp>
+#include <kdl/chainidsolver.hpp>  // KDL::Wrenches
+#include <kdl/frames.hpp>
+#include <kdl/jacobian.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/solveri.hpp>
+
+#include "vereshchagin/chain_hd_solver.hpp"
+
+namespace vereshchagin {
+namespace kdl_compat {
+
+class ChainHdSolver_Vereshchagin : public KDL::SolverI {
+  typedef std::vector<KDL::Twist> Twists;
+  typedef std::vector<KDL::Frame> Frames;
+
+ public:
+  // chain: copied (keep it alive only if you call updateInternalDataStructures()). root_acc: the
+  // base's acceleration, base frame (gravity g = (0, 0, -9.81) is root_acc = (0, 0, +9.81, 0, 0,
+  // 0)). nc: the number of alfa columns every CartToJnt call passes (0..6).
+  ChainHdSolver_Vereshchagin(const KDL::Chain& chain, const KDL::Twist& root_acc, const unsigned int nc);
+
+  // q, q_dot (n_joints): joint positions and velocities; q_dotdot (n_joints, output): joint
+  // accelerations. alfa (6 x nc): unit constraint wrenches, rows 0-2 force, 3-5 moment, base axes,
+  // moment about the last segment's tip origin; all-zero columns are disabled constraints. beta
+  // (nc): acceleration energies alfa^T Xdd_N (including root_acc). f_ext (n_segments): wrench on
+  // each segment, base axes, moment about its tip origin. ff_torques (n_joints): joint torques.
+  // constraint_torques (n_joints, output): the command torques -J^T alfa nu (see above).
+  // Returns 0, E_SIZE_MISMATCH, or a ChainHdSolver error code (negative).
+  int CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot, const KDL::Jacobian& alfa,
+                const KDL::JntArray& beta, const KDL::Wrenches& f_ext, const KDL::JntArray& ff_torques,
+                KDL::JntArray& constraint_torques);
+
+  // Re-reads the chain given to the constructor (after the caller changed it) and rebuilds.
+  void updateInternalDataStructures() override;
+
+  // After a successful CartToJnt. Frames: "base" = base axes (and base origin for poses); link
+  // quantities refer to each segment's tip frame, moments and velocities about its tip origin.
+  // Outputs are resized as needed (no allocation when already the right size).
+  // x_dotdot (n_segments + 1): [0] = root_acc, [i] = segment i-1's tip acceleration, base axes.
+  void getTransformedLinkAcceleration(Twists& x_dotdot);
+  // total_tau (n_joints): ff_torques + constraint_torques (see above).
+  void getTotalTorque(KDL::JntArray& total_tau);
+  // nu (nc): constraint force magnitudes in alfa's column order (0 for disabled columns); the
+  // wrench on the last segment is -alfa nu. (KDL's spelling.)
+  void getContraintForceMagnitude(Eigen::VectorXd& nu_);
+  // n_segments entries each: [i] = segment i's tip frame in the base frame / its velocity and
+  // acceleration in base axes.
+  void getLinkCartesianPose(Frames& x_base);
+  void getLinkCartesianVelocity(Twists& xDot_base);
+  void getLinkCartesianAcceleration(Twists& xDotDot_base);
+  // n_segments entries each: [i] = segment i's tip frame in its parent's tip frame / its velocity
+  // and acceleration in its own tip axes.
+  void getLinkPose(Frames& x_local);
+  void getLinkVelocity(Twists& xDot_local);
+  void getLinkAcceleration(Twists& xDotdot_local);
+
+  // Driver pass-through (ChainHdSolver::setPassThrough; Shakhimardanov 2015, eq. 3.42), per alfa
+  // column (nc entries each, in [0, 1]): 0 (default) = the constraint compensates that driver
+  // (f_ext or ff_torques) along that column, as KDL; 1 = the driver's own acceleration along that
+  // column passes through (alfa_c^T Xdd_N = beta_c + the driver's share). Kept until changed.
+  // Returns E_SIZE_MISMATCH if a vector does not have nc entries, E_OUT_OF_RANGE for entries
+  // outside [0, 1]. (A KDL fork has a method of this name whose weights meant the opposite in
+  // one of its versions: here a weight is always the share that passes through.)
+  int setDriverWeights(const Eigen::VectorXd& w_f_ext, const Eigen::VectorXd& w_ff_torques);
+
+  const char* errorMessage() const { return solver_.errorMessage(); }
+  const char* strError(const int error) const override { return solver_.strError(error); }
+  const ChainHdSolver& solver() const { return solver_; }
+
+ private:
+  void allocate();
+  // Base-frame pose of every segment's tip at the last solve, into poses_ (on request).
+  void updateBasePoses();
+
+  const KDL::Chain* source_;  // the constructor's chain, for updateInternalDataStructures()
+  KDL::Twist root_acc_;
+  unsigned int nc_;
+  ChainHdSolver solver_;
+  unsigned int nj_ = 0, ns_ = 0;
+  int active_ = 0;                         // enabled (non-zero) alfa columns at the last solve
+  ChainHdSolver::Matrix6X alfa_on_, f_ext_;  // the enabled columns; f_ext as a 6 x n_segments matrix
+  Eigen::VectorXd beta_on_, nu_, total_;
+  Eigen::VectorXi column_;                 // alfa column of each enabled one
+  Eigen::VectorXd w_f_, w_t_, w_f_on_, w_t_on_;  // pass-through weights (nc), of the enabled columns
+  bool weighted_ = false;
+  Frames poses_;
+};
+
+}  // namespace kdl_compat
+}  // namespace vereshchagin

@@ -1,0 +1,152 @@
+// KDL-compatible drop-in class over ChainHdSolver. Conventions and differences in kdl_compat.hpp.
+#include "vereshchagin/kdl_compat.hpp"
+
+namespace vereshchagin {
+namespace kdl_compat {
+
+namespace {
+
+SolverOptions compatOptions() {
+  SolverOptions o;
+  o.inertia_check = InertiaCheck::JointSpace;  // identified models, as KDL accepts them
+  return o;
+}
+
+template <typename T>
+void ensureSize(std::vector<T>& v, std::size_t n) {
+  if (v.size() != n) v.resize(n);
+}
+
+}  // namespace
+
+ChainHdSolver_Vereshchagin::ChainHdSolver_Vereshchagin(const KDL::Chain& chain, const KDL::Twist& root_acc,
+                                                       const unsigned int nc)
+    : source_(&chain), root_acc_(root_acc), nc_(nc), solver_(chain, root_acc, compatOptions()) {
+  allocate();
+}
+
+void ChainHdSolver_Vereshchagin::allocate() {
+  nj_ = solver_.nrOfJoints();
+  ns_ = solver_.nrOfSegments();
+  active_ = 0;
+  alfa_on_ = ChainHdSolver::Matrix6X::Zero(6, nc_);
+  f_ext_ = ChainHdSolver::Matrix6X::Zero(6, ns_);
+  beta_on_ = nu_ = w_f_ = w_t_ = w_f_on_ = w_t_on_ = Eigen::VectorXd::Zero(nc_);
+  column_ = Eigen::VectorXi::Zero(nc_);
+  total_ = Eigen::VectorXd::Zero(nj_);
+  weighted_ = false;
+  poses_.assign(ns_, KDL::Frame::Identity());
+}
+
+void ChainHdSolver_Vereshchagin::updateInternalDataStructures() {
+  solver_ = ChainHdSolver(*source_, root_acc_, compatOptions());
+  allocate();
+}
+
+int ChainHdSolver_Vereshchagin::setDriverWeights(const Eigen::VectorXd& w_f_ext, const Eigen::VectorXd& w_ff_torques) {
+  if (w_f_ext.size() != nc_ || w_ff_torques.size() != nc_) return error = E_SIZE_MISMATCH;
+  for (unsigned int c = 0; c < nc_; ++c)
+    if (!(w_f_ext(c) >= 0.0 && w_f_ext(c) <= 1.0) || !(w_ff_torques(c) >= 0.0 && w_ff_torques(c) <= 1.0))
+      return error = E_OUT_OF_RANGE;
+  w_f_ = w_f_ext;
+  w_t_ = w_ff_torques;
+  weighted_ = (w_f_.array() != 0.0).any() || (w_t_.array() != 0.0).any();
+  return error = E_NOERROR;
+}
+
+int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot,
+                                          const KDL::Jacobian& alfa, const KDL::JntArray& beta,
+                                          const KDL::Wrenches& f_ext, const KDL::JntArray& ff_torques,
+                                          KDL::JntArray& constraint_torques) {
+  if (q.rows() != nj_ || q_dot.rows() != nj_ || q_dotdot.rows() != nj_ || ff_torques.rows() != nj_ ||
+      constraint_torques.rows() != nj_ || f_ext.size() != ns_ || alfa.columns() != nc_ || beta.rows() != nc_)
+    return error = E_SIZE_MISMATCH;
+  // Zero columns disable their constraints (KDL's convention): solve with the others only.
+  active_ = 0;
+  for (unsigned int c = 0; c < nc_; ++c) {
+    if ((alfa.data.col(c).array() == 0.0).all()) continue;
+    alfa_on_.col(active_) = alfa.data.col(c);
+    beta_on_(active_) = beta(c);
+    w_f_on_(active_) = w_f_(c);
+    w_t_on_(active_) = w_t_(c);
+    column_(active_++) = static_cast<int>(c);
+  }
+  for (unsigned int i = 0; i < ns_; ++i)
+    for (int k = 0; k < 3; ++k) {
+      f_ext_(k, i) = f_ext[i].force(k);
+      f_ext_(3 + k, i) = f_ext[i].torque(k);
+    }
+  if (weighted_) {
+    solver_.setPassThrough(w_f_on_.head(active_), w_t_on_.head(active_));
+  } else if (solver_.passThroughColumns() >= 0) {
+    solver_.clearPassThrough();
+  }
+  const int rc = solver_.solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_,
+                               ff_torques.data);
+  if (rc != E_NOERROR) return error = rc;
+  q_dotdot.data = solver_.qdd();
+  constraint_torques.data = solver_.commandTorques();
+  total_ = ff_torques.data + solver_.commandTorques();
+  nu_.setZero();
+  const auto nu = solver_.nu();
+  for (int k = 0; k < active_; ++k) nu_(column_(k)) = nu(k);
+  return error = E_NOERROR;
+}
+
+void ChainHdSolver_Vereshchagin::getTransformedLinkAcceleration(Twists& x_dotdot) {
+  ensureSize(x_dotdot, ns_ + 1);
+  const auto& acc = solver_.linkAccelerations();
+  for (unsigned int i = 0; i <= ns_; ++i)
+    x_dotdot[i] = KDL::Twist(KDL::Vector(acc(0, i), acc(1, i), acc(2, i)), KDL::Vector(acc(3, i), acc(4, i), acc(5, i)));
+}
+
+void ChainHdSolver_Vereshchagin::getTotalTorque(KDL::JntArray& total_tau) {
+  if (total_tau.rows() != nj_) total_tau.resize(nj_);
+  total_tau.data = total_;
+}
+
+void ChainHdSolver_Vereshchagin::getContraintForceMagnitude(Eigen::VectorXd& nu_out) { nu_out = nu_; }
+
+void ChainHdSolver_Vereshchagin::updateBasePoses() {
+  KDL::Frame parent = KDL::Frame::Identity();
+  for (unsigned int i = 0; i < ns_; ++i) {
+    parent = parent * solver_.linkLocalPose(i);
+    poses_[i] = parent;
+  }
+}
+
+void ChainHdSolver_Vereshchagin::getLinkCartesianPose(Frames& x_base) {
+  updateBasePoses();
+  ensureSize(x_base, ns_);
+  for (unsigned int i = 0; i < ns_; ++i) x_base[i] = poses_[i];
+}
+
+void ChainHdSolver_Vereshchagin::getLinkCartesianVelocity(Twists& xDot_base) {
+  updateBasePoses();
+  ensureSize(xDot_base, ns_);
+  for (unsigned int i = 0; i < ns_; ++i) xDot_base[i] = poses_[i].M * solver_.linkLocalVelocity(i);
+}
+
+void ChainHdSolver_Vereshchagin::getLinkCartesianAcceleration(Twists& xDotDot_base) {
+  updateBasePoses();
+  ensureSize(xDotDot_base, ns_);
+  for (unsigned int i = 0; i < ns_; ++i) xDotDot_base[i] = poses_[i].M * solver_.linkLocalAcceleration(i);
+}
+
+void ChainHdSolver_Vereshchagin::getLinkPose(Frames& x_local) {
+  ensureSize(x_local, ns_);
+  for (unsigned int i = 0; i < ns_; ++i) x_local[i] = solver_.linkLocalPose(i);
+}
+
+void ChainHdSolver_Vereshchagin::getLinkVelocity(Twists& xDot_local) {
+  ensureSize(xDot_local, ns_);
+  for (unsigned int i = 0; i < ns_; ++i) xDot_local[i] = solver_.linkLocalVelocity(i);
+}
+
+void ChainHdSolver_Vereshchagin::getLinkAcceleration(Twists& xDotdot_local) {
+  ensureSize(xDotdot_local, ns_);
+  for (unsigned int i = 0; i < ns_; ++i) xDotdot_local[i] = solver_.linkLocalAcceleration(i);
+}
+
+}  // namespace kdl_compat
+}  // namespace vereshchagin

@@ -1,0 +1,308 @@
+// The drop-in class vereshchagin::kdl_compat::ChainHdSolver_Vereshchagin against Orocos KDL
+// 1.5.1's KDL::ChainHdSolver_Vereshchagin. Every scenario is one function template written only
+// with KDL's API and instantiated twice, once with KDL's class and once with ours (the type is the
+// only change), on KDL's own test scenarios (written here from their description):
+//  * the KUKA LWR 4 with identified parameters and rotor inertias (kuka_lwr4.hpp), a six-column
+//    task with two zero columns, an external wrench on the end-effector and feed-forward torques:
+//    the end-effector accelerations equal beta along the enabled columns, nu equals KDL's (and
+//    KDL's published regression values), q_dotdot equals KDL's;
+//  * the same arm with an all-zero alfa: q_dotdot equals KDL's forward dynamics (ChainFdSolver_RNE);
+//  * random chains with a mix of zero and random columns.
+// Ours only (documented differences): constraint_torques realise q_dotdot (KDL forward dynamics
+// with ff + constraint_torques), getTotalTorque = ff + constraint_torques, link poses and
+// velocities against KDL's forward kinematics, setDriverWeights with weight 1 on ff torques
+// against the dense formula (the task solved without ff, plus H^-1 ff), error codes.
+#include <string>
+#include <vector>
+
+#include <Eigen/LU>
+#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainfksolvervel_recursive.hpp>
+#include <kdl/chainhdsolver_vereshchagin.hpp>
+
+#include "kuka_lwr4.hpp"
+#include "random_chain.hpp"
+#include "test_common.hpp"
+#include "vereshchagin/kdl_compat.hpp"
+
+using testutil::relErr;
+using testutil::str;
+using Ours = vereshchagin::kdl_compat::ChainHdSolver_Vereshchagin;
+using Theirs = KDL::ChainHdSolver_Vereshchagin;
+
+namespace {
+
+struct Scenario {
+  KDL::Chain chain;
+  KDL::Twist root_acc;
+  KDL::JntArray q, qd, ff;
+  KDL::Wrenches f_ext;
+  KDL::Jacobian alfa;
+  KDL::JntArray beta;
+};
+
+struct Outcome {
+  int rc = 0;
+  Eigen::VectorXd qdd, constraint_tau, total_tau, nu;
+  std::vector<KDL::Twist> xdd;
+};
+
+// Written against KDL's API only: the same text for both classes.
+template <class HdSolver>
+Outcome run(const Scenario& s) {
+  const unsigned int nj = s.chain.getNrOfJoints(), ns = s.chain.getNrOfSegments();
+  HdSolver solver(s.chain, s.root_acc, s.alfa.columns());
+  KDL::JntArray qdd(nj), constraint_tau(nj), total(nj);
+  Outcome out;
+  out.rc = solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, constraint_tau);
+  out.xdd.resize(ns + 1);
+  solver.getTransformedLinkAcceleration(out.xdd);
+  solver.getTotalTorque(total);
+  out.nu.resize(s.alfa.columns());
+  solver.getContraintForceMagnitude(out.nu);
+  out.qdd = qdd.data;
+  out.constraint_tau = constraint_tau.data;
+  out.total_tau = total.data;
+  return out;
+}
+
+Eigen::Matrix<double, 6, 1> toVec(const KDL::Twist& t) {
+  Eigen::Matrix<double, 6, 1> v;
+  v << t.vel.x(), t.vel.y(), t.vel.z(), t.rot.x(), t.rot.y(), t.rot.z();
+  return v;
+}
+
+// KDL's forward dynamics (RNE convention: gravity as gravity, f_ext in each tip's axes).
+Eigen::VectorXd kdlForward(const Scenario& s, const Eigen::VectorXd& tau) {
+  const unsigned int nj = s.chain.getNrOfJoints();
+  KDL::ChainFdSolver_RNE fd(s.chain, -s.root_acc.vel);
+  KDL::JntArray t(nj), qdd(nj);
+  t.data = tau;
+  const int rc = fd.CartToJnt(s.q, s.qd, t, testutil::toTipAxes(s.chain, s.q, s.f_ext), qdd);
+  return rc == 0 ? qdd.data : Eigen::VectorXd::Constant(nj, NAN);
+}
+
+// KDL's Vereshchagin test 1 state on the LWR 4 (gravity as root acceleration 9.81 up).
+Scenario lwrTask() {
+  Scenario s;
+  s.chain = testutil::kukaLwr4();
+  const unsigned int n = 7;
+  s.root_acc = KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero());
+  s.q.resize(n), s.qd.resize(n), s.ff.resize(n);
+  const double q[7] = {1.6, 0.0, -1.6, -1.57, 0.0, 1.57, -0.8};
+  const double qd[7] = {1.0, -2.0, 3.0, -4.0, 5.0, -6.0, 7.0};
+  const double ff[7] = {5.0, 0.0, 0.0, 0.0, 0.0, -6.0, 0.0};
+  for (unsigned int j = 0; j < n; ++j) s.q(j) = q[j], s.qd(j) = qd[j], s.ff(j) = ff[j];
+  s.f_ext.assign(n, KDL::Wrench::Zero());
+  s.f_ext[n - 1] = KDL::Wrench(KDL::Vector(10.0, 15.0, 0.0), KDL::Vector(0.0, 0.0, 5.0));  // base axes
+  // Linear x, y, z and angular z constrained; angular x and y disabled (zero columns).
+  s.alfa = KDL::Jacobian(6);
+  KDL::SetToZero(s.alfa);
+  s.alfa(0, 0) = s.alfa(1, 1) = s.alfa(2, 2) = s.alfa(5, 5) = 1.0;
+  s.beta.resize(6);
+  const double beta[6] = {-0.5, -0.5, 0.0, 0.0, 0.0, 0.2};
+  for (int c = 0; c < 6; ++c) s.beta(c) = beta[c];
+  return s;
+}
+
+// KDL's forward-dynamics consistency state on the LWR 4, with an all-zero six-column alfa.
+Scenario lwrFree() {
+  Scenario s = lwrTask();
+  const double q[7] = {1.0, 0.0, 0.0, -1.57, 0.0, 1.57, -0.8};
+  const double ff[7] = {50.0, -20.0, 10.0, 40.0, -60.0, 15.0, -10.0};
+  for (int j = 0; j < 7; ++j) s.q(j) = q[j], s.ff(j) = ff[j];
+  KDL::ChainFkSolverPos_recursive fk(s.chain);
+  KDL::Frame tip;
+  fk.JntToCart(s.q, tip);
+  s.f_ext[6] = tip.M * KDL::Wrench(KDL::Vector(10.0, -20.0, 30.0), KDL::Vector(3.0, -4.0, 5.0));
+  KDL::SetToZero(s.alfa);
+  KDL::SetToZero(s.beta);
+  return s;
+}
+
+void lwrTaskChecks(testutil::Checker& ck) {
+  const Scenario s = lwrTask();
+  const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
+  ck.check(kdl.rc == 0 && ours.rc == 0, "LWR task: return codes " + str(kdl.rc) + ", " + str(ours.rc));
+  // End-effector accelerations along the enabled columns equal beta.
+  const Eigen::Matrix<double, 6, 1> a_ours = toVec(ours.xdd[7]), a_kdl = toVec(kdl.xdd[7]);
+  for (int c : {0, 1, 2, 5}) {
+    ck.check(std::abs(a_ours(c) - s.beta(c)) <= 1e-9, "LWR task: ours Xdd(" + str(c) + ") = " + str(a_ours(c)) +
+                                                           " vs beta " + str(s.beta(c)));
+    ck.check(std::abs(a_kdl(c) - s.beta(c)) <= 1e-3, "LWR task: KDL Xdd(" + str(c) + ") = " + str(a_kdl(c)));
+  }
+  // nu equals KDL's, and KDL's published regression values (its tests' tolerance 1e-3).
+  const double e_nu = relErr(ours.nu, kdl.nu), e_qdd = relErr(ours.qdd, kdl.qdd);
+  ck.check(e_nu <= 1e-6, "LWR task: nu vs KDL rel err " + str(e_nu) + " (ours " + testutil::mat(ours.nu) + ", KDL " +
+                             testutil::mat(kdl.nu) + ")");
+  ck.check(e_qdd <= 1e-6, "LWR task: qdd vs KDL rel err " + str(e_qdd));
+  const double published[6] = {669693.30355, 5930.60826, -639.5238, 0.0, 0.0, 573.90485};
+  for (int c = 0; c < 6; ++c)
+    ck.check(std::abs(ours.nu(c) - published[c]) <= 1e-3 * std::max(1.0, std::abs(published[c])),
+             "LWR task: nu(" + str(c) + ") = " + str(ours.nu(c)) + " vs KDL's published " + str(published[c]));
+  ck.check(ours.nu(3) == 0.0 && ours.nu(4) == 0.0, "LWR task: disabled columns have nu exactly 0");
+  // Documented differences: ours realise q_dotdot; total torque = ff + constraint torques.
+  const Eigen::VectorXd fd = kdlForward(s, s.ff.data + ours.constraint_tau);
+  const double e_fd = relErr(fd, ours.qdd), e_kdl_fd = relErr(kdlForward(s, s.ff.data + kdl.constraint_tau), kdl.qdd);
+  ck.check(e_fd <= 1e-9, "LWR task: KDL FD with ff + our constraint_torques rel err " + str(e_fd));
+  ck.check(ours.total_tau == s.ff.data + ours.constraint_tau, "LWR task: getTotalTorque != ff + constraint_torques");
+  std::printf("LWR 4 task: |qdd - KDL| rel %.2e, |nu - KDL| rel %.2e, FD with our torques %.2e (with KDL's: %.2e)\n",
+              e_qdd, e_nu, e_fd, e_kdl_fd);
+}
+
+void lwrFreeChecks(testutil::Checker& ck) {
+  const Scenario s = lwrFree();
+  const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
+  const Eigen::VectorXd fd = kdlForward(s, s.ff.data);
+  const double e_ours = relErr(ours.qdd, fd), e_kdl = relErr(kdl.qdd, fd);
+  ck.check(ours.rc == 0 && e_ours <= 1e-9, "LWR all-zero alfa: ours vs KDL FD rel err " + str(e_ours));
+  ck.check(kdl.rc == 0 && e_kdl <= 1e-9, "LWR all-zero alfa: KDL's Vereshchagin vs KDL FD rel err " + str(e_kdl));
+  ck.check(ours.constraint_tau.isZero(0.0) && ours.nu.isZero(0.0), "LWR all-zero alfa: no constraint torques, nu = 0");
+  std::printf("LWR 4 all-zero alfa: ours vs FD_RNE %.2e, KDL vs FD_RNE %.2e\n", e_ours, e_kdl);
+}
+
+// Random chains (no fixed joints: KDL needs n_joints = n_segments), zero and random columns.
+void randomChecks(testutil::Checker& ck) {
+  double worst_qdd = 0.0, worst_nu = 0.0;
+  int compared = 0;
+  for (int k = 0; k < 60; ++k) {
+    testutil::RandomGen g(424242ULL + 31ULL * static_cast<unsigned long long>(k));
+    Scenario s;
+    const int n = g.integer(3, 9);
+    s.chain = g.chain(n, /*allow_prismatic=*/true, /*rotor_inertia=*/true);
+    s.root_acc = KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero());
+    s.q = g.q(n), s.qd = g.qdot(n), s.ff = g.torques(n);
+    s.f_ext = g.fext(n);
+    const int nc = g.integer(1, std::min(6, n));
+    s.alfa = g.alfa(nc);
+    s.beta = g.beta(nc);
+    for (int c = 0; c < nc; ++c)
+      if (g.coin(0.3)) s.alfa.data.col(c).setZero();
+    const testutil::DenseModel d = testutil::denseModel(s.chain, s.q);
+    Eigen::MatrixXd on(6, 0);
+    for (int c = 0; c < nc; ++c)
+      if (!s.alfa.data.col(c).isZero(0.0)) on.conservativeResize(6, on.cols() + 1), on.rightCols(1) = s.alfa.data.col(c);
+    if (!testutil::wellConditioned(testutil::couplingEigenvalues(d, on))) continue;
+    const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
+    const std::string tag = "random " + str(k) + " (n=" + str(n) + ", nc=" + str(nc) + ", enabled " + str(on.cols()) + ")";
+    ck.check(kdl.rc == 0 && ours.rc == 0, tag + ": return codes");
+    const double e_qdd = relErr(ours.qdd, kdl.qdd), e_nu = relErr(ours.nu, kdl.nu);
+    ck.check(e_qdd <= 1e-8 && e_nu <= 1e-8, tag + ": vs KDL rel err qdd " + str(e_qdd) + ", nu " + str(e_nu));
+    worst_qdd = std::max(worst_qdd, e_qdd), worst_nu = std::max(worst_nu, e_nu);
+    ++compared;
+  }
+  ck.check(compared >= 30, "random chains: too few compared (" + str(compared) + ")");
+  std::printf("random chains: %d compared with KDL, worst rel err qdd %.2e, nu %.2e\n", compared, worst_qdd, worst_nu);
+}
+
+// Link getters (ours only: KDL 1.5.1 declares but does not define them) against KDL's FK.
+void getterChecks(testutil::Checker& ck) {
+  const Scenario s = lwrTask();
+  Ours solver(s.chain, s.root_acc, 6);
+  KDL::JntArray qdd(7), tc(7);
+  ck.check(solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0, "getters: solve");
+  std::vector<KDL::Frame> pose_base, pose_local;
+  std::vector<KDL::Twist> vel_base, vel_local, acc_base, acc_local, xdd;
+  solver.getLinkCartesianPose(pose_base);
+  solver.getLinkPose(pose_local);
+  solver.getLinkCartesianVelocity(vel_base);
+  solver.getLinkVelocity(vel_local);
+  solver.getLinkCartesianAcceleration(acc_base);
+  solver.getLinkAcceleration(acc_local);
+  solver.getTransformedLinkAcceleration(xdd);
+  KDL::ChainFkSolverPos_recursive fk(s.chain);
+  KDL::ChainFkSolverVel_recursive fkv(s.chain);
+  KDL::JntArrayVel qv(s.q, s.qd);
+  double worst = 0.0;
+  for (int i = 0; i < 7; ++i) {
+    KDL::Frame F;
+    KDL::FrameVel FV;
+    fk.JntToCart(s.q, F, i + 1);
+    fkv.JntToCart(qv, FV, i + 1);
+    const KDL::Frame F_parent = i == 0 ? KDL::Frame::Identity() : pose_base[i - 1];
+    worst = std::max({worst,
+                      relErr(toVec(FV.GetTwist()), toVec(vel_base[i])),
+                      relErr(toVec(pose_base[i].M * vel_local[i]), toVec(vel_base[i])),
+                      relErr(toVec(pose_base[i].M * acc_local[i]), toVec(acc_base[i])),
+                      relErr(toVec(xdd[i + 1]), toVec(acc_base[i]))});
+    ck.check(KDL::Equal(F, pose_base[i], 1e-12) && KDL::Equal(F_parent * pose_local[i], F, 1e-12),
+             "getters: pose of segment " + str(i));
+  }
+  ck.check(worst <= 1e-12, "getters: velocities / accelerations inconsistent, worst " + str(worst));
+}
+
+// setDriverWeights: with weight 1 on the ff torques in every column the task is solved as if ff
+// were absent and ff then acts unconstrained: nu unchanged, qdd + H^-1 ff.
+void driverWeightChecks(testutil::Checker& ck) {
+  Scenario s = lwrTask();
+  s.alfa.data.col(3)(3) = 1.0;  // enable all six columns
+  s.alfa.data.col(4)(4) = 1.0;
+  Scenario no_ff = s;
+  no_ff.ff.data.setZero();
+  Ours passing(s.chain, s.root_acc, 6), plain(s.chain, s.root_acc, 6);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(6), one = Eigen::VectorXd::Ones(6);
+  ck.check(passing.setDriverWeights(zero, one) == 0, "setDriverWeights accepted");
+  ck.check(passing.setDriverWeights(zero, Eigen::VectorXd::Ones(5)) == Ours::E_SIZE_MISMATCH, "5 weights for nc = 6 refused");
+  ck.check(passing.setDriverWeights(zero, 2.0 * one) == Ours::E_OUT_OF_RANGE, "weight 2 refused");
+  KDL::JntArray qdd(7), tc(7), qdd0(7), tc0(7);
+  ck.check(passing.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
+               plain.CartToJnt(no_ff.q, no_ff.qd, qdd0, no_ff.alfa, no_ff.beta, no_ff.f_ext, no_ff.ff, tc0) == 0,
+           "driver weights: solves");
+  Eigen::VectorXd nu(6), nu0(6);
+  passing.getContraintForceMagnitude(nu);
+  plain.getContraintForceMagnitude(nu0);
+  const testutil::DenseModel d = testutil::denseModel(s.chain, s.q);
+  const Eigen::VectorXd expect = qdd0.data + d.H.lu().solve(s.ff.data);
+  const double e_qdd = relErr(qdd.data, expect), e_nu = relErr(nu, nu0);
+  ck.check(e_qdd <= 1e-9 && e_nu <= 1e-9, "ff passed through: qdd rel err " + str(e_qdd) + ", nu rel err " + str(e_nu));
+  // Zero weights again: bit for bit KDL's behaviour of this class.
+  Ours fresh(s.chain, s.root_acc, 6);
+  KDL::JntArray qdd1(7), qdd2(7);
+  passing.setDriverWeights(zero, zero);
+  passing.CartToJnt(s.q, s.qd, qdd1, s.alfa, s.beta, s.f_ext, s.ff, tc);
+  fresh.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc);
+  ck.check(qdd1.data == qdd2.data, "zero driver weights: not bit-identical to none");
+}
+
+void errorChecks(testutil::Checker& ck) {
+  const Scenario s = lwrTask();
+  Ours solver(s.chain, s.root_acc, 6);
+  KDL::JntArray qdd(7), tc(7), short_q(6);
+  KDL::Jacobian five(5);
+  ck.check(solver.CartToJnt(short_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH, "q size");
+  ck.check(solver.CartToJnt(s.q, s.qd, qdd, five, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH, "alfa columns != nc");
+  KDL::JntArray bad_q = s.q;
+  bad_q(2) = NAN;
+  ck.check(solver.CartToJnt(bad_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) ==
+               vereshchagin::ChainHdSolver::E_NONFINITE_INPUT,
+           "NaN q: E_NONFINITE_INPUT");
+  // A temporary chain: ours copies it (KDL would keep a dangling reference).
+  Ours from_temporary(testutil::kukaLwr4(), s.root_acc, 6);
+  KDL::JntArray qdd2(7);
+  ck.check(from_temporary.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
+               solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 && qdd.data == qdd2.data,
+           "temporary chain");
+  // updateInternalDataStructures re-reads the (changed) chain.
+  Scenario grown = s;
+  Ours follower(grown.chain, s.root_acc, 6);
+  grown.chain.addSegment(KDL::Segment("extra", KDL::Joint(KDL::Joint::RotZ), KDL::Frame(KDL::Vector(0, 0, 0.1)),
+                                      KDL::RigidBodyInertia(1.0, KDL::Vector(0, 0, 0.05), KDL::RotationalInertia(0.01, 0.01, 0.01))));
+  follower.updateInternalDataStructures();
+  KDL::JntArray q8(8), qd8(8), qdd8(8), ff8(8), tc8(8);
+  KDL::Wrenches f8(8, KDL::Wrench::Zero());
+  ck.check(follower.CartToJnt(q8, qd8, qdd8, s.alfa, s.beta, f8, ff8, tc8) == 0, "updateInternalDataStructures: 8 joints");
+}
+
+}  // namespace
+
+int main() {
+  testutil::Checker ck("test_kdl_compat");
+  lwrTaskChecks(ck);
+  lwrFreeChecks(ck);
+  randomChecks(ck);
+  getterChecks(ck);
+  driverWeightChecks(ck);
+  errorChecks(ck);
+  return ck.finish("");
+}
