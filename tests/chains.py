@@ -206,8 +206,9 @@ def random_chain(rng, n_joints, prismatic=True, rotor=True, fixed_prob=0.0):
     return build(segments)
 
 
-def build(segments):
-    """Build both the vereshchagin Chain and the Pinocchio Model from segment specs."""
+def build(segments, inertia_check="physical"):
+    """Build both the vereshchagin Chain and the Pinocchio Model from segment specs
+    (``inertia_check='joint_space'`` for identified, non-rigid-body inertias)."""
     chain = vs.Chain()
     for i, s in enumerate(segments):
         if s.kind == "revolute":
@@ -219,7 +220,8 @@ def build(segments):
         else:
             joint = s.kind
         chain.add_segment(
-            f"seg{i}", joint, tip=s.tip, mass=s.mass, com=s.com, inertia=s.inertia, rotor_inertia=s.rotor
+            f"seg{i}", joint, tip=s.tip, mass=s.mass, com=s.com, inertia=s.inertia, rotor_inertia=s.rotor,
+            inertia_check=inertia_check,
         )
 
     model = pin.Model()
@@ -227,7 +229,8 @@ def build(segments):
     root_in_parent = np.eye(4)  # current segment root frame in the parent Pinocchio joint frame
     tip_frames, seg_joint, armature = [], [], []
     for i, s in enumerate(segments):
-        body = pin.Inertia(s.mass, np.array(s.com), np.array(s.inertia))
+        body = pin.Inertia(s.mass, np.array(s.com), np.eye(3))
+        body.inertia = np.array(s.inertia)  # assigned: the constructor rejects identified (non-PSD) inertias
         if s.moving:
             placement = root_in_parent @ homogeneous(None, s.origin)
             if s.kind in ("rot_x", "rot_y", "rot_z"):

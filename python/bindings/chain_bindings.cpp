@@ -9,18 +9,22 @@
 #include <kdl/chainfksolvervel_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include "py_solver.hpp"  // inertiaCheckArg
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
-PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, const std::string& tip) {
+PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, const std::string& tip,
+                          vereshchagin::InertiaCheck inertia_check) {
   vereshchagin::UrdfResult r;
+  vereshchagin::UrdfOptions options;
+  options.inertia_check = inertia_check;
   if (source.find('<') != std::string::npos) {
-    r = vereshchagin::chainFromUrdfString(source, root, tip);
+    r = vereshchagin::chainFromUrdfString(source, root, tip, options);
   } else {
     std::ifstream probe(source);
     if (!probe) raise("URDF source is neither XML text nor a readable file: '" + source + "'");
-    r = vereshchagin::chainFromUrdfFile(source, root, tip);
+    r = vereshchagin::chainFromUrdfFile(source, root, tip, options);
   }
   if (!r.ok) raise(r.message);
   PyChain c;
@@ -30,7 +34,10 @@ PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, co
 
 void PyChain::addSegment(const std::string& name, const py::object& joint, const py::object& tip,
                          const py::object& mass_obj, const py::object& com, const py::object& inertia,
-                         const py::object& rotor_obj, const std::string& joint_name) {
+                         const py::object& rotor_obj, const std::string& joint_name,
+                         const std::string& inertia_check) {
+  const bool physical =
+      inertiaCheckArg(inertia_check, "segment '" + name + "': ") == vereshchagin::InertiaCheck::Physical;
   // Every failure names the segment and the argument: "segment 'link3': mass must be ...".
   const std::string where = "segment '" + name + "': ";
   const std::string jname = joint_name.empty() ? name + "_joint" : joint_name;
@@ -64,9 +71,14 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
   if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) raise(where + "inertia must be symmetric");
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(I, Eigen::EigenvaluesOnly);
-  if (es.eigenvalues().minCoeff() < -1e-12 * scale)
-    raise(where + "inertia must be positive semi-definite (smallest eigenvalue " +
-          std::to_string(es.eigenvalues().minCoeff()) + ")");
+  const Eigen::Vector3d moments = es.eigenvalues();  // ascending
+  if (physical && moments(0) < -1e-12 * scale)
+    raise(where + "inertia must be positive semi-definite (smallest eigenvalue " + std::to_string(moments(0)) +
+          "); identified models with such inertias: inertia_check='joint_space'");
+  if (physical && moments(0) + moments(1) < moments(2) - 1e-6 * std::abs(moments(2)))
+    raise(where + "inertia's principal moments " + fmtDouble(moments(0)) + ", " + fmtDouble(moments(1)) + ", " +
+          fmtDouble(moments(2)) + " violate the triangle inequality I1 + I2 >= I3 (no rigid body has them); "
+          "identified models: inertia_check='joint_space'");
   if (!std::isfinite(rotor_inertia) || rotor_inertia < 0.0)
     raise(where + "rotor_inertia must be finite and >= 0, got " + fmtDouble(rotor_inertia));
   if (spec.type == KDL::Joint::Fixed && rotor_inertia != 0.0) raise(where + "rotor_inertia: a fixed joint has none");
@@ -419,21 +431,31 @@ rotor_inertia : float
     Motor rotor inertia reflected to the joint (kg m^2 or kg), added to the joint's inertia.
 joint_name : str, optional
     Defaults to ``name + '_joint'``.
+inertia_check : {'physical', 'joint_space'}
+    'physical' (default): the body must be a rigid body (PSD inertia whose principal moments obey
+    the triangle inequality). 'joint_space': any symmetric inertia (identified models); a
+    ``Solver(..., inertia_check='joint_space')`` then checks that H(q) is positive definite at
+    each solve.
 )doc", py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(),
            py::arg("mass") = 0.0, py::arg("com") = py::none(), py::arg("inertia") = py::none(),
-           py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "")
-      .def_static("from_urdf", [](const py::object& source, const std::string& root, const std::string& tip) {
+           py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "", py::arg("inertia_check") = "physical")
+      .def_static("from_urdf", [](const py::object& source, const std::string& root, const std::string& tip,
+                                  const std::string& inertia_check) {
         const py::object os = py::module_::import("os");
         if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
           raise("source must be URDF XML text or a file path");
-        return PyChain::fromUrdf(py::str(os.attr("fspath")(source)).cast<std::string>(), root, tip);
-      }, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
+        return PyChain::fromUrdf(py::str(os.attr("fspath")(source)).cast<std::string>(), root, tip,
+                                 inertiaCheckArg(inertia_check, ""));
+      }, py::arg("source"), py::arg("root") = "", py::arg("tip") = "", py::arg("inertia_check") = "physical",
                   R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
 
 Fixed joints are merged into their parent link (masses and inertias combined); the last
 segment's tip frame is the ``tip`` link's frame. Defaults: the URDF's root link and its single
 leaf. Raises SolverError for malformed XML, unknown links, tip not below root, floating, planar
-or mimic joints on the path, negative mass or a non-PSD inertia.
+or mimic joints on the path, negative mass, or (``inertia_check='physical'``, the default) a
+link inertia that no rigid body has (not PSD, or principal moments violating the triangle
+inequality); ``inertia_check='joint_space'`` accepts identified models (any symmetric inertia;
+use ``Solver(..., inertia_check='joint_space')`` with them).
 )doc")
       .def_property_readonly("n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); }, "int: number of moving joints n (the length of q, qd, tau_ff).")
       .def_property_readonly("n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); }, "int: number of segments (moving joints plus fixed-joint segments; rows of f_ext).")

@@ -6,6 +6,7 @@
 
 #include <kdl/chain.hpp>
 
+#include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/robot_chain.hpp"
 
 #include "common.hpp"
@@ -62,13 +63,14 @@ inline JointSpec jointFromString(const std::string& s) {
 struct PyChain {
   vereshchagin::RobotChain robot;
 
-  static PyChain fromUrdf(const std::string& source, const std::string& root, const std::string& tip);
+  static PyChain fromUrdf(const std::string& source, const std::string& root, const std::string& tip,
+                          vereshchagin::InertiaCheck inertia_check);
   // Pickle state: every segment (joint, tip frame, inertia bit for bit), joint and link metadata.
   py::tuple getState() const;
   static PyChain fromState(const py::tuple& state);
   void addSegment(const std::string& name, const py::object& joint, const py::object& tip, const py::object& mass,
                   const py::object& com, const py::object& inertia, const py::object& rotor_inertia,
-                  const std::string& joint_name);
+                  const std::string& joint_name, const std::string& inertia_check);
   std::vector<std::string> segmentNames() const;
   std::vector<std::string> jointNames() const;
   py::array_t<double> jointField(double vereshchagin::JointInfo::*field) const;

@@ -4,7 +4,7 @@
 namespace vsbind {
 namespace docs {
 
-inline constexpr const char* kSolve = R"doc(solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, out=None)
+inline constexpr const char* kSolve = R"doc(solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -42,6 +42,12 @@ constraints : dict, optional
     end), with the end-segment conventions at that frame: base axes, moment about that frame's
     origin, ``beta_i`` including ``-gravity``. At most 6 columns per segment. Combines with
     ``alpha``/``beta``.
+f_ext_pass_through, tau_ff_pass_through : array_like, shape (m_total,), optional
+    Driver pass-through per constraint column, in the order of ``nu`` (Shakhimardanov 2015,
+    eq. 3.42), each in [0, 1]: 0 (default) = the constraint compensates that driver (``f_ext``,
+    respectively ``tau_ff``) along that column, as KDL does; 1 = the driver's own acceleration
+    along that column passes through (``alpha^T a = beta + a_driver``: a commanded press on a
+    table, a support); in between, linear. Friction is always compensated.
 out : SolveResult, optional
     A result of an earlier solve with the same kind of arguments (same m, friction or not):
     its arrays are overwritten in place and it is returned (no allocation; for control loops).
@@ -65,7 +71,7 @@ The GIL is released during the solve. One solver serialises concurrent calls; us
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
 )doc";
 
-inline constexpr const char* kSolveBatch = R"doc(solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, threads=1)
+inline constexpr const char* kSolveBatch = R"doc(solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 )doc";

@@ -76,6 +76,23 @@ const double* Engine::assembleExternal(const RowInputs& in) {
 }
 
 int Engine::run(const RowInputs& in) {
+  if (in.f_ext_pass_through == nullptr && in.tau_ff_pass_through == nullptr) return runWeighted(in);
+  using MapV = Eigen::Map<const Eigen::VectorXd>;
+  int columns = 0;
+  for (int b = 0; b < in.n_blocks; ++b) columns += in.blocks[b].cols;
+  const MapV pf(in.f_ext_pass_through, in.f_ext_pass_through ? columns : 0);
+  const MapV pt(in.tau_ff_pass_through, in.tau_ff_pass_through ? columns : 0);
+  last_friction_ = in.friction != nullptr;  // errorMessage() of the right solver
+  int rc = in.friction ? friction_.setPassThrough(pf, pt) : hd_.setPassThrough(pf, pt);
+  if (rc == ChainHdSolver::E_NOERROR) rc = runWeighted(in);
+  if (in.friction)  // the weights hold for this row only
+    friction_.clearPassThrough();
+  else
+    hd_.clearPassThrough();
+  return rc;
+}
+
+int Engine::runWeighted(const RowInputs& in) {
   using Map6X = Eigen::Map<const ChainHdSolver::Matrix6X>;
   using MapV = Eigen::Map<const Eigen::VectorXd>;
   const MapV q(in.q, nj), qd(in.qd, nj);

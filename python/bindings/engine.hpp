@@ -49,6 +49,10 @@ struct RowInputs {
   int n_link_wrenches = 0;
   const double* tau_ff = nullptr;           // (n_joints,) or nullptr
   const vereshchagin::FrictionModel* friction = nullptr;
+  // Driver pass-through weights per constraint column in nu's order (nullptr: 0), see
+  // ChainHdSolver::setPassThrough.
+  const double* f_ext_pass_through = nullptr;
+  const double* tau_ff_pass_through = nullptr;
 };
 
 class Engine {
@@ -57,6 +61,8 @@ class Engine {
 
   // Solves one row; returns 0 or the C++ error code (message in errorMessage()).
   int run(const RowInputs& in);
+  // run() with the row's pass-through weights set for this solve only.
+  int runWeighted(const RowInputs& in);
   const char* errorMessage() const;
   void setGravity(const KDL::Vector& gravity);
 

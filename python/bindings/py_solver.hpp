@@ -19,7 +19,7 @@ namespace vsbind {
 // The arguments of one solve, checked: views into the caller's arrays plus the blocks, wrenches
 // and friction model that RowInputs points at.
 struct ParsedSolve {
-  F64View q, qd, alpha, beta, f_ext, tau;
+  F64View q, qd, alpha, beta, f_ext, tau, f_ext_pass_through, tau_ff_pass_through;
   std::vector<F64View> block_views;   // alpha_i, beta_i of constraints= entries (kept alive)
   std::vector<ConstraintBlock> blocks;
   std::vector<py::object> block_keys;  // constraints= keys, in order (for segment_nu)
@@ -34,11 +34,13 @@ struct ParsedSolve {
 
 class PySolver {
  public:
-  PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping);
+  PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping,
+           const std::string& inertia_check);
 
   // Parses solve()'s arguments (objects may be null for "not given") into `p`.
-  void parse(PyObject* q, PyObject* qd, PyObject* alpha, PyObject* beta, PyObject* f_ext, PyObject* tau_ff,
-             PyObject* friction, PyObject* constraints, ParsedSolve& p);
+  // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
+  // tau_ff_pass_through (the order of solve()'s parameters; `out` is not parsed here).
+  void parse(PyObject* const* args, ParsedSolve& p);
   // Solves the parsed row on engine 0 with the GIL released; raises SolverError on failure.
   void runParsed(const ParsedSolve& p);
   // The result of the last runParsed(): new arrays, or written into `out` (a SolveResult).
@@ -46,7 +48,8 @@ class PySolver {
 
   py::dict solveBatch(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
                       const py::object& f_ext, const py::object& tau_ff, const py::object& friction,
-                      const py::object& constraints, const py::object& threads);
+                      const py::object& constraints, const py::object& f_ext_pass_through,
+                      const py::object& tau_ff_pass_through, const py::object& threads);
   py::tuple responseColumns(const py::object& joints, bool hold_sticking);
   double timeCpp(const ParsedSolve& p, long reps);
 
@@ -58,6 +61,7 @@ class PySolver {
   std::unique_lock<std::mutex> lock();
 
   const PyChain& chain() const { return chain_; }
+  std::string inertiaCheck() const { return vereshchagin::inertiaCheckName(options_.inertia_check); }
   unsigned int nj = 0, ns = 0;
   ParsedSolve parsed;  // scratch of solve(), reused under the lock
 
@@ -78,6 +82,12 @@ class PySolver {
   vereshchagin::FrictionModel friction_cache_;
   std::mutex mutex_;
 };
+
+// "physical" or "joint_space" (raises otherwise, naming `where`).
+vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where);
+
+// Checked pass-through weights: (m,) in [0, 1].
+void checkWeights(const double* w, py::ssize_t m, const std::string& name);
 
 // Checked alpha: (6, m) or (6,) (one column), m <= 6, finite.
 F64View alphaView(PyObject* obj, const std::string& name);

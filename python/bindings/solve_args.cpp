@@ -9,7 +9,7 @@
 namespace vsbind {
 
 void ParsedSolve::clear() {
-  q = qd = alpha = beta = f_ext = tau = F64View();
+  q = qd = alpha = beta = f_ext = tau = f_ext_pass_through = tau_ff_pass_through = F64View();
   block_views.clear();
   blocks.clear();
   block_keys.clear();
@@ -41,8 +41,23 @@ std::string keyRepr(PyObject* key) { return py::repr(key).cast<std::string>(); }
 
 }  // namespace
 
-void PySolver::parse(PyObject* q, PyObject* qd, PyObject* alpha, PyObject* beta, PyObject* f_ext, PyObject* tau_ff,
-                     PyObject* friction, PyObject* constraints, ParsedSolve& p) {
+vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where) {
+  if (value == "physical") return vereshchagin::InertiaCheck::Physical;
+  if (value == "joint_space") return vereshchagin::InertiaCheck::JointSpace;
+  raise(where + "inertia_check must be 'physical' (every body a rigid body) or 'joint_space' (identified models: "
+        "any symmetric inertia, H(q) positive definite at each solve), got '" + value + "'");
+}
+
+void checkWeights(const double* w, py::ssize_t m, const std::string& name) {
+  for (py::ssize_t c = 0; c < m; ++c)
+    if (!(w[c] >= 0.0 && w[c] <= 1.0))
+      raise(name + "[" + std::to_string(c) + "] must be in [0, 1] (0: the constraint compensates that driver, 1: "
+            "its effect passes through), got " + fmtDouble(w[c]));
+}
+
+void PySolver::parse(PyObject* const* a, ParsedSolve& p) {
+  PyObject *q = a[0], *qd = a[1], *alpha = a[2], *beta = a[3], *f_ext = a[4], *tau_ff = a[5], *friction = a[6],
+           *constraints = a[7];
   p.clear();
   if (q == nullptr || qd == nullptr) raise("solve() needs q and qd");
   p.q = vectorView(q, "q", nj);
@@ -67,6 +82,15 @@ void PySolver::parse(PyObject* q, PyObject* qd, PyObject* alpha, PyObject* beta,
   if (given(tau_ff)) p.tau = vectorView(tau_ff, "tau_ff", nj);
   if (given(constraints)) parseConstraints(constraints, p);
   parseFriction(friction, p);
+  py::ssize_t columns = 0;
+  for (const ConstraintBlock& b : p.blocks) columns += b.cols;
+  const char* weight_names[2] = {"f_ext_pass_through", "tau_ff_pass_through"};
+  F64View* weights[2] = {&p.f_ext_pass_through, &p.tau_ff_pass_through};
+  for (int k = 0; k < 2; ++k) {
+    if (!given(a[8 + k])) continue;
+    *weights[k] = vectorView(a[8 + k], weight_names[k], columns, /*scalar_ok=*/true);
+    checkWeights(weights[k]->data, columns, weight_names[k]);
+  }
   RowInputs& r = p.row;
   r.q = p.q.data;
   r.qd = p.qd.data;
@@ -79,6 +103,8 @@ void PySolver::parse(PyObject* q, PyObject* qd, PyObject* alpha, PyObject* beta,
   r.n_link_wrenches = static_cast<int>(p.link_wrenches.size());
   r.tau_ff = p.tau.data;
   r.friction = p.friction;
+  r.f_ext_pass_through = p.f_ext_pass_through.data;
+  r.tau_ff_pass_through = p.tau_ff_pass_through.data;
 }
 
 // f_ext: (n_segments, 6) rows [force, moment] (base axes, moment about each tip origin), or a

@@ -99,7 +99,7 @@ Batched alphaArg(PyObject* obj, const std::string& name, BatchSize& bs, py::ssiz
 struct BatchRunner {
   PySolver& s;
   BatchSize bs;
-  Batched q, qd, f_ext, tau;
+  Batched q, qd, f_ext, tau, f_ext_pass_through, tau_ff_pass_through;
   std::vector<Batched> alpha, beta;             // one per block (end segment first)
   std::vector<ConstraintBlock> block_template;  // segment, cols, offset per block
   std::vector<py::object> block_keys;
@@ -257,6 +257,8 @@ struct BatchRunner {
     r.n_link_wrenches = static_cast<int>(wrenches.size());
     r.tau_ff = tau.row(b);
     r.friction = frictionOf(b);
+    r.f_ext_pass_through = f_ext_pass_through.row(b);
+    r.tau_ff_pass_through = tau_ff_pass_through.row(b);
     return r;
   }
 };
@@ -264,6 +266,7 @@ struct BatchRunner {
 py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj, const py::object& alpha_obj,
                               const py::object& beta_obj, const py::object& f_ext_obj, const py::object& tau_obj,
                               const py::object& friction_obj, const py::object& constraints_obj,
+                              const py::object& f_ext_pass_through_obj, const py::object& tau_ff_pass_through_obj,
                               const py::object& threads_obj) {
   auto lk = lock();
   BatchRunner br(*this);
@@ -285,6 +288,14 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
   if (!tau_obj.is_none()) br.tau = batchedArg(tau_obj.ptr(), "tau_ff", 1, {n}, br.bs);
   if (!constraints_obj.is_none()) br.parseConstraints(constraints_obj.ptr());
   br.parseFrictionArg(friction_obj.ptr());
+  const std::pair<const py::object*, const char*> weight_args[2] = {{&f_ext_pass_through_obj, "f_ext_pass_through"},
+                                                                    {&tau_ff_pass_through_obj, "tau_ff_pass_through"}};
+  Batched* weights[2] = {&br.f_ext_pass_through, &br.tau_ff_pass_through};
+  for (int k = 0; k < 2; ++k) {
+    if (weight_args[k].first->is_none()) continue;
+    *weights[k] = betaArg(weight_args[k].first->ptr(), weight_args[k].second, br.M, br.bs);
+    checkWeights(weights[k]->view.data, weights[k]->view.size(), weight_args[k].second);
+  }
   br.B = br.bs.B < 0 ? 1 : br.bs.B;
   br.finishFExt();
   long threads = threads_obj.is_none() ? 1 : static_cast<long>(scalarArg(threads_obj, "threads"));

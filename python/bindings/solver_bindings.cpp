@@ -14,18 +14,20 @@
 
 namespace vsbind {
 
-PySolver::PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping)
+PySolver::PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping,
+                   const std::string& inertia_check)
     : chain_(chain), damping_arg_(damping) {
   options_.rcond = scalarArg(rcond, "rcond");
+  options_.inertia_check = inertiaCheckArg(inertia_check, "");
   if (!damping.is_none()) {
     options_.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
     options_.damping = scalarArg(damping, "damping");
   }
   gravity_ = vec3(gravity, "gravity");
-  engines_.push_back(std::make_unique<Engine>(chain.robot.chain, gravity_, options_));
-  ChainHdSolver probe(chain.robot.chain, KDL::Twist::Zero());
+  ChainHdSolver probe(chain.robot.chain, KDL::Twist::Zero(), options_);
   if (probe.modelError() != ChainHdSolver::E_NOERROR) raise(std::string("invalid chain: ") + probe.errorMessage());
   if (probe.setOptions(options_) != ChainHdSolver::E_NOERROR) raise(probe.errorMessage());
+  engines_.push_back(std::make_unique<Engine>(chain.robot.chain, gravity_, options_));
   nj = probe.nrOfJoints();
   ns = probe.nrOfSegments();
   const auto n = static_cast<Eigen::Index>(chain.robot.joints.size());
@@ -197,7 +199,8 @@ py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking
 }
 
 py::tuple PySolver::getState() const {
-  return py::make_tuple(py::cast(chain_), gravity(), options_.rcond, damping_arg_);
+  return py::make_tuple(py::cast(chain_), gravity(), options_.rcond, damping_arg_,
+                        vereshchagin::inertiaCheckName(options_.inertia_check));
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -205,7 +208,10 @@ py::tuple PySolver::getState() const {
 // interned strings first (what the interpreter passes for literal keywords), then by value.
 namespace {
 
-constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints", "out"};
+constexpr const char* kSolveParams[] = {"q",           "qd",     "alpha",  "beta",
+                                        "f_ext",       "tau_ff", "friction", "constraints",
+                                        "f_ext_pass_through", "tau_ff_pass_through", "out"};
+constexpr int kOut = 10;
 constexpr int kNumSolveParams = sizeof(kSolveParams) / sizeof(kSolveParams[0]);
 PyObject* g_solve_names[kNumSolveParams];
 PyObject* g_solver_error = nullptr;
@@ -274,9 +280,9 @@ PyObject* solveEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, Py
     bindArguments("solve", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
     PySolver& s = solverOf(self);
     auto lk = s.lock();
-    s.parse(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], s.parsed);
+    s.parse(a, s.parsed);
     s.runParsed(s.parsed);
-    PyObject* out = (a[8] == nullptr || a[8] == Py_None) ? nullptr : a[8];
+    PyObject* out = (a[kOut] == nullptr || a[kOut] == Py_None) ? nullptr : a[kOut];
     return s.result(s.parsed, out);
   });
 }
@@ -292,7 +298,7 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
     PySolver& s = solverOf(self);
     auto lk = s.lock();
     ParsedSolve p;
-    s.parse(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], p);
+    s.parse(a, p);
     return py::float_(s.timeCpp(p, reps));
   });
 }
@@ -316,13 +322,14 @@ void bindSolver(py::module_& mod) {
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
   py::class_<PySolver> cls(mod, "Solver", docs::kSolverCore);
-  cls.def(py::init<const PyChain&, const py::object&, const py::object&, const py::object&>(), py::arg("chain"),
-          py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
-          py::arg("damping") = py::none())
+  cls.def(py::init<const PyChain&, const py::object&, const py::object&, const py::object&, const std::string&>(),
+          py::arg("chain"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
+          py::arg("damping") = py::none(), py::arg("inertia_check") = "physical")
       .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
-           py::arg("friction") = py::none(), py::arg("constraints") = py::none(), py::arg("threads") = 1,
-           docs::kSolveBatch)
+           py::arg("friction") = py::none(), py::arg("constraints") = py::none(),
+           py::arg("f_ext_pass_through") = py::none(), py::arg("tau_ff_pass_through") = py::none(),
+           py::arg("threads") = 1, docs::kSolveBatch)
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            docs::kResponseColumns)
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, docs::kGravity)
@@ -330,10 +337,13 @@ void bindSolver(py::module_& mod) {
       .def_property_readonly("n_segments", [](const PySolver& s) { return s.ns; },
                              "Number of segments (moving and fixed-joint segments of the chain).")
       .def_property_readonly("chain", [](const PySolver& s) { return s.chain(); }, "A copy of the solver's Chain.")
+      .def_property_readonly("inertia_check", [](const PySolver& s) { return s.inertiaCheck(); },
+                             "str: 'physical' or 'joint_space' (see Solver).")
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
-                        if (t.size() != 4) raise("Solver state must have 4 entries");
-                        return std::make_unique<PySolver>(t[0].cast<PyChain>(), t[1], t[2], t[3]);
+                        if (t.size() != 5) raise("Solver state must have 5 entries");
+                        return std::make_unique<PySolver>(t[0].cast<PyChain>(), t[1], t[2], t[3],
+                                                          t[4].cast<std::string>());
                       }));
   addFastMethod(cls, &g_solve_def);
   addFastMethod(cls, &g_time_def);

@@ -18,7 +18,9 @@ class Joint:
 class Chain:
     def __init__(self) -> None: ...
     @staticmethod
-    def from_urdf(source: str | os.PathLike[str], root: str = "", tip: str = "") -> Chain: ...
+    def from_urdf(
+        source: str | os.PathLike[str], root: str = "", tip: str = "", inertia_check: str = "physical"
+    ) -> Chain: ...
     def add_segment(
         self,
         name: str,
@@ -29,6 +31,7 @@ class Chain:
         inertia: Optional[ArrayLike] = None,
         rotor_inertia: float = 0.0,
         joint_name: str = "",
+        inertia_check: str = "physical",
     ) -> None: ...
     @property
     def n_joints(self) -> int: ...
@@ -130,6 +133,7 @@ class Solver:
         gravity: ArrayLike = ...,
         rcond: float = 1e-12,
         damping: Optional[float] = None,
+        inertia_check: str = "physical",
     ) -> None: ...
     def solve(
         self,
@@ -144,6 +148,8 @@ class Solver:
         constraints: Optional[
             Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]
         ] = None,
+        f_ext_pass_through: Optional[ArrayLike] = None,
+        tau_ff_pass_through: Optional[ArrayLike] = None,
         out: Optional[SolveResult] = None,
     ) -> SolveResult: ...
     def _time_cpp(self, reps: int, /, *args: object, **kwargs: object) -> float: ...
@@ -159,6 +165,8 @@ class Solver:
         constraints: Optional[
             Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]
         ] = None,
+        f_ext_pass_through: Optional[ArrayLike] = None,
+        tau_ff_pass_through: Optional[ArrayLike] = None,
         threads: int = 1,
     ) -> dict: ...
     def response_columns(
@@ -168,6 +176,8 @@ class Solver:
     def __setstate__(self, state: tuple) -> None: ...
     @property
     def chain(self) -> Chain: ...
+    @property
+    def inertia_check(self) -> str: ...
     gravity: NDArray[np.float64]
     @property
     def n_joints(self) -> int: ...

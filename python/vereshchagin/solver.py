@@ -73,6 +73,11 @@ class Solver(_core.Solver):
         treated as zero (truncated pseudo-inverse; the rank is reported).
     damping : float, optional
         If given, use damped least squares ``lambda / (lambda^2 + damping^2)`` instead.
+    inertia_check : {'physical', 'joint_space'}
+        'physical' (default): every body must be a rigid body (checked once). 'joint_space':
+        identified models (e.g. the published KUKA LWR 4 parameters) whose link inertias need
+        not be positive semi-definite; each solve then checks that every articulated joint
+        inertia is positive (H(q) positive definite) and names the joint when not.
 
     Notes
     -----
@@ -90,7 +95,7 @@ class Solver(_core.Solver):
     """
 
     def solve_batch(self, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None,
-                    threads=1) -> BatchResult:
+                    f_ext_pass_through=None, tau_ff_pass_through=None, threads=1) -> BatchResult:
         """Solve B states at once (each row exactly as :meth:`solve` would).
 
         Every argument is either shared by all rows (the shape :meth:`solve` takes) or has a
@@ -109,6 +114,8 @@ class Solver(_core.Solver):
         constraints : dict, optional
             ``{segment: (alpha_i, beta_i)}`` with ``alpha_i`` (6, m_i) or (B, 6, m_i) and
             ``beta_i`` (m_i,) or (B, m_i).
+        f_ext_pass_through, tau_ff_pass_through : array_like, shape (B, m) or (m,), optional
+            Driver pass-through weights in [0, 1] per constraint column (see :meth:`solve`).
         threads : int
             Rows are split into ``threads`` contiguous chunks solved in parallel with the GIL
             released (0: one per core). Results do not depend on it.
@@ -123,7 +130,8 @@ class Solver(_core.Solver):
             Shapes that do not fit (the message names the argument and its batch axis), or the
             first failing row (``"batch row 3: ..."``).
         """
-        return BatchResult(**super().solve_batch(q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, threads))
+        return BatchResult(**super().solve_batch(q, qd, alpha, beta, f_ext, tau_ff, friction, constraints,
+                                                 f_ext_pass_through, tau_ff_pass_through, threads))
 
     def response_columns(self, joints, hold_sticking=True):
         """Affine response of the last solve to unit feed-forward joint torques.

@@ -32,6 +32,8 @@ class Solver(_core.Solver):
         tau_ff: Optional[ArrayLike] = None,
         friction: object = None,
         constraints: Optional[Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]] = None,
+        f_ext_pass_through: Optional[ArrayLike] = None,
+        tau_ff_pass_through: Optional[ArrayLike] = None,
         threads: int = 1,
     ) -> BatchResult: ...
     def response_columns(  # type: ignore[override]
