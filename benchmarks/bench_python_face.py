@@ -6,7 +6,8 @@ chain; 64 seeded states; m = 0, 1, 6 orthonormal constraint columns on the last 
 cases: the same states with joints 2, 4, 6 (1-based: every second joint) at rest and static
 friction 0.5-2 N m, m = 0 and 1.
 
-Timed per call, all in one process, interleaved batches (A B C A B C ...), medians:
+Timed per call, all in one process, interleaved batches (A B C A B C ...), medians; every variant
+repeats each state the same number of times in a row (as the C++ loop does):
   C++ solve        Solver._time_cpp: the C++ Engine::run + reading every output solve() returns
                    (link accelerations; with friction also friction/limit torques, status,
                    gauss_value), looped in C++ with the GIL released
@@ -70,19 +71,21 @@ def case_rows(label, segs, seed, batches, batch_s):
             for q, qd, kw, _, _ in calls:
                 solver._time_cpp(reps, q, qd, **kw)
 
+        # Every variant repeats each state `reps` times in a row, as _time_cpp does, so that the
+        # comparison sees the same sequence of states (and the same branch history).
         def py(reps):
-            for _ in range(reps):
-                for q, qd, kw, _, _ in calls:
+            for q, qd, kw, _, _ in calls:
+                for _ in range(reps):
                     solver.solve(q, qd, **kw)
 
         def py_read(reps):
-            for _ in range(reps):
-                for q, qd, kw, _, _ in calls:
+            for q, qd, kw, _, _ in calls:
+                for _ in range(reps):
                     solver.solve(q, qd, **kw).qdd
 
         def py_out(reps):
-            for _ in range(reps):
-                for (q, qd, kw, _, _), out in zip(calls, outs):
+            for (q, qd, kw, _, _), out in zip(calls, outs):
+                for _ in range(reps):
                     solver.solve(q, qd, out=out, **kw)
 
         variants = {"cpp": cpp, "py": py, "py+qdd": py_read, "out": py_out}
@@ -91,8 +94,8 @@ def case_rows(label, segs, seed, batches, batch_s):
                 pin_args = [(model, data, q, qd, tau) for q, qd, _, _, tau in calls]
 
                 def pin_run(reps):
-                    for _ in range(reps):
-                        for a in pin_args:
+                    for a in pin_args:
+                        for _ in range(reps):
                             pin.aba(*a)
             else:
                 def pipeline(q, qd, tau, alpha, beta):
@@ -102,8 +105,8 @@ def case_rows(label, segs, seed, batches, batch_s):
                     return pin.forwardDynamics(model, data, tau, J, gamma)
 
                 def pin_run(reps):
-                    for _ in range(reps):
-                        for q, qd, _, task, tau in calls:
+                    for q, qd, _, task, tau in calls:
+                        for _ in range(reps):
                             pipeline(q, qd, tau, *task)
             variants["pin"] = pin_run
         print(f"timing {label}, m {m}{' friction' if with_friction else ''} ...", file=sys.stderr, flush=True)
