@@ -11,7 +11,8 @@
    report's vertex enumeration, about 30 s) and benchmarks/bench_friction_pinocchio.py (static
    friction vs Pinocchio's JointFrictionConstraintModel + ADMM, about 10 s);
 5. runs benchmarks/bench_segments.py (constraints on 1, 2, 3 segments vs Pinocchio's KKT solve, from
-   Python, about 15-20 s);
+   Python, about 15-20 s) and benchmarks/bench_python_face.py (the Python call's overhead over the C++
+   solve, out=, solve_batch per row and with threads=2, about 15 s);
 6. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
    the method, the target checks and all reports.
 """
@@ -176,6 +177,10 @@ def main():
     seg_file.unlink(missing_ok=True)
     seg_rc = run([sys.executable, REPO / "benchmarks" / "bench_segments.py", "--out", seg_file],
                  stdout=subprocess.DEVNULL).returncode
+    face_file = build / "bench_python_face.md"
+    face_file.unlink(missing_ok=True)
+    face_rc = run([sys.executable, REPO / "benchmarks" / "bench_python_face.py", "--out", face_file],
+                  stdout=subprocess.DEVNULL).returncode
     load_end = loadavg()
 
     cpp_md, py_md = cpp_file.read_text(), py_file.read_text()
@@ -231,9 +236,11 @@ def main():
     md += ["", py_md.rstrip(), ""]
     md += friction_section(fr_file, fr_rc, frpy_file, frpy_rc)
     md += segments_section(seg_file, seg_rc)
+    md += ["", face_file.read_text().rstrip() if face_file.exists() else
+           f"**bench_python_face.py exited with code {face_rc} and wrote no report.**", ""]
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
-    return 0 if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 and seg_rc == 0 else 1
+    return 0 if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 and seg_rc == 0 and face_rc == 0 else 1
 
 
 if __name__ == "__main__":

@@ -12,8 +12,26 @@ from .friction import Friction
 from .kdl_interop import chain_from_kdl as _chain_from_kdl, chain_to_kdl as _chain_to_kdl
 from .solver import BatchResult, Solver
 
-# PyKDL interoperability (kdl_interop.py), attached to the compiled class.
-Chain.from_kdl = staticmethod(_chain_from_kdl)  # type: ignore[method-assign]
-Chain.to_kdl = _chain_to_kdl  # type: ignore[method-assign,assignment]
+
+def _to_kdl(self: Chain):
+    """This chain as a PyKDL ``Chain`` (see :func:`vereshchagin.kdl_interop.chain_to_kdl`).
+
+    Returns
+    -------
+    PyKDL.Chain
+        Segments with names, joints, tip frames at joint position 0 and inertias.
+
+    Raises
+    ------
+    ImportError
+        PyKDL is not importable.
+    """
+    return _chain_to_kdl(self)
+
+
+# PyKDL interoperability (kdl_interop.py), attached to the compiled class (its stub declares both;
+# setattr because a type checker rejects assigning to a declared method).
+setattr(Chain, "from_kdl", staticmethod(_chain_from_kdl))  # noqa: B010
+setattr(Chain, "to_kdl", _to_kdl)  # noqa: B010
 
 __all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]

@@ -34,7 +34,7 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
     case : {"friction", "demo", "contact", "friction-energy", "all"}
-        ``contact``: report 003's three use cases in MuJoCo (:mod:`vereshchagin.contact.report`);
+        ``contact``: the three use cases of W. K. Lau (2023) in MuJoCo (:mod:`vereshchagin.contact.report`);
         ``friction-energy``: the motor effort exact static friction saves on the Gen3
         (:mod:`vereshchagin.experiments.friction_energy_report`).
 
@@ -52,10 +52,10 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     if case in ("friction", "all"):
         from .experiments.friction_figures import run as run_friction
 
-        _say(f"[reproduce] report 000 friction figures -> {out}{' (quick)' if quick else ''}")
+        _say(f"[reproduce] Vukcevic (2018) friction figures -> {out}{' (quick)' if quick else ''}")
         res = run_friction(out, quick=quick, progress=_say)
         ok &= bool(res["ok"])
-        index += ["## Static joint friction on the 1-DOF arm (report 000, chapters 5-6)", "",
+        index += ["## Static joint friction on the 1-DOF arm (D. Vukcevic (2018), chapters 5-6)", "",
                   f"Table: [{_rel(res['table_md'], out)}]({_rel(res['table_md'], out)}) "
                   f"(CSV: [{_rel(res['table_csv'], out)}]({_rel(res['table_csv'], out)}))", ""]
         table = res["table_md"].read_text(encoding="utf-8").splitlines()
@@ -85,7 +85,7 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     if case in ("contact", "all"):
         from .contact.report import run as run_contact
 
-        ok &= _section("report 003 contact use cases (MuJoCo plant)", run_contact, out, quick, index)
+        ok &= _section("Lau (2023) contact use cases (MuJoCo plant)", run_contact, out, quick, index)
     if case in ("friction-energy", "all"):
         from .experiments.friction_energy_report import run as run_energy
 
@@ -97,11 +97,23 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
 
 
 def main(argv=None) -> int:
+    """The command line (``python -m vereshchagin demo | reproduce [--out DIR] [--quick] [--case CASE]``).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments without the program name; None: ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 1 if a reproduced result failed its checks.
+    """
     parser = argparse.ArgumentParser(prog="vereshchagin", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("demo", help="solve three tasks on a 7-joint arm and print the results")
-    rep = sub.add_parser("reproduce", help="reproduce report 000's friction figures, the demo, report 003's contact "
-                         "use cases and the friction-energy experiment into a folder")
+    rep = sub.add_parser("reproduce", help="reproduce the friction figures of Vukcevic (2018), the demo, the contact "
+                         "use cases of Lau (2023) and the friction-energy experiment into a folder")
     rep.add_argument("--out", default="results", help="output folder (default: ./results)")
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
     rep.add_argument("--case", choices=("friction", "demo", "contact", "friction-energy", "all"), default="all",

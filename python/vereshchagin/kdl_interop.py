@@ -100,6 +100,7 @@ def _segment_arguments(kdl, segment, index: int) -> dict[str, Any]:
     joint = segment.getJoint()
     kind = _joint_type_name(kdl, joint)
     where = f"segment {index} ('{name}')"
+    spec: Joint | str
     if kind in ("RotAxis", "TransAxis"):
         make = Joint.revolute if kind == "RotAxis" else Joint.prismatic
         spec = make(_vec(joint.JointAxis()), _vec(joint.JointOrigin()))

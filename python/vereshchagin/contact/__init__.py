@@ -1,0 +1,21 @@
+"""The contact use cases of W. K. Lau (2023) on a simulated Kinova Gen3 (needs ``mujoco``).
+
+W. K. Lau, "Exploiting contact constraints in robotic manipulation tasks", R&D project report,
+Hochschule Bonn-Rhein-Sieg, 2023, lets the environment carry part of a task: a gripper slides on a
+table before grasping, a pen draws on it, an elbow rests on a support. Here the same tasks run in
+closed loop at 1 kHz, with this package's solver inside the controller:
+
+- :mod:`.robot_interface`: what a control loop reads (joint state) and writes (torques) each cycle;
+- :mod:`.mujoco_plant`: the MuJoCo plant, compiled from the same URDF as the controller's chain;
+- :mod:`.controller`: the report's cascaded P controller (pose error -> twist -> ``beta``),
+  z released in contact, joint friction handled by the friction-aware solve;
+- :mod:`.use_cases`: the phases of the grasp and writing tasks and the loop that runs them;
+- :mod:`.elbow`: the resting-elbow task, with the support left to the plant or stated as a segment
+  constraint;
+- :mod:`.metrics`: effort and accuracy numbers of a run (the report's Tables 6.1-6.3);
+- :mod:`.report`: runs everything and writes tables and figures
+  (``python -m vereshchagin reproduce --case contact``).
+
+Units are SI (m, rad, s, N, N m); poses and twists are in the robot's base frame, z up, gravity
+``[0, 0, -9.81]`` m/s^2.
+"""

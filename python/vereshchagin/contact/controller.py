@@ -1,4 +1,4 @@
-"""Report 003's controller (sec. 5.1): cascaded P position -> velocity -> ``beta``, our solver inside.
+"""The controller of W. K. Lau (2023), sec. 5.1: cascaded P position -> velocity -> ``beta``, our solver inside.
 
 One cycle (:meth:`CascadedController.command`):
 
@@ -14,7 +14,7 @@ One cycle (:meth:`CascadedController.command`):
    estimated from the model (the force along ``w = [e_z; r x e_z]`` at the contact point ``r``
    that stops the predicted z acceleration of that point: ``N = (g - w.a_pred) / (w^T J G J^T w)``
    with ``G`` the constrained inverse inertia from :meth:`Solver.response_columns`, clipped at 0)
-   and a friction force ``mu_est * N`` against the desired sliding direction (report 003 used
+   and a friction force ``mu_est * N`` against the desired sliding direction (Lau (2023) used
    ``f_ext`` "to counter friction");
 5. the solver's command: ``solve(q, qd, alpha, beta, f_ext, tau_ff, friction)``. ``tau_ff`` holds
    the plant's modelled viscous damping ``-d * qd`` (the plant applies it, the motors compensate
@@ -34,7 +34,7 @@ the threshold). On contact the gains switch to the contact set and the direction
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
@@ -48,16 +48,28 @@ G = 9.81
 
 @dataclass(frozen=True)
 class Gains:
-    """P gains ``k_pos = (linear, angular)`` (1/s) and ``k_vel = (linear, angular)`` (1/s)."""
+    """Gains of the cascaded P controller, each split into a linear and an angular part.
+
+    Attributes
+    ----------
+    k_pos : (float, float)
+        Position gains ``(linear, angular)`` (1/s): the desired twist is ``k_pos * e`` for the
+        pose error ``e`` (translation in m, rotation axis * angle in rad, base axes), before
+        saturation at ``v_max`` / ``w_max``.
+    k_vel : (float, float)
+        Velocity gains ``(linear, angular)`` (1/s): the desired classical acceleration is
+        ``k_vel * (v_d - v)`` (m/s^2, rad/s^2) for the desired and measured twists (base axes,
+        linear part at the end-effector origin).
+    """
 
     k_pos: tuple = (40.0, 80.0)
     k_vel: tuple = (30.0, 2.0)
 
 
 FREE_GAINS = Gains((40.0, 80.0), (30.0, 40.0))
-"""Report 003, use case 1, before contact."""
+"""Gains of W. K. Lau (2023), use case 1, before contact, except the angular ``k_vel`` = 40 instead of 2."""
 CONTACT_GAINS = Gains((10.0, 80.0), (15.0, 40.0))
-"""Report 003, use case 1, after contact, except the linear ``k_vel`` = 15 instead of 4.
+"""Gains of W. K. Lau (2023), use case 1, after contact, except the linear ``k_vel`` = 15 instead of 4.
 
 In contact the velocity loop is the only feedback against what the model compensates imperfectly:
 the sliding friction ``mu N`` of the table (about 15 N when the arm's weight presses with ~50 N
@@ -84,13 +96,14 @@ class ControllerConfig:
     Attributes
     ----------
     free_gains, contact_gains : Gains
+        Gains before contact (all directions constrained) and after contact (z released).
     v_max, w_max : float
         Saturation of the desired twist (m/s, rad/s).
     contact_threshold : float
         |v_z| (m/s) below which a sample counts towards contact.
     contact_samples : int
         Consecutive samples needed (report: 10).
-    contact_point : (3,)
+    contact_point : (float, float, float)
         The tool's contact point in the end-effector frame (m), for ``f_ext``.
     mu_estimate : float
         Surface friction coefficient assumed in ``f_ext`` (0: no friction compensation).
@@ -138,7 +151,28 @@ class ControllerConfig:
 
 @dataclass
 class CycleInfo:
-    """What one control cycle computed (for logging)."""
+    """What one control cycle computed (for logging).
+
+    Attributes
+    ----------
+    pose : ndarray, shape (4, 4)
+        Measured end-effector pose (homogeneous transform, base frame, m).
+    twist : ndarray, shape (6,)
+        Measured end-effector twist ``[v; w]`` (m/s, rad/s; base axes, linear part at the
+        end-effector origin).
+    error : ndarray, shape (6,)
+        Pose error towards the goal (m, rad; :func:`vereshchagin.task.pose_error`).
+    normal_force_estimate : float
+        Model estimate ``N`` of the table's normal force (N, >= 0; 0 in free space).
+    contact : bool
+        The controller was in contact mode (z released) during the cycle.
+    result : SolveResult
+        The solver's result of the commanding solve.
+    inputs : dict
+        The solve's arguments (``q, qd, alpha, beta, f_ext, tau_ff`` and segment ``constraints``,
+        without ``friction``) and ``motor_ff``, the motor-side part of ``tau_ff`` added to the
+        command (N m, shape (n,)).
+    """
 
     pose: np.ndarray
     twist: np.ndarray
@@ -147,19 +181,34 @@ class CycleInfo:
     contact: bool
     result: object = field(repr=False, default=None)
     inputs: dict = field(repr=False, default_factory=dict)
-    """The solve's arguments (``q, qd, alpha, beta, f_ext, tau_ff`` and segment ``constraints``,
-    without ``friction``) and ``motor_ff``, the motor-side part of ``tau_ff`` added to the command."""
 
 
 class CascadedController:
-    """The cascaded P controller of report 003 around :class:`vereshchagin.Solver` (module doc).
+    """The cascaded P controller of W. K. Lau (2023) around :class:`vereshchagin.Solver` (module doc).
 
     Parameters
     ----------
     chain : Chain
+        The robot (n joints); its ``friction`` (N m) and ``damping`` (N m s/rad) are the plant's.
     solver : Solver
-        Built from ``chain`` with gravity ``[0, 0, -9.81]``.
+        Built from ``chain`` with gravity ``[0, 0, -9.81]`` (m/s^2, base frame).
     config : ControllerConfig
+        Gains, saturation, contact detection and friction handling.
+
+    Attributes
+    ----------
+    goal : ndarray, shape (4, 4) or None
+        Desired end-effector pose (base frame, m); None until :meth:`set_goal`.
+    in_contact : bool
+        Contact mode: z released, contact gains, ``f_ext`` with the normal-force estimate.
+    q_ref : ndarray, shape (n,) or None
+        Reference of the posture term (rad); the first commanded ``q`` when None.
+    extra_constraints : dict, callable or None
+        Segment constraints passed to :meth:`Solver.solve` as ``constraints=``: a dict
+        ``{segment name: (alpha (6, m), beta (m,))}`` or a callable ``(q, qd) -> dict``.
+    support_share : callable or None
+        ``support_share(result, q) -> (n,)``: joint torque (N m) the environment supplies,
+        subtracted from the motor command.
     """
 
     def __init__(self, chain, solver, config: ControllerConfig = ControllerConfig()):
@@ -174,34 +223,55 @@ class CascadedController:
         self.joint_friction = np.asarray(chain.friction, float)
         self.friction = Friction(static=self.joint_friction, velocity_tolerance=config.friction_velocity_tolerance) \
             if config.friction_mode == "maxmin" and np.any(self.joint_friction > 0) else None
-        self.goal = None
+        self.goal: Optional[np.ndarray] = None
         self.in_contact = False
         self.detect = False
         self._armed = False
         self._count = 0
-        self.q_ref = None
-        self.extra_constraints = None  # dict for segment constraints (solver API of issue 5)
-        self.support_share = None  # callable(result, q) -> torque the environment supplies
+        self.q_ref: Optional[np.ndarray] = None
+        self.extra_constraints: Optional[Union[dict, Callable[[np.ndarray, np.ndarray], dict]]] = None
+        self.support_share: Optional[Callable[[Any, np.ndarray], np.ndarray]] = None
         self._all = list(range(n))
-        self._alpha = {}  # constraint directions per tuple of names
+        self._alpha: dict[tuple, np.ndarray] = {}  # constraint directions (6, m) per tuple of names
 
     # -- task state ------------------------------------------------------------------------------
     def set_goal(self, T_goal) -> None:
-        """Desired end-effector pose (4x4, base frame)."""
+        """Set the desired end-effector pose.
+
+        Parameters
+        ----------
+        T_goal : array_like, shape (4, 4)
+            Homogeneous transform of the goal in the base frame (m).
+        """
         self.goal = np.asarray(T_goal, float)
 
     def arm_contact_detection(self, on: bool = True) -> None:
-        """Start (or stop) watching |v_z| for contact."""
+        """Start (or stop) watching the end-effector's |v_z| (base z, m/s) for contact.
+
+        Parameters
+        ----------
+        on : bool
+            True: watch, switching to contact mode after ``contact_samples`` slow samples once
+            the tool has moved; False: stop watching. Either way the count restarts.
+        """
         self.detect = on
         self._armed = False
         self._count = 0
 
     def set_contact(self, contact: bool) -> None:
-        """Switch directions and gains to contact (z released) or free space."""
+        """Switch directions and gains to contact (z released) or free space.
+
+        Parameters
+        ----------
+        contact : bool
+            True: contact mode (directions x, y, rx, ry, rz; contact gains; table force in
+            ``f_ext``); False: free space (``free_directions``, free gains).
+        """
         self.in_contact = contact
 
     @property
     def gains(self) -> Gains:
+        """The gains in use: ``config.contact_gains`` in contact mode, else ``config.free_gains``."""
         return self.config.contact_gains if self.in_contact else self.config.free_gains
 
     # -- one cycle -------------------------------------------------------------------------------
@@ -216,7 +286,20 @@ class CascadedController:
             self.detect = False
 
     def command(self, q, qd) -> tuple[np.ndarray, CycleInfo]:
-        """Motor torques (n,) for the measured ``q``, ``qd``, and what was computed."""
+        """One control cycle: the motor torques for the measured joint state.
+
+        Parameters
+        ----------
+        q, qd : array_like, shape (n,)
+            Measured joint positions (rad) and velocities (rad/s).
+
+        Returns
+        -------
+        tau : ndarray, shape (n,)
+            Motor torque command (N m, acting on the joints; before the plant's saturation).
+        info : CycleInfo
+            What the cycle computed (pose, twist, error, solve inputs and result).
+        """
         cfg = self.config
         q = np.asarray(q, float)
         qd = np.asarray(qd, float)
@@ -246,7 +329,7 @@ class CascadedController:
                 self.q_ref = q.copy()
             tau_motor_ff = K * (self.q_ref - q) - D * qd
         tau_ff = tau_motor_ff - self.damping * qd
-        kw = {}
+        kw: dict[str, Any] = {}
         if self.extra_constraints:
             kw["constraints"] = self.extra_constraints(q, qd) if callable(self.extra_constraints) \
                 else self.extra_constraints

@@ -1,6 +1,6 @@
-"""Use case 3 (report 003 sec. 6.4): the end-effector moves while the elbow rests on a support.
+"""Use case 3 (W. K. Lau (2023), sec. 6.4): the end-effector moves while the elbow rests on a support.
 
-Pose: report 003 does not give one (the elbow rested on a stack of books). With the tool held
+Pose: the report does not give one (the elbow rested on a stack of books). With the tool held
 fixed, the Gen3's elbow (joint 4's centre, the tip of the ``forearm_link`` segment) can only move
 on the self-motion circle around the shoulder-wrist axis; at the circle's lowest point a support
 cannot carry anything to first order (the elbow's height does not change with the self-motion
@@ -85,10 +85,29 @@ def support_share(chain, seg: int):
 
 
 def elbow(variant: str, quick: bool = False, progress=None):
-    """Run use case 3 in one of :data:`VARIANTS` (see module doc); returns a :class:`~.use_cases.Run`.
+    """Run use case 3 in one of :data:`VARIANTS` (see module doc).
 
-    ``run.info``: ``elbow_z`` (elbow height per sample, m), ``support_top`` (m or None) and
-    ``support_force_model`` (the solver's ``-nu_e`` per sample, N; NaN without the constraint).
+    Parameters
+    ----------
+    variant : {"unsupported", "plant", "constraint"}
+        Who carries the elbow: the motors (segment constraint), the plant's support unknown to
+        the controller, or the support stated as the segment constraint.
+    quick : bool
+        Shorter settle, slide and hold phases.
+    progress : callable, optional
+        ``progress(fraction)``, see :func:`~.use_cases.run_loop`.
+
+    Returns
+    -------
+    Run
+        Phases ``settle``, ``slide``, ``hold``; ``run.info``: ``elbow_z`` (elbow height per
+        sample, m, base z), ``support_top`` (m or None) and ``support_force_model`` (the solver's
+        ``-nu_e`` per sample, N, positive pushing up; NaN without the constraint).
+
+    Raises
+    ------
+    ValueError
+        If ``variant`` is not one of :data:`VARIANTS`.
     """
     if variant not in VARIANTS:
         raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")
@@ -114,17 +133,13 @@ def elbow(variant: str, quick: bool = False, progress=None):
     phases = [Phase("settle", lambda T: _shifted(T, R=R0), duration, contact=False),
               Phase("slide", lambda T: _shifted(T, dx=ELBOW_DX, R=R0), SLIDE / v + (1.0 if quick else 1.5)),
               Phase("hold", lambda T: _shifted(T, R=R0), duration)]
-    nu_log = []
-    if variant != "plant":
-        command = ctl.command
+    nu_log: list[float] = []
 
-        def logged(q, qd):
-            tau, info = command(q, qd)
-            nu_log.append(-float(np.asarray(info.result.nu)[N_TOOL]))
-            return tau, info
+    def log_nu(k, command, info) -> None:
+        nu_log.append(-float(np.asarray(info.result.nu)[N_TOOL]))
 
-        ctl.command = logged
-    run = run_loop(robot, ctl, phases, "elbow", variant, (0.0, 0.0, 0.0), progress)
+    run = run_loop(robot, ctl, phases, "elbow", variant, (0.0, 0.0, 0.0), progress,
+                   on_cycle=None if variant == "plant" else log_nu)
     elbow_z = np.array([np.asarray(chain.fk(q, segment=seg))[2, 3] for q in run.q])
     run.info.update(elbow_z=elbow_z, support_top=None if support is None else 2 * support[0][2],
                     support_force_model=np.array(nu_log[:len(run.t)]) if nu_log else np.full(len(run.t), np.nan))

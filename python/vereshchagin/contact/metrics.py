@@ -2,7 +2,7 @@
 
 For the samples of a window (sample period dt = 1 ms), per joint j:
 
-- ``mean_tau``: average torque (N m), signed, as report 003's Table 6.2;
+- ``mean_tau``: average torque (N m), signed, as Table 6.2 of W. K. Lau (2023);
 - ``mean_abs_tau``: average |torque| (N m);
 - ``mean_power``: average mechanical power tau * qd (W), signed (negative: the joint brakes);
 - ``energy_abs``: integral of |tau * qd| dt (J), the mechanical work the motor moves in either
@@ -22,7 +22,21 @@ __all__ = ["effort", "elbow_outcome", "grasp_outcome", "writing_accuracy"]
 
 
 def effort(run, mask=None) -> dict:
-    """Effort metrics (see module doc) over the samples ``mask`` (default: all), arrays of shape (n,)."""
+    """Effort metrics (see module doc) over some samples of a run.
+
+    Parameters
+    ----------
+    run : Run
+        The run (k samples, n joints).
+    mask : array_like of bool, shape (k,), optional
+        Samples to use (e.g. ``run.window("slide")``); None: all.
+
+    Returns
+    -------
+    dict
+        ``mean_tau``, ``mean_abs_tau`` (N m), ``mean_power`` (W), ``energy_abs`` (J),
+        ``energy_tau2`` (N^2 m^2 s): ndarrays of shape (n,); ``duration``: the masked time (s).
+    """
     m = np.ones(len(run.t), bool) if mask is None else np.asarray(mask, bool)
     tau, qd = run.tau[m], run.qd[m]
     dt = float(np.median(np.diff(run.t))) if len(run.t) > 1 else 1e-3
@@ -34,7 +48,24 @@ def effort(run, mask=None) -> dict:
 
 
 def grasp_outcome(run, phase: str = "slide") -> dict:
-    """Contact detection, distance slid along x, time in contact, final position error (m)."""
+    """Outcome of a grasp run over its ``phase`` (the tool's contact point, base frame).
+
+    Parameters
+    ----------
+    run : Run
+        A :func:`~.use_cases.grasp` run.
+    phase : str
+        The sliding phase's name.
+
+    Returns
+    -------
+    dict
+        ``contact_detected`` (bool) and ``contact_time`` (s or None); ``distance_x``: the tool's
+        x travel over the phase (m, + towards +x); ``contact_fraction``: share of the phase's
+        samples with a table force; ``touched``: arm geoms that touched the table;
+        ``final_error_x``: final x minus the goal (start x + 0.10 m), m; ``final_drift_yz``:
+        distance the tool left the line in y and z (m); ``mean_table_force``: N.
+    """
     m = run.window(phase)
     tool = run.tool[m]
     touching = run.table_force[m] > 0.0
@@ -54,9 +85,20 @@ def grasp_outcome(run, phase: str = "slide") -> dict:
 def writing_accuracy(run, phase: str = "write") -> dict:
     """Displacement of the pen tip in y from the reference line (y = y at the start, along +x).
 
-    Returns maximum |dy| and the signed average dy (m) over the drawn part (x between the start
-    and start + 0.10 m), as report 003's Table 6.3, plus the fraction of those samples in which
-    the plant reports table contact.
+    Parameters
+    ----------
+    run : Run
+        A :func:`~.use_cases.writing` run.
+    phase : str
+        The drawing phase's name.
+
+    Returns
+    -------
+    dict
+        ``max_displacement``: max |dy| and ``mean_displacement``: signed mean dy (m, base y) over
+        the drawn part (x between the start and start + 0.10 m), as Table 6.3 of W. K. Lau (2023);
+        NaN if nothing was drawn; ``length``: final x minus start x (m); ``contact_fraction``:
+        share of the drawn samples in which the plant reports table contact.
     """
     m = run.window(phase)
     tool = run.tool[m]

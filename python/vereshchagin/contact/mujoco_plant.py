@@ -160,6 +160,19 @@ class MujocoGen3:
         From :func:`build_model`.
     q0 : array_like, shape (n,)
         Initial joint positions (rad), at rest.
+
+    Attributes
+    ----------
+    model : mujoco.MjModel
+        The compiled plant.
+    data : mujoco.MjData
+        The simulation state (``qpos``, ``qvel``, ``ctrl``, ``time``, contacts).
+    n_joints : int
+        Number of actuated joints (one torque motor each).
+    period : float
+        Control period = simulation time step (s).
+    gripper : float
+        Last gripper command, 0 (open) .. 1 (closed); recorded only (the gripper is rigid).
     """
 
     def __init__(self, model: mujoco.MjModel, q0):
@@ -170,7 +183,7 @@ class MujocoGen3:
         self.data.qpos[:] = np.asarray(q0, float)
         self.gripper = 0.0
         mujoco.mj_forward(model, self.data)
-        self._env = {}
+        self._env: dict[int, str] = {}  # environment geom id -> name
         for name in ("table", "support"):
             gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
             if gid >= 0:
@@ -179,19 +192,47 @@ class MujocoGen3:
         self._frictionloss = model.dof_frictionloss[:self.n_joints].copy()
 
     def read(self) -> JointState:
+        """The simulation's current joint sample.
+
+        Returns
+        -------
+        JointState
+            ``q`` (rad), ``qd`` (rad/s), ``tau`` the motor torques applied in the last step after
+            saturation at the ``ctrlrange`` (N m), ``time`` the simulation clock (s); copies.
+        """
         d = self.data
         return JointState(q=d.qpos.copy(), qd=d.qvel.copy(), tau=d.actuator_force.copy(), time=float(d.time))
 
     def write(self, tau) -> None:
+        """Command joint torques for the next step (MuJoCo clips them to +-effort limit).
+
+        Parameters
+        ----------
+        tau : array_like, shape (n,)
+            Motor torques (N m, positive along each joint's axis).
+
+        Raises
+        ------
+        ValueError
+            If ``tau`` has another shape or a non-finite entry.
+        """
         tau = np.asarray(tau, float)
         if tau.shape != (self.n_joints,) or not np.all(np.isfinite(tau)):
             raise ValueError(f"torque command must be {self.n_joints} finite values, got {tau!r}")
         self.data.ctrl[:] = tau
 
     def wait(self) -> None:
+        """Advance the physics by one period (one ``mj_step`` of ``period`` s)."""
         mujoco.mj_step(self.model, self.data)
 
     def set_gripper(self, position: float) -> None:
+        """Record a gripper command (the gripper is rigid: no motion).
+
+        Parameters
+        ----------
+        position : float
+            0 (open) .. 1 (closed); clipped to that range.
+        """
         self.gripper = float(np.clip(position, 0.0, 1.0))  # rigid gripper: recorded only
 
     # -- simulator-only diagnostics ------------------------------------------------------------
@@ -204,7 +245,7 @@ class MujocoGen3:
             ``{name: (normal force, set of arm geom names)}`` for environment geoms in contact.
         """
         m, d = self.model, self.data
-        out = {}
+        out: dict[str, tuple[float, set[str]]] = {}
         for i in range(d.ncon):
             c = d.contact[i]
             g1, g2 = int(c.geom1), int(c.geom2)

@@ -1,4 +1,4 @@
-"""Run report 003's use cases in simulation and write tables, figures and the comparison text.
+"""Run the use cases of W. K. Lau (2023) in simulation and write tables, figures and the comparison text.
 
 :func:`run` is what ``python -m vereshchagin reproduce --case contact`` calls. Tables follow the
 report's layout (Tables 6.1-6.3: per joint, contact next to contactless), as Markdown and CSV;
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import time
+from functools import partial
 from pathlib import Path
 from typing import Callable, Optional
 
@@ -17,11 +18,11 @@ import numpy as np
 
 from . import metrics
 from .elbow import VARIANTS as ELBOW_VARIANTS, elbow
-from .use_cases import JOINT_DAMPING, JOINT_FRICTION, grasp, writing
+from .use_cases import JOINT_DAMPING, JOINT_FRICTION, Run, grasp, writing
 
-__all__ = ["REPORT_003", "md_table", "run", "write_csv"]
+__all__ = ["LAU_2023", "md_table", "run", "write_csv"]
 
-REPORT_003 = {
+LAU_2023 = {
     # Table 6.2, average torque (N m) per joint 0..6: contact, contactless
     "torque_contact": (0.2164, 9.8474, 0.3025, -3.1071, 0.3014, -1.7027, -0.0787),
     "torque_contactless": (-0.1564, 16.7563, 0.9884, -1.3727, 0.3063, -2.5120, -0.1095),
@@ -32,6 +33,7 @@ REPORT_003 = {
     "writing_contact": (0.00211145, -0.00120878),
     "writing_contactless": (0.00089509, 0.00034292),
 }
+"""Published numbers of W. K. Lau (2023) that the tables print next to ours (joints counted from 0 there)."""
 KEY_JOINTS = {1: "shoulder", 3: "elbow", 5: "wrist"}  # report's 0-based joint -> name
 
 
@@ -151,7 +153,7 @@ def _verdict(same: bool) -> str:
 def _grasp_comparison(e_c, e_n) -> list[str]:
     lines = []
     for j, name in KEY_JOINTS.items():
-        rc, rn = abs(REPORT_003["torque_contact"][j]), abs(REPORT_003["torque_contactless"][j])
+        rc, rn = abs(LAU_2023["torque_contact"][j]), abs(LAU_2023["torque_contactless"][j])
         sc, sn = e_c["mean_abs_tau"][j], e_n["mean_abs_tau"][j]
         sim_pct = 100.0 * (sn - sc) / sc
         rep_pct = 100.0 * (rn - rc) / rc
@@ -189,10 +191,10 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     out = Path(out_dir) / "contact"
     out.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
-    jobs = [("grasp", "contact", lambda: grasp(True, quick)), ("grasp", "contactless", lambda: grasp(False, quick)),
-            ("writing", "contact", lambda: writing(True, quick)),
-            ("writing", "contactless", lambda: writing(False, quick))]
-    jobs += [("elbow", v, lambda v=v: elbow(v, quick)) for v in ELBOW_VARIANTS]
+    jobs: list[tuple[str, str, Callable[[], Run]]] = [
+        ("grasp", "contact", partial(grasp, True, quick)), ("grasp", "contactless", partial(grasp, False, quick)),
+        ("writing", "contact", partial(writing, True, quick)), ("writing", "contactless", partial(writing, False, quick))]
+    jobs += [("elbow", v, partial(elbow, v, quick)) for v in ELBOW_VARIANTS]
     runs = {}
     for k, (case, variant, job) in enumerate(jobs):
         t0 = time.perf_counter()
@@ -200,12 +202,14 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         say(f"[contact] {_bar((k + 1) / len(jobs))} {case} {variant} "
             f"({runs[(case, variant)].t[-1]:.1f} s simulated in {time.perf_counter() - t0:.1f} s)")
 
-    rel = lambda p: f"contact/{p.name}"  # noqa: E731
-    idx = ["## Exploiting contact surfaces: report 003's use cases in simulation", "",
+    def rel(p: Path) -> str:
+        return f"contact/{p.name}"
+
+    idx = ["## Exploiting contact surfaces: the use cases of W. K. Lau (2023) in simulation", "",
            "Plant: MuJoCo (1 kHz, implicitfast) model of the Kinova Gen3 + rigid Robotiq 2F-85 compiled from our "
            "URDF (same inertias as the controller's chain); joint friction (MuJoCo frictionloss, hard as the step "
            f"allows) {list(JOINT_FRICTION)} N m, damping {list(JOINT_DAMPING)} N m s/rad; torque motors limited "
-           "to ±39 / ±9 N m; contact friction 0.3. Controller: report 003's cascaded P position -> velocity -> beta "
+           "to ±39 / ±9 N m; contact friction 0.3. Controller: the report's cascaded P position -> velocity -> beta "
            "with our solver, twist saturated at 0.05 m/s / 0.5 rad/s, z released on contact (|v_z| < 5 mm/s for "
            "10 samples), friction-aware solve (friction compensation), f_ext with the model's normal-force "
            "estimate and mu = 0.3 against the sliding direction, a joint posture term in tau_ff for the "
@@ -259,9 +263,9 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     wh = ["case", "maximum displacement (m)", "average displacement (m)", "line length (m)", "in contact",
           "report max (m)", "report average (m)"]
     wrows = [["Contact", f"{ac['max_displacement']:.8f}", f"{ac['mean_displacement']:.8f}", f"{ac['length']:.4f}",
-              f"{100 * ac['contact_fraction']:.1f} %", *map(str, REPORT_003["writing_contact"])],
+              f"{100 * ac['contact_fraction']:.1f} %", *map(str, LAU_2023["writing_contact"])],
              ["Contactless", f"{an['max_displacement']:.8f}", f"{an['mean_displacement']:.8f}", f"{an['length']:.4f}",
-              f"{100 * an['contact_fraction']:.1f} %", *map(str, REPORT_003["writing_contactless"])]]
+              f"{100 * an['contact_fraction']:.1f} %", *map(str, LAU_2023["writing_contactless"])]]
     write_csv(out / "writing_accuracy.csv", wh, wrows)
     (out / "writing_accuracy.md").write_text("\n".join(md_table(wh, wrows)) + "\n", encoding="utf-8")
     ew_c, ew_n = metrics.effort(wc, wc.window("write")), metrics.effort(wn, wn.window("write"))

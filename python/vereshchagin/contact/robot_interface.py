@@ -1,7 +1,7 @@
 """The seam between a control loop and a robot: what the loop may read and write each cycle.
 
 A backend (the MuJoCo plant in :mod:`.mujoco_plant`, later a driver of the real Kinova Gen3 such
-as robif2b's ``kinova_gen3`` ports of report 003, Listing 5.1) implements :class:`RobotInterface`.
+as robif2b's ``kinova_gen3`` ports of W. K. Lau (2023), Listing 5.1) implements :class:`RobotInterface`.
 The loop in :mod:`.use_cases` uses nothing else, so it runs unchanged against any backend.
 
 Contract

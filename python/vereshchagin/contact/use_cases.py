@@ -1,10 +1,10 @@
-"""Report 003's three use cases (sec. 6.2-6.4), each with and without contact, run in closed loop.
+"""The three use cases of W. K. Lau (2023), sec. 6.2-6.4, each with and without contact, run in closed loop.
 
 Every run: the MuJoCo plant (:mod:`.mujoco_plant`) behind :class:`~.robot_interface.RobotInterface`,
 the controller of :mod:`.controller`, a list of phases (goal, directions, contact detection,
 duration). The loop (:func:`run_loop`) only uses the interface.
 
-Geometry (base frame, m). Start pose: report 003's ``q`` (joint angles wrapped to [-pi, pi],
+Geometry (base frame, m). Start pose: the report's ``q`` (joint angles wrapped to [-pi, pi],
 :data:`vereshchagin.robots.GEN3_START_POSE`): the end-effector at (0.457, 0.001, 0.434), tool axis
 along +x. The tables are placed from that pose:
 
@@ -37,8 +37,8 @@ JOINT_FRICTION = (0.5, 0.5, 0.5, 0.5, 0.3, 0.3, 0.3)
 JOINT_DAMPING = (0.1, 0.1, 0.1, 0.1, 0.05, 0.05, 0.05)
 """Viscous joint damping, N m s/rad."""
 
-SLIDE = 0.10  # m, report 003: d_x = 0.1
-DESCENT = 0.25  # m, report 003: "about 25 cm"
+SLIDE = 0.10  # m, Lau (2023): d_x = 0.1
+DESCENT = 0.25  # m, Lau (2023): "about 25 cm"
 CLEARANCE = 0.03  # m, tool above the table in the contactless grasp
 PEN_DIRECTION_WORLD = (0.0, 0.0, -1.0)
 
@@ -54,6 +54,14 @@ def gen3_model(friction_scale: float = 1.0, payload: Optional[tuple] = None):
         ``(mass kg, position m in the end-effector frame)`` of a solid sphere (radius
         :data:`PAYLOAD_RADIUS`) held rigidly by the gripper (:func:`with_tool_link`); the plant
         and the chain both carry it (a known payload).
+
+    Returns
+    -------
+    urdf : str
+        URDF text (for the plant, :func:`~.mujoco_plant.build_model`).
+    chain : Chain
+        ``base_link`` to :data:`vereshchagin.robots.GEN3_TIP_LINK`, 7 joints, with the URDF's
+        friction (N m) and damping (N m s/rad).
     """
     friction = tuple(friction_scale * f for f in JOINT_FRICTION)
     urdf = robots.gen3_urdf(gripper=True, joint_friction=friction, joint_damping=JOINT_DAMPING)
@@ -69,8 +77,24 @@ PAYLOAD_RADIUS = 0.04
 def with_tool_link(urdf: str, name: str, xyz, mass: float = 0.0, radius: float = 0.0) -> str:
     """The URDF with a link ``name`` fixed to the end-effector link at ``xyz`` (m).
 
-    Massless by default; with ``mass`` (kg) > 0 the link is a solid sphere of that mass and
-    ``radius`` (m) centred at its origin (inertial only, no collision shape).
+    Parameters
+    ----------
+    urdf : str
+        URDF text with a link named :data:`vereshchagin.robots.GEN3_TIP_LINK`.
+    name : str
+        Name of the new link (its fixed joint is ``{name}_joint``).
+    xyz : sequence of 3 float
+        Its origin in the end-effector frame (m), no rotation.
+    mass : float
+        kg; 0 (default): massless. Else the link is a solid sphere of that mass and ``radius``
+        (m) centred at its origin (inertial only, no collision shape).
+    radius : float
+        m, used only with ``mass`` > 0.
+
+    Returns
+    -------
+    str
+        The URDF text with the link and joint added before ``</robot>``.
     """
     inertial = ""
     if mass > 0.0:
@@ -88,11 +112,25 @@ def with_tool_link(urdf: str, name: str, xyz, mass: float = 0.0, radius: float =
 class Phase:
     """One step of a task: drive the end-effector to ``goal`` for at most ``duration`` s.
 
-    ``goal`` is a 4x4 pose or a callable ``goal(pose_now) -> 4x4`` evaluated when the
-    phase starts. ``path``: optional ``path(goal, t) -> 4x4``, the goal at ``t`` s into the phase
-    (set every cycle; a moving reference). ``detect``: end the phase when contact is detected.
-    ``contact``: directions with z released (None: keep the current mode). ``gripper``: command
-    at the phase start.
+    Attributes
+    ----------
+    name : str
+        Phase name (``Run.window(name)`` selects its samples).
+    goal : ndarray (4, 4) or callable
+        Goal pose of the end-effector (homogeneous transform, base frame, m), or a callable
+        ``goal(pose_now) -> (4, 4)`` evaluated once when the phase starts.
+    duration : float
+        Length of the phase (s); it ends earlier on contact when ``detect``.
+    detect : bool
+        Watch for contact and end the phase when it is detected.
+    contact : bool or None
+        Switch the controller to contact mode (True: z released) or free space (False) at the
+        phase start; None: keep the current mode.
+    gripper : float or None
+        Gripper command at the phase start, 0 (open) .. 1 (closed); None: none.
+    path : callable or None
+        ``path(goal, t) -> (4, 4)``: the goal ``t`` s into the phase, set every cycle (a moving
+        reference); None: the fixed ``goal``.
     """
 
     name: str
@@ -106,7 +144,38 @@ class Phase:
 
 @dataclass
 class Run:
-    """The log of one run (arrays over samples) and its summary."""
+    """The log of one run (arrays over the k logged samples, one per control cycle) and its summary.
+
+    Attributes
+    ----------
+    case : str
+        ``"grasp"``, ``"writing"`` or ``"elbow"``.
+    variant : str
+        ``"contact"`` / ``"contactless"``, or one of :data:`vereshchagin.contact.elbow.VARIANTS`.
+    t : ndarray, shape (k,)
+        Plant clock after each step (s).
+    q, qd, tau : ndarray, shape (k, n)
+        Measured joint positions (rad), velocities (rad/s) and applied motor torques (N m).
+    tip : ndarray, shape (k, 3)
+        End-effector origin (base frame, m) at the start of each cycle.
+    tool : ndarray, shape (k, 3)
+        The tool's contact point (base frame, m) at the start of each cycle.
+    phase : ndarray of int, shape (k,)
+        Index into ``phases`` of each sample.
+    contact_mode : ndarray of bool, shape (k,)
+        The controller was in contact mode (z released).
+    table_force, support_force : ndarray, shape (k,)
+        Plant: total normal force on the table and on the elbow support (N, >= 0).
+    table_touch : list of str
+        Names of the arm geoms that ever touched the table, sorted.
+    phases : list of Phase
+        The phases run.
+    contact_time : float or None
+        Plant time (s) at which contact was detected; None: never.
+    info : dict
+        Case-specific extras (e.g. ``table_top`` m, ``tool_point`` (3,) m in the end-effector
+        frame; :func:`~.elbow.elbow` adds the elbow logs).
+    """
 
     case: str
     variant: str
@@ -114,19 +183,19 @@ class Run:
     q: np.ndarray
     qd: np.ndarray
     tau: np.ndarray
-    tip: np.ndarray  # end-effector origin (m)
-    tool: np.ndarray  # the tool's contact point (m)
-    phase: np.ndarray  # phase index per sample
-    contact_mode: np.ndarray  # controller in contact mode
-    table_force: np.ndarray  # plant: normal force on the table (N)
-    support_force: np.ndarray  # plant: normal force on the elbow support (N)
-    table_touch: list  # names of arm geoms that ever touched the table
+    tip: np.ndarray
+    tool: np.ndarray
+    phase: np.ndarray
+    contact_mode: np.ndarray
+    table_force: np.ndarray
+    support_force: np.ndarray
+    table_touch: list
     phases: list
     contact_time: Optional[float]
     info: dict = field(default_factory=dict)
 
     def window(self, name: str) -> np.ndarray:
-        """Boolean mask of the samples of phase ``name``."""
+        """Boolean mask, shape (k,), of the samples of phase ``name`` (ValueError if no such phase)."""
         k = [p.name for p in self.phases].index(name)
         return self.phase == k
 
@@ -145,10 +214,28 @@ def run_loop(robot, controller: CascadedController, phases, case: str, variant: 
              on_cycle: Optional[Callable[[int, np.ndarray, object], None]] = None) -> Run:
     """Run the phases on ``robot`` (any :class:`~.robot_interface.RobotInterface`).
 
-    ``tool_point`` is the contact point in the end-effector frame (logged as ``tool``).
-    ``progress(fraction)`` is called now and then. ``on_cycle(k, command, cycle_info)`` is called
-    after each step with the sample index, the torque written and the controller's
-    :class:`~.controller.CycleInfo` (extra logging).
+    Parameters
+    ----------
+    robot : RobotInterface
+        The backend; a ``contact_forces()`` method, if it has one, fills the force logs.
+    controller : CascadedController
+        Gets each phase's goal, contact mode and detection, and computes every command.
+    phases : sequence of Phase
+        Run in order; a phase with ``detect`` ends early on contact.
+    case, variant : str
+        Labels stored in the :class:`Run`.
+    tool_point : sequence of 3 float
+        The tool's contact point in the end-effector frame (m), logged as ``tool``.
+    progress : callable, optional
+        ``progress(fraction)`` with the fraction (0..1) of the planned samples done, every 500.
+    on_cycle : callable, optional
+        ``on_cycle(k, command, cycle_info)`` after each step: the sample index, the torque written
+        (N m, shape (n,)) and the controller's :class:`~.controller.CycleInfo` (extra logging).
+
+    Returns
+    -------
+    Run
+        One sample per control cycle.
     """
     dt = robot.period
     total = int(round(sum(p.duration for p in phases) / dt)) + len(phases)
@@ -257,7 +344,27 @@ def _controller(chain, tool_point, **overrides):
 
 
 def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[float] = None) -> Run:
-    """Use case 1: approach the table, slide 0.10 m along +x (in contact or 0.03 m above), grasp."""
+    """Use case 1: approach the table, slide 0.10 m along +x (in contact or 0.03 m above), grasp.
+
+    Parameters
+    ----------
+    contact : bool
+        True: descend until contact is detected, slide with z released; False: stop 0.03 m above
+        the table and slide in the air with all six directions constrained.
+    quick : bool
+        Shorter run: 0.05 m descent instead of 0.25 m.
+    progress : callable, optional
+        ``progress(fraction)``, see :func:`run_loop`.
+    descent : float, optional
+        Height (m) of the gripper's lowest point above the table at the start; overrides
+        ``quick``'s choice.
+
+    Returns
+    -------
+    Run
+        Phases ``approach``, ``slide``, ``grasp``; ``info``: ``table_top`` (m, base z),
+        ``descent`` (m), ``tool_point`` (3,) (the gripper's lowest point, end-effector frame, m).
+    """
     urdf, chain = gen3_model()
     q0 = np.array(robots.GEN3_START_POSE)
     R0 = np.asarray(chain.fk(q0))[:3, :3]
@@ -287,7 +394,24 @@ def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[f
 
 
 def writing(contact: bool, quick: bool = False, progress=None) -> Run:
-    """Use case 2: draw a 0.10 m line along +x with the pen on the table, or 0.10 m above it."""
+    """Use case 2: draw a 0.10 m line along +x with the pen on the table, or 0.10 m above it.
+
+    Parameters
+    ----------
+    contact : bool
+        True: the table 0.01 m below the pen tip, approach until contact, draw with z released;
+        False: the table 0.10 m below, draw in the air with all six directions constrained.
+    quick : bool
+        Accepted for a uniform signature; the writing runs are short either way.
+    progress : callable, optional
+        ``progress(fraction)``, see :func:`run_loop`.
+
+    Returns
+    -------
+    Run
+        Phases ``approach`` (contact) or ``settle``, then ``write``; ``info``: ``table_top``
+        (m, base z), ``tool_point`` (3,) (the pen tip, end-effector frame, m).
+    """
     urdf, chain = gen3_model()
     q0 = np.array(robots.GEN3_START_POSE)
     T0 = np.asarray(chain.fk(q0))

@@ -1,4 +1,4 @@
-"""Reproductions of report 000's experiments (static joint friction, chapters 5-6).
+"""Reproductions of the static joint friction experiments of D. Vukcevic (2018), chapters 5-6.
 
 - :mod:`.gauss`: the slow reference evaluations of Vereshchagin's max-min (the Gauss function
   g(mu) by one frictionless solve per friction vector, grid sampling and vertex enumeration),

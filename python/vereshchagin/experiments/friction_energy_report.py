@@ -309,7 +309,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     c_header, c_rows, c_lines = context(quick)
     write_csv(files[1], c_header, c_rows)
     idx = _intro(quick) + ["### Friction against gravity at the held poses", "", *c_lines, "",
-                           f"Per joint: [friction_energy/context.csv](friction_energy/context.csv).", ""]
+                           "Per joint: [friction_energy/context.csv](friction_energy/context.csv).", ""]
     for task in fe.tasks(quick):
         png = out / f"{task.name}.png"
         plot_task(png, results, task)

@@ -46,27 +46,61 @@ def arm_1dof() -> Chain:
 
 @dataclass(frozen=True)
 class Case:
-    """One experiment of the report and its published numbers (``None``: not published)."""
+    """One experiment of the report on the 1-DOF arm at rest and its published numbers.
+
+    Attributes
+    ----------
+    key : str
+        Short name, used in file names (``"scenario1"``, ...).
+    label : str
+        Human-readable title for figures and tables.
+    tip_force : float
+        Force at the tip (N) along the link's tangential direction (base y at ``q = 0``); the
+        joint torque it makes is ``tip_force * 1 m``. 0: none.
+    task_qdd : float or None
+        Task: angular acceleration of the tip about base z (rad/s^2), a one-column constraint;
+        None: no task (the joint moves freely).
+    figures : dict of str to str
+        Kind of figure (``"energy"``, ``"acceleration"``, ``"torques"``, ``"surface"``) -> the
+        report's figure number (``""``: drawn, but no figure in the report).
+    friction : float or None
+        Published friction torque at the optimum (N m, physical sign, i.e. ``-mu``, acting on
+        the joint like a motor torque). None in this and the following fields: not published.
+    qdd : float or None
+        Published joint acceleration at the optimum (rad/s^2).
+    qdd_digits : int or None
+        Decimals to which the report rounds ``qdd`` (None: exact, compared at 1e-9).
+    tau_command : float or None
+        Published motor command at the optimum (N m).
+    net : float or None
+        Published net joint torque, load + friction + command (N m).
+    """
 
     key: str
     label: str
-    tip_force: float = 0.0  # N along the tangential (y) direction at q = 0
-    task_qdd: Optional[float] = None  # rad/s^2 (angular z acceleration task)
-    figures: dict = field(default_factory=dict)  # kind -> report figure number (or "")
-    friction: Optional[float] = None  # published friction torque at the optimum, N m
-    qdd: Optional[float] = None  # published acceleration, rad/s^2
-    qdd_digits: Optional[int] = None  # the report gives qdd to this many decimals
+    tip_force: float = 0.0
+    task_qdd: Optional[float] = None
+    figures: dict = field(default_factory=dict)
+    friction: Optional[float] = None
+    qdd: Optional[float] = None
+    qdd_digits: Optional[int] = None
     tau_command: Optional[float] = None
-    net: Optional[float] = None  # published net joint torque (load + friction + command)
+    net: Optional[float] = None
 
     @property
-    def f_ext(self):
+    def f_ext(self) -> Optional[np.ndarray]:
+        """External wrench on the link, shape (1, 6), or None without a tip force.
+
+        ``[force; moment]`` (N, N m) applied on the link by the environment, base-frame axes,
+        moment about the tip origin (the :meth:`Solver.solve` convention): ``tip_force`` along y.
+        """
         if not self.tip_force:
             return None
         return np.array([[0.0, self.tip_force, 0.0, 0.0, 0.0, 0.0]])
 
     @property
-    def alpha(self):
+    def alpha(self) -> Optional[np.ndarray]:
+        """Task direction, shape (6, 1): angular base z (``[0 0 0 0 0 1]``); None without a task."""
         if self.task_qdd is None:
             return None
         a = np.zeros((6, 1))
@@ -74,7 +108,12 @@ class Case:
         return a
 
     @property
-    def beta(self):
+    def beta(self) -> Optional[np.ndarray]:
+        """Task right-hand side, shape (1,): ``[task_qdd]`` (rad/s^2); None without a task.
+
+        The solver imposes ``alpha.T @ a_tip = beta`` on the tip's spatial acceleration; without
+        gravity and at rest that is the angular acceleration about z itself.
+        """
         return None if self.task_qdd is None else np.array([self.task_qdd])
 
 

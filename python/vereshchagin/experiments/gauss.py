@@ -58,7 +58,16 @@ class GaussSample:
 
 
 class Best(NamedTuple):
-    """The best multiplier found by a search and its Gauss value."""
+    """The best multiplier found by a search and its Gauss value.
+
+    Attributes
+    ----------
+    mu : ndarray, shape (k,)
+        Multipliers of the resting joints (N m; physical friction torque ``-mu``) with the largest
+        g among the candidates searched.
+    g : float
+        Its Gauss value g(mu) (J/s^2, like the acceleration energy Z0).
+    """
 
     mu: np.ndarray
     g: float
@@ -193,6 +202,8 @@ def _best(solver, q, qd, candidates, resting, alpha, beta, f_ext, tau_ff) -> Bes
         g = evaluate(solver, q, qd, mu, resting, alpha, beta, f_ext, tff, qdd_free=free).g
         if g > best_g:
             best_mu, best_g = np.asarray(mu, float), g
+    if best_mu is None:
+        raise ValueError("no candidate multiplier has a Gauss value above -inf (empty set or NaN values)")
     return Best(best_mu, best_g)
 
 

@@ -64,7 +64,7 @@ def example_robot_urdf(name: str) -> str:
         raise ModuleNotFoundError(
             "example_robot_urdf needs the PyPI package example-robot-data: "
             "pip install example-robot-data") from None
-    robots = Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
+    robots = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
     if not robots.is_dir():
         raise ModuleNotFoundError(f"example-robot-data is installed but {robots} is missing")
     if "/" in name:
