@@ -65,50 +65,7 @@ def case_rows(label, segs, seed, batches, batch_s):
             if with_friction:
                 kw["friction"] = friction
             calls.append((q, qd, kw, tasks.get(m), tau))
-        outs = [solver.solve(q, qd, **kw) for q, qd, kw, _, _ in calls]
-
-        def cpp(reps):
-            for q, qd, kw, _, _ in calls:
-                solver._time_cpp(reps, q, qd, **kw)
-
-        # Every variant repeats each state `reps` times in a row, as _time_cpp does, so that the
-        # comparison sees the same sequence of states (and the same branch history).
-        def py(reps):
-            for q, qd, kw, _, _ in calls:
-                for _ in range(reps):
-                    solver.solve(q, qd, **kw)
-
-        def py_read(reps):
-            for q, qd, kw, _, _ in calls:
-                for _ in range(reps):
-                    solver.solve(q, qd, **kw).qdd
-
-        def py_out(reps):
-            for (q, qd, kw, _, _), out in zip(calls, outs):
-                for _ in range(reps):
-                    solver.solve(q, qd, out=out, **kw)
-
-        variants = {"cpp": cpp, "py": py, "py+qdd": py_read, "out": py_out}
-        if not with_friction:
-            if m == 0:
-                pin_args = [(model, data, q, qd, tau) for q, qd, _, _, tau in calls]
-
-                def pin_run(reps):
-                    for a in pin_args:
-                        for _ in range(reps):
-                            pin.aba(*a)
-            else:
-                def pipeline(q, qd, tau, alpha, beta):
-                    pin.computeAllTerms(model, data, q, qd)
-                    J = alpha.T @ pin.getFrameJacobian(model, data, fid, LWA)
-                    gamma = alpha.T @ (pin.getFrameAcceleration(model, data, fid, LWA).vector + UP) - beta
-                    return pin.forwardDynamics(model, data, tau, J, gamma)
-
-                def pin_run(reps):
-                    for q, qd, _, task, tau in calls:
-                        for _ in range(reps):
-                            pipeline(q, qd, tau, *task)
-            variants["pin"] = pin_run
+        variants = make_variants(solver, calls, model, data, fid, pin_variant=not with_friction, m=m)
         print(f"timing {label}, m {m}{' friction' if with_friction else ''} ...", file=sys.stderr, flush=True)
         us = time_group(variants, batches, batch_s)
         med = {k: statistics.median(v) for k, v in us.items()}
@@ -120,6 +77,50 @@ def case_rows(label, segs, seed, batches, batch_s):
         row.update(batch_rows(solver, calls, batches))
         rows.append(row)
     return rows
+
+
+def make_variants(solver, calls, model, data, fid, pin_variant, m):
+    """The timed variants of one case; each repeats every state `reps` times in a row, as
+    _time_cpp does, so all see the same sequence of states (and the same branch history)."""
+    outs = [solver.solve(q, qd, **kw) for q, qd, kw, _, _ in calls]
+
+    def cpp(reps):
+        for q, qd, kw, _, _ in calls:
+            solver._time_cpp(reps, q, qd, **kw)
+
+    def py(reps):
+        for q, qd, kw, _, _ in calls:
+            for _ in range(reps):
+                solver.solve(q, qd, **kw)
+
+    def py_read(reps):
+        for q, qd, kw, _, _ in calls:
+            for _ in range(reps):
+                _ = solver.solve(q, qd, **kw).qdd
+
+    def py_out(reps):
+        for (q, qd, kw, _, _), out in zip(calls, outs):
+            for _ in range(reps):
+                solver.solve(q, qd, out=out, **kw)
+
+    def pipeline(q, qd, tau, alpha, beta):
+        pin.computeAllTerms(model, data, q, qd)
+        J = alpha.T @ pin.getFrameJacobian(model, data, fid, LWA)
+        gamma = alpha.T @ (pin.getFrameAcceleration(model, data, fid, LWA).vector + UP) - beta
+        return pin.forwardDynamics(model, data, tau, J, gamma)
+
+    def pin_run(reps):
+        for q, qd, _, task, tau in calls:
+            for _ in range(reps):
+                if m:
+                    pipeline(q, qd, tau, *task)
+                else:
+                    pin.aba(model, data, q, qd, tau)
+
+    variants = {"cpp": cpp, "py": py, "py+qdd": py_read, "out": py_out}
+    if pin_variant:
+        variants["pin"] = pin_run
+    return variants
 
 
 def batch_rows(solver, calls, batches):

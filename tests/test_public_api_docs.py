@@ -115,7 +115,8 @@ def test_solve_has_a_full_docstring_and_signature():
     for section in ("Parameters", "Returns", "Raises", "alpha", "beta", "f_ext", "friction", "constraints", "out"):
         assert section in doc, section
     params = list(inspect.signature(vs.Solver.solve).parameters)
-    assert params == ["self", "q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints", "out"]
+    assert params == ["self", "q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
+                      "f_ext_pass_through", "tau_ff_pass_through", "out"]
 
 
 def test_stubs_match_the_runtime():
