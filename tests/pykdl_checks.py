@@ -83,7 +83,8 @@ def random_kdl_rotation(rng):
 
 def random_body(rng):
     R = np.linalg.qr(rng.normal(size=(3, 3)))[0]
-    I = R @ np.diag(rng.uniform(0.05, 0.3, 3)) @ R.T
+    a, b, c = rng.uniform(0.02, 0.15, 3)  # second moments: principal moments of a rigid body
+    I = R @ np.diag([b + c, a + c, a + b]) @ R.T
     Ic = kdl.RotationalInertia(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
     return kdl.RigidBodyInertia(rng.uniform(0.2, 4.0), kdl.Vector(*rng.uniform(-0.3, 0.3, 3)), Ic)
 

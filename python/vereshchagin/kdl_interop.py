@@ -116,7 +116,7 @@ def _segment_arguments(kdl, segment, index: int) -> dict[str, Any]:
                 joint_name="" if joint_name == _KDL_UNNAMED else joint_name)
 
 
-def chain_from_kdl(kdl_chain) -> Chain:
+def chain_from_kdl(kdl_chain, inertia_check: str = "physical") -> Chain:
     """Build a :class:`Chain` from a PyKDL ``Chain``.
 
     Parameters
@@ -128,6 +128,9 @@ def chain_from_kdl(kdl_chain) -> Chain:
         reference point, the tip origin, to the centre of mass). Rotor inertias
         (``Joint::getInertia()``) are carried over. Segments and joints named KDL's default
         ``'NoName'`` become ``'segment<i>'`` and ``'segment<i>_joint'``.
+    inertia_check : {'physical', 'joint_space'}
+        As in :meth:`Chain.add_segment`: 'joint_space' accepts the identified (non-rigid-body)
+        inertias KDL models often have; solve them with ``Solver(..., inertia_check='joint_space')``.
 
     Returns
     -------
@@ -147,7 +150,7 @@ def chain_from_kdl(kdl_chain) -> Chain:
         raise SolverError(f"kdl_chain must be a PyKDL.Chain, got {type(kdl_chain).__name__}")
     chain = Chain()
     for i in range(kdl_chain.getNrOfSegments()):
-        chain.add_segment(**_segment_arguments(kdl, kdl_chain.getSegment(i), i))
+        chain.add_segment(**_segment_arguments(kdl, kdl_chain.getSegment(i), i), inertia_check=inertia_check)
     return chain
 
 
