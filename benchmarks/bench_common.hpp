@@ -38,15 +38,14 @@
 
 namespace bench {
 
-constexpr int kStates = 64;            // pre-generated random states per chain
-constexpr int kBatches = 61;           // timed batches per measurement (median reported)
-constexpr double kBatchSeconds = 0.008;// target duration of one batch
+constexpr int kStates = 64;              // pre-generated random states per chain
+constexpr int kBatches = 61;             // timed batches per measurement (median reported)
+constexpr double kBatchSeconds = 0.008;  // target duration of one batch
 constexpr double kWarmupSeconds = 0.02;
 constexpr double kGravity = 9.81;
 constexpr double kPi = 3.14159265358979323846;
 
 inline double g_sink = 0.0;  // printed at the end: keeps every timed result observable
-
 
 // ---------------------------------------------------------------------------------------------
 // Deterministic random numbers: std::mt19937_64's output sequence is fixed by the standard; the
@@ -67,29 +66,92 @@ class Rng {
 
 struct Gen3Link {
   const char* joint;
-  double xyz[3];   // URDF joint origin translation (parent link frame)
-  double rpy[3];   // URDF joint origin roll, pitch, yaw
-  double mass;     // child link
-  double com[3];   // child link COM in the child link frame
+  double xyz[3];                        // URDF joint origin translation (parent link frame)
+  double rpy[3];                        // URDF joint origin roll, pitch, yaw
+  double mass;                          // child link
+  double com[3];                        // child link COM in the child link frame
   double ixx, iyy, izz, ixy, ixz, iyz;  // about the COM, axes parallel to the child link frame
 };
 
 // Kinova Gen3 7-DoF; see the file comment for the source. All joint axes are +z of the joint frame.
 inline const Gen3Link kGen3[7] = {
-    {"joint_1", {0.0, 0.0, 0.15643}, {3.1416, 2.7629e-18, -4.9305e-36},
-     1.3773, {-2.3e-05, -0.010364, -0.07336}, 0.00457, 0.004831, 0.001409, 1e-06, 2e-06, 0.000448},
-    {"joint_2", {0.0, 0.005375, -0.12838}, {1.5708, 2.1343e-17, -1.1102e-16},
-     1.1636, {-4.4e-05, -0.09958, -0.013278}, 0.011088, 0.001072, 0.011255, 5e-06, 0.0, -0.000691},
-    {"joint_3", {0.0, -0.21038, -0.006375}, {-1.5708, 1.2326e-32, -2.9122e-16},
-     1.1636, {-4.4e-05, -0.006641, -0.117892}, 0.010932, 0.011127, 0.001043, 0.0, -7e-06, 0.000606},
-    {"joint_4", {0.0, 0.006375, -0.21038}, {1.5708, -6.6954e-17, -1.6653e-16},
-     0.9302, {-1.8e-05, -0.075478, -0.015006}, 0.008147, 0.000631, 0.008316, -1e-06, 0.0, -0.0005},
-    {"joint_5", {0.0, -0.20843, -0.006375}, {-1.5708, 2.2204e-16, -6.373e-17},
-     0.6781, {1e-06, -0.009432, -0.063883}, 0.001596, 0.001607, 0.000399, 0.0, 0.0, 0.000256},
-    {"joint_6", {0.0, 0.00017505, -0.10593}, {1.5708, 9.2076e-28, -8.2157e-15},
-     0.6781, {1e-06, -0.045483, -0.00965}, 0.001641, 0.00041, 0.001641, 0.0, 0.0, -0.000278},
-    {"joint_7", {0.0, -0.10593, -0.00017505}, {-1.5708, -5.5511e-17, 9.6396e-17},
-     0.364, {-9.3e-05, 0.000132, -0.022905}, 0.000214, 0.000223, 0.00024, 0.0, 1e-06, -2e-06},
+    {"joint_1",
+     {0.0, 0.0, 0.15643},
+     {3.1416, 2.7629e-18, -4.9305e-36},
+     1.3773,
+     {-2.3e-05, -0.010364, -0.07336},
+     0.00457,
+     0.004831,
+     0.001409,
+     1e-06,
+     2e-06,
+     0.000448},
+    {"joint_2",
+     {0.0, 0.005375, -0.12838},
+     {1.5708, 2.1343e-17, -1.1102e-16},
+     1.1636,
+     {-4.4e-05, -0.09958, -0.013278},
+     0.011088,
+     0.001072,
+     0.011255,
+     5e-06,
+     0.0,
+     -0.000691},
+    {"joint_3",
+     {0.0, -0.21038, -0.006375},
+     {-1.5708, 1.2326e-32, -2.9122e-16},
+     1.1636,
+     {-4.4e-05, -0.006641, -0.117892},
+     0.010932,
+     0.011127,
+     0.001043,
+     0.0,
+     -7e-06,
+     0.000606},
+    {"joint_4",
+     {0.0, 0.006375, -0.21038},
+     {1.5708, -6.6954e-17, -1.6653e-16},
+     0.9302,
+     {-1.8e-05, -0.075478, -0.015006},
+     0.008147,
+     0.000631,
+     0.008316,
+     -1e-06,
+     0.0,
+     -0.0005},
+    {"joint_5",
+     {0.0, -0.20843, -0.006375},
+     {-1.5708, 2.2204e-16, -6.373e-17},
+     0.6781,
+     {1e-06, -0.009432, -0.063883},
+     0.001596,
+     0.001607,
+     0.000399,
+     0.0,
+     0.0,
+     0.000256},
+    {"joint_6",
+     {0.0, 0.00017505, -0.10593},
+     {1.5708, 9.2076e-28, -8.2157e-15},
+     0.6781,
+     {1e-06, -0.045483, -0.00965},
+     0.001641,
+     0.00041,
+     0.001641,
+     0.0,
+     0.0,
+     -0.000278},
+    {"joint_7",
+     {0.0, -0.10593, -0.00017505},
+     {-1.5708, -5.5511e-17, 9.6396e-17},
+     0.364,
+     {-9.3e-05, 0.000132, -0.022905},
+     0.000214,
+     0.000223,
+     0.00024,
+     0.0,
+     1e-06,
+     -2e-06},
 };
 
 // URDF joint -> KDL segment: the joint rotates about the joint frame's z axis through the joint
@@ -100,11 +162,9 @@ inline KDL::Chain makeGen3Chain() {
   for (const Gen3Link& l : kGen3) {
     const KDL::Frame origin(KDL::Rotation::RPY(l.rpy[0], l.rpy[1], l.rpy[2]),
                             KDL::Vector(l.xyz[0], l.xyz[1], l.xyz[2]));
-    const KDL::Joint joint(l.joint, origin.p, origin.M * KDL::Vector(0.0, 0.0, 1.0),
-                           KDL::Joint::RotAxis);
-    const KDL::RigidBodyInertia inertia(
-        l.mass, KDL::Vector(l.com[0], l.com[1], l.com[2]),
-        KDL::RotationalInertia(l.ixx, l.iyy, l.izz, l.ixy, l.ixz, l.iyz));
+    const KDL::Joint joint(l.joint, origin.p, origin.M * KDL::Vector(0.0, 0.0, 1.0), KDL::Joint::RotAxis);
+    const KDL::RigidBodyInertia inertia(l.mass, KDL::Vector(l.com[0], l.com[1], l.com[2]),
+                                        KDL::RotationalInertia(l.ixx, l.iyy, l.izz, l.ixy, l.ixz, l.iyz));
     chain.addSegment(KDL::Segment(l.joint, joint, origin, inertia));
   }
   return chain;
@@ -116,8 +176,8 @@ inline KDL::Chain makeRandomChain(int n, std::uint64_t seed) {
   const KDL::Joint::JointType axes[3] = {KDL::Joint::RotX, KDL::Joint::RotY, KDL::Joint::RotZ};
   for (int i = 0; i < n; ++i) {
     const KDL::Joint joint(axes[rng.index(3)]);
-    const KDL::Rotation tip_rot = KDL::Rotation::RPY(rng.uniform(-kPi, kPi), rng.uniform(-kPi / 2, kPi / 2),
-                                                     rng.uniform(-kPi, kPi));
+    const KDL::Rotation tip_rot =
+        KDL::Rotation::RPY(rng.uniform(-kPi, kPi), rng.uniform(-kPi / 2, kPi / 2), rng.uniform(-kPi, kPi));
     const KDL::Vector tip_pos(rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05), rng.uniform(0.08, 0.2));
     const double mass = rng.uniform(0.5, 2.0);
     const KDL::Vector com = tip_pos * rng.uniform(0.3, 0.7) +
@@ -126,8 +186,8 @@ inline KDL::Chain makeRandomChain(int n, std::uint64_t seed) {
     // triangle inequalities; rotate them by a random rotation.
     const double a = rng.uniform(2e-4, 5e-3), b = rng.uniform(2e-4, 5e-3), c = rng.uniform(2e-4, 5e-3);
     const Eigen::Vector3d principal(mass * (b + c), mass * (a + c), mass * (a + b));
-    const KDL::Rotation r = KDL::Rotation::RPY(rng.uniform(-kPi, kPi), rng.uniform(-kPi / 2, kPi / 2),
-                                               rng.uniform(-kPi, kPi));
+    const KDL::Rotation r =
+        KDL::Rotation::RPY(rng.uniform(-kPi, kPi), rng.uniform(-kPi / 2, kPi / 2), rng.uniform(-kPi, kPi));
     Eigen::Matrix3d rm;
     for (int row = 0; row < 3; ++row)
       for (int col = 0; col < 3; ++col) rm(row, col) = r(row, col);
@@ -154,7 +214,7 @@ struct Bench {
   std::string name;
   std::function<void(int reps)> run;  // reps x kStates calls; the loop is inside the callable
   int reps = 1;
-  std::vector<double> us;             // per-call microseconds, one entry per batch
+  std::vector<double> us;  // per-call microseconds, one entry per batch
 };
 
 inline void addBench(std::vector<Bench>& group, const std::string& name, std::function<void(int)> run) {

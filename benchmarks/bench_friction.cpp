@@ -47,12 +47,12 @@
 
 #include <unistd.h>
 
+#include <kdl/config.h>
 #include <Eigen/Core>
 #include <kdl/chain.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
-#include <kdl/config.h>
 #include <kdl/frames.hpp>
 #include <kdl/jacobian.hpp>
 #include <kdl/jntarray.hpp>
@@ -72,9 +72,9 @@ constexpr double kFrictionLo = 0.5, kFrictionHi = 3.0;  // N m, static friction 
 constexpr double kDiffTol = 1e-6;                       // "vertex answer differs": relative qdd
 
 // Issue targets.
-constexpr double kTargetPlain = 2.5;    // friction / our plain solve: at most
-constexpr double kTargetKdl = 1.0;      // friction / KDL plain solve: below
-constexpr double kTargetVertex = 100.0; // vertex enumeration / friction: at least
+constexpr double kTargetPlain = 2.5;     // friction / our plain solve: at most
+constexpr double kTargetKdl = 1.0;       // friction / KDL plain solve: below
+constexpr double kTargetVertex = 100.0;  // vertex enumeration / friction: at least
 
 struct Task {
   KDL::Jacobian alfa_kdl;
@@ -143,10 +143,25 @@ std::vector<State> makeStates(const KDL::Chain& chain, std::uint64_t seed) {
 class VertexEnumeration {
  public:
   VertexEnumeration(const KDL::Chain& chain, const KDL::Twist& root_acc, int m)
-      : n_(static_cast<int>(chain.getNrOfJoints())), m_(m), free_(chain, root_acc, 0), task_(chain, root_acc, m),
-        jac_solver_(chain), f_ext_(chain.getNrOfSegments(), KDL::Wrench::Zero()), alfa0_(0), beta0_(0),
-        qdd_free_(n_), qdd_(n_), tau_(n_), tau_out_(n_), jac_(n_), jta_(n_, m), nu_(m), mu_(n_), tau_cmd_(n_),
-        best_mu_(n_), best_qdd_(n_) {}
+      : n_(static_cast<int>(chain.getNrOfJoints())),
+        m_(m),
+        free_(chain, root_acc, 0),
+        task_(chain, root_acc, m),
+        jac_solver_(chain),
+        f_ext_(chain.getNrOfSegments(), KDL::Wrench::Zero()),
+        alfa0_(0),
+        beta0_(0),
+        qdd_free_(n_),
+        qdd_(n_),
+        tau_(n_),
+        tau_out_(n_),
+        jac_(n_),
+        jta_(n_, m),
+        nu_(m),
+        mu_(n_),
+        tau_cmd_(n_),
+        best_mu_(n_),
+        best_qdd_(n_) {}
 
   // Returns the best g; best_mu() and best_qdd() hold its vertex and motion.
   double run(const State& s, const Task& t) {
@@ -217,11 +232,11 @@ struct Row {
   int max_iter = 0;
   double mean_stick = 0, mean_slip = 0;
   int vertex_differs = 0;
-  double max_gap = 0, mean_rel_gap = 0;     // g* - g(best vertex)
-  double max_plain_dqdd = 0;                // ours plain vs KDL
-  double max_g_check = 0;                   // |g_KDL(mu*) - gaussValue()| / max(1, |g*|)
-  double max_cmd_check = 0;                 // |-J^T alfa nu (KDL) - ours tau_cmd|
-  int g_violations = 0;                     // best vertex g above the exact optimum
+  double max_gap = 0, mean_rel_gap = 0;  // g* - g(best vertex)
+  double max_plain_dqdd = 0;             // ours plain vs KDL
+  double max_g_check = 0;                // |g_KDL(mu*) - gaussValue()| / max(1, |g*|)
+  double max_cmd_check = 0;              // |-J^T alfa nu (KDL) - ours tau_cmd|
+  int g_violations = 0;                  // best vertex g above the exact optimum
 };
 
 double relDiff(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
@@ -276,11 +291,11 @@ int main(int argc, char** argv) {
         const Task& t = s.tasks[ti];
         const int r1 = fric.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau, s.friction);
         const int r2 = plain.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
-        const int r3 = kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl,
-                                        tau_out_kdl);
+        const int r3 =
+            kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_out_kdl);
         if (r1 != 0 || r2 != 0 || r3 != 0) {
-          std::cerr << "solver error (" << label << "): friction " << r1 << " (" << fric.errorMessage()
-                    << "), plain " << r2 << ", KDL " << r3 << "\n";
+          std::cerr << "solver error (" << label << "): friction " << r1 << " (" << fric.errorMessage() << "), plain "
+                    << r2 << ", KDL " << r3 << "\n";
           ++failures;
           continue;
         }
@@ -309,7 +324,8 @@ int main(int argc, char** argv) {
         // The command -J^T alfa nu from KDL against ours at the best vertex.
         vertices.gaussAt(s, t, mu_vertex);
         plain.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau - mu_vertex);
-        row.max_cmd_check = std::max(row.max_cmd_check, (vertices.commandTorques() - plain.commandTorques()).cwiseAbs().maxCoeff());
+        row.max_cmd_check =
+            std::max(row.max_cmd_check, (vertices.commandTorques() - plain.commandTorques()).cwiseAbs().maxCoeff());
         if (vertices.lastError() != 0) {
           std::cerr << "KDL error in the vertex enumeration (" << label << "): " << vertices.lastError() << "\n";
           ++failures;
@@ -323,20 +339,21 @@ int main(int argc, char** argv) {
 
       std::vector<Bench> group;
       addBench(group, "friction", overStates(states, [&](const State& s) {
-        const Task& t = s.tasks[ti];
-        fric.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau, s.friction);
-        return fric.qdd()(n - 1);
-      }));
+                 const Task& t = s.tasks[ti];
+                 fric.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau, s.friction);
+                 return fric.qdd()(n - 1);
+               }));
       addBench(group, "plain", overStates(states, [&](const State& s) {
-        const Task& t = s.tasks[ti];
-        plain.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
-        return plain.qdd()(n - 1);
-      }));
+                 const Task& t = s.tasks[ti];
+                 plain.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
+                 return plain.qdd()(n - 1);
+               }));
       addBench(group, "KDL", overStates(states, [&](const State& s) {
-        const Task& t = s.tasks[ti];
-        kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_out_kdl);
-        return qdd_kdl(n - 1);
-      }));
+                 const Task& t = s.tasks[ti];
+                 kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl,
+                                  tau_out_kdl);
+                 return qdd_kdl(n - 1);
+               }));
       addBench(group, "vertex enumeration",
                overStates(states, [&](const State& s) { return vertices.run(s, s.tasks[ti]); }));
       std::cerr << "timing " << label << " ..." << std::endl;
@@ -402,15 +419,15 @@ int main(int argc, char** argv) {
     return all;
   };
   md << "\n";
-  const bool t1 = verdict("friction-aware solve at most 2.5x our plain solve",
-                          [](const Row& r) { return r.r_plain <= kTargetPlain; },
-                          [](const Row& r) { return r.r_plain; }, "%.2f");
-  const bool t2 = verdict("friction-aware solve faster than one KDL plain solve",
-                          [](const Row& r) { return r.r_kdl < kTargetKdl; }, [](const Row& r) { return r.r_kdl; },
-                          "%.2f");
-  const bool t3 = verdict("friction-aware solve at least 100x faster than vertex enumeration",
-                          [](const Row& r) { return r.r_vertex >= kTargetVertex; },
-                          [](const Row& r) { return r.r_vertex; }, "%.0f");
+  const bool t1 = verdict(
+      "friction-aware solve at most 2.5x our plain solve", [](const Row& r) { return r.r_plain <= kTargetPlain; },
+      [](const Row& r) { return r.r_plain; }, "%.2f");
+  const bool t2 = verdict(
+      "friction-aware solve faster than one KDL plain solve", [](const Row& r) { return r.r_kdl < kTargetKdl; },
+      [](const Row& r) { return r.r_kdl; }, "%.2f");
+  const bool t3 = verdict(
+      "friction-aware solve at least 100x faster than vertex enumeration",
+      [](const Row& r) { return r.r_vertex >= kTargetVertex; }, [](const Row& r) { return r.r_vertex; }, "%.0f");
 
   md << "\n## Answers: exact optimum against the best vertex\n\n";
   md << "Per case, over the " << kStates << " states: joints sticking / slipping at the exact optimum (mean per "

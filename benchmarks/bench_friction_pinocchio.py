@@ -32,6 +32,7 @@ Usage: python benchmarks/bench_friction_pinocchio.py [--out FILE] [--batches N] 
 Markdown to stdout (and FILE); progress to stderr. Exit code 2 if our solve and the tight ADMM disagree
 by more than 1e-6 (relative to max(1, |qdd|)).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -66,7 +67,7 @@ def make_states(model, data, seed=2024):
 
 
 def admm_settings(kind, n):
-    """"default": ADMMSolverSettings() as constructed (tolerances 1e-6, 1000 iterations, no Anderson
+    """ "default": ADMMSolverSettings() as constructed (tolerances 1e-6, 1000 iterations, no Anderson
     acceleration); "tuned": Anderson acceleration (capacity 4) and rho momentum 0.9 as in Pinocchio's
     own ADMM unit test (unittest/python/bindings_admm.py), up to 10000 iterations, tolerances 1e-6;
     "tight": "tuned" with tolerances 1e-12. All with lanczos_size = n, as Pinocchio's tests."""
@@ -137,8 +138,14 @@ def main():
             dtau.append(np.abs(last["lam"] - r.friction_torque).max())
             iters.append(last["iterations"])
             conv += bool(last["converged"])
-        check[name] = dict(dq_max=max(dq), dq_med=statistics.median(dq), dtau_max=max(dtau),
-                           it_mean=float(np.mean(iters)), it_max=int(max(iters)), converged=conv)
+        check[name] = dict(
+            dq_max=max(dq),
+            dq_med=statistics.median(dq),
+            dtau_max=max(dtau),
+            it_mean=float(np.mean(iters)),
+            it_max=int(max(iters)),
+            converged=conv,
+        )
     stick = np.mean([np.sum(np.asarray(r.status) == 1) for r in ours])
     our_iters = np.mean([r.iterations for r in ours])
 
@@ -155,7 +162,9 @@ def main():
     }
     for kind, st in settings.items():
         variants[f"pin ADMM {kind}"] = per_state(
-            pin_friction, [(q, tau, cms, cds, st) for (q, tau, _), cms, cds in zip(states, cms_per_state, cds_per_state)])
+            pin_friction,
+            [(q, tau, cms, cds, st) for (q, tau, _), cms, cds in zip(states, cms_per_state, cds_per_state)],
+        )
     print("timing Gen3 static friction (Python) ...", file=sys.stderr, flush=True)
     us = time_group(variants, args.batches, args.batch_ms * 1e-3)
     med = {k: statistics.median(v) for k, v in us.items()}
@@ -163,44 +172,56 @@ def main():
 
     ok = check["tight"]["dq_max"] <= RTOL_CHECK
     out = ["# Python: ours against Pinocchio's JointFrictionConstraintModel + ADMM (Gen3, m = 0)", ""]
-    out.append(f"pinocchio {pin.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}, vereshchagin "
-               f"from `{vs.__file__}`. Gen3 from `gen3_urdf(gripper=False, use_external_cable=True)`, "
-               f"{N_STATES} seeded states, every joint at rest (q_dot = 0), static friction in [0.5, 3] N m, "
-               "feed-forward = (random factor in [0, 1]) x gravity torque + U(-2, 2) N m; no task (m = 0). Pinocchio: "
-               "`JointFrictionConstraintModel` on all 7 joints with bounds +-f (time step 1, so impulses are torques), "
-               "`ConstraintCholeskyDecomposition` for the Delassus operator M^-1, `ADMMConstraintSolver` "
-               "(`lanczos_size` 7) with the settings `default` (as constructed: tolerances 1e-6, at most 1000 "
-               "iterations), `tuned` (Anderson acceleration 4 and rho momentum 0.9 as in Pinocchio's own ADMM test, "
-               "at most 10000 iterations, tolerances 1e-6) or `tight` (tuned, tolerances 1e-12), qdd = "
-               "`aba(tau + lambda)`; the timed call includes `crba`, the free `aba`, the "
-               "decomposition, the ADMM and the final `aba`. Ours: `Solver.solve(q, qd, tau_ff=tau, "
-               f"friction=Friction(static=f))` (exact active set). {args.batches} interleaved batches of about "
-               f"{args.batch_ms:.0f} ms, median per-call time; ratio = median of per-batch ratios. Run time {wall:.0f} s.")
+    out.append(
+        f"pinocchio {pin.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}, vereshchagin "
+        f"from `{vs.__file__}`. Gen3 from `gen3_urdf(gripper=False, use_external_cable=True)`, "
+        f"{N_STATES} seeded states, every joint at rest (q_dot = 0), static friction in [0.5, 3] N m, "
+        "feed-forward = (random factor in [0, 1]) x gravity torque + U(-2, 2) N m; no task (m = 0). Pinocchio: "
+        "`JointFrictionConstraintModel` on all 7 joints with bounds +-f (time step 1, so impulses are torques), "
+        "`ConstraintCholeskyDecomposition` for the Delassus operator M^-1, `ADMMConstraintSolver` "
+        "(`lanczos_size` 7) with the settings `default` (as constructed: tolerances 1e-6, at most 1000 "
+        "iterations), `tuned` (Anderson acceleration 4 and rho momentum 0.9 as in Pinocchio's own ADMM test, "
+        "at most 10000 iterations, tolerances 1e-6) or `tight` (tuned, tolerances 1e-12), qdd = "
+        "`aba(tau + lambda)`; the timed call includes `crba`, the free `aba`, the "
+        "decomposition, the ADMM and the final `aba`. Ours: `Solver.solve(q, qd, tau_ff=tau, "
+        f"friction=Friction(static=f))` (exact active set). {args.batches} interleaved batches of about "
+        f"{args.batch_ms:.0f} ms, median per-call time; ratio = median of per-batch ratios. Run time {wall:.0f} s."
+    )
     out.append("")
-    out.append(f"At the exact optimum {stick:.2f} of 7 joints stick on average; our active-set iterations: "
-               f"{our_iters:.2f} on average.")
+    out.append(
+        f"At the exact optimum {stick:.2f} of 7 joints stick on average; our active-set iterations: "
+        f"{our_iters:.2f} on average."
+    )
     out.append("")
-    out.append("| variant | us per call | ratio to ours friction | ADMM iterations mean (max) | converged | "
-               "max rel. qdd diff to ours | median rel. qdd diff | max friction torque diff (N m) |")
+    out.append(
+        "| variant | us per call | ratio to ours friction | ADMM iterations mean (max) | converged | "
+        "max rel. qdd diff to ours | median rel. qdd diff | max friction torque diff (N m) |"
+    )
     out.append("|---|---:|---:|---:|---:|---:|---:|---:|")
     for name in us:
         ratio = paired_ratio(us[name], us["ours friction"])
         if name.startswith("pin ADMM"):
             c = check[name.split()[-1]]
-            extra = (f"{c['it_mean']:.1f} ({c['it_max']}) | {c['converged']} / {N_STATES} | {c['dq_max']:.1e} | "
-                     f"{c['dq_med']:.1e} | {c['dtau_max']:.1e}")
+            extra = (
+                f"{c['it_mean']:.1f} ({c['it_max']}) | {c['converged']} / {N_STATES} | {c['dq_max']:.1e} | "
+                f"{c['dq_med']:.1e} | {c['dtau_max']:.1e}"
+            )
         else:
             extra = "- | - | - | - | -"
         out.append(f"| {name} | {med[name]:.1f} | {ratio:.2f} | {extra} |")
     out.append("")
-    out.append("Relative qdd difference: max |qdd_pin - qdd_ours| / max(1, max |qdd_ours|) per state. ADMM is "
-               "iterative: its answer is as accurate as its tolerances (absolute and relative feasibility and "
-               "complementarity, 1e-6 by default); ours satisfies the complementarity conditions to round-off. Both "
-               "libraries pay Python call overhead here (the C++ table above has ours without it).")
+    out.append(
+        "Relative qdd difference: max |qdd_pin - qdd_ours| / max(1, max |qdd_ours|) per state. ADMM is "
+        "iterative: its answer is as accurate as its tolerances (absolute and relative feasibility and "
+        "complementarity, 1e-6 by default); ours satisfies the complementarity conditions to round-off. Both "
+        "libraries pay Python call overhead here (the C++ table above has ours without it)."
+    )
     if not ok:
         out.append("")
-        out.append(f"**The tight ADMM and our solve disagree by {check['tight']['dq_max']:.1e} (relative) > "
-                   f"{RTOL_CHECK:.0e}.**")
+        out.append(
+            f"**The tight ADMM and our solve disagree by {check['tight']['dq_max']:.1e} (relative) > "
+            f"{RTOL_CHECK:.0e}.**"
+        )
     text = "\n".join(out) + "\n"
     print(text)
     if args.out:

@@ -23,6 +23,7 @@ Our constraint alpha^T a_tip = beta is Pinocchio's J qdd + gamma = 0 with the J 
 Usage: python benchmarks/bench_pinocchio.py [--out FILE] [--batches N] [--batch-ms MS]
 The Markdown section goes to stdout (and FILE); progress to stderr. Exit code 2 if a check failed.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -51,29 +52,68 @@ Segment = namedtuple("Segment", "P axis T mass com inertia")
 # Kinova Gen3 7-DoF, the table of bench_solver.cpp: URDF joint origin xyz, rpy; child link mass,
 # com and inertia (ixx, iyy, izz, ixy, ixz, iyz). All joints rotate about z of the joint frame.
 GEN3 = [
-    ((0.0, 0.0, 0.15643), (3.1416, 2.7629e-18, -4.9305e-36), 1.3773, (-2.3e-05, -0.010364, -0.07336),
-     (0.00457, 0.004831, 0.001409, 1e-06, 2e-06, 0.000448)),
-    ((0.0, 0.005375, -0.12838), (1.5708, 2.1343e-17, -1.1102e-16), 1.1636, (-4.4e-05, -0.09958, -0.013278),
-     (0.011088, 0.001072, 0.011255, 5e-06, 0.0, -0.000691)),
-    ((0.0, -0.21038, -0.006375), (-1.5708, 1.2326e-32, -2.9122e-16), 1.1636, (-4.4e-05, -0.006641, -0.117892),
-     (0.010932, 0.011127, 0.001043, 0.0, -7e-06, 0.000606)),
-    ((0.0, 0.006375, -0.21038), (1.5708, -6.6954e-17, -1.6653e-16), 0.9302, (-1.8e-05, -0.075478, -0.015006),
-     (0.008147, 0.000631, 0.008316, -1e-06, 0.0, -0.0005)),
-    ((0.0, -0.20843, -0.006375), (-1.5708, 2.2204e-16, -6.373e-17), 0.6781, (1e-06, -0.009432, -0.063883),
-     (0.001596, 0.001607, 0.000399, 0.0, 0.0, 0.000256)),
-    ((0.0, 0.00017505, -0.10593), (1.5708, 9.2076e-28, -8.2157e-15), 0.6781, (1e-06, -0.045483, -0.00965),
-     (0.001641, 0.00041, 0.001641, 0.0, 0.0, -0.000278)),
-    ((0.0, -0.10593, -0.00017505), (-1.5708, -5.5511e-17, 9.6396e-17), 0.364, (-9.3e-05, 0.000132, -0.022905),
-     (0.000214, 0.000223, 0.00024, 0.0, 1e-06, -2e-06)),
+    (
+        (0.0, 0.0, 0.15643),
+        (3.1416, 2.7629e-18, -4.9305e-36),
+        1.3773,
+        (-2.3e-05, -0.010364, -0.07336),
+        (0.00457, 0.004831, 0.001409, 1e-06, 2e-06, 0.000448),
+    ),
+    (
+        (0.0, 0.005375, -0.12838),
+        (1.5708, 2.1343e-17, -1.1102e-16),
+        1.1636,
+        (-4.4e-05, -0.09958, -0.013278),
+        (0.011088, 0.001072, 0.011255, 5e-06, 0.0, -0.000691),
+    ),
+    (
+        (0.0, -0.21038, -0.006375),
+        (-1.5708, 1.2326e-32, -2.9122e-16),
+        1.1636,
+        (-4.4e-05, -0.006641, -0.117892),
+        (0.010932, 0.011127, 0.001043, 0.0, -7e-06, 0.000606),
+    ),
+    (
+        (0.0, 0.006375, -0.21038),
+        (1.5708, -6.6954e-17, -1.6653e-16),
+        0.9302,
+        (-1.8e-05, -0.075478, -0.015006),
+        (0.008147, 0.000631, 0.008316, -1e-06, 0.0, -0.0005),
+    ),
+    (
+        (0.0, -0.20843, -0.006375),
+        (-1.5708, 2.2204e-16, -6.373e-17),
+        0.6781,
+        (1e-06, -0.009432, -0.063883),
+        (0.001596, 0.001607, 0.000399, 0.0, 0.0, 0.000256),
+    ),
+    (
+        (0.0, 0.00017505, -0.10593),
+        (1.5708, 9.2076e-28, -8.2157e-15),
+        0.6781,
+        (1e-06, -0.045483, -0.00965),
+        (0.001641, 0.00041, 0.001641, 0.0, 0.0, -0.000278),
+    ),
+    (
+        (0.0, -0.10593, -0.00017505),
+        (-1.5708, -5.5511e-17, 9.6396e-17),
+        0.364,
+        (-9.3e-05, 0.000132, -0.022905),
+        (0.000214, 0.000223, 0.00024, 0.0, 1e-06, -2e-06),
+    ),
 ]
 
 
 def rpy(roll, pitch, yaw):
     """KDL::Rotation::RPY: Rz(yaw) Ry(pitch) Rx(roll)."""
     cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
 
 
 def frame(R=None, p=(0.0, 0.0, 0.0)):
@@ -195,6 +235,7 @@ def per_state(fn, args):
         for _ in range(reps):
             for a in args:
                 fn(*a)
+
     return run
 
 
@@ -212,14 +253,20 @@ def bench_case(label, segs, seed, batches, batch_s):
     rows = []
     for m in TASK_SIZES:
         ours_args = [(q, qd, *(s[m] if m else (None, None)), None, tau) for q, qd, tau, s in states]
-        batch_args = (Q, QD, *((np.array([s[3][m][0] for s in states]), np.array([s[3][m][1] for s in states]))
-                               if m else (None, None)), None, TAU)
+        batch_args = (
+            Q,
+            QD,
+            *((np.array([s[3][m][0] for s in states]), np.array([s[3][m][1] for s in states])) if m else (None, None)),
+            None,
+            TAU,
+        )
         if m == 0:
             pin_args = [(model, data, q, qd, tau) for q, qd, tau, _ in states]
             pin_fd = pin.aba
         else:
-            pin_args = [(model, data, q, qd, tau, *pinocchio_task(model, data, fid, q, qd, *s[m]))
-                        for q, qd, tau, s in states]
+            pin_args = [
+                (model, data, q, qd, tau, *pinocchio_task(model, data, fid, q, qd, *s[m])) for q, qd, tau, s in states
+            ]
             pin_fd = pin.forwardDynamics
 
         def pipeline(q, qd, tau, alpha, beta):
@@ -230,54 +277,73 @@ def bench_case(label, segs, seed, batches, batch_s):
 
         # Check once: all variants give the same joint accelerations.
         expected = np.array([np.array(pin_fd(*a)) for a in pin_args])
-        got = {"ours solve": np.array([solver.solve(*a).qdd for a in ours_args]),
-               "ours batch": solver.solve_batch(*batch_args).qdd}
+        got = {
+            "ours solve": np.array([solver.solve(*a).qdd for a in ours_args]),
+            "ours batch": solver.solve_batch(*batch_args).qdd,
+        }
         if m:
             got["pin pipeline"] = np.array([np.array(pipeline(q, qd, tau, *s[m])) for q, qd, tau, s in states])
         worst = max(rel_diff(g[i], expected[i]) for g in got.values() for i in range(N_STATES))
 
-        variants = {"ours solve": per_state(solver.solve, ours_args),
-                    "ours batch": lambda reps, args=batch_args: [solver.solve_batch(*args) for _ in range(reps)],
-                    "pin FD": per_state(pin_fd, pin_args)}
+        variants = {
+            "ours solve": per_state(solver.solve, ours_args),
+            "ours batch": lambda reps, args=batch_args: [solver.solve_batch(*args) for _ in range(reps)],
+            "pin FD": per_state(pin_fd, pin_args),
+        }
         if m:
             variants["pin pipeline"] = per_state(pipeline, [(q, qd, tau, *s[m]) for q, qd, tau, s in states])
         print(f"timing {label}, m {m} ...", file=sys.stderr, flush=True)
         us = time_group(variants, batches, batch_s)
         pipe = "pin pipeline" if m else "pin FD"
-        rows.append(dict(label=label, m=m, worst=worst, **{k: statistics.median(v) for k, v in us.items()},
-                         r_fd=paired_ratio(us["ours solve"], us["pin FD"]),
-                         r_pipe=paired_ratio(us["ours solve"], us[pipe]),
-                         r_batch=paired_ratio(us["ours batch"], us[pipe]),
-                         spread=max((np.percentile(v, 75) - np.percentile(v, 25)) / np.median(v) for v in us.values())))
+        rows.append(
+            dict(
+                label=label,
+                m=m,
+                worst=worst,
+                **{k: statistics.median(v) for k, v in us.items()},
+                r_fd=paired_ratio(us["ours solve"], us["pin FD"]),
+                r_pipe=paired_ratio(us["ours solve"], us[pipe]),
+                r_batch=paired_ratio(us["ours batch"], us[pipe]),
+                spread=max((np.percentile(v, 75) - np.percentile(v, 25)) / np.median(v) for v in us.values()),
+            )
+        )
     return rows
 
 
 def report(rows, batches, batch_s, wall):
     failed = [r for r in rows if not r["worst"] <= RTOL]
     out = ["## Python: vereshchagin.Solver vs Pinocchio (both called from Python)", ""]
-    out.append(f"Python {sys.version.split()[0]}, numpy {np.__version__}, pinocchio {pin.__version__}, "
-               f"vereshchagin from `{vs.__file__}`. {N_STATES} seeded states per chain, m = 0, 1, 6; "
-               f"time.perf_counter, {batches} interleaved batches of about {batch_s * 1e3:.0f} ms per variant, "
-               f"median per-call time; ratio = median of per-batch ratios. Run time {wall:.0f} s; largest batch "
-               f"inter-quartile range / median: {100 * max(r['spread'] for r in rows):.0f} %.")
+    out.append(
+        f"Python {sys.version.split()[0]}, numpy {np.__version__}, pinocchio {pin.__version__}, "
+        f"vereshchagin from `{vs.__file__}`. {N_STATES} seeded states per chain, m = 0, 1, 6; "
+        f"time.perf_counter, {batches} interleaved batches of about {batch_s * 1e3:.0f} ms per variant, "
+        f"median per-call time; ratio = median of per-batch ratios. Run time {wall:.0f} s; largest batch "
+        f"inter-quartile range / median: {100 * max(r['spread'] for r in rows):.0f} %."
+    )
     out.append("")
-    out.append("Columns (microseconds per call): `ours solve` = `Solver.solve(q, qd, alpha, beta, None, tau)`; "
-               "`ours batch` = `Solver.solve_batch` over the 64 states, per row; `pin FD` = `pin.aba` for m = 0, "
-               "`pin.forwardDynamics(q, v, tau, J, gamma)` with J and gamma precomputed for m > 0; `pin pipeline` "
-               "= what our solve does from alpha and beta: `computeAllTerms`, `getFrameJacobian` and "
-               "`getFrameAcceleration` (LOCAL_WORLD_ALIGNED) to form J = alpha^T J_tip and gamma = "
-               "alpha^T (a_tip(qdd = 0) + [-g; 0]) - beta, then `forwardDynamics(tau, J, gamma)` (for m = 0 the "
-               "same as `pin.aba`). The like-for-like ratio is ours solve / pin pipeline. max rel dqdd = largest "
-               "||qdd - qdd_pin|| / max(||qdd_pin||, 1) over the states and our two entry points (and the pipeline).")
+    out.append(
+        "Columns (microseconds per call): `ours solve` = `Solver.solve(q, qd, alpha, beta, None, tau)`; "
+        "`ours batch` = `Solver.solve_batch` over the 64 states, per row; `pin FD` = `pin.aba` for m = 0, "
+        "`pin.forwardDynamics(q, v, tau, J, gamma)` with J and gamma precomputed for m > 0; `pin pipeline` "
+        "= what our solve does from alpha and beta: `computeAllTerms`, `getFrameJacobian` and "
+        "`getFrameAcceleration` (LOCAL_WORLD_ALIGNED) to form J = alpha^T J_tip and gamma = "
+        "alpha^T (a_tip(qdd = 0) + [-g; 0]) - beta, then `forwardDynamics(tau, J, gamma)` (for m = 0 the "
+        "same as `pin.aba`). The like-for-like ratio is ours solve / pin pipeline. max rel dqdd = largest "
+        "||qdd - qdd_pin|| / max(||qdd_pin||, 1) over the states and our two entry points (and the pipeline)."
+    )
     out.append("")
-    out.append("| n | m | ours solve us | ours batch us/row | pin FD us | pin pipeline us | ours / pin FD | "
-               "ours / pin pipeline | ours batch / pin pipeline | max rel dqdd |")
+    out.append(
+        "| n | m | ours solve us | ours batch us/row | pin FD us | pin pipeline us | ours / pin FD | "
+        "ours / pin pipeline | ours batch / pin pipeline | max rel dqdd |"
+    )
     out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in rows:
         pipe = r.get("pin pipeline", r["pin FD"])
         flag = "" if r["worst"] <= RTOL else " **FAIL**"
-        out.append(f"| {r['label']} | {r['m']} | {r['ours solve']:.2f} | {r['ours batch']:.2f} | {r['pin FD']:.2f} | "
-                   f"{pipe:.2f} | {r['r_fd']:.2f} | {r['r_pipe']:.2f} | {r['r_batch']:.2f} | {r['worst']:.1e}{flag} |")
+        out.append(
+            f"| {r['label']} | {r['m']} | {r['ours solve']:.2f} | {r['ours batch']:.2f} | {r['pin FD']:.2f} | "
+            f"{pipe:.2f} | {r['r_fd']:.2f} | {r['r_pipe']:.2f} | {r['r_batch']:.2f} | {r['worst']:.1e}{flag} |"
+        )
     if failed:
         out.append("")
         out.append(f"**{len(failed)} case(s) disagree with Pinocchio by more than {RTOL:.0e} (relative).**")

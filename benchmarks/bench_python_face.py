@@ -22,6 +22,7 @@ repeats each state the same number of times in a row (as the C++ loop does):
 
 Usage: python benchmarks/bench_python_face.py [--out FILE] [--batches N] [--batch-ms MS]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -36,8 +37,18 @@ import pinocchio as pin
 import vereshchagin as vs
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_pinocchio import (LWA, N_STATES, UP, build_ours, build_pinocchio, gen3_segments,  # noqa: E402
-                             make_states, paired_ratio, random_segments, time_group)
+from bench_pinocchio import (
+    LWA,
+    N_STATES,
+    UP,
+    build_ours,
+    build_pinocchio,
+    gen3_segments,  # noqa: E402
+    make_states,
+    paired_ratio,
+    random_segments,
+    time_group,
+)
 
 BATCH_ROWS = 1024
 
@@ -69,9 +80,14 @@ def case_rows(label, segs, seed, batches, batch_s):
         print(f"timing {label}, m {m}{' friction' if with_friction else ''} ...", file=sys.stderr, flush=True)
         us = time_group(variants, batches, batch_s)
         med = {k: statistics.median(v) for k, v in us.items()}
-        row = dict(label=label, m=m, friction=with_friction, **med,
-                   overhead=statistics.median(p - c for p, c in zip(us["py"], us["cpp"])),
-                   overhead_read=statistics.median(p - c for p, c in zip(us["py+qdd"], us["cpp"])))
+        row = dict(
+            label=label,
+            m=m,
+            friction=with_friction,
+            **med,
+            overhead=statistics.median(p - c for p, c in zip(us["py"], us["cpp"])),
+            overhead_read=statistics.median(p - c for p, c in zip(us["py+qdd"], us["cpp"])),
+        )
         if "pin" in us:
             row["r_pin"] = paired_ratio(us["py+qdd"], us["pin"])
         row.update(batch_rows(solver, calls, batches))
@@ -141,45 +157,58 @@ def batch_rows(solver, calls, batches):
             t0 = time.perf_counter()
             solver.solve_batch(Q, QD, threads=threads, **kw)
             sink.append((time.perf_counter() - t0) * 1e6 / len(Q))
-    return {"batch1": statistics.median(t1), "batch2": statistics.median(t2),
-            "speedup": statistics.median(a / b for a, b in zip(t1, t2))}
+    return {
+        "batch1": statistics.median(t1),
+        "batch2": statistics.median(t2),
+        "speedup": statistics.median(a / b for a, b in zip(t1, t2)),
+    }
 
 
 def report(rows, batches, batch_s, wall):
     out = ["## Python face: overhead over the C++ solve, batch throughput", ""]
-    out.append(f"Python {sys.version.split()[0]}, numpy {np.__version__}, pinocchio {pin.__version__}, "
-               f"{os.cpu_count()} cores, load average {' '.join(open('/proc/loadavg').read().split()[:3])} at the "
-               f"end. {N_STATES} seeded states per chain; {batches} interleaved batches of about "
-               f"{batch_s * 1e3:.0f} ms per variant, medians; overhead = median over batches of (Python - C++) in "
-               f"the same batch round. Run time {wall:.0f} s.")
+    out.append(
+        f"Python {sys.version.split()[0]}, numpy {np.__version__}, pinocchio {pin.__version__}, "
+        f"{os.cpu_count()} cores, load average {' '.join(open('/proc/loadavg').read().split()[:3])} at the "
+        f"end. {N_STATES} seeded states per chain; {batches} interleaved batches of about "
+        f"{batch_s * 1e3:.0f} ms per variant, medians; overhead = median over batches of (Python - C++) in "
+        f"the same batch round. Run time {wall:.0f} s."
+    )
     out.append("")
-    out.append("Columns (microseconds per call): `C++` = the C++ solve and reading every output `solve()` returns, "
-               "looped in C++ (`Solver._time_cpp`); `py` = `solver.solve(q, qd, alpha=alpha, beta=beta, "
-               "tau_ff=tau)` (keywords as in the README); `py + qdd` = the same and reading `.qdd`; `out=` = "
-               "the result reused in place; `pin` = `pin.aba` (m = 0) or the Pinocchio pipeline (m > 0, see "
-               "the Pinocchio section); `batch` = `solve_batch` per row over 1024 rows with `threads=1` and `2`; "
-               "`speedup` = threads=1 time / threads=2 time.")
+    out.append(
+        "Columns (microseconds per call): `C++` = the C++ solve and reading every output `solve()` returns, "
+        "looped in C++ (`Solver._time_cpp`); `py` = `solver.solve(q, qd, alpha=alpha, beta=beta, "
+        "tau_ff=tau)` (keywords as in the README); `py + qdd` = the same and reading `.qdd`; `out=` = "
+        "the result reused in place; `pin` = `pin.aba` (m = 0) or the Pinocchio pipeline (m > 0, see "
+        "the Pinocchio section); `batch` = `solve_batch` per row over 1024 rows with `threads=1` and `2`; "
+        "`speedup` = threads=1 time / threads=2 time."
+    )
     out.append("")
-    out.append("| chain | m | friction | C++ us | py us | py + qdd us | out= us | overhead us | overhead + qdd us | "
-               "pin us | py + qdd / pin | batch/row t=1 us | batch t=1 / C++ | batch t=2 us | speedup t=2 |")
+    out.append(
+        "| chain | m | friction | C++ us | py us | py + qdd us | out= us | overhead us | overhead + qdd us | "
+        "pin us | py + qdd / pin | batch/row t=1 us | batch t=1 / C++ | batch t=2 us | speedup t=2 |"
+    )
     out.append("|---|---|---|" + "---:|" * 12)
     for r in rows:
         pin_us = f"{r['pin']:.2f}" if "pin" in r else "-"
         ratio = f"{r['r_pin']:.2f}" if "r_pin" in r else "-"
-        out.append(f"| {r['label']} | {r['m']} | {'yes' if r['friction'] else 'no'} | {r['cpp']:.2f} | {r['py']:.2f} | "
-                   f"{r['py+qdd']:.2f} | {r['out']:.2f} | {r['overhead']:.2f} | {r['overhead_read']:.2f} | {pin_us} | "
-                   f"{ratio} | {r['batch1']:.2f} | {r['batch1'] / r['cpp']:.2f} | {r['batch2']:.2f} | "
-                   f"{r['speedup']:.2f} |")
+        out.append(
+            f"| {r['label']} | {r['m']} | {'yes' if r['friction'] else 'no'} | {r['cpp']:.2f} | {r['py']:.2f} | "
+            f"{r['py+qdd']:.2f} | {r['out']:.2f} | {r['overhead']:.2f} | {r['overhead_read']:.2f} | {pin_us} | "
+            f"{ratio} | {r['batch1']:.2f} | {r['batch1'] / r['cpp']:.2f} | {r['batch2']:.2f} | "
+            f"{r['speedup']:.2f} |"
+        )
     out.append("")
     worst = max(r["overhead_read"] for r in rows)
     aba = [r["r_pin"] for r in rows if r["m"] == 0 and "r_pin" in r]
     m6 = [r["r_pin"] for r in rows if r["m"] == 6 and "r_pin" in r]
     batch = max(r["batch1"] / r["cpp"] for r in rows)
     speed = min(r["speedup"] for r in rows)
-    out.append(f"Targets: overhead (with reading qdd) <= 1.0 us: worst {worst:.2f} us; solve at m = 0 / pin.aba <= 1.0: "
-               f"{', '.join(f'{x:.2f}' for x in aba)}; m = 6 / Pinocchio pipeline <= 0.5: "
-               f"{', '.join(f'{x:.2f}' for x in m6)}; batch row / C++ solve <= 1.15: worst {batch:.2f}; threads=2 "
-               f">= 1.7x: worst {speed:.2f}.")
+    out.append(
+        f"Targets: overhead (with reading qdd) <= 1.0 us: worst {worst:.2f} us; solve at m = 0 / pin.aba <= 1.0: "
+        f"{', '.join(f'{x:.2f}' for x in aba)}; m = 6 / Pinocchio pipeline <= 0.5: "
+        f"{', '.join(f'{x:.2f}' for x in m6)}; batch row / C++ solve <= 1.15: worst {batch:.2f}; threads=2 "
+        f">= 1.7x: worst {speed:.2f}."
+    )
     return "\n".join(out) + "\n"
 
 

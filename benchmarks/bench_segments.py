@@ -35,6 +35,7 @@ nu = -lambda. Before timing every state is checked: qdd of all three and nu agai
 Usage: python benchmarks/bench_segments.py [--out FILE] [--batches 61] [--batch-ms 10]
 Markdown to stdout (and FILE); progress to stderr. Exit code 2 if a check failed. About 15-20 s.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -71,10 +72,12 @@ def panda_robot():
 
 def constraint_sets(upper, elbow, tool):
     """(label, [(segment, m_i)]) in the order of the table."""
-    return [("tool", [(tool, 6)]),
-            ("elbow", [(elbow, 3)]),
-            ("elbow + tool", [(elbow, 3), (tool, 3)]),
-            ("upper arm + elbow + tool", [(upper, 1), (elbow, 2), (tool, 3)])]
+    return [
+        ("tool", [(tool, 6)]),
+        ("elbow", [(elbow, 3)]),
+        ("elbow + tool", [(elbow, 3), (tool, 3)]),
+        ("upper arm + elbow + tool", [(upper, 1), (elbow, 2), (tool, 3)]),
+    ]
 
 
 def directions(rng, m):
@@ -85,8 +88,10 @@ def directions(rng, m):
     return np.ascontiguousarray(Q[:, :m])
 
 
-ROBOTS = [("Gen3 + gripper", gen3_robot, ("half_arm_2_link", "forearm_link", "end_effector_link"), 7001),
-          ("Panda", panda_robot, ("panda_link3", "panda_link4", "panda_hand"), 7002)]
+ROBOTS = [
+    ("Gen3 + gripper", gen3_robot, ("half_arm_2_link", "forearm_link", "end_effector_link"), 7001),
+    ("Panda", panda_robot, ("panda_link3", "panda_link4", "panda_hand"), 7002),
+]
 
 
 def pin_configuration(model, q):
@@ -121,8 +126,14 @@ def make_states(chain, model, data, sets, seed):
         for _, segs in sets:
             alphas = [directions(rng, m) for _, m in segs]
             betas = [a.T @ UP + rng.uniform(-1, 1, a.shape[1]) for a in alphas]
-            tasks.append(dict(alphas=alphas, betas=betas, beta=np.concatenate(betas),
-                              alpha_t=scipy.linalg.block_diag(*[a.T for a in alphas])))
+            tasks.append(
+                dict(
+                    alphas=alphas,
+                    betas=betas,
+                    beta=np.concatenate(betas),
+                    alpha_t=scipy.linalg.block_diag(*[a.T for a in alphas]),
+                )
+            )
         pq = pin_configuration(model, q)
         Minv = np.array(pin.computeMinverse(model, data, pq))
         Minv = np.triu(Minv) + np.triu(Minv, 1).T
@@ -182,8 +193,11 @@ def bench_robot(label, build, names, seed, batches, batch_s):
             dnu = max(dnu, rel_diff(res.nu, -lam))
             rank_ok &= res.constraint_rank == m
         print(f"timing {label}, {set_label} ...", file=sys.stderr, flush=True)
-        variants = {"ours": per_state(ours, ours_args), "pin pipeline": per_state(pipeline, pipe_args),
-                    "pin KKT only": per_state(pin.forwardDynamics, kkt_args)}
+        variants = {
+            "ours": per_state(ours, ours_args),
+            "pin pipeline": per_state(pipeline, pipe_args),
+            "pin KKT only": per_state(pin.forwardDynamics, kkt_args),
+        }
         if len(segs) == 1 and segs[0][0] == chain.segment_names[-1]:
             # the same task through the end-segment arguments alpha=, beta= (no dict), for scale
             end_args = [(s["q"], s["qd"], t["alphas"][0], t["betas"][0], None, s["tau"]) for s, t in zip(states, tasks)]
@@ -191,12 +205,23 @@ def bench_robot(label, build, names, seed, batches, batch_s):
             variants["ours alpha="] = per_state(solver.solve, end_args)
         us = time_group(variants, batches, batch_s)
         segments = ", ".join(f"{name} ({m_i})" for name, m_i in segs)
-        rows.append(dict(robot=label, n_seg=len(segs), segments=segments, set_label=set_label, m=m,
-                         dq=dq, dnu=dnu, ok=dq <= RTOL and dnu <= RTOL and rank_ok, rank_ok=rank_ok,
-                         **{k: statistics.median(v) for k, v in us.items()},
-                         r_pipe=paired_ratio(us["ours"], us["pin pipeline"]),
-                         r_kkt=paired_ratio(us["ours"], us["pin KKT only"]),
-                         spread=max((np.percentile(v, 75) - np.percentile(v, 25)) / np.median(v) for v in us.values())))
+        rows.append(
+            dict(
+                robot=label,
+                n_seg=len(segs),
+                segments=segments,
+                set_label=set_label,
+                m=m,
+                dq=dq,
+                dnu=dnu,
+                ok=dq <= RTOL and dnu <= RTOL and rank_ok,
+                rank_ok=rank_ok,
+                **{k: statistics.median(v) for k, v in us.items()},
+                r_pipe=paired_ratio(us["ours"], us["pin pipeline"]),
+                r_kkt=paired_ratio(us["ours"], us["pin KKT only"]),
+                spread=max((np.percentile(v, 75) - np.percentile(v, 25)) / np.median(v) for v in us.values()),
+            )
+        )
     return rows, dict(robot=label, drawn=drawn, worst=worst_ratio)
 
 
@@ -217,12 +242,14 @@ def report(rows, kept, batches, batch_s, wall):
         f"{N_STATES} seeded states per robot (q within the limits, q_dot in [-1, 1], tau_ff in [-2, 2] N m, "
         "beta_i = alpha_i^T (0, 0, 9.81, 0, 0, 0) + U(-1, 1)), the same states for every set of a robot, kept only if "
         f"every set is well conditioned there (eigenvalues of A M^-1 A^T: smallest / largest >= {MIN_EIG_RATIO:.0e}; "
-        + "; ".join(f"{k['robot']}: {N_STATES} kept of {k['drawn']} drawn, smallest ratio kept {k['worst']:.1e}"
-                    for k in kept)
+        + "; ".join(
+            f"{k['robot']}: {N_STATES} kept of {k['drawn']} drawn, smallest ratio kept {k['worst']:.1e}" for k in kept
+        )
         + f"). time.perf_counter with the garbage collector off, {batches} interleaved batches of about "
         f"{batch_s * 1e3:.0f} ms per variant, median per-call time in microseconds; ratio = median of per-batch "
         f"ratios (below 1: ours is faster). Run time {wall:.0f} s; largest batch inter-quartile range / median: "
-        f"{100 * max(r['spread'] for r in rows):.0f} %.")
+        f"{100 * max(r['spread'] for r in rows):.0f} %."
+    )
     out.append("")
     out.append(
         "Columns: `ours` = `Solver.solve(q, qd, tau_ff=tau, constraints=...)` with the dict built once per state; "
@@ -234,21 +261,28 @@ def report(rows, kept, batches, batch_s, wall):
         "same task through the end-segment arguments, `Solver.solve(q, qd, alpha, beta, None, tau)`, without the dict. "
         "Checked on every state before timing: "
         "max rel dqdd = largest ||qdd - qdd_pin|| / max(||qdd_pin||, 1) over our entry points and the pipeline against the KKT "
-        "solve; max rel dnu = the same for our nu against Pinocchio's -lambda; our constraint rank equals m.")
+        "solve; max rel dnu = the same for our nu against Pinocchio's -lambda; our constraint rank equals m."
+    )
     out.append("")
-    out.append("| robot | segments (m each) | total m | ours us | pin pipeline us | pin KKT only us | ours / pin pipeline | "
-               "ours / pin KKT only | ours alpha= us | max rel dqdd | max rel dnu |")
+    out.append(
+        "| robot | segments (m each) | total m | ours us | pin pipeline us | pin KKT only us | ours / pin pipeline | "
+        "ours / pin KKT only | ours alpha= us | max rel dqdd | max rel dnu |"
+    )
     out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in rows:
         flag = "" if r["ok"] else " **FAIL**" + ("" if r["rank_ok"] else " (rank)")
         end = f"{r['ours alpha=']:.2f}" if "ours alpha=" in r else "-"
-        out.append(f"| {r['robot']} | {r['n_seg']}: {r['segments']} | {r['m']} | {r['ours']:.2f} | "
-                   f"{r['pin pipeline']:.2f} | {r['pin KKT only']:.2f} | {r['r_pipe']:.2f} | {r['r_kkt']:.2f} | "
-                   f"{end} | {r['dq']:.1e} | {r['dnu']:.1e}{flag} |")
+        out.append(
+            f"| {r['robot']} | {r['n_seg']}: {r['segments']} | {r['m']} | {r['ours']:.2f} | "
+            f"{r['pin pipeline']:.2f} | {r['pin KKT only']:.2f} | {r['r_pipe']:.2f} | {r['r_kkt']:.2f} | "
+            f"{end} | {r['dq']:.1e} | {r['dnu']:.1e}{flag} |"
+        )
     failed = [r for r in rows if not r["ok"]]
     if failed:
         out.append("")
-        out.append(f"**{len(failed)} case(s) disagree with Pinocchio by more than {RTOL:.0e} (relative) or lost rank.**")
+        out.append(
+            f"**{len(failed)} case(s) disagree with Pinocchio by more than {RTOL:.0e} (relative) or lost rank.**"
+        )
     return "\n".join(out) + "\n", not failed
 
 

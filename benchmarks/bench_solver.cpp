@@ -47,13 +47,13 @@
 
 #include <unistd.h>
 
+#include <kdl/config.h>
 #include <Eigen/Core>
 #include <Eigen/QR>
 #include <kdl/chain.hpp>
 #include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
-#include <kdl/config.h>
 #include <kdl/frames.hpp>
 #include <kdl/jacobian.hpp>
 #include <kdl/jntarray.hpp>
@@ -128,11 +128,11 @@ std::vector<State> makeStates(int n, std::uint64_t seed) {
   return states;
 }
 
-
 struct Row {
   std::string label;
   int m = 0;
-  double ours_ctj = 0, ours_solve = 0, kdl = 0, ratio_ctj = 0, ratio_solve = 0, max_dqdd = 0, max_qdd = 0, min_sigma = 0;
+  double ours_ctj = 0, ours_solve = 0, kdl = 0, ratio_ctj = 0, ratio_solve = 0, max_dqdd = 0, max_qdd = 0,
+         min_sigma = 0;
 };
 
 struct ScaleRow {
@@ -149,11 +149,11 @@ int main(int argc, char** argv) {
   std::vector<ChainCase> cases;
   cases.push_back({"7 (Gen3)", std::make_unique<KDL::Chain>(makeGen3Chain()), 7});
   for (int n : {7, 15, 30, 60})
-    cases.push_back({std::to_string(n) + " (random)",
-                     std::make_unique<KDL::Chain>(makeRandomChain(n, 0x5eed0000ULL + n)), n});
+    cases.push_back(
+        {std::to_string(n) + " (random)", std::make_unique<KDL::Chain>(makeRandomChain(n, 0x5eed0000ULL + n)), n});
 
   const KDL::Twist root_acc(KDL::Vector(0.0, 0.0, kGravity), KDL::Vector::Zero());  // Vereshchagin
-  const KDL::Vector gravity(0.0, 0.0, -kGravity);                                  // RNE / FD
+  const KDL::Vector gravity(0.0, 0.0, -kGravity);                                   // RNE / FD
 
   std::vector<Row> rows;
   std::vector<ScaleRow> scale_rows;
@@ -187,11 +187,11 @@ int main(int argc, char** argv) {
       double max_dqdd = 0.0, max_qdd = 0.0, min_sigma = std::numeric_limits<double>::infinity();
       for (const State& s : states) {
         const Task& t = s.tasks[ti];
-        const int r1 = ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl,
-                                      s.tau_kdl, tau_cmd);
+        const int r1 =
+            ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_cmd);
         const int r2 = ours.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
-        const int r3 = kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl,
-                                        s.tau_kdl, tau_out_kdl);
+        const int r3 =
+            kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_out_kdl);
         if (r1 != 0 || r2 != 0 || r3 != 0) {
           std::cerr << "solver error (chain " << cc.label << ", m " << m << "): ours CartToJnt " << r1
                     << ", ours solve " << r2 << ", KDL " << r3 << " " << ours.errorMessage() << "\n";
@@ -205,20 +205,21 @@ int main(int argc, char** argv) {
 
       std::vector<Bench> group;
       addBench(group, "ours CartToJnt", overStates(states, [&](const State& s) {
-        const Task& t = s.tasks[ti];
-        ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_cmd);
-        return qdd_ours(n - 1);
-      }));
+                 const Task& t = s.tasks[ti];
+                 ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_cmd);
+                 return qdd_ours(n - 1);
+               }));
       addBench(group, "ours solve()", overStates(states, [&](const State& s) {
-        const Task& t = s.tasks[ti];
-        ours.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
-        return ours.qdd()(n - 1);
-      }));
+                 const Task& t = s.tasks[ti];
+                 ours.solve(s.q, s.qd, t.alfa, t.beta, f_ext, s.tau);
+                 return ours.qdd()(n - 1);
+               }));
       addBench(group, "KDL Vereshchagin", overStates(states, [&](const State& s) {
-        const Task& t = s.tasks[ti];
-        kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_out_kdl);
-        return qdd_kdl(n - 1);
-      }));
+                 const Task& t = s.tasks[ti];
+                 kdl_hd.CartToJnt(s.q_kdl, s.qd_kdl, qdd_kdl, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl,
+                                  tau_out_kdl);
+                 return qdd_kdl(n - 1);
+               }));
       const std::string label = "n " + cc.label + ", m " + std::to_string(m);
       std::cerr << "timing " << label << " ..." << std::endl;
       runGroup(group, label);
@@ -240,19 +241,19 @@ int main(int argc, char** argv) {
     // KDL's recursive Newton-Euler solvers for scale (independent of m).
     std::vector<Bench> group;
     addBench(group, "KDL ChainIdSolver_RNE", overStates(states, [&](const State& s) {
-        kdl_id.CartToJnt(s.q_kdl, s.qd_kdl, qdd_zero, f_ext_kdl, tau_out_kdl);
-        return tau_out_kdl(n - 1);
-      }));
+               kdl_id.CartToJnt(s.q_kdl, s.qd_kdl, qdd_zero, f_ext_kdl, tau_out_kdl);
+               return tau_out_kdl(n - 1);
+             }));
     addBench(group, "KDL ChainFdSolver_RNE", overStates(states, [&](const State& s) {
-        kdl_fd.CartToJnt(s.q_kdl, s.qd_kdl, s.tau_kdl, f_ext_kdl, qdd_kdl);
-        return qdd_kdl(n - 1);
-      }));
+               kdl_fd.CartToJnt(s.q_kdl, s.qd_kdl, s.tau_kdl, f_ext_kdl, qdd_kdl);
+               return qdd_kdl(n - 1);
+             }));
     // Ours without constraints (m = 0) again, interleaved with these for paired ratios.
     addBench(group, "ours CartToJnt m=0", overStates(states, [&](const State& s) {
-        const Task& t = s.tasks[0];
-        ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_cmd);
-        return qdd_ours(n - 1);
-      }));
+               const Task& t = s.tasks[0];
+               ours.CartToJnt(s.q_kdl, s.qd_kdl, qdd_ours, t.alfa_kdl, t.beta_kdl, f_ext_kdl, s.tau_kdl, tau_cmd);
+               return qdd_ours(n - 1);
+             }));
     const std::string label = "n " + cc.label + ", RNE";
     std::cerr << "timing " << label << " ..." << std::endl;
     runGroup(group, label);
@@ -272,10 +273,10 @@ int main(int argc, char** argv) {
   std::ostringstream md;
   md << "# C++ benchmark: vereshchagin::ChainHdSolver vs KDL " << KDL_VERSION_STRING << "\n\n";
   md << "- Date: " << utcNow() << "\n";
-  md << "- Machine: " << cpuModel() << ", " << sysconf(_SC_NPROCESSORS_ONLN) << " online CPUs (nproc); load average (1, 5, 15 min) "
-     << load_at_start << " at start, " << loadAverage() << " at end\n";
-  md << "- Compiler: " << BENCH_CXX_COMPILER << " (`__VERSION__` = " << __VERSION__ << "), C++ "
-     << __cplusplus << "\n";
+  md << "- Machine: " << cpuModel() << ", " << sysconf(_SC_NPROCESSORS_ONLN)
+     << " online CPUs (nproc); load average (1, 5, 15 min) " << load_at_start << " at start, " << loadAverage()
+     << " at end\n";
+  md << "- Compiler: " << BENCH_CXX_COMPILER << " (`__VERSION__` = " << __VERSION__ << "), C++ " << __cplusplus << "\n";
   md << "- Build type: " << BENCH_BUILD_TYPE << "; flags (library and benchmark): `" << BENCH_CXX_FLAGS
      << "` (no -march)\n";
   md << "- KDL: system library (headers " << KDL_VERSION_STRING << ", distribution binary with its own flags); Eigen "
@@ -292,10 +293,12 @@ int main(int argc, char** argv) {
   md << "`ours` = `vereshchagin::ChainHdSolver::CartToJnt` (KDL types); `ours solve()` = the Eigen entry point; "
      << "`KDL` = `KDL::ChainHdSolver_Vereshchagin::CartToJnt` (one solver per m). "
      << "max abs dqdd = largest difference of joint accelerations between ours and KDL over all states (rad/s^2; "
-     << "max abs qdd = largest joint acceleration, for scale); min sigma(K) = smallest eigenvalue of the m x m coupling "
+     << "max abs qdd = largest joint acceleration, for scale); min sigma(K) = smallest eigenvalue of the m x m "
+        "coupling "
      << "matrix over all states (ours, `smallestSingularValue()`): small values make the task ill-conditioned and "
      << "explain larger differences, since KDL pseudo-inverts K by SVD and we by eigen-decomposition.\n\n";
-  md << "| n | m | ours us | ours solve() us | KDL us | ratio ours/KDL | ratio solve()/KDL | max abs dqdd | max abs qdd | min sigma(K) |\n";
+  md << "| n | m | ours us | ours solve() us | KDL us | ratio ours/KDL | ratio solve()/KDL | max abs dqdd | max abs "
+        "qdd | min sigma(K) |\n";
   md << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Row& r : rows) {
     md << "| " << r.label << " | " << r.m << " | " << fmt("%.2f", r.ours_ctj) << " | " << fmt("%.2f", r.ours_solve)

@@ -16,6 +16,7 @@
 6. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
    the method, the target checks and all reports.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -47,8 +48,7 @@ def run(cmd, **kw):
 
 
 def kdl_version():
-    out = run(["dpkg-query", "-W", "-f", "${Package} ${Version}\\n", "liborocos-kdl*"],
-              capture_output=True, text=True)
+    out = run(["dpkg-query", "-W", "-f", "${Package} ${Version}\\n", "liborocos-kdl*"], capture_output=True, text=True)
     pkgs = [l for l in out.stdout.splitlines() if len(l.split()) == 2]  # installed packages only
     return ", ".join(pkgs) if pkgs else "(dpkg-query found no liborocos-kdl package)"
 
@@ -56,13 +56,16 @@ def kdl_version():
 def extension_note():
     """Where the installed Python extension is, when it was built, and whether sources are newer."""
     import vereshchagin._core as core
+
     so = Path(core.__file__)
     sources = [p for d in ("cpp/src", "cpp/include", "python/bindings") for p in (REPO / d).rglob("*") if p.is_file()]
     newest = max((p.stat().st_mtime for p in sources), default=0.0)
     built = datetime.datetime.fromtimestamp(so.stat().st_mtime, datetime.timezone.utc)
     note = f"`{so}` (file time {built:%Y-%m-%d %H:%M UTC}"
     if newest > so.stat().st_mtime:
-        note += "; **older than the newest library/binding source in the repository: reinstall to time the current code**"
+        note += (
+            "; **older than the newest library/binding source in the repository: reinstall to time the current code**"
+        )
     note += ")"
     # pip builds it with scikit-build-core in build/<wheel tag>/; report that CMake cache if present.
     for cache_file in (REPO / "build").glob("*/CMakeCache.txt"):
@@ -73,8 +76,10 @@ def extension_note():
                     key, value = line.split("=", 1)
                     cache[key.split(":")[0]] = value
             flags = f"{cache.get('CMAKE_CXX_FLAGS', '')} {cache.get('CMAKE_CXX_FLAGS_RELEASE', '')}".strip()
-            note += (f"; pip build cache `{cache_file.parent.relative_to(REPO)}`: build type "
-                     f"{cache.get('CMAKE_BUILD_TYPE', '?')}, `{cache.get('CMAKE_CXX_COMPILER', '?')}`, flags `{flags}`")
+            note += (
+                f"; pip build cache `{cache_file.parent.relative_to(REPO)}`: build type "
+                f"{cache.get('CMAKE_BUILD_TYPE', '?')}, `{cache.get('CMAKE_CXX_COMPILER', '?')}`, flags `{flags}`"
+            )
             break
     return note
 
@@ -95,8 +100,10 @@ def target_lines(cpp_md):
                 lines.append(f"  - n = {cells[0]}, m = 6, ours {name} / KDL = {cells[col]}: {verdict}")
     if not lines:
         return ["- Target: could not find the n = 7, m = 6 rows in the C++ report."], False
-    head = (f"- **Target: our m = 6 solve at most {TARGET}x KDL's time at n = 7: "
-            f"{'met' if met else 'NOT met'} in this run** (all n = 7, m = 6 ratios below):")
+    head = (
+        f"- **Target: our m = 6 solve at most {TARGET}x KDL's time at n = 7: "
+        f"{'met' if met else 'NOT met'} in this run** (all n = 7, m = 6 ratios below):"
+    )
     return [head] + lines, met
 
 
@@ -105,8 +112,10 @@ def friction_summary(fr_file):
     if not fr_file.exists():
         return ["- Static-friction targets: bench_friction produced no report (see the Static friction section)."]
     lines = [l for l in fr_file.read_text().splitlines() if l.startswith("- **Target:")]
-    return ["- Static-friction targets (section Static friction; friction-aware solve on a 7-joint arm, all joints "
-            "at rest, m = 0, 1, 6):"] + ["  " + l.replace("- **Target: ", "- **", 1) for l in lines]
+    return [
+        "- Static-friction targets (section Static friction; friction-aware solve on a 7-joint arm, all joints "
+        "at rest, m = 0, 1, 6):"
+    ] + ["  " + l.replace("- **Target: ", "- **", 1) for l in lines]
 
 
 def friction_section(fr_file, fr_rc, frpy_file, frpy_rc):
@@ -125,8 +134,11 @@ def friction_section(fr_file, fr_rc, frpy_file, frpy_rc):
     ]
     for name, f, rc in (("bench_friction", fr_file, fr_rc), ("bench_friction_pinocchio.py", frpy_file, frpy_rc)):
         if rc:
-            md += [f"**{name} exited with code {rc}" + (": see its report below.**" if f.exists() else
-                                                         " and wrote no report.**"), ""]
+            md += [
+                f"**{name} exited with code {rc}"
+                + (": see its report below.**" if f.exists() else " and wrote no report.**"),
+                "",
+            ]
         if f.exists():
             md += ["##" + l if l.startswith("#") else l for l in f.read_text().rstrip().splitlines()]
             md += [""]
@@ -136,8 +148,12 @@ def friction_section(fr_file, fr_rc, frpy_file, frpy_rc):
 def segments_section(seg_file, seg_rc):
     """The "Constraints on several segments" section: bench_segments.py's report (it has the heading)."""
     if not seg_file.exists():
-        return ["## Constraints on several segments", "",
-                f"**bench_segments.py exited with code {seg_rc} and wrote no report.**", ""]
+        return [
+            "## Constraints on several segments",
+            "",
+            f"**bench_segments.py exited with code {seg_rc} and wrote no report.**",
+            "",
+        ]
     heading, *body = seg_file.read_text().rstrip().splitlines()
     warn = ["", f"**bench_segments.py exited with code {seg_rc}: see the table below.**"] if seg_rc else []
     return [heading, *warn, *body, ""]
@@ -152,9 +168,21 @@ def main():
     date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     load_start = loadavg()
 
-    for cmd in (["cmake", "-S", REPO, "-B", build, "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release",
-                 "-DVERESHCHAGIN_BUILD_TESTS=OFF", "-DVERESHCHAGIN_BUILD_BENCHMARKS=ON"],
-                ["cmake", "--build", build]):
+    for cmd in (
+        [
+            "cmake",
+            "-S",
+            REPO,
+            "-B",
+            build,
+            "-G",
+            "Ninja",
+            "-DCMAKE_BUILD_TYPE=Release",
+            "-DVERESHCHAGIN_BUILD_TESTS=OFF",
+            "-DVERESHCHAGIN_BUILD_BENCHMARKS=ON",
+        ],
+        ["cmake", "--build", build],
+    ):
         res = run(cmd, capture_output=True, text=True)
         if res.returncode:
             sys.exit(f"build failed:\n{res.stdout}\n{res.stderr}")
@@ -163,24 +191,29 @@ def main():
     cpp_rc = run([build / "benchmarks" / "bench_solver", cpp_file], stdout=subprocess.DEVNULL).returncode
     if not cpp_file.exists():
         sys.exit(f"bench_solver failed (exit code {cpp_rc})")
-    py_rc = run([sys.executable, REPO / "benchmarks" / "bench_pinocchio.py", "--out", py_file],
-                stdout=subprocess.DEVNULL).returncode
+    py_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_pinocchio.py", "--out", py_file], stdout=subprocess.DEVNULL
+    ).returncode
     if not py_file.exists():
         sys.exit(f"bench_pinocchio.py failed (exit code {py_rc})")
     fr_file, frpy_file = build / "bench_friction.md", build / "bench_friction_pinocchio.md"
     for f in (fr_file, frpy_file):
         f.unlink(missing_ok=True)
     fr_rc = run([build / "benchmarks" / "bench_friction", fr_file], stdout=subprocess.DEVNULL).returncode
-    frpy_rc = run([sys.executable, REPO / "benchmarks" / "bench_friction_pinocchio.py", "--out", frpy_file],
-                  stdout=subprocess.DEVNULL).returncode
+    frpy_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_friction_pinocchio.py", "--out", frpy_file],
+        stdout=subprocess.DEVNULL,
+    ).returncode
     seg_file = build / "bench_segments.md"
     seg_file.unlink(missing_ok=True)
-    seg_rc = run([sys.executable, REPO / "benchmarks" / "bench_segments.py", "--out", seg_file],
-                 stdout=subprocess.DEVNULL).returncode
+    seg_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_segments.py", "--out", seg_file], stdout=subprocess.DEVNULL
+    ).returncode
     face_file = build / "bench_python_face.md"
     face_file.unlink(missing_ok=True)
-    face_rc = run([sys.executable, REPO / "benchmarks" / "bench_python_face.py", "--out", face_file],
-                  stdout=subprocess.DEVNULL).returncode
+    face_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_python_face.py", "--out", face_file], stdout=subprocess.DEVNULL
+    ).returncode
     load_end = loadavg()
 
     cpp_md, py_md = cpp_file.read_text(), py_file.read_text()
@@ -236,8 +269,13 @@ def main():
     md += ["", py_md.rstrip(), ""]
     md += friction_section(fr_file, fr_rc, frpy_file, frpy_rc)
     md += segments_section(seg_file, seg_rc)
-    md += ["", face_file.read_text().rstrip() if face_file.exists() else
-           f"**bench_python_face.py exited with code {face_rc} and wrote no report.**", ""]
+    md += [
+        "",
+        face_file.read_text().rstrip()
+        if face_file.exists()
+        else f"**bench_python_face.py exited with code {face_rc} and wrote no report.**",
+        "",
+    ]
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
     return 0 if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 and seg_rc == 0 and face_rc == 0 else 1

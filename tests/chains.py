@@ -24,6 +24,7 @@ of fixed segments are appended to the last moving joint before them (the univers
 
 Everything is drawn from a seeded ``numpy.random.Generator`` so a failure reproduces from its seed.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -220,7 +221,13 @@ def build(segments, inertia_check="physical"):
         else:
             joint = s.kind
         chain.add_segment(
-            f"seg{i}", joint, tip=s.tip, mass=s.mass, com=s.com, inertia=s.inertia, rotor_inertia=s.rotor,
+            f"seg{i}",
+            joint,
+            tip=s.tip,
+            mass=s.mass,
+            com=s.com,
+            inertia=s.inertia,
+            rotor_inertia=s.rotor,
             inertia_check=inertia_check,
         )
 
@@ -337,7 +344,9 @@ def assert_close(actual, expected, rtol=1e-9, what=""):
     assert actual.shape == expected.shape, f"{what}: shape {actual.shape} != {expected.shape}"
     err = np.linalg.norm(actual - expected)
     scale = max(np.linalg.norm(expected), 1.0)
-    assert err <= rtol * scale, f"{what}: |error| = {err:.3e} > {rtol:.0e} * {scale:.3e}\nactual={actual}\nexpected={expected}"
+    assert err <= rtol * scale, (
+        f"{what}: |error| = {err:.3e} > {rtol:.0e} * {scale:.3e}\nactual={actual}\nexpected={expected}"
+    )
 
 
 def pin_configuration(model, q):

@@ -54,6 +54,7 @@ limit are enumerated and the tie-break uses the opened bounds. An infeasible pri
 a joint into its limit) is ``OracleInfeasible`` from (b) and a negative margin of ``limit_margin`` (an
 LP by HiGHS).
 """
+
 from __future__ import annotations
 
 import itertools
@@ -186,9 +187,23 @@ def _sym(M, n):
     return np.triu(M) + np.triu(M, 1).T
 
 
-def pinocchio_problem(model, data, q, qd, *, tau_ff=None, fext_tau=None, static, kinetic=None,
-                      velocity_tolerance=1e-6, tip_frame=None, alpha=None, beta=None, at_lower=None,
-                      at_upper=None):
+def pinocchio_problem(
+    model,
+    data,
+    q,
+    qd,
+    *,
+    tau_ff=None,
+    fext_tau=None,
+    static,
+    kinetic=None,
+    velocity_tolerance=1e-6,
+    tip_frame=None,
+    alpha=None,
+    beta=None,
+    at_lower=None,
+    at_upper=None,
+):
     """The friction problem of a Pinocchio model (gravity = model.gravity).
 
     q: Pinocchio configuration (nq); qd (nv); tau_ff (nv); fext_tau: generalised external force
@@ -216,9 +231,18 @@ def pinocchio_problem(model, data, q, qd, *, tau_ff=None, fext_tau=None, static,
         a0 = pin.getFrameAcceleration(model, data, tip_frame, LWA).vector
         A = alpha.T @ J
         b = np.asarray(beta, float).reshape(-1) - alpha.T @ (a0 + np.r_[-g, 0.0, 0.0, 0.0])
-    return FrictionProblem(H, qdd_free, A, b, resting, static, kin,
-                           extra=dict(J=J, tau_ff=tau_ff, fext_tau=fext_tau, g=g),
-                           at_lower=at_lower, at_upper=at_upper)
+    return FrictionProblem(
+        H,
+        qdd_free,
+        A,
+        b,
+        resting,
+        static,
+        kin,
+        extra=dict(J=J, tau_ff=tau_ff, fext_tau=fext_tau, g=g),
+        at_lower=at_lower,
+        at_upper=at_upper,
+    )
 
 
 def limit_flags(q, lower, upper, limit_tolerance=1e-9):
@@ -251,9 +275,15 @@ def limit_margin(prob, cap=1.0):
     E[np.arange(E.shape[0]), np.flatnonzero(locked)] = 1.0
     Aeq = np.hstack([np.vstack([prob.A, E]), np.zeros((prob.A.shape[0] + E.shape[0], 1))])
     beq = np.r_[prob.b / s, np.zeros(E.shape[0])]
-    res = linprog(np.r_[np.zeros(n), -1.0], A_ub=np.array(rows) if rows else None,
-                  b_ub=np.zeros(len(rows)) if rows else None, A_eq=Aeq if Aeq.shape[0] else None,
-                  b_eq=beq if Aeq.shape[0] else None, bounds=[(None, None)] * n + [(None, cap)], method="highs")
+    res = linprog(
+        np.r_[np.zeros(n), -1.0],
+        A_ub=np.array(rows) if rows else None,
+        b_ub=np.zeros(len(rows)) if rows else None,
+        A_eq=Aeq if Aeq.shape[0] else None,
+        b_eq=beq if Aeq.shape[0] else None,
+        bounds=[(None, None)] * n + [(None, cap)],
+        method="highs",
+    )
     if res.status == 2:
         return -np.inf
     if res.status != 0:
@@ -423,8 +453,9 @@ def tie_break(prob, qdd, zero_tol=None):
         base[Zj[bnd], :] += vals_b
         # N is orthonormal: a direction of N_Z^T below 1e-10 does not constrain mu_Z (its effect on
         # N^T tau is below the 1e-9 tscale check), however small the whole of N_Z is.
-        X, ok = equality_qp_batch(np.eye(free.size), base[Zj[free], :], N[Zj[free], :].T, -N.T @ base,
-                                  feas_rtol=1e-10, atol=1e-10)
+        X, ok = equality_qp_batch(
+            np.eye(free.size), base[Zj[free], :], N[Zj[free], :].T, -N.T @ base, feas_rtol=1e-10, atol=1e-10
+        )
         slack_hi = np.where(np.isfinite(hi[free]), np.abs(hi[free]) * 1e-12, 0.0)[:, None] + 1e-14 * tscale
         slack_lo = np.where(np.isfinite(lo[free]), np.abs(lo[free]) * 1e-12, 0.0)[:, None] + 1e-14 * tscale
         ok &= np.all(X <= hi[free, None] + slack_hi, axis=0)
@@ -472,9 +503,15 @@ def tie_break_scipy(prob, qdd, zero_tol=None):
         Ur = U[:, :r]
         if r:
             cons = [dict(type="eq", fun=lambda x: Ur.T @ (N.T @ c + M @ x), jac=lambda x: Ur.T @ M)]
-    res = minimize(lambda x: 0.5 * np.sum((c + E @ x) ** 2), np.zeros(Zj.size),
-                   jac=lambda x: E.T @ (c + E @ x), bounds=list(zip(-f, f)), constraints=cons,
-                   method="SLSQP", options=dict(ftol=1e-13, maxiter=300))
+    res = minimize(
+        lambda x: 0.5 * np.sum((c + E @ x) ** 2),
+        np.zeros(Zj.size),
+        jac=lambda x: E.T @ (c + E @ x),
+        bounds=list(zip(-f, f)),
+        constraints=cons,
+        method="SLSQP",
+        options=dict(ftol=1e-13, maxiter=300),
+    )
     return c + E @ res.x
 
 
@@ -538,8 +575,10 @@ def enumeration_oracle(prob, max_resting=7):
         if vals[i] < best_val:
             best_val, best = vals[i], Xf[:, i].copy()
     if best is None:
-        raise OracleInfeasible(f"enumeration_oracle: no feasible pattern among {n_patterns} (inconsistent task, "
-                               f"or the task forces a joint into its limit?)")
+        raise OracleInfeasible(
+            f"enumeration_oracle: no feasible pattern among {n_patterns} (inconsistent task, "
+            f"or the task forces a joint into its limit?)"
+        )
     return _finish(prob, best, prob.objective(best), dict(patterns=n_patterns, feasible=n_feasible))
 
 
@@ -580,7 +619,7 @@ def _slsqp_primal(prob):
     # variables y = [u (n), p (k), q (k)], u_R = p - q, p, q >= 0
     def fun(y):
         d = y[:n] - x0
-        return 0.5 * d @ H @ d + f @ (y[n:n + k] + y[n + k:])
+        return 0.5 * d @ H @ d + f @ (y[n : n + k] + y[n + k :])
 
     def jac(y):
         return np.r_[H @ y[:n] - Hx0, f, f]
@@ -589,8 +628,8 @@ def _slsqp_primal(prob):
     Ceq = np.zeros((m + k, n + 2 * k))
     Ceq[:m, :n] = prob.A
     Ceq[m:, R] = np.eye(k)
-    Ceq[m:, n:n + k] = -np.eye(k)
-    Ceq[m:, n + k:] = np.eye(k)
+    Ceq[m:, n : n + k] = -np.eye(k)
+    Ceq[m:, n + k :] = np.eye(k)
     deq = np.r_[prob.b, np.zeros(k)]
     u0 = equality_qp(H, -Hx0, prob.A, prob.b)  # frictionless constrained motion (feasible start)
     if u0 is None:
@@ -602,8 +641,9 @@ def _slsqp_primal(prob):
     cons = [dict(type="eq", fun=lambda y: Ceq @ y - deq, jac=lambda y: Ceq)] if m + k else []
     bounds = [(0.0 if prob.at_lower[j] else None, 0.0 if prob.at_upper[j] else None) for j in range(n)]
     bounds += [(0.0, None)] * (2 * k)
-    res = minimize(fun, y0, jac=jac, bounds=bounds, constraints=cons, method="SLSQP",
-                   options=dict(ftol=1e-12, maxiter=300))
+    res = minimize(
+        fun, y0, jac=jac, bounds=bounds, constraints=cons, method="SLSQP", options=dict(ftol=1e-12, maxiter=300)
+    )
     return res.x[:n], res
 
 
@@ -647,8 +687,10 @@ def scipy_oracle(prob, thresholds=(1e-6, 1e-9, 1e-3), max_polish=None):
     log = []
     for thr in thresholds:
         pattern = {j: (STICK if abs(u[j]) <= thr * scale else (SLIP_POS if u[j] > 0 else SLIP_NEG)) for j in R}
-        pattern = {j: (p if p == STICK or prob.slip_allowed(j, 1 if p == SLIP_POS else -1) else STICK)
-                   for j, p in pattern.items()}
+        pattern = {
+            j: (p if p == STICK or prob.slip_allowed(j, 1 if p == SLIP_POS else -1) else STICK)
+            for j, p in pattern.items()
+        }
         for step in range(max_polish + 1):
             x = _kkt_candidate(prob, pattern)
             if x is None:
@@ -663,10 +705,20 @@ def scipy_oracle(prob, thresholds=(1e-6, 1e-9, 1e-3), max_polish=None):
             stick = {j for j in R if pattern[j] == STICK}
             resid, mu_ls = _certify(prob, x, stick)
             if resid <= 1e-10:
-                return _finish(prob, x, prob.objective(x),
-                               dict(slsqp_qdd=u, slsqp_message=res.message, threshold=thr, polish_steps=step,
-                                    certificate_residual=resid, polish_shift=np.linalg.norm(x - u) / scale),
-                               zero_tol=0.0)
+                return _finish(
+                    prob,
+                    x,
+                    prob.objective(x),
+                    dict(
+                        slsqp_qdd=u,
+                        slsqp_message=res.message,
+                        threshold=thr,
+                        polish_steps=step,
+                        certificate_residual=resid,
+                        polish_shift=np.linalg.norm(x - u) / scale,
+                    ),
+                    zero_tol=0.0,
+                )
             S = sorted(stick)
             mlo, mhi = prob.mu_bounds()
             ratio = [max(mu_ls[i] - mhi[j], mlo[j] - mu_ls[i]) for i, j in enumerate(S)]
@@ -728,19 +780,23 @@ def mujoco_xml(segments, gravity, frictionloss, options=None):
             jpos = R.T @ (s.origin - p)
             kind = "hinge" if s.revolute else "slide"
             fl = next(flist)
-            lines.append(f'<joint name="j{i}" type="{kind}" axis="{_fmt(axis)}" pos="{_fmt(jpos)}" '
-                         f'armature="{float(s.rotor)!r}" damping="0" frictionloss="{float(fl)!r}" '
-                         f'solreffriction="{opts.get("solref", "0.02 1")}" '
-                         f'solimpfriction="{opts.get("solimp", "0.9 0.95 0.001 0.5 2")}"/>')
+            lines.append(
+                f'<joint name="j{i}" type="{kind}" axis="{_fmt(axis)}" pos="{_fmt(jpos)}" '
+                f'armature="{float(s.rotor)!r}" damping="0" frictionloss="{float(fl)!r}" '
+                f'solreffriction="{opts.get("solref", "0.02 1")}" '
+                f'solimpfriction="{opts.get("solimp", "0.9 0.95 0.001 0.5 2")}"/>'
+            )
         I = s.inertia
-        lines.append(f'<inertial pos="{_fmt(s.com)}" mass="{float(s.mass)!r}" '
-                     f'fullinertia="{_fmt([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>')
+        lines.append(
+            f'<inertial pos="{_fmt(s.com)}" mass="{float(s.mass)!r}" '
+            f'fullinertia="{_fmt([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>'
+        )
         depth += 1
     lines += ["</body>"] * depth
     return f"""<mujoco>
   <compiler angle="radian" inertiafromgeom="false" balanceinertia="false" boundmass="0" boundinertia="0"/>
-  <option gravity="{_fmt(gravity)}" timestep="0.001" iterations="{opts['iterations']}" tolerance="{opts['tolerance']!r}"
-          noslip_iterations="{opts['noslip_iterations']}" noslip_tolerance="{opts['noslip_tolerance']!r}"
+  <option gravity="{_fmt(gravity)}" timestep="0.001" iterations="{opts["iterations"]}" tolerance="{opts["tolerance"]!r}"
+          noslip_iterations="{opts["noslip_iterations"]}" noslip_tolerance="{opts["noslip_tolerance"]!r}"
           impratio="1" cone="pyramidal" jacobian="dense" solver="Newton">
     <flag contact="disable"/>
   </option>

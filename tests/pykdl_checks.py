@@ -8,6 +8,7 @@ interpreter /usr/bin/python3: tests/test_pykdl_interop.py runs this file there (
 Usage: ``python pykdl_checks.py PANDA_URDF UR5_URDF``; prints the largest relative differences and
 exits non-zero on the first failed check.
 """
+
 from __future__ import annotations
 
 import sys
@@ -73,8 +74,13 @@ def kdl_dynamics(chain, q, qd, qdd, f_tip):
         f = kdl.Frame()
         assert fk.JntToCart(jnt_array(q), f, i + 1) == 0
         frames.append(np.array([[f.M[r, k] for k in range(3)] + [f.p[r]] for r in range(3)] + [[0, 0, 0, 1.0]]))
-    return {"M": np.array([[H[r, k] for k in range(n)] for r in range(n)]), "g": to_numpy(g, n),
-            "c": to_numpy(c, n), "tau": to_numpy(tau, n), "frames": np.array(frames).reshape(ns, 4, 4)}
+    return {
+        "M": np.array([[H[r, k] for k in range(n)] for r in range(n)]),
+        "g": to_numpy(g, n),
+        "c": to_numpy(c, n),
+        "tau": to_numpy(tau, n),
+        "frames": np.array(frames).reshape(ns, 4, 4),
+    }
 
 
 def random_kdl_rotation(rng):
@@ -118,12 +124,15 @@ def compare_with_kdl(report, chain, kdl_chain, rng, tag):
         f_tip = rng.uniform(-10, 10, (ns, 6))
         ref = kdl_dynamics(kdl_chain, q, qd, qdd, f_tip)
         R = ref["frames"][:, :3, :3]
-        f_base = np.concatenate([np.einsum("sij,sj->si", R, f_tip[:, :3]),
-                                 np.einsum("sij,sj->si", R, f_tip[:, 3:])], axis=1)
+        f_base = np.concatenate(
+            [np.einsum("sij,sj->si", R, f_tip[:, :3]), np.einsum("sij,sj->si", R, f_tip[:, 3:])], axis=1
+        )
         report.check(f"{tag}: mass_matrix vs KDL ChainDynParam", chain.mass_matrix(q), ref["M"])
         report.check(f"{tag}: gravity_torques vs KDL", chain.gravity_torques(q), ref["g"])
         report.check(f"{tag}: coriolis_torques vs KDL", chain.coriolis_torques(q, qd), ref["c"])
-        report.check(f"{tag}: inverse_dynamics(f_ext) vs KDL RNE", chain.inverse_dynamics(q, qd, qdd, f_base), ref["tau"])
+        report.check(
+            f"{tag}: inverse_dynamics(f_ext) vs KDL RNE", chain.inverse_dynamics(q, qd, qdd, f_base), ref["tau"]
+        )
         report.check(f"{tag}: fk_all vs KDL FK", chain.fk_all(q), ref["frames"])
 
 
@@ -148,14 +157,20 @@ def check_round_trip(report, chain, rng, tag):
         alpha = rng.normal(size=(6, m))
         alpha, beta = (alpha / np.linalg.norm(alpha, axis=0), rng.normal(size=m)) if m else (None, None)
         f_ext = rng.uniform(-5, 5, (chain.n_segments, 6))
-        report.check(f"{tag}: solve after round trip", solve_outputs(back, q, qd, alpha, beta, f_ext, tau),
-                     solve_outputs(chain, q, qd, alpha, beta, f_ext, tau))
+        report.check(
+            f"{tag}: solve after round trip",
+            solve_outputs(back, q, qd, alpha, beta, f_ext, tau),
+            solve_outputs(chain, q, qd, alpha, beta, f_ext, tau),
+        )
 
 
 def check_rejections():
     """Joints with a KDL scale or offset and non-chains fail with SolverError."""
-    for joint in (kdl.Joint("off", kdl.Joint.RotZ, 1.0, 0.1), kdl.Joint("scaled", kdl.Joint.TransX, 2.0),
-                  kdl.Joint("axis_off", kdl.Vector(0, 0, 0.1), kdl.Vector(0, 1, 0), kdl.Joint.RotAxis, 1.0, 0.2)):
+    for joint in (
+        kdl.Joint("off", kdl.Joint.RotZ, 1.0, 0.1),
+        kdl.Joint("scaled", kdl.Joint.TransX, 2.0),
+        kdl.Joint("axis_off", kdl.Vector(0, 0, 0.1), kdl.Vector(0, 1, 0), kdl.Joint.RotAxis, 1.0, 0.2),
+    ):
         chain = kdl.Chain()
         chain.addSegment(kdl.Segment("s", joint, kdl.Frame(), kdl.RigidBodyInertia(1.0)))
         try:
@@ -182,8 +197,11 @@ def run_all(panda_urdf, ur5_urdf):
     assert list(ours.joint_names) == [f"j{i}" for i in range(10) if i not in (3, 9)]
     compare_with_kdl(report, ours, native, rng, "native PyKDL chain")
     check_round_trip(report, ours, rng, "native PyKDL chain")
-    robots = {"gen3+gripper": vs.robots.gen3(True), "panda": vs.Chain.from_urdf(panda_urdf, tip="panda_hand"),
-              "ur5": vs.Chain.from_urdf(ur5_urdf, tip="tool0")}
+    robots = {
+        "gen3+gripper": vs.robots.gen3(True),
+        "panda": vs.Chain.from_urdf(panda_urdf, tip="panda_hand"),
+        "ur5": vs.Chain.from_urdf(ur5_urdf, tip="tool0"),
+    }
     for tag, chain in robots.items():
         chain.rotor_inertia = rng.uniform(0.0, 0.4, chain.n_joints)
         compare_with_kdl(report, chain, chain.to_kdl(), rng, tag)

@@ -1,6 +1,7 @@
 """The Python API: result types and shapes, batch solving, input validation, singular tasks,
 copy semantics, threads and determinism. Expected values are hand-derived or come from other
 calls' documented relations, never from the code path under test alone."""
+
 import concurrent.futures
 import gc
 import threading
@@ -21,8 +22,14 @@ def planar_arm(lengths=(1.0, 1.0), mass=1.0):
     frame)."""
     chain = vs.Chain()
     for k, L in enumerate(lengths):
-        chain.add_segment(f"link{k}", "rot_z", tip=homogeneous(None, [L, 0.0, 0.0]), mass=mass,
-                          com=[-L / 2, 0.0, 0.0], inertia=np.diag([1e-3, mass * L * L / 12, mass * L * L / 12]))
+        chain.add_segment(
+            f"link{k}",
+            "rot_z",
+            tip=homogeneous(None, [L, 0.0, 0.0]),
+            mass=mass,
+            com=[-L / 2, 0.0, 0.0],
+            inertia=np.diag([1e-3, mass * L * L / 12, mass * L * L / 12]),
+        )
     return chain
 
 
@@ -37,7 +44,8 @@ def assert_results_equal(a, b):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
     assert a.constraint_rank == b.constraint_rank
     assert a.smallest_singular_value == b.smallest_singular_value or (
-        np.isnan(a.smallest_singular_value) and np.isnan(b.smallest_singular_value))
+        np.isnan(a.smallest_singular_value) and np.isnan(b.smallest_singular_value)
+    )
 
 
 def assert_error(fn, *names):
@@ -109,8 +117,7 @@ def test_chain_properties():
     chain = vs.Chain()
     chain.add_segment("a", "rot_z", mass=1.0, com=[0.5, 0, 0], inertia=np.eye(3) * 0.01)
     chain.add_segment("b", vs.Joint.fixed(), mass=1.0)
-    chain.add_segment("c", vs.Joint.revolute([1, 1, 0], [0, 0, 0.1]), mass=1.0, com=[0, 0.3, 0],
-                      joint_name="elbow")
+    chain.add_segment("c", vs.Joint.revolute([1, 1, 0], [0, 0, 0.1]), mass=1.0, com=[0, 0.3, 0], joint_name="elbow")
     assert chain.n_joints == 2 and chain.n_segments == 3
     assert chain.segment_names == ["a", "b", "c"]
     assert chain.joint_names == ["a_joint", "elbow"]
@@ -224,7 +231,7 @@ def _compare_batch(batch, loop, m):
         np.testing.assert_allclose(batch.qdd[b], r.qdd, rtol=1e-13, atol=1e-13)
         np.testing.assert_allclose(batch.tau_command[b], r.tau_command, rtol=1e-13, atol=1e-13)
         np.testing.assert_allclose(batch.nu[b, : r.nu.size], r.nu, rtol=1e-13, atol=1e-13)
-        assert np.all(np.isnan(batch.nu[b, r.nu.size:]))
+        assert np.all(np.isnan(batch.nu[b, r.nu.size :]))
         np.testing.assert_allclose(batch.link_acc[b], r.link_acc, rtol=1e-13, atol=1e-13)
         assert batch.constraint_rank[b] == r.constraint_rank
         assert batch.smallest_singular_value[b] == pytest.approx(r.smallest_singular_value, rel=1e-13, abs=1e-300)
@@ -260,8 +267,9 @@ def test_solve_batch_per_row_arguments(m):
     f = rng.normal(size=(B, rc.n_segments, 6))
     tau = rng.normal(size=(B, rc.n_joints))
     batch = solver.solve_batch(Q, QD, alpha, beta, f, tau)
-    _compare_batch(batch, _loop(vs.Solver(rc.chain), Q, QD, alpha, beta, f, tau,
-                                per_row=("alpha", "beta", "f", "tau")), m)
+    _compare_batch(
+        batch, _loop(vs.Solver(rc.chain), Q, QD, alpha, beta, f, tau, per_row=("alpha", "beta", "f", "tau")), m
+    )
     # mixed: shared alpha, per-row beta; per-row f_ext, shared tau_ff
     batch = solver.solve_batch(Q, QD, alpha[0], beta, f, tau[0])
     _compare_batch(batch, _loop(vs.Solver(rc.chain), Q, QD, alpha[0], beta, f, tau[0], per_row=("beta", "f")), m)
@@ -297,8 +305,9 @@ def test_solve_batch_errors():
     assert_error(lambda: solver.solve_batch(Q, QD, None, None, None, np.zeros((3, n))), "tau_ff")
     assert_error(lambda: solver.solve_batch(Q, QD, None, None, np.zeros((4, rc.n_segments, 5))), "f_ext")
     # ragged alphas cannot be a batch
-    assert_error(lambda: solver.solve_batch(Q[:2], QD[:2], [np.eye(6)[:, :1], np.eye(6)[:, :2]], [[0.0], [0.0, 0.0]]),
-                 "alpha")
+    assert_error(
+        lambda: solver.solve_batch(Q[:2], QD[:2], [np.eye(6)[:, :1], np.eye(6)[:, :2]], [[0.0], [0.0, 0.0]]), "alpha"
+    )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -306,8 +315,14 @@ def test_solve_batch_errors():
 # ------------------------------------------------------------------------------------------------
 def _solve_kwargs(rc):
     n, ns = rc.n_joints, rc.n_segments
-    return dict(q=np.zeros(n), qd=np.zeros(n), alpha=np.eye(6)[:, :2], beta=np.zeros(2),
-                f_ext=np.zeros((ns, 6)), tau_ff=np.zeros(n))
+    return dict(
+        q=np.zeros(n),
+        qd=np.zeros(n),
+        alpha=np.eye(6)[:, :2],
+        beta=np.zeros(2),
+        f_ext=np.zeros((ns, 6)),
+        tau_ff=np.zeros(n),
+    )
 
 
 BAD_SOLVE_INPUTS = [
@@ -335,8 +350,13 @@ BAD_SOLVE_INPUTS = [
 
 def _materialise(rc, kwargs):
     n, ns = rc.n_joints, rc.n_segments
-    special = {"n1": np.zeros(n + 1), "col": np.zeros((n, 1)), "short": np.zeros(max(n - 1, 0)),
-               "2d": np.zeros((1, n)), "transposed": np.zeros((6, ns))}
+    special = {
+        "n1": np.zeros(n + 1),
+        "col": np.zeros((n, 1)),
+        "short": np.zeros(max(n - 1, 0)),
+        "2d": np.zeros((1, n)),
+        "transposed": np.zeros((6, ns)),
+    }
     out = {}
     for k, v in kwargs.items():
         if isinstance(v, str) and k in ("f_ext",) and v == "short":
@@ -356,8 +376,15 @@ def test_bad_shapes_raise(label, bad, name):
     kw = _solve_kwargs(rc)
     kw.update(_materialise(rc, bad))
     assert_error(lambda: solver.solve(**kw), name)
-    assert_error(lambda: solver.solve_batch(*[np.asarray(kw[k])[None] if k in ("q", "qd") else kw[k]
-                                              for k in ("q", "qd", "alpha", "beta", "f_ext", "tau_ff")]), name)
+    assert_error(
+        lambda: solver.solve_batch(
+            *[
+                np.asarray(kw[k])[None] if k in ("q", "qd") else kw[k]
+                for k in ("q", "qd", "alpha", "beta", "f_ext", "tau_ff")
+            ]
+        ),
+        name,
+    )
 
 
 @pytest.mark.parametrize("name", ["q", "qd", "alpha", "beta", "f_ext", "tau_ff"])
@@ -485,10 +512,19 @@ def test_point_mass_on_prismatic_joint_is_valid():
     assert res.qdd[0] == pytest.approx(0.5, rel=1e-14)
 
 
-@pytest.mark.parametrize("kw,name", [(dict(rcond=-1.0), "rcond"), (dict(rcond=np.nan), "rcond"),
-                                     (dict(damping=0.0), "damping"), (dict(damping=-1e-3), "damping"),
-                                     (dict(damping=np.inf), "damping"), (dict(gravity=[0.0, 0.0]), "gravity"),
-                                     (dict(gravity=[0.0, np.nan, 0.0]), "gravity"), (dict(gravity="up"), "gravity")])
+@pytest.mark.parametrize(
+    "kw,name",
+    [
+        (dict(rcond=-1.0), "rcond"),
+        (dict(rcond=np.nan), "rcond"),
+        (dict(damping=0.0), "damping"),
+        (dict(damping=-1e-3), "damping"),
+        (dict(damping=np.inf), "damping"),
+        (dict(gravity=[0.0, 0.0]), "gravity"),
+        (dict(gravity=[0.0, np.nan, 0.0]), "gravity"),
+        (dict(gravity="up"), "gravity"),
+    ],
+)
 def test_bad_solver_options_raise(kw, name):
     assert_error(lambda: vs.Solver(planar_arm(), **kw), name)
 
@@ -629,6 +665,7 @@ def test_solver_copies_the_chain():
 def test_solver_outlives_temporary_chain():
     def make():
         return vs.Solver(planar_arm((0.7, 0.4)))
+
     solver = make()
     gc.collect()
     ref = vs.Solver(planar_arm((0.7, 0.4)))
@@ -679,8 +716,8 @@ def test_repeated_solves_are_bit_identical():
     s1, s2 = vs.Solver(rc.chain), vs.Solver(rc.chain)
     first = [s1.solve(*s) for s in states]
     for s, r in zip(states, first):
-        assert_results_equal(s1.solve(*s), r)   # same instance, after other solves in between
-        assert_results_equal(s2.solve(*s), r)   # another instance
+        assert_results_equal(s1.solve(*s), r)  # same instance, after other solves in between
+        assert_results_equal(s2.solve(*s), r)  # another instance
     # interleaving constraint counts does not leak state from one solve into the next
     for s, r in zip(reversed(states), reversed(first)):
         assert_results_equal(s1.solve(*s), r)

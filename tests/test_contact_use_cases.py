@@ -5,6 +5,7 @@ on the table, which arm geoms touched it, where the tool went -- not on controll
 The mass-matrix test compares MuJoCo's mj_fullM of the plant compiled from our URDF with the
 inverse of the solver's unconstrained response columns (H^-1) at random configurations.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -162,8 +163,14 @@ def test_reproduce_contact_writes_index_tables_and_figures(tmp_path):
     index = (tmp_path / "index.md").read_text(encoding="utf-8")
     assert "Use case 1" in index and "Use case 2" in index and "Use case 3" in index
     assert "report (Table 6.2)" in index and ("**agrees**" in index or "**disagrees**" in index)
-    for name in ("grasp_effort.csv", "writing_accuracy.csv", "elbow_effort.csv", "grasp_torque_power.png",
-                 "writing_line.png", "elbow_torque_power.png"):
+    for name in (
+        "grasp_effort.csv",
+        "writing_accuracy.csv",
+        "elbow_effort.csv",
+        "grasp_torque_power.png",
+        "writing_line.png",
+        "elbow_torque_power.png",
+    ):
         path = tmp_path / "contact" / name
         assert path.is_file() and path.stat().st_size > 0
         assert f"contact/{name}" in index

@@ -15,6 +15,7 @@ anywhere (tests/chains.py). Every expected value comes from Pinocchio:
   linear part is Pinocchio's classical frame acceleration at ``a = 0``;
 * ``fk_all`` = the placements ``oMf`` of the segments' frames.
 """
+
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -41,8 +42,12 @@ def _robot(name, seed):
     _with_rotors(r, rng)
     frames = [r.model.getFrameId(s) for s in r.chain.segment_names]
     assert all(f < len(r.model.frames) for f in frames)
-    segs = SimpleNamespace(model=r.model, tip_frames=frames, n_segments=len(frames),
-                           seg_joint=[r.model.frames[f].parentJoint for f in frames])
+    segs = SimpleNamespace(
+        model=r.model,
+        tip_frames=frames,
+        n_segments=len(frames),
+        seg_joint=[r.model.frames[f].parentJoint for f in frames],
+    )
     return r, segs, rng
 
 
@@ -70,10 +75,18 @@ def test_inverse_dynamics_matches_rnea(name):
         f_ext = rng.uniform(-20.0, 20.0, (r.chain.n_segments, 6))
         pq = r.pin_q(q)
         fext = fext_to_pinocchio(segs, data, pq, f_ext)
-        assert_close(r.chain.inverse_dynamics(q, qd, qdd, f_ext), pin.rnea(r.model, data, pq, qd, qdd, fext),
-                     RTOL, "inverse_dynamics with f_ext vs pin.rnea")
-        assert_close(r.chain.inverse_dynamics(q, qd, qdd), pin.rnea(r.model, data, pq, qd, qdd),
-                     RTOL, "inverse_dynamics vs pin.rnea")
+        assert_close(
+            r.chain.inverse_dynamics(q, qd, qdd, f_ext),
+            pin.rnea(r.model, data, pq, qd, qdd, fext),
+            RTOL,
+            "inverse_dynamics with f_ext vs pin.rnea",
+        )
+        assert_close(
+            r.chain.inverse_dynamics(q, qd, qdd),
+            pin.rnea(r.model, data, pq, qd, qdd),
+            RTOL,
+            "inverse_dynamics vs pin.rnea",
+        )
 
 
 @pytest.mark.parametrize("name", ROBOTS)
@@ -87,8 +100,12 @@ def test_mass_matrix_gravity_coriolis(name):
         M = r.chain.mass_matrix(q)
         np.testing.assert_array_equal(M, M.T)
         assert_close(M, _symmetric(pin.crba(r.model, data, pq)), RTOL, "mass_matrix vs pin.crba")
-        assert_close(r.chain.gravity_torques(q), pin.computeGeneralizedGravity(r.model, data, pq),
-                     RTOL, "gravity_torques vs computeGeneralizedGravity")
+        assert_close(
+            r.chain.gravity_torques(q),
+            pin.computeGeneralizedGravity(r.model, data, pq),
+            RTOL,
+            "gravity_torques vs computeGeneralizedGravity",
+        )
         C = pin.computeCoriolisMatrix(r.model, data, pq, qd)
         assert_close(r.chain.coriolis_torques(q, qd), C @ qd, RTOL, "coriolis_torques vs C(q, v) v")
 
@@ -151,12 +168,17 @@ def test_random_chains(seed):
         qdd = rng.normal(size=rc.n_joints)
         f_ext = rng.uniform(-5.0, 5.0, (rc.n_segments, 6))
         fext = fext_to_pinocchio(rc, data, q, f_ext)
-        assert_close(rc.chain.inverse_dynamics(q, qd, qdd, f_ext), pin.rnea(rc.model, data, q, qd, qdd, fext),
-                     RTOL, "inverse_dynamics")
+        assert_close(
+            rc.chain.inverse_dynamics(q, qd, qdd, f_ext),
+            pin.rnea(rc.model, data, q, qd, qdd, fext),
+            RTOL,
+            "inverse_dynamics",
+        )
         assert_close(rc.chain.mass_matrix(q), _symmetric(pin.crba(rc.model, data, q)), RTOL, "mass_matrix")
         assert_close(rc.chain.gravity_torques(q), pin.computeGeneralizedGravity(rc.model, data, q), RTOL, "gravity")
-        assert_close(rc.chain.coriolis_torques(q, qd), pin.computeCoriolisMatrix(rc.model, data, q, qd) @ qd,
-                     RTOL, "coriolis")
+        assert_close(
+            rc.chain.coriolis_torques(q, qd), pin.computeCoriolisMatrix(rc.model, data, q, qd) @ qd, RTOL, "coriolis"
+        )
         pin.computeJointJacobiansTimeVariation(rc.model, data, q, qd)
         pin.updateFramePlacements(rc.model, data)
         poses = rc.chain.fk_all(q)

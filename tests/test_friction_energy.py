@@ -7,6 +7,7 @@ plant's friction diagnostics and gravity torques agree with MuJoCo's own dynamic
 chain of the same URDF (payload included); the outputs are written. Which controller saves more is
 not asserted: the experiment reports what happens.
 """
+
 from __future__ import annotations
 
 import csv
@@ -74,8 +75,12 @@ def _expected_command(run, k: int, solver, friction) -> np.ndarray:
     mode = run.info["config"].friction_mode
     res = solver.solve(inp["q"], inp["qd"], friction=friction if mode == "maxmin" else None, **args)
     f, eps, qd = np.asarray(run.info["chain"].friction), fe.REST_TOLERANCE, inp["qd"]
-    extra = {"none": 0.0, "maxmin": 0.0, "smooth": f * np.tanh(qd / eps),
-             "sign": f * np.where(np.abs(qd) > eps, np.sign(qd), np.sign(res.qdd))}[mode]
+    extra = {
+        "none": 0.0,
+        "maxmin": 0.0,
+        "smooth": f * np.tanh(qd / eps),
+        "sign": f * np.where(np.abs(qd) > eps, np.sign(qd), np.sign(res.qdd)),
+    }[mode]
     return np.asarray(res.tau_command) + inp["motor_ff"] + extra
 
 

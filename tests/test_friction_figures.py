@@ -6,6 +6,7 @@ Numbers (friction-maxmin.md sec. 5): 1-DOF arm, f = 10 N m; scenario 1 (-5 N m):
 qdd 0; scenario 2 (-11 N m): friction +10 N m, qdd -0.444; fully constrained (qdd = 5): friction
 -10 N m, qdd 5, command 21.25 N m. Friction torque = -mu.
 """
+
 from __future__ import annotations
 
 import csv
@@ -51,8 +52,9 @@ def _solver():
 
 def _exact(solver, case):
     z = np.zeros(1)
-    return solver.solve(z, z, alpha=case.alpha, beta=case.beta, f_ext=case.f_ext,
-                        friction=vs.Friction(static=np.array([F])))
+    return solver.solve(
+        z, z, alpha=case.alpha, beta=case.beta, f_ext=case.f_ext, friction=vs.Friction(static=np.array([F]))
+    )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -162,8 +164,15 @@ def test_gauss_terms_without_mass_matrix():
     tip = np.eye(4)
     tip[0, 3] = 1.0
     for k in range(2):
-        chain.add_segment(name=f"l{k}", joint="rot_z", tip=tip, mass=1.0, com=[-0.5, 0.0, 0.0],
-                          inertia=np.diag([0.01, 0.1, 0.1]), rotor_inertia=0.05)
+        chain.add_segment(
+            name=f"l{k}",
+            joint="rot_z",
+            tip=tip,
+            mass=1.0,
+            com=[-0.5, 0.0, 0.0],
+            inertia=np.diag([0.01, 0.1, 0.1]),
+            rotor_inertia=0.05,
+        )
     g = [0.0, -9.81, 0.0]
     solver = vs.Solver(chain, gravity=g)
     q, qd = np.array([0.3, -0.8]), np.zeros(2)
@@ -209,8 +218,13 @@ def test_input_validation():
 # ------------------------------------------------------------------------------------------------
 def test_reproduce_command(tmp_path):
     out = tmp_path / "results"
-    proc = subprocess.run([sys.executable, "-m", "vereshchagin", "reproduce", "--quick", "--out", str(out)],
-                          cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    proc = subprocess.run(
+        [sys.executable, "-m", "vereshchagin", "reproduce", "--quick", "--out", str(out)],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert proc.returncode == 0, proc.stdout + proc.stderr
     index = (out / "index.md").read_text(encoding="utf-8")
     links = re.findall(r"\]\(([^)]+)\)", index)
@@ -223,7 +237,6 @@ def test_reproduce_command(tmp_path):
 
 
 def test_demo_command_still_works():
-    proc = subprocess.run([sys.executable, "-m", "vereshchagin", "demo"], capture_output=True, text=True,
-                          timeout=300)
+    proc = subprocess.run([sys.executable, "-m", "vereshchagin", "demo"], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "hold pose (m=6)" in proc.stdout

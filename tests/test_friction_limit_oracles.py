@@ -23,6 +23,7 @@ limit with its friction at the bound; qdd_j >= 0 at a lower limit and <= 0 at an
 friction 0 or <~ 1e-6 of the torques on a limit joint whose acceleration the task fixes, the QP's
 gradient tolerance fell below the round-off of its gradient ('unbounded' error, no tie-break).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -85,15 +86,18 @@ def check_limit_result(res, prob, rnea_tau, oracles, what=""):
     assert np.linalg.norm(eom) <= KKT_TOL * t_s, f"{what}: equation of motion residual {np.linalg.norm(eom):.2e}"
     if prob.A.shape[0]:
         task = prob.A @ qdd - prob.b
-        assert np.linalg.norm(task) <= KKT_TOL * max(1.0, np.linalg.norm(prob.b), np.linalg.norm(prob.A) * a_s), \
+        assert np.linalg.norm(task) <= KKT_TOL * max(1.0, np.linalg.norm(prob.b), np.linalg.norm(prob.A) * a_s), (
             f"{what}: task residual {np.linalg.norm(task):.2e}"
+        )
     off_range = null_space(prob.A).T @ tc
     assert np.linalg.norm(off_range) <= KKT_TOL * t_s, f"{what}: tau_command not in range(-J^T alpha)"
     for j in range(n):
         f = prob.static[j]
         lo, up = prob.at_lower[j], prob.at_upper[j]
-        tag = f"{what}: joint {j} (lower {lo}, upper {up}, f {f:.3g}, qdd {qdd[j]:.3e}, friction {fr[j]:.6g}, " \
-              f"limit {lt[j]:.6g}, status {st[j]})"
+        tag = (
+            f"{what}: joint {j} (lower {lo}, upper {up}, f {f:.3g}, qdd {qdd[j]:.3e}, friction {fr[j]:.6g}, "
+            f"limit {lt[j]:.6g}, status {st[j]})"
+        )
         assert abs(fr[j]) <= f * (1 + 1e-12), f"{tag}: friction outside [-f, f]"
         if lo:
             assert qdd[j] >= -KKT_TOL * a_s, f"{tag}: accelerates into the lower limit"
@@ -123,8 +127,9 @@ def check_limit_result(res, prob, rnea_tau, oracles, what=""):
     # --- the oracles ---
     for name, o in oracles.items():
         assert _rel(qdd, o.qdd, a_s) <= RTOL, f"{what}: qdd vs oracle {name}\n{qdd}\n{o.qdd}"
-        assert abs(res.gauss_value - o.objective) <= RTOL * prob.objective_scale(o.qdd), \
+        assert abs(res.gauss_value - o.objective) <= RTOL * prob.objective_scale(o.qdd), (
             f"{what}: gauss_value {res.gauss_value!r} vs oracle {name} {o.objective!r}"
+        )
     ref = oracles["enumeration"]
     np.testing.assert_array_equal(st, ref.status, err_msg=f"{what}: status vs enumeration")
     assert _rel(fr, ref.friction_torque, t_s) <= RTOL, f"{what}: friction_torque\n{fr}\n{ref.friction_torque}"
@@ -168,8 +173,24 @@ def _hold_beta(model, data, pq, qd, fid, alpha, g, qdd_target):
     return alpha.T @ (pin.getFrameAcceleration(model, data, fid, LWA).vector + np.r_[-g, 0.0, 0.0, 0.0])
 
 
-def make_case(rng, chain, model, fid, q_range, m, *, friction, task="random", p_limit=0.5, push=0.7,
-              gravity=G_EARTH, fext_fn=None, fixed_limits=None, feasible=True, locked=0):
+def make_case(
+    rng,
+    chain,
+    model,
+    fid,
+    q_range,
+    m,
+    *,
+    friction,
+    task="random",
+    p_limit=0.5,
+    push=0.7,
+    gravity=G_EARTH,
+    fext_fn=None,
+    fixed_limits=None,
+    feasible=True,
+    locked=0,
+):
     """A limit case: q in q_range, limits (fixed_limits or random around q), tau_ff pushing the
     on-limit joints into their limits with probability ``push``. feasible: True -> redraw until the
     primal is strictly feasible (or, for 'hold' / 'partial' tasks, feasible); False -> until it is
@@ -215,8 +236,11 @@ def make_case(rng, chain, model, fid, q_range, m, *, friction, task="random", p_
             target = np.zeros(n)
             if task == "partial":
                 j = int(rng.integers(n))
-                target[j] = (1.0 if at_lower[j] else -1.0 if at_upper[j] else rng.choice([-1.0, 1.0])) \
-                    * rng.uniform(0.5, 3.0) * (0.0 if at_lower[j] and at_upper[j] else 1.0)
+                target[j] = (
+                    (1.0 if at_lower[j] else -1.0 if at_upper[j] else rng.choice([-1.0, 1.0]))
+                    * rng.uniform(0.5, 3.0)
+                    * (0.0 if at_lower[j] and at_upper[j] else 1.0)
+                )
             beta = _hold_beta(model, data, pq, qd, fid, alpha, gravity, target)
         bias = pin.rnea(model, data, pq, qd, np.zeros(n)) - fext_tau  # torque holding the arm still
         scale = max(1.0, np.linalg.norm(bias) / np.sqrt(n))
@@ -225,8 +249,20 @@ def make_case(rng, chain, model, fid, q_range, m, *, friction, task="random", p_
         pushed = rng.random(n) < push
         tau += np.where(pushed, into * rng.uniform(0.5, 3.0, n) * scale, 0.0)
         static = random_friction(rng, n, friction, scale)
-        prob = pinocchio_problem(model, data, pq, qd, tau_ff=tau, fext_tau=fext_tau, static=static,
-                                 tip_frame=fid, alpha=alpha, beta=beta, at_lower=at_lower, at_upper=at_upper)
+        prob = pinocchio_problem(
+            model,
+            data,
+            pq,
+            qd,
+            tau_ff=tau,
+            fext_tau=fext_tau,
+            static=static,
+            tip_frame=fid,
+            alpha=alpha,
+            beta=beta,
+            at_lower=at_lower,
+            at_upper=at_upper,
+        )
         margin = limit_margin(prob)
         if feasible is True and not (margin > 1e-6 or (task != "random" and margin >= 0.0)):
             continue
@@ -250,20 +286,48 @@ def make_case(rng, chain, model, fid, q_range, m, *, friction, task="random", p_
 
 
 def case_dict(v):
-    keys = ("chain", "model", "data", "q", "pq", "qd", "tau", "f_ext", "alpha", "beta", "static", "lower", "upper",
-            "prob", "margin", "fid")
+    keys = (
+        "chain",
+        "model",
+        "data",
+        "q",
+        "pq",
+        "qd",
+        "tau",
+        "f_ext",
+        "alpha",
+        "beta",
+        "static",
+        "lower",
+        "upper",
+        "prob",
+        "margin",
+        "fid",
+    )
     out = {k: v[k] for k in keys}
     out["g"] = np.array(v["gravity"], float)
     return out
 
 
 def solve_case(case, **override):
-    friction = vs.Friction(static=case["static"], kinetic=None, velocity_tolerance=1e-6,
-                           lower=override.get("lower", case["lower"]), upper=override.get("upper", case["upper"]),
-                           limit_tolerance=LIMIT_TOL)
+    friction = vs.Friction(
+        static=case["static"],
+        kinetic=None,
+        velocity_tolerance=1e-6,
+        lower=override.get("lower", case["lower"]),
+        upper=override.get("upper", case["upper"]),
+        limit_tolerance=LIMIT_TOL,
+    )
     solver = vs.Solver(case["chain"], gravity=case["g"])
-    return solver.solve(case["q"], case["qd"], alpha=case["alpha"], beta=case["beta"], f_ext=case["f_ext"],
-                        tau_ff=case["tau"], friction=friction)
+    return solver.solve(
+        case["q"],
+        case["qd"],
+        alpha=case["alpha"],
+        beta=case["beta"],
+        f_ext=case["f_ext"],
+        tau_ff=case["tau"],
+        friction=friction,
+    )
 
 
 def check_case(case, what):
@@ -299,8 +363,9 @@ def random_limit_case(rng, n, m, **kw):
     rc, q_range, fext_fn = _random_chain_setup(rng, n)
     use_fext = kw.pop("fext", rng.random() < 0.5)
     g = kw.pop("gravity", [np.zeros(3), G_EARTH, rng.normal(size=3) * 5.0][int(rng.integers(3))])
-    case = make_case(rng, rc.chain, rc.model, rc.tip_frames[-1], q_range, m, gravity=g,
-                     fext_fn=fext_fn if use_fext else None, **kw)
+    case = make_case(
+        rng, rc.chain, rc.model, rc.tip_frames[-1], q_range, m, gravity=g, fext_fn=fext_fn if use_fext else None, **kw
+    )
     case["rc"] = rc
     return case
 
@@ -315,8 +380,10 @@ def test_random_chains_on_limits(seed, m):
     n = int(rng.integers(max(2, m), 8))
     case = random_limit_case(rng, n, m, friction=FRICTION_KINDS[(seed + m) % 4])
     p = case["prob"]
-    check_case(case, f"seed {seed} n {n} m {m} lower {p.at_lower.astype(int)} upper {p.at_upper.astype(int)} "
-                     f"f {case['static']}")
+    check_case(
+        case,
+        f"seed {seed} n {n} m {m} lower {p.at_lower.astype(int)} upper {p.at_upper.astype(int)} f {case['static']}",
+    )
 
 
 @pytest.mark.parametrize("task", ["hold", "partial"])
@@ -346,12 +413,20 @@ def test_random_chains_locked_joint(seed):
 
 
 # ---- robots ----
-ROBOT_CASES = [("panda", 0, "moderate", "random"), ("panda", 1, "mixed", "random"),
-               ("panda", 2, "zero", "random"), ("panda", 3, "moderate", "random"),
-               ("panda", 2, "moderate", "hold"), ("panda", 3, "large", "random"),
-               ("gen3_bare", 0, "mixed", "random"), ("gen3_bare", 1, "moderate", "random"),
-               ("gen3_bare", 2, "moderate", "partial"), ("gen3_bare", 3, "zero", "random"),
-               ("gen3_gripper", 2, "mixed", "random"), ("gen3_gripper", 3, "moderate", "hold")]
+ROBOT_CASES = [
+    ("panda", 0, "moderate", "random"),
+    ("panda", 1, "mixed", "random"),
+    ("panda", 2, "zero", "random"),
+    ("panda", 3, "moderate", "random"),
+    ("panda", 2, "moderate", "hold"),
+    ("panda", 3, "large", "random"),
+    ("gen3_bare", 0, "mixed", "random"),
+    ("gen3_bare", 1, "moderate", "random"),
+    ("gen3_bare", 2, "moderate", "partial"),
+    ("gen3_bare", 3, "zero", "random"),
+    ("gen3_gripper", 2, "mixed", "random"),
+    ("gen3_gripper", 3, "moderate", "hold"),
+]
 
 
 @pytest.mark.parametrize("rcase", ROBOT_CASES, ids=lambda c: "-".join(map(str, c)))
@@ -364,18 +439,40 @@ def test_robots_on_urdf_limits(rcase):
     rotor = rng.uniform(0.0, 0.3, chain.n_joints)
     chain.rotor_inertia = rotor
     model.armature = rotor
-    case = make_case(rng, chain, model, model.getFrameId(robot.tip), (-np.pi, np.pi), m, friction=friction,
-                     task=task, p_limit=0.6, fixed_limits=(chain.lower, chain.upper))
+    case = make_case(
+        rng,
+        chain,
+        model,
+        model.getFrameId(robot.tip),
+        (-np.pi, np.pi),
+        m,
+        friction=friction,
+        task=task,
+        p_limit=0.6,
+        fixed_limits=(chain.lower, chain.upper),
+    )
     np.testing.assert_array_equal(case["lower"], chain.lower)
     check_case(case, str(rcase))
     if m == 0:  # friction=True: the chain's URDF friction (Panda: 0) and limits
         p = case["prob"]
-        prob = pinocchio_problem(model, case["data"], case["pq"], case["qd"], tau_ff=case["tau"],
-                                 static=chain.friction, at_lower=p.at_lower, at_upper=p.at_upper)
+        prob = pinocchio_problem(
+            model,
+            case["data"],
+            case["pq"],
+            case["qd"],
+            tau_ff=case["tau"],
+            static=chain.friction,
+            at_lower=p.at_lower,
+            at_upper=p.at_upper,
+        )
         res = vs.Solver(chain, gravity=case["g"]).solve(case["q"], case["qd"], tau_ff=case["tau"], friction=True)
-        check_limit_result(res, prob, lambda a: pin.rnea(model, case["data"], case["pq"], case["qd"], a),
-                           {"enumeration": enumeration_oracle(prob), "scipy": scipy_oracle(prob)},
-                           f"{rcase} friction=True")
+        check_limit_result(
+            res,
+            prob,
+            lambda a: pin.rnea(model, case["data"], case["pq"], case["qd"], a),
+            {"enumeration": enumeration_oracle(prob), "scipy": scipy_oracle(prob)},
+            f"{rcase} friction=True",
+        )
 
 
 # ---- infeasible: the task drives a joint into its limit ----
@@ -388,19 +485,40 @@ def test_task_forcing_a_joint_into_its_limit_raises(seed):
     n = m = int(rng.integers(1, 4))
     for _ in range(100):
         rc, q_range, _ = _random_chain_setup(rng, n)
-        case = make_case(rng, rc.chain, rc.model, rc.tip_frames[-1], q_range, m, friction="moderate",
-                         task="hold", p_limit=0.8, feasible="any")
+        case = make_case(
+            rng,
+            rc.chain,
+            rc.model,
+            rc.tip_frames[-1],
+            q_range,
+            m,
+            friction="moderate",
+            task="hold",
+            p_limit=0.8,
+            feasible="any",
+        )
         p = case["prob"]
         j = int(np.flatnonzero(p.on_limit)[0])
         if p.at_lower[j] and p.at_upper[j]:
             continue
         target = np.zeros(n)
         target[j] = (-1.0 if p.at_lower[j] else 1.0) * rng.uniform(0.5, 2.0)  # into the limit
-        case["beta"] = _hold_beta(case["model"], case["data"], case["pq"], case["qd"], case["fid"], case["alpha"],
-                                  case["g"], target)
-        prob = pinocchio_problem(case["model"], case["data"], case["pq"], case["qd"], tau_ff=case["tau"],
-                                 static=case["static"], tip_frame=case["fid"], alpha=case["alpha"],
-                                 beta=case["beta"], at_lower=p.at_lower, at_upper=p.at_upper)
+        case["beta"] = _hold_beta(
+            case["model"], case["data"], case["pq"], case["qd"], case["fid"], case["alpha"], case["g"], target
+        )
+        prob = pinocchio_problem(
+            case["model"],
+            case["data"],
+            case["pq"],
+            case["qd"],
+            tau_ff=case["tau"],
+            static=case["static"],
+            tip_frame=case["fid"],
+            alpha=case["alpha"],
+            beta=case["beta"],
+            at_lower=p.at_lower,
+            at_upper=p.at_upper,
+        )
         break
     np.testing.assert_allclose(np.linalg.solve(prob.A, prob.b), target, atol=1e-9)
     assert limit_margin(prob) < -1e-6
@@ -460,8 +578,13 @@ def test_small_friction_on_limit_held_by_task(f, side, push):
     alpha = np.zeros((6, 1))
     alpha[5, 0] = 1.0
     res = vs.Solver(_arm_1dof(), gravity=[0, 0, 0]).solve(
-        [0.0], [0.0], alpha=alpha, beta=[0.0], tau_ff=[tau],
-        friction=vs.Friction(static=[f], lower=[lower], upper=[upper], limit_tolerance=LIMIT_TOL))
+        [0.0],
+        [0.0],
+        alpha=alpha,
+        beta=[0.0],
+        tau_ff=[tau],
+        friction=vs.Friction(static=[f], lower=[lower], upper=[upper], limit_tolerance=LIMIT_TOL),
+    )
     friction = -f * np.sign(tau)
     limit = -(tau + friction) if push == "into" else 0.0
     assert abs(res.qdd[0]) < 1e-12

@@ -4,6 +4,7 @@ Expected values are worked out by hand for the 1-DOF arm of Vukcevic 2018, ch. 6
 no gravity, f = 2 N m here): a joint resting on its limit and pushed further stays (the limit
 reaction takes what friction cannot hold); pushed away it slips as usual.
 """
+
 import numpy as np
 import pytest
 

@@ -18,6 +18,7 @@ Status convention assumed (friction-maxmin.md sec. 3 and the API note): a restin
 (stick) iff qdd_j = 0, also when its friction is at the bound |friction_j| = f_j (the holding case
 of sec. 4 against 14.7 Nm); 2 / 3 iff it slips with qdd_j > 0 / < 0.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -67,9 +68,11 @@ def _rel(a, b, scale):
 
 
 def friction_arg(static, kinetic=None, tol=1e-6):
-    return vs.Friction(static=np.asarray(static, float),
-                       kinetic=None if kinetic is None else np.asarray(kinetic, float),
-                       velocity_tolerance=tol)
+    return vs.Friction(
+        static=np.asarray(static, float),
+        kinetic=None if kinetic is None else np.asarray(kinetic, float),
+        velocity_tolerance=tol,
+    )
 
 
 def complementarity_residual(prob, qdd, friction, status):
@@ -119,11 +122,13 @@ def check_against_oracles(res, prob, rnea_tau, *, oracles, what=""):
     assert np.linalg.norm(eom) <= KKT_TOL * t_s, f"{what}: equation of motion residual {np.linalg.norm(eom):.2e}"
     if prob.A.shape[0]:
         task = prob.A @ qdd - prob.b
-        assert np.linalg.norm(task) <= KKT_TOL * max(1.0, np.linalg.norm(prob.b), np.linalg.norm(prob.A) * a_s), \
+        assert np.linalg.norm(task) <= KKT_TOL * max(1.0, np.linalg.norm(prob.b), np.linalg.norm(prob.A) * a_s), (
             f"{what}: task residual {np.linalg.norm(task):.2e}"
+        )
     off_range = null_space(prob.A).T @ tc
-    assert np.linalg.norm(off_range) <= KKT_TOL * t_s, \
+    assert np.linalg.norm(off_range) <= KKT_TOL * t_s, (
         f"{what}: tau_command not in range(-J^T alpha): {np.linalg.norm(off_range):.2e}"
+    )
     comp = complementarity_residual(prob, qdd, fr, st)
     assert comp <= KKT_TOL, f"{what}: complementarity residual {comp:.2e}; status {st}, qdd {qdd}, friction {fr}"
 
@@ -131,14 +136,17 @@ def check_against_oracles(res, prob, rnea_tau, *, oracles, what=""):
     for name, o in oracles.items():
         assert _rel(qdd, o.qdd, a_s) <= RTOL, f"{what}: qdd vs oracle {name}\n{qdd}\n{o.qdd}"
         scale = prob.objective_scale(o.qdd)
-        assert abs(res.gauss_value - o.objective) <= RTOL * scale, \
+        assert abs(res.gauss_value - o.objective) <= RTOL * scale, (
             f"{what}: gauss_value {res.gauss_value!r} vs oracle {name} {o.objective!r}"
+        )
     ref = oracles["enumeration"]
     np.testing.assert_array_equal(st, ref.status, err_msg=f"{what}: status vs enumeration")
-    assert _rel(fr, ref.friction_torque, t_s) <= RTOL, \
+    assert _rel(fr, ref.friction_torque, t_s) <= RTOL, (
         f"{what}: friction_torque vs tie-broken oracle\n{fr}\n{ref.friction_torque}"
-    assert _rel(tc, ref.tau_command, t_s) <= RTOL, \
+    )
+    assert _rel(tc, ref.tau_command, t_s) <= RTOL, (
         f"{what}: tau_command vs tie-broken oracle (min ||tau_command||)\n{tc}\n{ref.tau_command}"
+    )
     # gauss_value is the objective at the solver's own qdd
     assert abs(res.gauss_value - prob.objective(qdd)) <= RTOL * prob.objective_scale(qdd), f"{what}: gauss_value"
 
@@ -153,8 +161,16 @@ def both_oracles(prob):
 # The 1-DOF arm of Vukcevic 2018, ch. 6: mass 1, length 1, COM 0.5, joint-axis inertia 2.25, revolute about z
 # ------------------------------------------------------------------------------------------------
 def arm_1dof():
-    seg = SegmentSpec("rot_z", np.array([0.0, 0.0, 1.0]), np.zeros(3), homogeneous(None, [1.0, 0.0, 0.0]),
-                      1.0, np.array([-0.5, 0.0, 0.0]), np.diag([1.0, 1.0, 2.0]), 0.0)
+    seg = SegmentSpec(
+        "rot_z",
+        np.array([0.0, 0.0, 1.0]),
+        np.zeros(3),
+        homogeneous(None, [1.0, 0.0, 0.0]),
+        1.0,
+        np.array([-0.5, 0.0, 0.0]),
+        np.diag([1.0, 1.0, 2.0]),
+        0.0,
+    )
     return build([seg])
 
 
@@ -163,9 +179,18 @@ def _arm_problem(rc, gravity, tau_ff=0.0, f_tip=None, alpha=None, beta=None, f=1
     data = rc.data()
     q, qd = np.zeros(1), np.zeros(1)
     f_ext = np.zeros((1, 6)) if f_tip is None else np.array([[0.0, f_tip, 0.0, 0.0, 0.0, 0.0]])
-    prob = pinocchio_problem(rc.model, data, q, qd, tau_ff=np.array([tau_ff]),
-                             fext_tau=fext_generalized(rc, data, q, f_ext), static=[f],
-                             tip_frame=rc.tip_frames[-1], alpha=alpha, beta=beta)
+    prob = pinocchio_problem(
+        rc.model,
+        data,
+        q,
+        qd,
+        tau_ff=np.array([tau_ff]),
+        fext_tau=fext_generalized(rc, data, q, f_ext),
+        static=[f],
+        tip_frame=rc.tip_frames[-1],
+        alpha=alpha,
+        beta=beta,
+    )
     return prob, f_ext
 
 
@@ -224,8 +249,15 @@ def test_report_000_numbers(case):
     rc = arm_1dof()
     prob, f_ext = _arm_problem(rc, g, tau, ftip, alpha, beta)
     solver = vs.Solver(rc.chain, gravity=g)
-    res = solver.solve([0.0], [0.0], alpha=alpha, beta=beta, f_ext=f_ext if ftip is not None else None,
-                       tau_ff=[tau], friction=friction_arg([10.0]))
+    res = solver.solve(
+        [0.0],
+        [0.0],
+        alpha=alpha,
+        beta=beta,
+        f_ext=f_ext if ftip is not None else None,
+        tau_ff=[tau],
+        friction=friction_arg([10.0]),
+    )
     np.testing.assert_allclose(res.qdd, [qdd], rtol=0, atol=1e-12)
     np.testing.assert_allclose(res.friction_torque, [fr], rtol=0, atol=1e-12)
     np.testing.assert_allclose(res.tau_command, [tc], rtol=0, atol=1e-12)
@@ -233,15 +265,22 @@ def test_report_000_numbers(case):
     assert res.gauss_value == pytest.approx(prob.objective(np.array([qdd])), rel=1e-12, abs=1e-12)
     data = rc.data()
     fext = fext_to_pinocchio(rc, data, np.zeros(1), f_ext)
-    check_against_oracles(res, prob, lambda a: pin.rnea(rc.model, data, np.zeros(1), np.zeros(1), a, fext),
-                          oracles=both_oracles(prob), what=case)
+    check_against_oracles(
+        res,
+        prob,
+        lambda a: pin.rnea(rc.model, data, np.zeros(1), np.zeros(1), a, fext),
+        oracles=both_oracles(prob),
+        what=case,
+    )
 
 
 def test_report_000_net_torque_and_gauss_values():
     """Sec. 5 by hand: net torque 0 / -1 Nm; Z0 + f|qdd| = 5.556, 26.667, 78.125."""
-    expected = {"scenario1_force": 0.5 * 2.25 * (5 / 2.25) ** 2,
-                "scenario2_force": 0.5 * 2.25 * (10 / 2.25) ** 2 + 10 / 2.25,
-                "constrained_angular": 0.5 * 2.25 * 25 + 50.0}
+    expected = {
+        "scenario1_force": 0.5 * 2.25 * (5 / 2.25) ** 2,
+        "scenario2_force": 0.5 * 2.25 * (10 / 2.25) ** 2 + 10 / 2.25,
+        "constrained_angular": 0.5 * 2.25 * 25 + 50.0,
+    }
     for case, value in expected.items():
         prob, gauss = _report_expected_gauss(case)
         assert gauss == pytest.approx(value, rel=1e-14)
@@ -256,8 +295,9 @@ def test_oracle_scipy_matches_enumeration_synthetic(seed):
     rng = np.random.default_rng([seed, 71])
     n = int(rng.integers(1, 8))
     m = int(rng.integers(0, min(n, 3) + 1))
-    prob = random_problem(rng, n, m, resting_fraction=[1.0, 0.6][seed % 2],
-                          friction=["mixed", "moderate", "zero", "large"][seed % 4])
+    prob = random_problem(
+        rng, n, m, resting_fraction=[1.0, 0.6][seed % 2], friction=["mixed", "moderate", "zero", "large"][seed % 4]
+    )
     b = enumeration_oracle(prob)
     a = scipy_oracle(prob)
     s = prob.accel_scale(b.qdd)
@@ -294,8 +334,7 @@ def test_oracle_tie_break_exact_vs_slsqp(seed):
 def test_oracle_problem_matches_pin_forward_dynamics(seed):
     """With zero friction the oracle problem is Pinocchio's constrained forward dynamics."""
     rng = np.random.default_rng([seed, 73])
-    case = random_chain_case(rng, int(rng.integers(2, 8)), int(rng.integers(1, 4)), rest="mixed",
-                             friction="zero")
+    case = random_chain_case(rng, int(rng.integers(2, 8)), int(rng.integers(1, 4)), rest="mixed", friction="zero")
     rc, prob = case["rc"], case["prob"]
     data = rc.data()
     q, qd = case["q"], case["qd"]
@@ -322,8 +361,9 @@ def test_oracle_mujoco_matches_enumeration(seed):
     agrees to round-off (4.5e-15 worst over these samples). Tolerance used: 1e-12."""
     rng = np.random.default_rng([seed, 74])
     n = int(rng.integers(2, 8))
-    case = random_chain_case(rng, n, 0, rest="all", friction=["mixed", "moderate"][seed % 2], fext=False,
-                             cap_friction=1e3)
+    case = random_chain_case(
+        rng, n, 0, rest="all", friction=["mixed", "moderate"][seed % 2], fext=False, cap_friction=1e3
+    )
     prob = case["prob"]
     o = enumeration_oracle(prob)
     qacc, _, _ = mujoco_qacc(case["rc"].segments, case["g"], case["q"], case["tau"], prob.static)
@@ -368,8 +408,20 @@ def _task_target(rng, n, task):
     return qdd
 
 
-def random_chain_case(rng, n, m, *, rest="all", friction="mixed", fext=True, cap_friction=None,
-                      gravity=None, tol=1e-6, task="random", accept=None):
+def random_chain_case(
+    rng,
+    n,
+    m,
+    *,
+    rest="all",
+    friction="mixed",
+    fext=True,
+    cap_friction=None,
+    gravity=None,
+    tol=1e-6,
+    task="random",
+    accept=None,
+):
     """A random chain, state, well-conditioned task (m <= n) and friction; its Pinocchio problem.
 
     task: 'random' beta, or beta met by qdd = 0 ('hold') or by a qdd that is zero on most joints
@@ -409,9 +461,20 @@ def random_chain_case(rng, n, m, *, rest="all", friction="mixed", fext=True, cap
         if cap_friction is not None:
             static = np.minimum(static, cap_friction)
         kinetic = static * rng.uniform(0.3, 1.0, n)
-        prob = pinocchio_problem(rc.model, data, q, qd, tau_ff=tau, fext_tau=fext_tau, static=static,
-                                 kinetic=kinetic, velocity_tolerance=tol, tip_frame=rc.tip_frames[-1],
-                                 alpha=alpha, beta=beta)
+        prob = pinocchio_problem(
+            rc.model,
+            data,
+            q,
+            qd,
+            tau_ff=tau,
+            fext_tau=fext_tau,
+            static=static,
+            kinetic=kinetic,
+            velocity_tolerance=tol,
+            tip_frame=rc.tip_frames[-1],
+            alpha=alpha,
+            beta=beta,
+        )
         o = enumeration_oracle(prob)
         R = prob.rest_idx
         slipping = np.abs(o.qdd[R])[o.status[R] != STICK]
@@ -419,8 +482,21 @@ def random_chain_case(rng, n, m, *, rest="all", friction="mixed", fext=True, cap
             continue
         if accept is not None and not accept(prob, o):
             continue
-        return dict(rc=rc, q=q, qd=qd, g=g, tau=tau, f_ext=f_ext, alpha=alpha, beta=beta, static=static,
-                    kinetic=kinetic, tol=tol, prob=prob, enumeration=o)
+        return dict(
+            rc=rc,
+            q=q,
+            qd=qd,
+            g=g,
+            tau=tau,
+            f_ext=f_ext,
+            alpha=alpha,
+            beta=beta,
+            static=static,
+            kinetic=kinetic,
+            tol=tol,
+            prob=prob,
+            enumeration=o,
+        )
     raise AssertionError("no usable sample")  # pragma: no cover
 
 
@@ -441,8 +517,15 @@ def _nontrivial_tie(prob, o):
 def _solve_chain_case(case):
     rc = case["rc"]
     solver = vs.Solver(rc.chain, gravity=case["g"])
-    return solver.solve(case["q"], case["qd"], alpha=case["alpha"], beta=case["beta"], f_ext=case["f_ext"],
-                        tau_ff=case["tau"], friction=friction_arg(case["static"], case["kinetic"], case["tol"]))
+    return solver.solve(
+        case["q"],
+        case["qd"],
+        alpha=case["alpha"],
+        beta=case["beta"],
+        f_ext=case["f_ext"],
+        tau_ff=case["tau"],
+        friction=friction_arg(case["static"], case["kinetic"], case["tol"]),
+    )
 
 
 def _check_chain_case(case, res, what):
@@ -451,8 +534,7 @@ def _check_chain_case(case, res, what):
     data = rc.data()
     fext = fext_to_pinocchio(rc, data, q, case["f_ext"])
     oracles = {"enumeration": case["enumeration"], "scipy": scipy_oracle(prob)}
-    check_against_oracles(res, prob, lambda a: pin.rnea(rc.model, data, q, qd, a, fext), oracles=oracles,
-                          what=what)
+    check_against_oracles(res, prob, lambda a: pin.rnea(rc.model, data, q, qd, a, fext), oracles=oracles, what=what)
 
 
 FRICTION_KINDS = ("mixed", "moderate", "zero", "large")
@@ -470,9 +552,22 @@ def test_random_chains(seed, m, rest):
     _check_chain_case(case, res, f"seed {seed} n {n} m {m} rest {rest} f {case['static']}")
 
 
-TIE_CASES = [("hold", "all", 1), ("hold", "all", 2), ("hold", "all", 3), ("hold", "all", 4), ("hold", "all", 5),
-             ("partial", "all", 2), ("partial", "all", 3), ("partial", "all", 4), ("partial", "all", 5),
-             ("hold", "one", 2), ("hold", "one", 3), ("hold", "one", 4), ("partial", "one", 3), ("partial", "one", 4)]
+TIE_CASES = [
+    ("hold", "all", 1),
+    ("hold", "all", 2),
+    ("hold", "all", 3),
+    ("hold", "all", 4),
+    ("hold", "all", 5),
+    ("partial", "all", 2),
+    ("partial", "all", 3),
+    ("partial", "all", 4),
+    ("partial", "all", 5),
+    ("hold", "one", 2),
+    ("hold", "one", 3),
+    ("hold", "one", 4),
+    ("partial", "one", 3),
+    ("partial", "one", 4),
+]
 
 
 @pytest.mark.parametrize("tie", TIE_CASES, ids=lambda t: "-".join(map(str, t)))
@@ -484,8 +579,7 @@ def test_random_chains_tie_break(seed, tie):
     task, rest, m = tie
     rng = np.random.default_rng([seed, m, rest == "all", task == "hold", 81])
     n = int(rng.integers(m + 1, 8))
-    case = random_chain_case(rng, n, m, rest=rest, friction="moderate", task=task,
-                             accept=_nontrivial_tie)
+    case = random_chain_case(rng, n, m, rest=rest, friction="moderate", task=task, accept=_nontrivial_tie)
     res = _solve_chain_case(case)
     _check_chain_case(case, res, f"seed {seed} n {n} m {m} rest {rest} task {task} f {case['static']}")
 
@@ -508,10 +602,12 @@ def test_zero_friction_is_the_plain_solve(seed):
     case = random_chain_case(rng, n, int(rng.integers(0, 4)), rest="mixed", friction="zero")
     res = _solve_chain_case(case)
     plain = vs.Solver(case["rc"].chain, gravity=case["g"]).solve(
-        case["q"], case["qd"], alpha=case["alpha"], beta=case["beta"], f_ext=case["f_ext"], tau_ff=case["tau"])
+        case["q"], case["qd"], alpha=case["alpha"], beta=case["beta"], f_ext=case["f_ext"], tau_ff=case["tau"]
+    )
     np.testing.assert_allclose(res.qdd, plain.qdd, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(plain.qdd).max()))
-    np.testing.assert_allclose(res.tau_command, plain.tau_command, rtol=1e-12,
-                               atol=1e-12 * max(1.0, np.abs(plain.tau_command).max()))
+    np.testing.assert_allclose(
+        res.tau_command, plain.tau_command, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(plain.tau_command).max())
+    )
     np.testing.assert_array_equal(res.friction_torque, np.zeros(n))
     _check_chain_case(case, res, f"zero friction seed {seed}")
 
@@ -521,8 +617,19 @@ def test_zero_friction_is_the_plain_solve(seed):
 # ------------------------------------------------------------------------------------------------
 def _planar_2link():
     """Two rot_z links of length 1 (COM 0.5, mass 1, Izz 0.1), rotors 0.05; arm along x at q = 0."""
-    segs = [SegmentSpec("rot_z", np.array([0.0, 0.0, 1.0]), np.zeros(3), homogeneous(None, [1.0, 0.0, 0.0]),
-                        1.0, np.array([-0.5, 0.0, 0.0]), np.diag([0.01, 0.1, 0.1]), 0.05) for _ in range(2)]
+    segs = [
+        SegmentSpec(
+            "rot_z",
+            np.array([0.0, 0.0, 1.0]),
+            np.zeros(3),
+            homogeneous(None, [1.0, 0.0, 0.0]),
+            1.0,
+            np.array([-0.5, 0.0, 0.0]),
+            np.diag([0.01, 0.1, 0.1]),
+            0.05,
+        )
+        for _ in range(2)
+    ]
     return build(segs)
 
 
@@ -530,12 +637,27 @@ def _tie_break_case(rc, q, g, alpha, beta, static, tau_ff):
     rc.model.gravity = pin.Motion(np.r_[g, 0.0, 0.0, 0.0])
     data = rc.data()
     n = rc.n_joints
-    prob = pinocchio_problem(rc.model, data, q, np.zeros(n), tau_ff=tau_ff, static=static,
-                             tip_frame=rc.tip_frames[-1], alpha=alpha, beta=beta)
-    res = vs.Solver(rc.chain, gravity=g).solve(q, np.zeros(n), alpha=alpha, beta=beta, tau_ff=tau_ff,
-                                               friction=friction_arg(static))
-    check_against_oracles(res, prob, lambda a: pin.rnea(rc.model, data, q, np.zeros(n), a),
-                          oracles=both_oracles(prob), what=f"tie-break (static {static})")
+    prob = pinocchio_problem(
+        rc.model,
+        data,
+        q,
+        np.zeros(n),
+        tau_ff=tau_ff,
+        static=static,
+        tip_frame=rc.tip_frames[-1],
+        alpha=alpha,
+        beta=beta,
+    )
+    res = vs.Solver(rc.chain, gravity=g).solve(
+        q, np.zeros(n), alpha=alpha, beta=beta, tau_ff=tau_ff, friction=friction_arg(static)
+    )
+    check_against_oracles(
+        res,
+        prob,
+        lambda a: pin.rnea(rc.model, data, q, np.zeros(n), a),
+        oracles=both_oracles(prob),
+        what=f"tie-break (static {static})",
+    )
     return res, prob, data
 
 
@@ -559,8 +681,9 @@ def test_tie_break_fully_constrained_two_joints(seed):
     qdd_target = np.zeros(2) if seed < 3 else np.array([0.0, rng.choice([-2.0, 2.0])])
     pin.forwardKinematics(rc.model, data, q, np.zeros(2), qdd_target)
     pin.updateFramePlacements(rc.model, data)
-    beta = alpha.T @ (pin.getFrameAcceleration(rc.model, data, rc.tip_frames[-1], LWA).vector
-                      + np.r_[-G_EARTH, 0.0, 0.0, 0.0])
+    beta = alpha.T @ (
+        pin.getFrameAcceleration(rc.model, data, rc.tip_frames[-1], LWA).vector + np.r_[-G_EARTH, 0.0, 0.0, 0.0]
+    )
     tau_ff = rng.normal(size=2)
     r = pin.rnea(rc.model, data, q, np.zeros(2), qdd_target) - tau_ff
     # friction able to hold joint 1 fully and joint 2 partly (seed-dependent)
@@ -569,15 +692,30 @@ def test_tie_break_fully_constrained_two_joints(seed):
     expected_tc = r - expected_fr
     # the same by an independent small QP (SLSQP) on the friction torques
     from scipy.optimize import minimize
+
     free = qdd_target == 0
-    sol = minimize(lambda x: np.sum((r[free] - x) ** 2), np.zeros(int(free.sum())),
-                   bounds=list(zip(-static[free], static[free])), method="SLSQP", options=dict(ftol=1e-14))
+    sol = minimize(
+        lambda x: np.sum((r[free] - x) ** 2),
+        np.zeros(int(free.sum())),
+        bounds=list(zip(-static[free], static[free])),
+        method="SLSQP",
+        options=dict(ftol=1e-14),
+    )
     np.testing.assert_allclose(sol.x, expected_fr[free], atol=1e-6 * max(1.0, np.abs(r).max()))
 
     t = max(1.0, np.abs(r).max())
     # ... and by the oracles' tie-break (guards the oracle used everywhere else)
-    prob = pinocchio_problem(rc.model, data, q, np.zeros(2), tau_ff=tau_ff, static=static,
-                             tip_frame=rc.tip_frames[-1], alpha=alpha, beta=beta)
+    prob = pinocchio_problem(
+        rc.model,
+        data,
+        q,
+        np.zeros(2),
+        tau_ff=tau_ff,
+        static=static,
+        tip_frame=rc.tip_frames[-1],
+        alpha=alpha,
+        beta=beta,
+    )
     for o in both_oracles(prob).values():
         np.testing.assert_allclose(o.qdd, qdd_target, atol=1e-10 * max(1.0, np.abs(qdd_target).max()))
         np.testing.assert_allclose(o.friction_torque, expected_fr, rtol=0, atol=1e-10 * t)
@@ -659,7 +797,9 @@ def _robot_case(name, rng, m, rest, friction, task="random", accept=None, **kw):
         if m:
             J = pin.computeFrameJacobian(model, data, pq, fid, LWA)
             A = alpha.T @ J
-            if not well_conditioned_task(A, np.linalg.inv(pinocchio_problem(model, data, pq, qd, static=np.zeros(n)).H)):
+            if not well_conditioned_task(
+                A, np.linalg.inv(pinocchio_problem(model, data, pq, qd, static=np.zeros(n)).H)
+            ):
                 continue
         if not m:
             beta = None
@@ -671,25 +811,47 @@ def _robot_case(name, rng, m, rest, friction, task="random", accept=None, **kw):
         load = pin.rnea(model, data, pq, qd, np.zeros(n)) - tau
         static = random_friction(rng, n, friction, max(1.0, np.linalg.norm(load) / np.sqrt(n)))
         kinetic = static * rng.uniform(0.3, 1.0, n)
-        prob = pinocchio_problem(model, data, pq, qd, tau_ff=tau, static=static, kinetic=kinetic,
-                                 tip_frame=fid, alpha=alpha, beta=beta)
+        prob = pinocchio_problem(
+            model, data, pq, qd, tau_ff=tau, static=static, kinetic=kinetic, tip_frame=fid, alpha=alpha, beta=beta
+        )
         o = enumeration_oracle(prob)
         slipping = np.abs(o.qdd[prob.rest_idx])[o.status[prob.rest_idx] != STICK]
         if slipping.size and slipping.min() < 1e-6 * prob.accel_scale(o.qdd):
             continue
         if accept is not None and not accept(prob, o):
             continue
-        return dict(chain=chain, model=model, data=data, q=q, pq=pq, qd=qd, tau=tau, alpha=alpha, beta=beta,
-                    static=static, kinetic=kinetic, prob=prob, enumeration=o)
+        return dict(
+            chain=chain,
+            model=model,
+            data=data,
+            q=q,
+            pq=pq,
+            qd=qd,
+            tau=tau,
+            alpha=alpha,
+            beta=beta,
+            static=static,
+            kinetic=kinetic,
+            prob=prob,
+            enumeration=o,
+        )
     raise AssertionError("no usable sample")  # pragma: no cover
 
 
-ROBOT_CASES = [("panda", 0, "all", "moderate", "random"), ("panda", 2, "mixed", "mixed", "random"),
-               ("panda", 3, "all", "mixed", "random"), ("panda", 3, "all", "zero", "random"),
-               ("panda", 2, "all", "moderate", "hold"), ("panda", 3, "all", "moderate", "partial"),
-               ("gen3", 0, "mixed", "mixed", "random"), ("gen3", 1, "all", "moderate", "random"),
-               ("gen3", 3, "mixed", "moderate", "random"), ("gen3", 2, "all", "large", "random"),
-               ("gen3", 1, "all", "moderate", "hold"), ("gen3", 3, "one", "moderate", "hold")]
+ROBOT_CASES = [
+    ("panda", 0, "all", "moderate", "random"),
+    ("panda", 2, "mixed", "mixed", "random"),
+    ("panda", 3, "all", "mixed", "random"),
+    ("panda", 3, "all", "zero", "random"),
+    ("panda", 2, "all", "moderate", "hold"),
+    ("panda", 3, "all", "moderate", "partial"),
+    ("gen3", 0, "mixed", "mixed", "random"),
+    ("gen3", 1, "all", "moderate", "random"),
+    ("gen3", 3, "mixed", "moderate", "random"),
+    ("gen3", 2, "all", "large", "random"),
+    ("gen3", 1, "all", "moderate", "hold"),
+    ("gen3", 3, "one", "moderate", "hold"),
+]
 
 
 @pytest.mark.parametrize("case", ROBOT_CASES, ids=lambda c: "-".join(map(str, c)))
@@ -698,12 +860,16 @@ def test_robots(case):
     rng = np.random.default_rng([len(name), m, len(rest), len(friction), len(task), 79])
     c = _robot_case(name, rng, m, rest, friction, task, accept=_nontrivial_tie if task != "random" else None)
     res = vs.Solver(c["chain"], gravity=G_EARTH).solve(
-        c["q"], c["qd"], alpha=c["alpha"], beta=c["beta"], tau_ff=c["tau"],
-        friction=friction_arg(c["static"], c["kinetic"]))
+        c["q"],
+        c["qd"],
+        alpha=c["alpha"],
+        beta=c["beta"],
+        tau_ff=c["tau"],
+        friction=friction_arg(c["static"], c["kinetic"]),
+    )
     model, data, pq, qd = c["model"], c["data"], c["pq"], c["qd"]
     oracles = {"enumeration": c["enumeration"], "scipy": scipy_oracle(c["prob"])}
-    check_against_oracles(res, c["prob"], lambda a: pin.rnea(model, data, pq, qd, a), oracles=oracles,
-                          what=str(case))
+    check_against_oracles(res, c["prob"], lambda a: pin.rnea(model, data, pq, qd, a), oracles=oracles, what=str(case))
 
 
 def test_friction_true_uses_chain_friction():
@@ -713,16 +879,26 @@ def test_friction_true_uses_chain_friction():
     c = _robot_case("gen3", rng, 1, "mixed", "zero", joint_friction=f)
     chain, model, data, pq, qd = c["chain"], c["model"], c["data"], c["pq"], c["qd"]
     np.testing.assert_array_equal(chain.friction, f)
-    prob = pinocchio_problem(model, data, pq, qd, tau_ff=c["tau"], static=f, kinetic=f,
-                             tip_frame=model.getFrameId("end_effector_link"), alpha=c["alpha"], beta=c["beta"])
+    prob = pinocchio_problem(
+        model,
+        data,
+        pq,
+        qd,
+        tau_ff=c["tau"],
+        static=f,
+        kinetic=f,
+        tip_frame=model.getFrameId("end_effector_link"),
+        alpha=c["alpha"],
+        beta=c["beta"],
+    )
     solver = vs.Solver(chain, gravity=G_EARTH)
     res = solver.solve(c["q"], qd, alpha=c["alpha"], beta=c["beta"], tau_ff=c["tau"], friction=True)
-    explicit = solver.solve(c["q"], qd, alpha=c["alpha"], beta=c["beta"], tau_ff=c["tau"],
-                            friction=friction_arg(f, f))
+    explicit = solver.solve(c["q"], qd, alpha=c["alpha"], beta=c["beta"], tau_ff=c["tau"], friction=friction_arg(f, f))
     np.testing.assert_array_equal(res.qdd, explicit.qdd)
     np.testing.assert_array_equal(res.friction_torque, explicit.friction_torque)
-    check_against_oracles(res, prob, lambda a: pin.rnea(model, data, pq, qd, a),
-                          oracles=both_oracles(prob), what="friction=True")
+    check_against_oracles(
+        res, prob, lambda a: pin.rnea(model, data, pq, qd, a), oracles=both_oracles(prob), what="friction=True"
+    )
 
 
 def test_kinetic_defaults_to_static():
@@ -740,8 +916,9 @@ def test_kinetic_defaults_to_static():
     np.testing.assert_array_equal(a.friction_torque, b.friction_torque)
     moving = np.abs(case["qd"]) > 1e-6
     assert moving.any()
-    np.testing.assert_allclose(a.friction_torque[moving], -case["static"][moving] * np.sign(case["qd"][moving]),
-                               rtol=1e-15, atol=0)
+    np.testing.assert_allclose(
+        a.friction_torque[moving], -case["static"][moving] * np.sign(case["qd"][moving]), rtol=1e-15, atol=0
+    )
 
 
 @pytest.mark.parametrize("tol", [1e-6, 1e-2])
@@ -754,10 +931,16 @@ def test_velocity_tolerance_boundary(tol):
     for qd in (np.array([tol, -1.5 * tol]), np.array([-tol, 1.5 * tol]), np.array([0.5 * tol, 0.0])):
         rc.model.gravity = pin.Motion(np.r_[g, 0.0, 0.0, 0.0])
         data = rc.data()
-        prob = pinocchio_problem(rc.model, data, q, qd, tau_ff=np.zeros(2), static=static, kinetic=kinetic,
-                                 velocity_tolerance=tol)
+        prob = pinocchio_problem(
+            rc.model, data, q, qd, tau_ff=np.zeros(2), static=static, kinetic=kinetic, velocity_tolerance=tol
+        )
         res = vs.Solver(rc.chain, gravity=g).solve(q, qd, friction=friction_arg(static, kinetic, tol))
         assert res.status[0] != MOVING
         assert (res.status[1] == MOVING) == (abs(qd[1]) > tol)
-        check_against_oracles(res, prob, lambda a, data=data, qd=qd: pin.rnea(rc.model, data, q, qd, a),
-                              oracles=both_oracles(prob), what=f"qd {qd}")
+        check_against_oracles(
+            res,
+            prob,
+            lambda a, data=data, qd=qd: pin.rnea(rc.model, data, q, qd, a),
+            oracles=both_oracles(prob),
+            what=f"qd {qd}",
+        )

@@ -18,6 +18,7 @@ Invalid inputs (wrong shapes, NaN/Inf, strings, ragged lists, None, bad chain pa
 Examples are derandomised so that CI is reproducible; the drawn seed and sizes are printed by
 hypothesis on failure.
 """
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, event, given, settings
@@ -26,15 +27,21 @@ from hypothesis import strategies as st
 import vereshchagin as vs
 from chains import random_alpha, random_chain, random_f_ext, random_state
 
-SETTINGS = settings(max_examples=60, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+SETTINGS = settings(
+    max_examples=60,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 
-chain_params = st.fixed_dictionaries({
-    "seed": st.integers(0, 2**32 - 1),
-    "n": st.integers(1, 8),
-    "prismatic": st.booleans(),
-    "fixed_prob": st.sampled_from([0.0, 0.2, 0.5]),
-})
+chain_params = st.fixed_dictionaries(
+    {
+        "seed": st.integers(0, 2**32 - 1),
+        "n": st.integers(1, 8),
+        "prismatic": st.booleans(),
+        "fixed_prob": st.sampled_from([0.0, 0.2, 0.5]),
+    }
+)
 
 
 def make(params):
@@ -69,8 +76,7 @@ def close(a, b, rtol):
 # Valid inputs
 # ------------------------------------------------------------------------------------------------
 @SETTINGS
-@given(params=chain_params, m=st.integers(0, 6), dependent=st.booleans(), damped=st.booleans(),
-       with_fext=st.booleans())
+@given(params=chain_params, m=st.integers(0, 6), dependent=st.booleans(), damped=st.booleans(), with_fext=st.booleans())
 def test_command_torques_reproduce_qdd(params, m, dependent, damped, with_fext):
     rng, rc = make(params)
     q, qd = random_state(rng, rc)
@@ -89,9 +95,14 @@ def test_command_torques_reproduce_qdd(params, m, dependent, damped, with_fext):
 
 
 @SETTINGS
-@given(params=chain_params, m=st.integers(0, 3), rest_mask=st.lists(st.booleans(), min_size=8, max_size=8),
-       friction_scale=st.sampled_from([0.0, 0.1, 1.0, 10.0, 1e6]), kinetic_ratio=st.floats(0.0, 1.0),
-       with_limits=st.booleans())
+@given(
+    params=chain_params,
+    m=st.integers(0, 3),
+    rest_mask=st.lists(st.booleans(), min_size=8, max_size=8),
+    friction_scale=st.sampled_from([0.0, 0.1, 1.0, 10.0, 1e6]),
+    kinetic_ratio=st.floats(0.0, 1.0),
+    with_limits=st.booleans(),
+)
 def test_friction_complementarity(params, m, rest_mask, friction_scale, kinetic_ratio, with_limits):
     rng, rc = make(params)
     n = rc.n_joints
@@ -125,7 +136,7 @@ def test_friction_complementarity(params, m, rest_mask, friction_scale, kinetic_
             assert f == pytest.approx(-fk[j] * np.sign(qd[j]), rel=1e-12, abs=0.0)
             continue
         assert abs(f) <= fs[j] * (1 + 1e-12)
-        if res.status[j] == 1:      # stick
+        if res.status[j] == 1:  # stick
             assert abs(qdd_j) <= 1e-9 * acc_scale
         elif res.limit_torque[j] == 0.0:  # slipping freely: full friction against the motion
             assert res.status[j] in (2, 3)
@@ -170,12 +181,19 @@ def test_power_balance(params, m):
 def junk(n_hint):
     floats = st.floats(allow_nan=True, allow_infinity=True)
     sizes = st.sampled_from([0, 1, n_hint - 1, n_hint, n_hint + 1, 6, 7])
-    arrays = st.builds(lambda k, data: np.asarray(data[:k] + [0.0] * max(0, k - len(data))),
-                       sizes, st.lists(floats, max_size=8))
+    arrays = st.builds(
+        lambda k, data: np.asarray(data[:k] + [0.0] * max(0, k - len(data))), sizes, st.lists(floats, max_size=8)
+    )
     matrices = st.builds(lambda r, c, x: np.full((r, c), x), sizes, sizes, floats)
-    return st.one_of(st.none(), floats, arrays, matrices, st.text(max_size=3),
-                     st.lists(st.lists(floats, max_size=3), max_size=3),  # possibly ragged
-                     st.sampled_from([object(), {"a": 1}, [None, 1.0], b"xy", True]))
+    return st.one_of(
+        st.none(),
+        floats,
+        arrays,
+        matrices,
+        st.text(max_size=3),
+        st.lists(st.lists(floats, max_size=3), max_size=3),  # possibly ragged
+        st.sampled_from([object(), {"a": 1}, [None, 1.0], b"xy", True]),
+    )
 
 
 @settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
@@ -189,8 +207,14 @@ def test_arbitrary_solve_arguments(data):
     args = {"q": q, "qd": qd, "alpha": None, "beta": None, "f_ext": None, "tau_ff": None}
     for name in data.draw(st.lists(st.sampled_from(sorted(args)), min_size=1, max_size=3, unique=True)):
         args[name] = data.draw(junk(n), label=name)
-    friction = data.draw(st.one_of(st.none(), st.just(True), st.fixed_dictionaries(
-        dict(static=junk(n), kinetic=junk(n), velocity_tolerance=junk(n)))), label="friction")
+    friction = data.draw(
+        st.one_of(
+            st.none(),
+            st.just(True),
+            st.fixed_dictionaries(dict(static=junk(n), kinetic=junk(n), velocity_tolerance=junk(n))),
+        ),
+        label="friction",
+    )
     try:  # a Friction with bad arrays raises when it is made, the solve when the sizes do not fit
         if isinstance(friction, dict):
             friction = vs.Friction(**friction)
@@ -209,11 +233,15 @@ def test_arbitrary_chain_parameters(data):
     chain = vs.Chain()
     num = st.one_of(st.floats(-1e3, 1e3), st.sampled_from([0.0, -0.0, 1e-300, 1e300, np.nan, np.inf, -1.0]))
     for k in range(data.draw(st.integers(1, 4))):
-        kw = dict(name=f"s{k}", joint=data.draw(st.sampled_from(["rot_x", "rot_z", "trans_y", "fixed", "bogus"])),
-                  mass=data.draw(num), rotor_inertia=data.draw(num),
-                  com=data.draw(st.lists(num, min_size=3, max_size=3)),
-                  inertia=np.diag(data.draw(st.lists(num, min_size=3, max_size=3))),
-                  tip=data.draw(st.sampled_from([None, np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0])])))
+        kw = dict(
+            name=f"s{k}",
+            joint=data.draw(st.sampled_from(["rot_x", "rot_z", "trans_y", "fixed", "bogus"])),
+            mass=data.draw(num),
+            rotor_inertia=data.draw(num),
+            com=data.draw(st.lists(num, min_size=3, max_size=3)),
+            inertia=np.diag(data.draw(st.lists(num, min_size=3, max_size=3))),
+            tip=data.draw(st.sampled_from([None, np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0])])),
+        )
         try:
             chain.add_segment(**kw)
         except vs.SolverError as e:

@@ -5,6 +5,7 @@ Oracles: Pinocchio (``aba`` on models with the same non-rigid-body inertias; the
 pass-through formula with ``crba``, ``rnea``, frame Jacobians and accelerations), the scipy primal
 and stick/slip enumeration oracles of tests/friction_oracles.py for friction on identified models.
 """
+
 from __future__ import annotations
 
 import copy
@@ -81,10 +82,19 @@ def test_indefinite_joint_space_inertia_fails_at_solve_naming_the_joint():
     c = vs.Chain()
     T = np.eye(4)
     T[0, 3] = 0.5
-    c.add_segment("upper", "rot_z", tip=T, mass=1.0, com=[-0.25, 0, 0], inertia=np.diag([1e-3, 2e-2, 2e-2]),
-                  joint_name="shoulder")
-    c.add_segment("forearm", "rot_y", tip=T, mass=1.0, com=[-0.25, 0, 0], inertia=np.diag([0.05, 0.05, -0.2]),
-                  joint_name="elbow", inertia_check="joint_space")
+    c.add_segment(
+        "upper", "rot_z", tip=T, mass=1.0, com=[-0.25, 0, 0], inertia=np.diag([1e-3, 2e-2, 2e-2]), joint_name="shoulder"
+    )
+    c.add_segment(
+        "forearm",
+        "rot_y",
+        tip=T,
+        mass=1.0,
+        com=[-0.25, 0, 0],
+        inertia=np.diag([0.05, 0.05, -0.2]),
+        joint_name="elbow",
+        inertia_check="joint_space",
+    )
     with pytest.raises(vs.SolverError, match="joint_space"):
         vs.Solver(c)
     solver = vs.Solver(c, inertia_check="joint_space")
@@ -117,8 +127,15 @@ def test_friction_on_identified_models_vs_scipy_and_enumeration(seed, monkeypatc
     m = int(rng.integers(0, 3))
     case = tfo.random_chain_case(rng, n, m, rest="mixed", friction="moderate")
     solver = vs.Solver(case["rc"].chain, gravity=case["g"], inertia_check="joint_space")
-    res = solver.solve(case["q"], case["qd"], alpha=case["alpha"], beta=case["beta"], f_ext=case["f_ext"],
-                       tau_ff=case["tau"], friction=tfo.friction_arg(case["static"], case["kinetic"], case["tol"]))
+    res = solver.solve(
+        case["q"],
+        case["qd"],
+        alpha=case["alpha"],
+        beta=case["beta"],
+        f_ext=case["f_ext"],
+        tau_ff=case["tau"],
+        friction=tfo.friction_arg(case["static"], case["kinetic"], case["tol"]),
+    )
     tfo._check_chain_case(case, res, f"identified seed {seed} n {n} m {m}")
 
 
@@ -160,21 +177,30 @@ def test_pass_through_random_chains_vs_dense_formula(seed):
     beta = rng.normal(size=m)
     p_f, p_t = rng.uniform(0, 1, m), rng.uniform(0, 1, m)
     p_f[0], p_t[-1] = 1.0, 0.0
-    res = solver.solve(q, qd, alpha=alpha, beta=beta, f_ext=f, tau_ff=tau, f_ext_pass_through=p_f,
-                       tau_ff_pass_through=p_t)
-    qdd, nu = dense_pass_through(rc.model, data, q, qd, tau, fext_generalized(rc, data, q, f), A, drift, beta,
-                                 p_f, p_t)
+    res = solver.solve(
+        q, qd, alpha=alpha, beta=beta, f_ext=f, tau_ff=tau, f_ext_pass_through=p_f, tau_ff_pass_through=p_t
+    )
+    qdd, nu = dense_pass_through(rc.model, data, q, qd, tau, fext_generalized(rc, data, q, f), A, drift, beta, p_f, p_t)
     assert_rel(res.qdd, qdd, "qdd", RTOL)
     assert_rel(res.nu, nu, "nu", RTOL)
     # zero weights are no weights, bit for bit; the weights do not outlive the call
     plain = solver.solve(q, qd, alpha=alpha, beta=beta, f_ext=f, tau_ff=tau)
-    zero = solver.solve(q, qd, alpha=alpha, beta=beta, f_ext=f, tau_ff=tau, f_ext_pass_through=np.zeros(m),
-                        tau_ff_pass_through=np.zeros(m))
+    zero = solver.solve(
+        q,
+        qd,
+        alpha=alpha,
+        beta=beta,
+        f_ext=f,
+        tau_ff=tau,
+        f_ext_pass_through=np.zeros(m),
+        tau_ff_pass_through=np.zeros(m),
+    )
     np.testing.assert_array_equal(zero.qdd, plain.qdd)
     np.testing.assert_array_equal(zero.nu, plain.nu)
     # the batch takes the weights per row too
-    batch = solver.solve_batch(np.array([q, q]), qd, alpha, beta, f, tau, f_ext_pass_through=np.array([p_f, 0 * p_f]),
-                               tau_ff_pass_through=p_t)
+    batch = solver.solve_batch(
+        np.array([q, q]), qd, alpha, beta, f, tau, f_ext_pass_through=np.array([p_f, 0 * p_f]), tau_ff_pass_through=p_t
+    )
     np.testing.assert_array_equal(batch.qdd[0], res.qdd)
 
 
@@ -202,8 +228,17 @@ def test_pass_through_robots_with_segment_constraints_vs_dense_formula(robot):
     J_elbow = pin.computeFrameJacobian(r.model, data, pq, r.model.getFrameId(elbow), LWA)
     beta = rng.normal(size=3)
     p_f, p_t = np.array([1.0, 0.3, 0.6]), np.array([0.0, 1.0, 0.5])
-    res = solver.solve(q, qd, alpha=a_tip, beta=beta[:2], f_ext={elbow: w}, tau_ff=tau,
-                       constraints={elbow: (a_elbow, beta[2])}, f_ext_pass_through=p_f, tau_ff_pass_through=p_t)
+    res = solver.solve(
+        q,
+        qd,
+        alpha=a_tip,
+        beta=beta[:2],
+        f_ext={elbow: w},
+        tau_ff=tau,
+        constraints={elbow: (a_elbow, beta[2])},
+        f_ext_pass_through=p_f,
+        tau_ff_pass_through=p_t,
+    )
     qdd, nu = dense_pass_through(r.model, data, pq, qd, tau, J_elbow.T @ w, A, drift, beta, p_f, p_t)
     assert_rel(res.qdd, qdd, "qdd", RTOL)
     assert_rel(res.nu, nu, "nu", RTOL)

@@ -12,6 +12,7 @@ Oracle relations used (all expected values come from Pinocchio or dense numpy li
 * Pinocchio's M ddq + b = tau + J^T lambda, so our nu (constraint wrench -alpha nu on the last
   segment, i.e. generalised force -A^T nu) equals -lambda.
 """
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -79,8 +80,20 @@ def _constrained_case(seed, m, fixed_prob=0.0, gravity="random"):
             beta = rng.normal(size=m) * 3.0
             f_ext = random_f_ext(rng, rc)
             tau = rng.normal(size=n) * 3.0
-            return dict(rc=rc, q=q, qd=qd, alpha=alpha, beta=beta, f_ext=f_ext, tau=tau, g=g, J=J, A=A,
-                        Minv=Minv, K=A @ Minv @ A.T)
+            return dict(
+                rc=rc,
+                q=q,
+                qd=qd,
+                alpha=alpha,
+                beta=beta,
+                f_ext=f_ext,
+                tau=tau,
+                g=g,
+                J=J,
+                A=A,
+                Minv=Minv,
+                K=A @ Minv @ A.T,
+            )
     raise AssertionError("no well-conditioned sample found")  # pragma: no cover
 
 
@@ -172,8 +185,9 @@ def test_revolute_origin_is_a_point_on_the_axis():
     q = 0) swings about the line through (d, 0, 0): inertia about the axis = Izz + m d^2."""
     d, mass, izz = 0.3, 2.0, 0.05
     chain = vs.Chain()
-    chain.add_segment("s", vs.Joint.revolute([0, 0, 1], [d, 0, 0]), tip=np.eye(4), mass=mass,
-                      inertia=np.diag([0.1, 0.12, izz]))
+    chain.add_segment(
+        "s", vs.Joint.revolute([0, 0, 1], [d, 0, 0]), tip=np.eye(4), mass=mass, inertia=np.diag([0.1, 0.12, izz])
+    )
     solver = vs.Solver(chain, gravity=[0, 0, 0])
     for q in (0.0, 0.7, -2.0):
         res = solver.solve([q], [0.0], tau_ff=[1.5])
@@ -194,8 +208,16 @@ def test_prismatic_origin_has_no_effect():
     rng = np.random.default_rng(99)
     rc = random_chain(rng, 5, prismatic=False)
     segs = list(rc.segments)
-    base = SegmentSpec("prismatic", np.array([0.6, 0.0, 0.8]), np.zeros(3), homogeneous(rot_axis(np.array([1.0, 0, 0]), 0.4), [0.1, 0.2, 0.3]),
-                       1.5, np.array([0.1, 0.0, 0.0]), np.diag([0.1, 0.2, 0.25]), 0.1)
+    base = SegmentSpec(
+        "prismatic",
+        np.array([0.6, 0.0, 0.8]),
+        np.zeros(3),
+        homogeneous(rot_axis(np.array([1.0, 0, 0]), 0.4), [0.1, 0.2, 0.3]),
+        1.5,
+        np.array([0.1, 0.0, 0.0]),
+        np.diag([0.1, 0.2, 0.25]),
+        0.1,
+    )
     shifted = SegmentSpec(**{**base.__dict__, "origin": np.array([0.5, -0.4, 0.3])})
     a = build(segs[:2] + [base] + segs[2:])
     b = build(segs[:2] + [shifted] + segs[2:])
@@ -252,8 +274,9 @@ def test_unconstrained_with_empty_alpha_is_plain_forward_dynamics(seed):
 @pytest.mark.parametrize("m", range(1, 7))
 @pytest.mark.parametrize("seed", range(12))
 def test_constrained_matches_forward_dynamics(seed, m):
-    case = _constrained_case(seed, m, fixed_prob=0.25 if seed % 3 == 0 else 0.0,
-                             gravity=["zero", "earth", "random"][seed % 3])
+    case = _constrained_case(
+        seed, m, fixed_prob=0.25 if seed % 3 == 0 else 0.0, gravity=["zero", "earth", "random"][seed % 3]
+    )
     rc, q, qd, g = case["rc"], case["q"], case["qd"], case["g"]
     solver = rc.solver(g)
     res = solver.solve(q, qd, case["alpha"], case["beta"], f_ext=case["f_ext"], tau_ff=case["tau"])
@@ -278,8 +301,16 @@ def test_tau_command_reproduces_qdd(seed, m):
         rng = np.random.default_rng([seed, 3])
         rc = random_chain(rng, int(rng.integers(1, 11)))
         q, qd = random_state(rng, rc)
-        case = dict(rc=rc, q=q, qd=qd, alpha=None, beta=None, f_ext=random_f_ext(rng, rc),
-                    tau=rng.normal(size=rc.n_joints), g=G_EARTH)
+        case = dict(
+            rc=rc,
+            q=q,
+            qd=qd,
+            alpha=None,
+            beta=None,
+            f_ext=random_f_ext(rng, rc),
+            tau=rng.normal(size=rc.n_joints),
+            g=G_EARTH,
+        )
     else:
         case = _constrained_case(seed + 100, m, fixed_prob=0.2, gravity="earth")
     rc, q, qd = case["rc"], case["q"], case["qd"]
@@ -308,8 +339,18 @@ def test_response_columns_dense(seed, m):
         rc = random_chain(rng, int(rng.integers(1, 11)), fixed_prob=0.2)
         q, qd = random_state(rng, rc)
         data = rc.data()
-        case = dict(rc=rc, q=q, qd=qd, alpha=None, beta=None, f_ext=None, tau=rng.normal(size=rc.n_joints),
-                    g=G_EARTH, A=np.zeros((0, rc.n_joints)), Minv=_mass_matrix_inverse(rc, data, q))
+        case = dict(
+            rc=rc,
+            q=q,
+            qd=qd,
+            alpha=None,
+            beta=None,
+            f_ext=None,
+            tau=rng.normal(size=rc.n_joints),
+            g=G_EARTH,
+            A=np.zeros((0, rc.n_joints)),
+            Minv=_mass_matrix_inverse(rc, data, q),
+        )
     else:
         case = _constrained_case(seed + 200, m, fixed_prob=0.2)
     rc, q, qd, n = case["rc"], case["q"], case["qd"], case["rc"].n_joints

@@ -1,5 +1,6 @@
 """Every public class, function, method, property and field has a docstring, and the stubs match
 the runtime (mypy's stubtest)."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -17,8 +18,10 @@ import vereshchagin as vs
 
 ROOT = Path(__file__).resolve().parents[1]
 # Modules whose public names are API: the package, its submodules and subpackages.
-MODULES = sorted({"vereshchagin"} | {m.name for m in pkgutil.walk_packages(vs.__path__, "vereshchagin.")
-                                     if not m.name.split(".")[-1].startswith("_")})
+MODULES = sorted(
+    {"vereshchagin"}
+    | {m.name for m in pkgutil.walk_packages(vs.__path__, "vereshchagin.") if not m.name.split(".")[-1].startswith("_")}
+)
 
 
 def _public(obj):
@@ -102,9 +105,23 @@ def test_every_public_object_has_a_docstring():
     assert not missing, "public objects without a docstring:\n  " + "\n  ".join(missing)
 
 
-@pytest.mark.parametrize("name", ["qdd", "tau_command", "nu", "link_acc", "constraint_rank", "smallest_singular_value",
-                                  "friction_torque", "limit_torque", "status", "gauss_value", "iterations",
-                                  "segment_nu"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "qdd",
+        "tau_command",
+        "nu",
+        "link_acc",
+        "constraint_rank",
+        "smallest_singular_value",
+        "friction_torque",
+        "limit_torque",
+        "status",
+        "gauss_value",
+        "iterations",
+        "segment_nu",
+    ],
+)
 def test_solve_result_fields_say_shape_and_units(name):
     doc = inspect.getdoc(getattr(vs.SolveResult, name))
     assert doc and len(doc) > 40, f"SolveResult.{name}: {doc!r}"
@@ -115,13 +132,33 @@ def test_solve_has_a_full_docstring_and_signature():
     for section in ("Parameters", "Returns", "Raises", "alpha", "beta", "f_ext", "friction", "constraints", "out"):
         assert section in doc, section
     params = list(inspect.signature(vs.Solver.solve).parameters)
-    assert params == ["self", "q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
-                      "f_ext_pass_through", "tau_ff_pass_through", "out"]
+    assert params == [
+        "self",
+        "q",
+        "qd",
+        "alpha",
+        "beta",
+        "f_ext",
+        "tau_ff",
+        "friction",
+        "constraints",
+        "f_ext_pass_through",
+        "tau_ff_pass_through",
+        "out",
+    ]
 
 
 def test_stubs_match_the_runtime():
     """mypy's stubtest over the installed package (allowlist: pybind11's metaclass and the like)."""
-    cmd = [sys.executable, "-m", "mypy.stubtest", "vereshchagin", "--mypy-config-file", str(ROOT / "pyproject.toml"),
-           "--allowlist", str(ROOT / "tests" / "stubtest_allowlist.txt")]
+    cmd = [
+        sys.executable,
+        "-m",
+        "mypy.stubtest",
+        "vereshchagin",
+        "--mypy-config-file",
+        str(ROOT / "pyproject.toml"),
+        "--allowlist",
+        str(ROOT / "tests" / "stubtest_allowlist.txt"),
+    ]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT / "tests", timeout=600)
     assert proc.returncode == 0, proc.stdout[-6000:] + proc.stderr[-2000:]

@@ -6,6 +6,7 @@ pytest can import PyKDL, the checks of tests/pykdl_checks.py run in-process; oth
 here, i.e. on the very extension module under test (CPython 3.11 on both sides). A missing PyKDL
 is a failure, not a skip: .ci/setup installs python3-pykdl and python3-numpy.
 """
+
 from __future__ import annotations
 
 import os
@@ -45,13 +46,16 @@ def test_from_kdl_to_kdl_against_debian_pykdl(tmp_path):
         return
     probe = subprocess.run([SYSTEM_PYTHON, "-c", "import PyKDL, numpy"], capture_output=True, text=True)
     if probe.returncode != 0:
-        pytest.fail(f"Debian's PyKDL is not importable by {SYSTEM_PYTHON} (apt-get install python3-pykdl "
-                    f"python3-numpy; .ci/setup does it):\n{probe.stderr}")
+        pytest.fail(
+            f"Debian's PyKDL is not importable by {SYSTEM_PYTHON} (apt-get install python3-pykdl "
+            f"python3-numpy; .ci/setup does it):\n{probe.stderr}"
+        )
     package = Path(vs.__file__).parent
     shutil.copytree(package, tmp_path / "vereshchagin", ignore=shutil.ignore_patterns("__pycache__"))
     env = {"PATH": os.environ.get("PATH", "/usr/bin:/bin"), "PYTHONPATH": str(tmp_path), "PYTHONNOUSERSITE": "1"}
-    run = subprocess.run([SYSTEM_PYTHON, str(CHECKS), *_urdfs()], capture_output=True, text=True, env=env,
-                         cwd=tmp_path, timeout=600)
+    run = subprocess.run(
+        [SYSTEM_PYTHON, str(CHECKS), *_urdfs()], capture_output=True, text=True, env=env, cwd=tmp_path, timeout=600
+    )
     assert run.returncode == 0, f"{SYSTEM_PYTHON} {CHECKS.name} failed:\n{run.stdout}\n{run.stderr}"
     assert "PYKDL CHECKS PASSED" in run.stdout
     print(run.stdout)

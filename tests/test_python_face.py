@@ -6,6 +6,7 @@ Expected values come from Pinocchio (frames merged into segments, held joints), 
 documented equivalences between argument forms (scalar vs (1,) beta, dict vs array f_ext, batch
 row vs single solve: bit for bit), or from finite differences of the friction-aware solve.
 """
+
 from __future__ import annotations
 
 import copy
@@ -68,10 +69,18 @@ def test_scalar_beta_and_one_dimensional_alpha():
     assert_error(lambda: solver.solve(q, qd, alpha=random_alpha(rng, 2), beta=4.0), "beta", "(2,)")
 
 
-@pytest.mark.parametrize("bad,what", [
-    (np.array(["1"] * 6), "dtype"), (np.ones(6, dtype=bool), "dtype"), (np.ones(6, dtype=complex), "dtype"),
-    (np.array([object()] * 6), "dtype"), ("abcdef", "real"), (True, "bool"), ([1, "a", 3, 4, 5, 6], "real"),
-])
+@pytest.mark.parametrize(
+    "bad,what",
+    [
+        (np.array(["1"] * 6), "dtype"),
+        (np.ones(6, dtype=bool), "dtype"),
+        (np.ones(6, dtype=complex), "dtype"),
+        (np.array([object()] * 6), "dtype"),
+        ("abcdef", "real"),
+        (True, "bool"),
+        ([1, "a", 3, 4, 5, 6], "real"),
+    ],
+)
 def test_non_numeric_arrays_are_rejected(bad, what):
     rng, rc, solver = arm(n=6)
     q, qd = random_state(rng, rc)
@@ -148,12 +157,20 @@ def test_batch_with_friction_and_constraints_equals_solve_bitwise(threads):
     a_mid = np.array([random_alpha(rng, 1) for _ in range(B)])
     b_mid = rng.normal(size=B)  # (B,) for m_i = 1
     frs = [vs.Friction(static=rng.uniform(0, 2, n)) if b % 3 else None for b in range(B)]
-    batch = solver.solve_batch(Q, QD, a_end, b_end, None, tau, friction=frs,
-                               constraints={mid: (a_mid, b_mid)}, threads=threads)
+    batch = solver.solve_batch(
+        Q, QD, a_end, b_end, None, tau, friction=frs, constraints={mid: (a_mid, b_mid)}, threads=threads
+    )
     ref = vs.Solver(rc.chain)
     for b in range(B):
-        r = ref.solve(Q[b], QD[b], alpha=a_end, beta=b_end[b], tau_ff=tau[b], friction=frs[b],
-                      constraints={mid: (a_mid[b], b_mid[b])})
+        r = ref.solve(
+            Q[b],
+            QD[b],
+            alpha=a_end,
+            beta=b_end[b],
+            tau_ff=tau[b],
+            friction=frs[b],
+            constraints={mid: (a_mid[b], b_mid[b])},
+        )
         got = fields(batch, b)
         for k, v in fields(r).items():
             if v is None:
@@ -291,8 +308,9 @@ def test_constraints_on_merged_links_match_pinocchio(panda, links):
         pin.forwardKinematics(r.model, data, pq, qd, np.zeros(r.model.nv))
         pin.updateFramePlacements(r.model, data)
         fids = [r.model.getFrameId(name) for name in links]
-        drift = np.concatenate([a.T @ (pin.getFrameAcceleration(r.model, data, fid, LWA).vector + GRAV)
-                                for fid, a in zip(fids, alphas)])
+        drift = np.concatenate(
+            [a.T @ (pin.getFrameAcceleration(r.model, data, fid, LWA).vector + GRAV) for fid, a in zip(fids, alphas)]
+        )
         A = np.vstack([a.T @ pin.computeFrameJacobian(r.model, data, pq, fid, LWA) for fid, a in zip(fids, alphas)])
         if not well_conditioned_task(A, _minv(r.model, data, pq)):
             continue
@@ -394,8 +412,9 @@ def _child_solve(payload):
 def test_pickle_and_deepcopy_round_trip_and_solve_in_a_child_process(panda):
     chain = panda.chain
     solver = vs.Solver(chain, gravity=[0.1, 0.0, -9.7], rcond=1e-10, damping=1e-5)
-    fr = vs.Friction(static=np.full(chain.n_joints, 0.4), kinetic=np.full(chain.n_joints, 0.3),
-                     lower=chain.lower, upper=chain.upper)
+    fr = vs.Friction(
+        static=np.full(chain.n_joints, 0.4), kinetic=np.full(chain.n_joints, 0.3), lower=chain.lower, upper=chain.upper
+    )
     q, qd = panda.random_state(np.random.default_rng(5))
     qd[::2] = 0.0
     args = (q, qd)
@@ -427,9 +446,10 @@ def test_pickle_and_deepcopy_round_trip_and_solve_in_a_child_process(panda):
 # ------------------------------------------------------------------------------------------------
 # Optional parts: the CLI names the extra to install instead of a traceback
 # ------------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("case,module,extra", [("contact", "mujoco", "experiments"),
-                                               ("friction", "matplotlib", "experiments"),
-                                               ("all", "mujoco", "experiments")])
+@pytest.mark.parametrize(
+    "case,module,extra",
+    [("contact", "mujoco", "experiments"), ("friction", "matplotlib", "experiments"), ("all", "mujoco", "experiments")],
+)
 def test_cli_names_the_extra_when_an_optional_package_is_missing(case, module, extra, tmp_path):
     import subprocess
     import sys
@@ -447,7 +467,8 @@ def test_cli_names_the_extra_when_an_optional_package_is_missing(case, module, e
         "_orig = importlib.util.find_spec\n"
         f"importlib.util.find_spec = lambda n, *a: None if n == {module!r} else _orig(n, *a)\n"
         "from vereshchagin.__main__ import main\n"
-        f"sys.exit(main(['reproduce', '--quick', '--case', {case!r}, '--out', {str(tmp_path)!r}]))\n")
+        f"sys.exit(main(['reproduce', '--quick', '--case', {case!r}, '--out', {str(tmp_path)!r}]))\n"
+    )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2, proc.stdout + proc.stderr
     assert f"vereshchagin[{extra}]" in proc.stderr and "Traceback" not in proc.stderr, proc.stderr

@@ -3,6 +3,7 @@ configurations, duplicated or linearly dependent constraint directions, zero-mas
 segments, extreme scales (masses 1e-6..1e4 kg, lengths 1e-4..1e2 m), velocities at the at-rest
 tolerance and friction of 0 or very large. Every success is also checked physically: the
 command torques reproduce qdd through an unconstrained solve."""
+
 import numpy as np
 import pytest
 
@@ -32,8 +33,14 @@ def scaled_arm(n, mass, length):
     r = 0.1 * length
     for k in range(n):
         inertia = np.diag([mass * r * r / 2] + [mass * (3 * r * r + length * length) / 12] * 2)
-        chain.add_segment(f"l{k}", "rot_y" if k % 2 == 0 else "rot_z", tip=homogeneous(None, [length, 0, 0]),
-                          mass=mass, com=[-length / 2, 0, 0], inertia=inertia)
+        chain.add_segment(
+            f"l{k}",
+            "rot_y" if k % 2 == 0 else "rot_z",
+            tip=homogeneous(None, [length, 0, 0]),
+            mass=mass,
+            com=[-length / 2, 0, 0],
+            inertia=inertia,
+        )
     return chain
 
 
@@ -44,7 +51,7 @@ def test_singular_configuration_full_task(damping):
     kw = {} if damping is None else dict(damping=damping)
     res = vs.Solver(chain, **kw).solve(np.zeros(7), np.zeros(7), alpha=np.eye(6), beta=np.arange(6.0))
     finite(res)
-    assert res.constraint_rank < 6           # the diagnostic
+    assert res.constraint_rank < 6  # the diagnostic
     assert res.smallest_singular_value < 1e-10
     reproduces(chain, np.zeros(7), np.zeros(7), res)
 
@@ -82,7 +89,7 @@ def test_zero_mass_distal_segments():
 def test_extreme_scales(mass, length):
     chain = scaled_arm(6, mass, length)
     q, qd = np.linspace(0.3, -1.2, 6), np.linspace(0.5, -0.5, 6)
-    tau = np.linspace(1.0, -1.0, 6) * mass * length ** 2
+    tau = np.linspace(1.0, -1.0, 6) * mass * length**2
     res = vs.Solver(chain).solve(q, qd, alpha=np.eye(6)[:, [2, 4]], beta=[9.81, 0.0], tau_ff=tau)
     finite(res)
     assert res.constraint_rank == 2
@@ -134,8 +141,12 @@ def test_chain_without_moving_joints(fixed_segments):
     for k in range(fixed_segments):
         chain.add_segment(f"plate{k}", vs.Joint.fixed(), tip=homogeneous(None, [0, 0, 0.1]), mass=1.0)
     solver = vs.Solver(chain)
-    for kw in (dict(), dict(friction=vs.Friction(static=np.zeros(0))), dict(friction=True),
-               dict(alpha=np.eye(6)[:, [2]], beta=[1.0], friction=vs.Friction(static=[]))):
+    for kw in (
+        dict(),
+        dict(friction=vs.Friction(static=np.zeros(0))),
+        dict(friction=True),
+        dict(alpha=np.eye(6)[:, [2]], beta=[1.0], friction=vs.Friction(static=[])),
+    ):
         res = solver.solve(np.zeros(0), np.zeros(0), **kw)
         finite(res)
         assert res.qdd.shape == (0,)
@@ -151,8 +162,8 @@ def test_one_huge_friction_bound_does_not_mask_the_others(huge):
     fs = np.r_[huge, np.full(6, 0.05)]
     res = vs.Solver(chain).solve(q, qd, friction=vs.Friction(static=fs))
     finite(res)
-    assert res.status[0] == 1                      # the huge one sticks
+    assert res.status[0] == 1  # the huge one sticks
     slipping = np.isin(res.status, (2, 3))
-    assert slipping.any()                          # 0.05 N m cannot hold this arm against gravity
+    assert slipping.any()  # 0.05 N m cannot hold this arm against gravity
     np.testing.assert_allclose(res.friction_torque[slipping], -fs[slipping] * np.sign(res.qdd[slipping]), rtol=1e-9)
     reproduces(chain, q, qd, res, tau_ff=res.friction_torque)

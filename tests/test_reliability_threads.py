@@ -2,6 +2,7 @@
 separate solver instances used from 4 Python threads at once (the GIL is released during the
 C++ solve) give bit-identical results to sequential use, and the same inputs give bit-identical
 outputs across calls and instances. (test_api.py covers the plain frictionless solve.)"""
+
 import threading
 
 import numpy as np
@@ -19,7 +20,7 @@ def workload(seed, count=12):
     calls = []
     for k in range(count):
         q, qd = random_state(rng, rc)
-        qd[rng.random(n) < 0.5] = 0.0   # resting joints for friction
+        qd[rng.random(n) < 0.5] = 0.0  # resting joints for friction
         m = k % 4
         alpha = random_alpha(rng, m) if m else None
         beta = rng.normal(size=m) if m else None
@@ -81,8 +82,10 @@ def test_four_threads_share_one_chain():
     reference = run(rc, calls, batch)
     barrier = threading.Barrier(THREADS)
     results = [None] * THREADS
-    threads = [threading.Thread(target=lambda i=i: results.__setitem__(i, run(rc, calls, batch, barrier)))
-               for i in range(THREADS)]
+    threads = [
+        threading.Thread(target=lambda i=i: results.__setitem__(i, run(rc, calls, batch, barrier)))
+        for i in range(THREADS)
+    ]
     for t in threads:
         t.start()
     for t in threads:
@@ -94,7 +97,7 @@ def test_four_threads_share_one_chain():
 def test_bit_identical_across_calls_and_instances():
     rc, calls, batch = workload(500)
     first = run(rc, calls, batch)
-    again = run(rc, calls, batch)                 # another instance
+    again = run(rc, calls, batch)  # another instance
     for a, b in zip(first, again):
         assert np.array_equal(a, b)
     # the same instance, interleaved with other inputs, then repeated

@@ -8,6 +8,7 @@ qdd = 0); ``nu = -lambda`` in the same row order. Also: ``pin.aba(tau_ff + tau_c
 accelerations; the static-friction max-min with mid-chain constraints against the scipy primal
 oracle and the stick/slip enumeration (tests/friction_oracles.py).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -23,11 +24,20 @@ from test_urdf_pinocchio import BUILDERS, G, LWA, _minv, _with_rotors, assert_re
 GRAV = np.r_[-G, 0.0, 0.0, 0.0]  # the base's acceleration [-g; 0] that beta includes
 # Two- and three-segment sets per robot, each with an elbow-plus-tool case first.
 SEGMENT_SETS = {
-    "panda": [("panda_link4", "panda_hand"), ("panda_link2", "panda_link5"),
-              ("panda_link3", "panda_link5", "panda_hand")],
-    "gen3_gripper": [("forearm_link", "end_effector_link"), ("half_arm_1_link", "spherical_wrist_1_link"),
-                     ("half_arm_2_link", "forearm_link", "end_effector_link")],
-    "gen3_bare": [("forearm_link", "end_effector_link"), ("shoulder_link", "spherical_wrist_2_link", "end_effector_link")],
+    "panda": [
+        ("panda_link4", "panda_hand"),
+        ("panda_link2", "panda_link5"),
+        ("panda_link3", "panda_link5", "panda_hand"),
+    ],
+    "gen3_gripper": [
+        ("forearm_link", "end_effector_link"),
+        ("half_arm_1_link", "spherical_wrist_1_link"),
+        ("half_arm_2_link", "forearm_link", "end_effector_link"),
+    ],
+    "gen3_bare": [
+        ("forearm_link", "end_effector_link"),
+        ("shoulder_link", "spherical_wrist_2_link", "end_effector_link"),
+    ],
 }
 
 
@@ -36,8 +46,9 @@ def _segment_rows(r, data, pq, qd, names, alphas):
     pin.forwardKinematics(r.model, data, pq, qd, np.zeros(r.model.nv))
     pin.updateFramePlacements(r.model, data)
     fids = [r.model.getFrameId(name) for name in names]
-    drift = [alpha.T @ (pin.getFrameAcceleration(r.model, data, fid, LWA).vector + GRAV)
-             for fid, alpha in zip(fids, alphas)]
+    drift = [
+        alpha.T @ (pin.getFrameAcceleration(r.model, data, fid, LWA).vector + GRAV) for fid, alpha in zip(fids, alphas)
+    ]
     jacs = [pin.computeFrameJacobian(r.model, data, pq, fid, LWA) for fid in fids]
     rows = [alpha.T @ J for J, alpha in zip(jacs, alphas)]
     return np.vstack(rows), np.concatenate(drift), jacs
@@ -130,7 +141,9 @@ def test_end_alpha_combines_with_segment_constraints():
     a_tool, b_tool = np.eye(6)[:, :3], np.array([0.1, -0.2, 9.81])
     a_elbow, b_elbow = np.eye(6)[:, 2:3], np.array([9.81])
     both = solver.solve(q, qd, a_tool, b_tool, constraints={"forearm_link": (a_elbow, b_elbow)})
-    dict_only = solver.solve(q, qd, constraints={"end_effector_link": (a_tool, b_tool), "forearm_link": (a_elbow, b_elbow)})
+    dict_only = solver.solve(
+        q, qd, constraints={"end_effector_link": (a_tool, b_tool), "forearm_link": (a_elbow, b_elbow)}
+    )
     np.testing.assert_allclose(both.qdd, dict_only.qdd, rtol=0, atol=1e-12)
     np.testing.assert_allclose(both.nu, dict_only.nu, rtol=0, atol=1e-12)
     assert both.segment_nu.keys() == {"forearm_link"}
@@ -138,7 +151,9 @@ def test_end_alpha_combines_with_segment_constraints():
     assert list(dict_only.segment_nu) == ["end_effector_link", "forearm_link"]
     np.testing.assert_array_equal(dict_only.segment_nu["end_effector_link"], dict_only.nu[:3])
     assert solver.solve(q, qd, a_tool, b_tool).segment_nu is None  # no constraints=, no split
-    reordered = solver.solve(q, qd, constraints={"forearm_link": (a_elbow, b_elbow), "end_effector_link": (a_tool, b_tool)})
+    reordered = solver.solve(
+        q, qd, constraints={"forearm_link": (a_elbow, b_elbow), "end_effector_link": (a_tool, b_tool)}
+    )
     np.testing.assert_allclose(reordered.nu, np.r_[dict_only.nu[3:], dict_only.nu[:3]], rtol=0, atol=1e-12)
     # the elbow constraint changes the motion (it is not ignored)
     tool_only = solver.solve(q, qd, a_tool, b_tool)
@@ -152,8 +167,14 @@ def test_conflicting_segment_constraints_are_finite_with_rank():
     for damping in (None, 1e-6):
         solver = vs.Solver(r.chain, damping=damping)
         q, qd = r.random_state(rng)
-        res = solver.solve(q, qd, constraints={"forearm_link": (np.eye(6), rng.normal(size=6)),
-                                               "end_effector_link": (np.eye(6), rng.normal(size=6))})
+        res = solver.solve(
+            q,
+            qd,
+            constraints={
+                "forearm_link": (np.eye(6), rng.normal(size=6)),
+                "end_effector_link": (np.eye(6), rng.normal(size=6)),
+            },
+        )
         for field in ("qdd", "tau_command", "nu", "link_acc"):
             assert np.all(np.isfinite(getattr(res, field))), field
         assert res.nu.shape == (12,)
@@ -208,15 +229,32 @@ def test_friction_with_mid_chain_constraints_vs_oracles(seed):
         betas = [rng.normal(size=a.shape[1]) for a in alphas]
         tau = rng.normal(size=r.chain.n_joints) * 2.0
         static = rng.uniform(0.0, 3.0, r.chain.n_joints)
-        res = solver.solve(q, qd, tau_ff=tau, friction=vs.Friction(static=static),
-                           constraints={n: (a, b) for n, a, b in zip(names, alphas, betas)})
+        res = solver.solve(
+            q,
+            qd,
+            tau_ff=tau,
+            friction=vs.Friction(static=static),
+            constraints={n: (a, b) for n, a, b in zip(names, alphas, betas)},
+        )
         H = np.array(pin.crba(r.model, data, pq))
         H = np.triu(H) + np.triu(H, 1).T
         qdd_free = np.array(pin.aba(r.model, data, pq, qd, tau))
-        prob = FrictionProblem(H, qdd_free, A, np.concatenate(betas) - drift, np.ones(r.chain.n_joints, bool), static,
-                               extra=dict(tau_ff=tau))
+        prob = FrictionProblem(
+            H,
+            qdd_free,
+            A,
+            np.concatenate(betas) - drift,
+            np.ones(r.chain.n_joints, bool),
+            static,
+            extra=dict(tau_ff=tau),
+        )
         oracles = {"scipy": scipy_oracle(prob), "enumeration": enumeration_oracle(prob)}
-        check_against_oracles(res, prob, lambda a, pq=pq, qd=qd: pin.rnea(r.model, data, pq, qd, a), oracles=oracles,
-                              what=f"{r.name} {names} seed {seed}")
+        check_against_oracles(
+            res,
+            prob,
+            lambda a, pq=pq, qd=qd: pin.rnea(r.model, data, pq, qd, a),
+            oracles=oracles,
+            what=f"{r.name} {names} seed {seed}",
+        )
         return
     raise AssertionError("no well-conditioned sample found")

@@ -4,6 +4,7 @@ Oracles: Pinocchio's classical frame acceleration (``getFrameClassicalAccelerati
 LOCAL_WORLD_ALIGNED) of the tip link after our ``qdd``; scipy's Rotation for rotation vectors;
 hand-written numpy for directions and small examples.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -143,8 +144,9 @@ def test_task_class_solves_for_the_classical_acceleration():
     rng = np.random.default_rng(23)
     R = random_rotation(rng)
     task = Task(["x", "z", "ry"], R)
-    np.testing.assert_allclose(task.alpha, np.c_[np.r_[R[:, 0], 0, 0, 0], np.r_[R[:, 2], 0, 0, 0],
-                                                np.r_[0, 0, 0, R[:, 1]]], atol=1e-15)
+    np.testing.assert_allclose(
+        task.alpha, np.c_[np.r_[R[:, 0], 0, 0, 0], np.r_[R[:, 2], 0, 0, 0], np.r_[0, 0, 0, R[:, 1]]], atol=1e-15
+    )
     q, qd = r.random_state(rng)
     a_des = rng.normal(size=6)
     res = task.solve(r.solver, r.chain, q, qd, a_des, tau_ff=np.ones(7))
@@ -159,8 +161,9 @@ def test_beta_for_by_hand():
     alpha = np.eye(6)
     expected = np.array([0.5 + 2.0, -1.0, 0.25 + 9.81, 0.1, 0.2, 0.3])
     np.testing.assert_allclose(beta_for(alpha, a, twist), expected, rtol=1e-15)
-    np.testing.assert_allclose(beta_for(alpha, a, twist, gravity=[1.0, 0.0, 0.0]), expected - [1.0, 0, 9.81, 0, 0, 0],
-                               rtol=1e-15)
+    np.testing.assert_allclose(
+        beta_for(alpha, a, twist, gravity=[1.0, 0.0, 0.0]), expected - [1.0, 0, 9.81, 0, 0, 0], rtol=1e-15
+    )
     # a single (6,) direction, tilted 45 degrees in the x-z plane
     d = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0]) / np.sqrt(2.0)
     np.testing.assert_allclose(beta_for(d, a, twist), [(2.5 + 10.06) / np.sqrt(2.0)], rtol=1e-15)
@@ -196,8 +199,9 @@ def test_directions_in_a_rotated_frame(seed):
             np.testing.assert_allclose(a[:, k], np.r_[R[:, k], 0, 0, 0], atol=1e-15)
             np.testing.assert_allclose(a[:, 3 + k], np.r_[0, 0, 0, R[:, k]], atol=1e-15)
         w = rng.normal(size=6)
-        np.testing.assert_allclose(directions([w], frame)[:, 0], np.r_[R @ w[:3], R @ w[3:]] / np.linalg.norm(w),
-                                   atol=1e-15)
+        np.testing.assert_allclose(
+            directions([w], frame)[:, 0], np.r_[R @ w[:3], R @ w[3:]] / np.linalg.norm(w), atol=1e-15
+        )
     # a direction along the frame's z axis, 90 degrees about base x: base -y
     Rx = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
     np.testing.assert_allclose(directions("z", Rx)[:, 0], [0, -1.0, 0, 0, 0, 0], atol=1e-16)
@@ -238,8 +242,9 @@ def test_pose_error_matches_scipy(seed):
     np.testing.assert_allclose(Rotation.from_rotvec(e[3:]).as_matrix() @ Tc[:3, :3], Td[:3, :3], atol=1e-12)
 
 
-@pytest.mark.parametrize("angle", [0.0, 1e-14, 1e-9, 1e-6, 1e-3, 0.5, 2.0, np.pi - 1e-3, np.pi - 1e-6,
-                                   np.pi - 1e-9, np.pi - 1e-12, np.pi])
+@pytest.mark.parametrize(
+    "angle", [0.0, 1e-14, 1e-9, 1e-6, 1e-3, 0.5, 2.0, np.pi - 1e-3, np.pi - 1e-6, np.pi - 1e-9, np.pi - 1e-12, np.pi]
+)
 @pytest.mark.parametrize("seed", range(4))
 def test_pose_error_small_and_near_pi(angle, seed):
     rng = np.random.default_rng([seed, 31])
@@ -268,8 +273,9 @@ def test_pose_error_by_hand():
     np.testing.assert_allclose(pose_error(Tc, Td), [0.5, 0, -1.0, 0, 0, np.pi / 2], atol=1e-15)
     # the rotation error is about base axes: with Rc = Rx(90), Rd = Rz(90) Rx(90) the error is about base z
     Rx = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
-    np.testing.assert_allclose(pose_error(_T(Rx, np.zeros(3)), _T(Rz @ Rx, np.zeros(3)))[3:], [0, 0, np.pi / 2],
-                               atol=1e-15)
+    np.testing.assert_allclose(
+        pose_error(_T(Rx, np.zeros(3)), _T(Rz @ Rx, np.zeros(3)))[3:], [0, 0, np.pi / 2], atol=1e-15
+    )
     with pytest.raises(ValueError):
         pose_error(np.eye(3), np.eye(4))
 

@@ -7,6 +7,7 @@ joint origin, at rest and without gravity, qdd = tau / (u^T I_O u) with I_O the 
 about the joint origin; with gravity g and tau = 0, qdd = u . (c x m g) / (u^T I_O u)). A few
 multi-joint checks use Pinocchio's URDF reader as the oracle.
 """
+
 from __future__ import annotations
 
 from xml.etree import ElementTree
@@ -90,14 +91,25 @@ def link(name, mass=None, com=(0, 0, 0), com_rpy=(0, 0, 0), inertia=None):
     if mass is None:
         return f'<link name="{name}"/>'
     I = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, float)
-    return (f'<link name="{name}"><inertial><origin xyz="{vec(com)}" rpy="{vec(com_rpy)}"/>'
-            f'<mass value="{float(mass)!r}"/><inertia ixx="{float(I[0, 0])!r}" ixy="{float(I[0, 1])!r}" '
-            f'ixz="{float(I[0, 2])!r}" iyy="{float(I[1, 1])!r}" iyz="{float(I[1, 2])!r}" '
-            f'izz="{float(I[2, 2])!r}"/></inertial></link>')
+    return (
+        f'<link name="{name}"><inertial><origin xyz="{vec(com)}" rpy="{vec(com_rpy)}"/>'
+        f'<mass value="{float(mass)!r}"/><inertia ixx="{float(I[0, 0])!r}" ixy="{float(I[0, 1])!r}" '
+        f'ixz="{float(I[0, 2])!r}" iyy="{float(I[1, 1])!r}" iyz="{float(I[1, 2])!r}" '
+        f'izz="{float(I[2, 2])!r}"/></inertial></link>'
+    )
 
 
-def joint(name, kind, parent, child, xyz=(0, 0, 0), rpy=(0, 0, 0), axis=(0, 0, 1), extra="",
-          limit='<limit lower="-3" upper="3" effort="10" velocity="2"/>'):
+def joint(
+    name,
+    kind,
+    parent,
+    child,
+    xyz=(0, 0, 0),
+    rpy=(0, 0, 0),
+    axis=(0, 0, 1),
+    extra="",
+    limit='<limit lower="-3" upper="3" effort="10" velocity="2"/>',
+):
     body = f'<parent link="{parent}"/><child link="{child}"/><origin xyz="{vec(xyz)}" rpy="{vec(rpy)}"/>'
     if kind == "continuous" and "lower" in limit:
         limit = '<limit effort="10" velocity="2"/>'
@@ -106,8 +118,24 @@ def joint(name, kind, parent, child, xyz=(0, 0, 0), rpy=(0, 0, 0), axis=(0, 0, 1
     return f'<joint name="{name}" type="{kind}">{body}{extra}</joint>'
 
 
-_NUMERIC = {"xyz", "rpy", "value", "ixx", "ixy", "ixz", "iyy", "iyz", "izz", "lower", "upper", "effort",
-            "velocity", "damping", "friction", "multiplier"}
+_NUMERIC = {
+    "xyz",
+    "rpy",
+    "value",
+    "ixx",
+    "ixy",
+    "ixz",
+    "iyy",
+    "iyz",
+    "izz",
+    "lower",
+    "upper",
+    "effort",
+    "velocity",
+    "damping",
+    "friction",
+    "multiplier",
+}
 
 
 def robot(*parts):
@@ -147,9 +175,13 @@ def _two_link_case(axis, seed=0):
     l2 = dict(mass=1.5, com=(0.01, 0.03, -0.04), com_rpy=(-0.5, 0.1, 0.9), inertia=inertia_matrix(rng))
     j1 = dict(xyz=(0.1, 0.2, 0.3), rpy=(0.3, -0.2, 0.5))
     fx = dict(xyz=(0.0, 0.15, 0.25), rpy=(1.0, 0.2, -0.7))
-    text = robot(link("base"), link("l1", **l1), link("l2", **l2),
-                 joint("j1", "revolute", "base", "l1", axis=axis, **j1),
-                 joint("weld", "fixed", "l1", "l2", **fx))
+    text = robot(
+        link("base"),
+        link("l1", **l1),
+        link("l2", **l2),
+        joint("j1", "revolute", "base", "l1", axis=axis, **j1),
+        joint("weld", "fixed", "l1", "l2", **fx),
+    )
     # Hand: everything in the l1 (joint) frame.
     b1 = body_in(pose(l1["com"], l1["com_rpy"]), l1["mass"], (0, 0, 0), l1["inertia"])
     b2 = body_in(pose(fx["xyz"], fx["rpy"]) @ pose(l2["com"], l2["com_rpy"]), l2["mass"], (0, 0, 0), l2["inertia"])
@@ -187,11 +219,11 @@ def test_merged_frames_and_any_axis(axis):
     for q in (0.0, 0.8, -2.5):
         T_l1 = h["T_joint"] @ rot4(axis, q)
         T_l2 = T_l1 @ h["T_fixed"]
-        np.testing.assert_allclose(chain.fk([q]), T_l2, atol=1e-14)           # tip = l2's frame
+        np.testing.assert_allclose(chain.fk([q]), T_l2, atol=1e-14)  # tip = l2's frame
         np.testing.assert_allclose(chain.fk([q], "l2"), T_l2, atol=1e-14)
-        np.testing.assert_allclose(chain.fk([q], "l1"), T_l1, atol=1e-14)     # merged link
+        np.testing.assert_allclose(chain.fk([q], "l1"), T_l1, atol=1e-14)  # merged link
         np.testing.assert_allclose(chain.fk([q], "base"), np.eye(4), atol=0)
-        w = T_l1[:3, :3] @ (np.asarray(axis, float) / np.linalg.norm(axis))   # axis in base axes
+        w = T_l1[:3, :3] @ (np.asarray(axis, float) / np.linalg.norm(axis))  # axis in base axes
         for name, T in (("l1", T_l1), ("l2", T_l2)):
             r = T[:3, 3] - h["T_joint"][:3, 3]
             np.testing.assert_allclose(chain.jacobian([q], name)[:, 0], np.r_[np.cross(w, r), w], atol=1e-14)
@@ -200,16 +232,25 @@ def test_merged_frames_and_any_axis(axis):
 
 def test_fixed_subtree_beyond_the_tip_is_merged():
     rng = np.random.default_rng(5)
-    L = {k: dict(mass=m, com=rng.uniform(-0.1, 0.1, 3), inertia=inertia_matrix(rng))
-         for k, m in (("a", 1.0), ("b", 0.5), ("c", 0.25), ("d", 0.75), ("e", 0.4))}
-    fb, fc, fd, je = pose((0, 0, 0.2), (0.3, 0, 0)), pose((0.1, 0, 0.05), (0, 0.5, 0)), \
-        pose((0, -0.1, 0), (0, 0, 1.2)), pose((0.05, 0.05, 0), (0.1, 0.2, 0.3))
-    text = robot(link("base"), *(link(k, **v) for k, v in L.items()),
-                 joint("ja", "revolute", "base", "a", xyz=(0, 0, 0.1), axis=(1, 0, 0)),
-                 joint("fb", "fixed", "a", "b", xyz=fb[:3, 3], rpy=(0.3, 0, 0)),
-                 joint("fc", "fixed", "b", "c", xyz=fc[:3, 3], rpy=(0, 0.5, 0)),
-                 joint("fd", "fixed", "a", "d", xyz=fd[:3, 3], rpy=(0, 0, 1.2)),
-                 joint("je", "revolute", "d", "e", xyz=je[:3, 3], rpy=(0.1, 0.2, 0.3), axis=(0, 1, 0)))
+    L = {
+        k: dict(mass=m, com=rng.uniform(-0.1, 0.1, 3), inertia=inertia_matrix(rng))
+        for k, m in (("a", 1.0), ("b", 0.5), ("c", 0.25), ("d", 0.75), ("e", 0.4))
+    }
+    fb, fc, fd, je = (
+        pose((0, 0, 0.2), (0.3, 0, 0)),
+        pose((0.1, 0, 0.05), (0, 0.5, 0)),
+        pose((0, -0.1, 0), (0, 0, 1.2)),
+        pose((0.05, 0.05, 0), (0.1, 0.2, 0.3)),
+    )
+    text = robot(
+        link("base"),
+        *(link(k, **v) for k, v in L.items()),
+        joint("ja", "revolute", "base", "a", xyz=(0, 0, 0.1), axis=(1, 0, 0)),
+        joint("fb", "fixed", "a", "b", xyz=fb[:3, 3], rpy=(0.3, 0, 0)),
+        joint("fc", "fixed", "b", "c", xyz=fc[:3, 3], rpy=(0, 0.5, 0)),
+        joint("fd", "fixed", "a", "d", xyz=fd[:3, 3], rpy=(0, 0, 1.2)),
+        joint("je", "revolute", "d", "e", xyz=je[:3, 3], rpy=(0.1, 0.2, 0.3), axis=(0, 1, 0)),
+    )
     chain = vs.Chain.from_urdf(text, tip="a")
     assert chain.n_joints == 1 and chain.segment_names == ["a"]
     assert chain.segment_masses[0] == pytest.approx(2.9, rel=1e-14)
@@ -232,14 +273,17 @@ def test_fixed_joints_between_moving_joints_and_before_the_first():
     """base -fixed-> mount -rev-> a -fixed-> b -rev-> c: two segments, tip frames b and c; the
     second joint's axis is in b's frame. Checked against Pinocchio at random states."""
     rng = np.random.default_rng(8)
-    parts = [link("base", 3.0, inertia=np.eye(3)), link("mount"),
-             link("a", 1.2, (0.1, 0, 0), inertia=inertia_matrix(rng)),
-             link("b", 0.7, (0, 0.05, 0.02), (0.3, 0.1, 0.2), inertia_matrix(rng)),
-             link("c", 0.9, (0.02, 0.0, 0.1), inertia=inertia_matrix(rng)),
-             joint("f0", "fixed", "base", "mount", (0.0, 0.1, 0.2), (0.1, 0.0, 0.4)),
-             joint("j1", "revolute", "mount", "a", (0.0, 0.0, 0.1), (0.0, 0.3, 0.0), axis=(0, 1, 1)),
-             joint("f1", "fixed", "a", "b", (0.3, 0.0, 0.0), (0.0, 0.0, 0.5)),
-             joint("j2", "continuous", "b", "c", (0.0, 0.2, 0.0), (0.2, 0.0, 0.0), axis=(1, 0, 0.5))]
+    parts = [
+        link("base", 3.0, inertia=np.eye(3)),
+        link("mount"),
+        link("a", 1.2, (0.1, 0, 0), inertia=inertia_matrix(rng)),
+        link("b", 0.7, (0, 0.05, 0.02), (0.3, 0.1, 0.2), inertia_matrix(rng)),
+        link("c", 0.9, (0.02, 0.0, 0.1), inertia=inertia_matrix(rng)),
+        joint("f0", "fixed", "base", "mount", (0.0, 0.1, 0.2), (0.1, 0.0, 0.4)),
+        joint("j1", "revolute", "mount", "a", (0.0, 0.0, 0.1), (0.0, 0.3, 0.0), axis=(0, 1, 1)),
+        joint("f1", "fixed", "a", "b", (0.3, 0.0, 0.0), (0.0, 0.0, 0.5)),
+        joint("j2", "continuous", "b", "c", (0.0, 0.2, 0.0), (0.2, 0.0, 0.0), axis=(1, 0, 0.5)),
+    ]
     text = robot(*parts)
     chain = vs.Chain.from_urdf(text)
     assert chain.segment_names == ["b", "c"]
@@ -255,8 +299,9 @@ def test_fixed_joints_between_moving_joints_and_before_the_first():
         qd = rng.normal(size=2)
         tau = rng.normal(size=2)
         pq = np.array([q[0], np.cos(q[1]), np.sin(q[1])])
-        np.testing.assert_allclose(solver.solve(q, qd, tau_ff=tau).qdd, pin.aba(model, data, pq, qd, tau),
-                                   rtol=1e-10, atol=1e-10)
+        np.testing.assert_allclose(
+            solver.solve(q, qd, tau_ff=tau).qdd, pin.aba(model, data, pq, qd, tau), rtol=1e-10, atol=1e-10
+        )
         pin.framesForwardKinematics(model, data, pq)
         for name in ("mount", "a", "b", "c"):
             np.testing.assert_allclose(chain.fk(q, name), data.oMf[model.getFrameId(name)].homogeneous, atol=1e-14)
@@ -269,19 +314,30 @@ def test_prismatic_joint_any_axis():
     axis = np.array([1.0, -2.0, 0.5])
     u = axis / np.linalg.norm(axis)
     rpy, xyz = (0.4, -0.3, 1.1), (0.2, 0.0, 0.5)
-    text = robot(link("base"), link("slider", 2.5, (0.1, 0.2, 0.0), inertia=np.diag([0.1, 0.2, 0.3])),
-                 joint("p", "prismatic", "base", "slider", xyz, rpy, axis,
-                       limit='<limit lower="-0.2" upper="0.4" effort="50" velocity="0.5"/>',
-                       extra='<dynamics damping="3.5" friction="1.25"/>'))
+    text = robot(
+        link("base"),
+        link("slider", 2.5, (0.1, 0.2, 0.0), inertia=np.diag([0.1, 0.2, 0.3])),
+        joint(
+            "p",
+            "prismatic",
+            "base",
+            "slider",
+            xyz,
+            rpy,
+            axis,
+            limit='<limit lower="-0.2" upper="0.4" effort="50" velocity="0.5"/>',
+            extra='<dynamics damping="3.5" friction="1.25"/>',
+        ),
+    )
     chain = vs.Chain.from_urdf(text)
     assert chain.joint_types == ["prismatic"]
     w = rpy_matrix(rpy) @ u  # axis in base axes
     for q in (-0.2, 0.0, 0.33):
         np.testing.assert_allclose(chain.fk([q]), trans4(w * q) @ pose(xyz, rpy), atol=1e-14)
         np.testing.assert_allclose(chain.jacobian([q])[:, 0], np.r_[w, 0, 0, 0], atol=1e-15)
-    assert qdd_one_joint(chain, [0, 0, 0], tau=5.0) == pytest.approx(2.0, rel=1e-12)       # tau / m
+    assert qdd_one_joint(chain, [0, 0, 0], tau=5.0) == pytest.approx(2.0, rel=1e-12)  # tau / m
     g = np.array([0.5, 1.0, -9.81])
-    assert qdd_one_joint(chain, g, q=0.1) == pytest.approx(w @ g, rel=1e-12)               # free fall
+    assert qdd_one_joint(chain, g, q=0.1) == pytest.approx(w @ g, rel=1e-12)  # free fall
     np.testing.assert_array_equal(chain.lower, [-0.2])
     np.testing.assert_array_equal(chain.upper, [0.4])
     np.testing.assert_array_equal(chain.velocity_limit, [0.5])
@@ -291,8 +347,11 @@ def test_prismatic_joint_any_axis():
 
 
 def test_continuous_joint_has_no_position_limits():
-    text = robot(link("base"), link("a", 1.0, inertia=np.eye(3) * 0.1),
-                 joint("c", "continuous", "base", "a", limit='<limit effort="7" velocity="3"/>'))
+    text = robot(
+        link("base"),
+        link("a", 1.0, inertia=np.eye(3) * 0.1),
+        joint("c", "continuous", "base", "a", limit='<limit effort="7" velocity="3"/>'),
+    )
     chain = vs.Chain.from_urdf(text)
     assert chain.joint_types == ["continuous"]
     np.testing.assert_array_equal(chain.lower, [-np.inf])
@@ -308,19 +367,29 @@ def test_continuous_joint_has_no_position_limits():
 # Root and tip
 # ------------------------------------------------------------------------------------------------
 def _tree():
-    return robot(link("world"), link("base", 1.0, inertia=np.eye(3)), link("a", 1.0, inertia=np.eye(3) * 0.1),
-                 link("b1", 0.5, inertia=np.eye(3) * 0.1), link("b2", 0.6, inertia=np.eye(3) * 0.1),
-                 link("c1", 0.2, inertia=np.eye(3) * 0.1),
-                 joint("fw", "fixed", "world", "base", (0, 0, 1.0)),
-                 joint("ja", "revolute", "base", "a", (0, 0, 0.3)),
-                 joint("jb1", "revolute", "a", "b1", (0.2, 0, 0), axis=(0, 1, 0)),
-                 joint("jb2", "revolute", "a", "b2", (-0.2, 0, 0), axis=(0, 1, 0)),
-                 joint("jc1", "prismatic", "b1", "c1", (0, 0, 0.2), axis=(0, 0, 1)))
+    return robot(
+        link("world"),
+        link("base", 1.0, inertia=np.eye(3)),
+        link("a", 1.0, inertia=np.eye(3) * 0.1),
+        link("b1", 0.5, inertia=np.eye(3) * 0.1),
+        link("b2", 0.6, inertia=np.eye(3) * 0.1),
+        link("c1", 0.2, inertia=np.eye(3) * 0.1),
+        joint("fw", "fixed", "world", "base", (0, 0, 1.0)),
+        joint("ja", "revolute", "base", "a", (0, 0, 0.3)),
+        joint("jb1", "revolute", "a", "b1", (0.2, 0, 0), axis=(0, 1, 0)),
+        joint("jb2", "revolute", "a", "b2", (-0.2, 0, 0), axis=(0, 1, 0)),
+        joint("jc1", "prismatic", "b1", "c1", (0, 0, 0.2), axis=(0, 0, 1)),
+    )
 
 
 def test_default_root_and_tip():
-    text = robot(link("r"), link("a", 1.0, inertia=np.eye(3)), link("b", 1.0, inertia=np.eye(3)),
-                 joint("j1", "revolute", "r", "a"), joint("j2", "revolute", "a", "b", (0, 0, 0.5), axis=(1, 0, 0)))
+    text = robot(
+        link("r"),
+        link("a", 1.0, inertia=np.eye(3)),
+        link("b", 1.0, inertia=np.eye(3)),
+        joint("j1", "revolute", "r", "a"),
+        joint("j2", "revolute", "a", "b", (0, 0, 0.5), axis=(1, 0, 0)),
+    )
     chain = vs.Chain.from_urdf(text)
     assert chain.root_link == "r"
     assert chain.segment_names == ["a", "b"]
@@ -365,18 +434,20 @@ def test_root_in_the_middle():
 # ------------------------------------------------------------------------------------------------
 def _simple(kind="revolute", extra="", mass=1.0, inertia=None, second=True):
     I = np.eye(3) * 0.1 if inertia is None else inertia
-    parts = [link("base"), link("a", mass, inertia=I),
-             joint("j", kind, "base", "a", extra=extra)]
+    parts = [link("base"), link("a", mass, inertia=I), joint("j", kind, "base", "a", extra=extra)]
     if second:
         parts += [link("b", 1.0, inertia=np.eye(3) * 0.1), joint("k", "revolute", "a", "b", axis=(1, 0, 0))]
     return robot(*parts)
 
 
-@pytest.mark.parametrize("text, words", [
-    ("<robot name='r'><link name='a'></robot>", ["malformed"]),
-    ("<robot name='r'><link name='a'/><joint name='j' type='revolute'>", ["malformed"]),
-    ("<notarobot/>", ["malformed"]),
-])
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ("<robot name='r'><link name='a'></robot>", ["malformed"]),
+        ("<robot name='r'><link name='a'/><joint name='j' type='revolute'>", ["malformed"]),
+        ("<notarobot/>", ["malformed"]),
+    ],
+)
 def test_malformed_xml(text, words):
     with pytest.raises(vs.SolverError) as info:
         vs.Chain.from_urdf(text)
@@ -384,12 +455,15 @@ def test_malformed_xml(text, words):
         assert w in str(info.value).lower()
 
 
-@pytest.mark.parametrize("root, tip, words", [
-    ("nowhere", "", ["root", "nowhere", "not found"]),
-    ("", "nowhere", ["tip", "nowhere", "not found"]),
-    ("b1", "b2", ["b2", "b1", "not below"]),
-    ("c1", "a", ["a", "c1", "not below"]),
-])
+@pytest.mark.parametrize(
+    "root, tip, words",
+    [
+        ("nowhere", "", ["root", "nowhere", "not found"]),
+        ("", "nowhere", ["tip", "nowhere", "not found"]),
+        ("b1", "b2", ["b2", "b1", "not below"]),
+        ("c1", "a", ["a", "c1", "not below"]),
+    ],
+)
 def test_bad_root_or_tip(root, tip, words):
     with pytest.raises(vs.SolverError) as info:
         vs.Chain.from_urdf(_tree(), root=root, tip=tip)
@@ -424,8 +498,13 @@ def test_inertia_not_positive_semidefinite(inertia):
 
 
 def test_bad_inertial_beyond_the_tip_is_reported_too():
-    text = robot(link("base"), link("a", 1.0, inertia=np.eye(3) * 0.1), link("x", -1.0, inertia=np.eye(3)),
-                 joint("j", "revolute", "base", "a"), joint("f", "fixed", "a", "x"))
+    text = robot(
+        link("base"),
+        link("a", 1.0, inertia=np.eye(3) * 0.1),
+        link("x", -1.0, inertia=np.eye(3)),
+        joint("j", "revolute", "base", "a"),
+        joint("f", "fixed", "a", "x"),
+    )
     with pytest.raises(vs.SolverError, match="negative mass"):
         vs.Chain.from_urdf(text, tip="a")
 

@@ -15,6 +15,7 @@ Every expected value comes from Pinocchio (see tests/test_pinocchio_oracle.py fo
 * fk / jacobian / twist = frame placement / LWA frame Jacobian / LWA frame velocity;
 * limits, friction and damping = the model's vectors.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -67,9 +68,21 @@ def _panda():
     lock = [full.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
     model = pin.buildReducedModel(full, lock, pin.neutral(full))
     chain = vs.Chain.from_urdf(path, tip="panda_hand")
-    return Robot("panda", chain, model, "panda_hand",
-                 ("panda_link8", "panda_link7", "panda_link3", "panda_hand_tcp", "panda_leftfinger",
-                  "panda_rightfinger", "panda_link0"))
+    return Robot(
+        "panda",
+        chain,
+        model,
+        "panda_hand",
+        (
+            "panda_link8",
+            "panda_link7",
+            "panda_link3",
+            "panda_hand_tcp",
+            "panda_leftfinger",
+            "panda_rightfinger",
+            "panda_link0",
+        ),
+    )
 
 
 def _ur5(tip):
@@ -139,8 +152,11 @@ def test_gen3_gripper_mass_is_on_the_last_segment():
 LIMIT_CASES = {
     "panda": _panda,
     "ur5_tool0": lambda: _ur5("tool0"),
-    "gen3_dyn": lambda: _gen3(True, joint_friction=[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7],
-                              joint_damping=[0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07]),
+    "gen3_dyn": lambda: _gen3(
+        True,
+        joint_friction=[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7],
+        joint_damping=[0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07],
+    ),
     "gen3_cable": lambda: _gen3(False, use_external_cable=True, joint_friction=0.25, joint_damping=0.5),
 }
 

@@ -152,7 +152,8 @@ std::string exerciseChain(const KDL::Chain& chain, ByteReader& r, const Eigen::V
       Eigen::VectorXd tau0 = ff;
       for (unsigned int k = 0; k < n; ++k)
         if (std::abs(qd(k)) > fm.velocity_tolerance)
-          tau0(k) -= (fm.kinetic_friction.size() ? fm.kinetic_friction(k) : fm.static_friction(k)) * (qd(k) > 0 ? 1 : -1);
+          tau0(k) -=
+              (fm.kinetic_friction.size() ? fm.kinetic_friction(k) : fm.static_friction(k)) * (qd(k) > 0 ? 1 : -1);
       ChainHdSolver free(chain, root_acc, opt);
       const int free_rc = free.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), fext, tau0);
       // Or the value itself is beyond the double range: its terms (friction or torque times
@@ -179,12 +180,18 @@ std::string exerciseChain(const KDL::Chain& chain, ByteReader& r, const Eigen::V
 KDL::Joint drawJoint(ByteReader& r, const std::string& name) {
   const double rotor = r.byte() < 128 ? 0.0 : r.value(0.0, 0.5);
   switch (r.integer(0, 8)) {
-    case 0: return KDL::Joint(name, KDL::Joint::RotX, 1.0, 0.0, rotor);
-    case 1: return KDL::Joint(name, KDL::Joint::RotY, 1.0, 0.0, rotor);
-    case 2: return KDL::Joint(name, KDL::Joint::RotZ, 1.0, 0.0, rotor);
-    case 3: return KDL::Joint(name, KDL::Joint::TransX, 1.0, 0.0, rotor);
-    case 4: return KDL::Joint(name, KDL::Joint::TransY, 1.0, 0.0, rotor);
-    case 5: return KDL::Joint(name, KDL::Joint::TransZ, 1.0, 0.0, rotor);
+    case 0:
+      return KDL::Joint(name, KDL::Joint::RotX, 1.0, 0.0, rotor);
+    case 1:
+      return KDL::Joint(name, KDL::Joint::RotY, 1.0, 0.0, rotor);
+    case 2:
+      return KDL::Joint(name, KDL::Joint::RotZ, 1.0, 0.0, rotor);
+    case 3:
+      return KDL::Joint(name, KDL::Joint::TransX, 1.0, 0.0, rotor);
+    case 4:
+      return KDL::Joint(name, KDL::Joint::TransY, 1.0, 0.0, rotor);
+    case 5:
+      return KDL::Joint(name, KDL::Joint::TransZ, 1.0, 0.0, rotor);
     case 6:
     case 7: {
       const KDL::Vector origin(r.value(-0.5, 0.5), r.value(-0.5, 0.5), r.value(-0.5, 0.5));
@@ -192,7 +199,8 @@ KDL::Joint drawJoint(ByteReader& r, const std::string& name) {
       return KDL::Joint(name, origin, axis, r.byte() & 1 ? KDL::Joint::RotAxis : KDL::Joint::TransAxis, 1.0, 0.0,
                         rotor);
     }
-    default: return KDL::Joint(name, KDL::Joint::Fixed);
+    default:
+      return KDL::Joint(name, KDL::Joint::Fixed);
   }
 }
 

@@ -23,7 +23,9 @@ namespace vereshchagin {
 
 namespace {
 
-bool allFinite(const Eigen::Ref<const Eigen::MatrixXd>& m) { return m.allFinite(); }
+bool allFinite(const Eigen::Ref<const Eigen::MatrixXd>& m) {
+  return m.allFinite();
+}
 
 Pose toPose(const KDL::Frame& f) {
   Pose X;
@@ -36,8 +38,7 @@ Pose toPose(const KDL::Frame& f) {
 
 }  // namespace
 
-ChainHdSolver::ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc,
-                             const SolverOptions& options)
+ChainHdSolver::ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
     : chain_(chain), options_(options) {
   setRootAcceleration(root_acc);
   buildModel();
@@ -47,7 +48,9 @@ ChainHdSolver::ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc
   }
 }
 
-void ChainHdSolver::updateInternalDataStructures() { buildModel(); }
+void ChainHdSolver::updateInternalDataStructures() {
+  buildModel();
+}
 
 void ChainHdSolver::setRootAcceleration(const KDL::Twist& root_acc) {
   for (int k = 0; k < 3; ++k) {
@@ -62,8 +65,7 @@ int ChainHdSolver::setOptions(const SolverOptions& options) {
   }
   if (!std::isfinite(options.damping) || options.damping < 0.0 ||
       (options.policy == SingularityPolicy::DampedLeastSquares && options.damping <= 0.0)) {
-    return fail(E_INVALID_OPTIONS,
-                "options.damping must be finite and > 0 for the damped least-squares policy, got %g",
+    return fail(E_INVALID_OPTIONS, "options.damping must be finite and > 0 for the damped least-squares policy, got %g",
                 options.damping);
   }
   const bool rebuild = options.inertia_check != options_.inertia_check;
@@ -87,14 +89,22 @@ int ChainHdSolver::fail(int code, const char* fmt, ...) {
 
 const char* ChainHdSolver::strError(const int code) const {
   switch (code) {
-    case E_NONFINITE_INPUT: return "An input contains NaN or Inf";
-    case E_INVALID_MODEL: return "The chain's physical parameters are invalid";
-    case E_DEGENERATE_INERTIA: return "A joint has zero articulated inertia";
-    case E_TOO_MANY_CONSTRAINTS: return "More than 6 constraints on one segment";
-    case E_NO_SOLUTION: return "No successful solve to take the response from";
-    case E_INVALID_OPTIONS: return "Invalid solver options";
-    case E_NONFINITE_RESULT: return "The results overflow (inputs too large)";
-    default: return KDL::SolverI::strError(code);
+    case E_NONFINITE_INPUT:
+      return "An input contains NaN or Inf";
+    case E_INVALID_MODEL:
+      return "The chain's physical parameters are invalid";
+    case E_DEGENERATE_INERTIA:
+      return "A joint has zero articulated inertia";
+    case E_TOO_MANY_CONSTRAINTS:
+      return "More than 6 constraints on one segment";
+    case E_NO_SOLUTION:
+      return "No successful solve to take the response from";
+    case E_INVALID_OPTIONS:
+      return "Invalid solver options";
+    case E_NONFINITE_RESULT:
+      return "The results overflow (inputs too large)";
+    default:
+      return KDL::SolverI::strError(code);
   }
 }
 
@@ -158,8 +168,8 @@ void ChainHdSolver::buildModel() {
     Vector3 c(cog.x(), cog.y(), cog.z());
     Matrix3 I_origin = Eigen::Map<const Matrix3>(Io.data);
     if (!c.allFinite()) {
-      model_error_ = fail(E_INVALID_MODEL, "segment %u ('%s'): non-finite inertial parameters", i,
-                          seg.getName().c_str());
+      model_error_ =
+          fail(E_INVALID_MODEL, "segment %u ('%s'): non-finite inertial parameters", i, seg.getName().c_str());
       return;
     }
     // Rotational inertia about the centre of mass, checked as options_.inertia_check says.
@@ -171,8 +181,8 @@ void ChainHdSolver::buildModel() {
       return;
     }
     s.I = rigidInertia(mass, c, 0.5 * (I_origin + I_origin.transpose()));
-    scale += I_com.cwiseAbs().trace() + mass * (c.squaredNorm() + seg.getFrameToTip().p.Norm() *
-                                                           seg.getFrameToTip().p.Norm());
+    scale += I_com.cwiseAbs().trace() +
+             mass * (c.squaredNorm() + seg.getFrameToTip().p.Norm() * seg.getFrameToTip().p.Norm());
     s.X0 = toPose(seg.pose(0.0));
     if (joint.getType() == KDL::Joint::Fixed) {
       s.joint = -1;
@@ -182,13 +192,13 @@ void ChainHdSolver::buildModel() {
       s.joint = static_cast<int>(j++);
       s.rotor = joint.getInertia();
       if (!std::isfinite(s.rotor) || s.rotor < 0.0) {
-        model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): rotor inertia must be >= 0, got %g",
-                            s.joint, joint.getName().c_str(), s.rotor);
+        model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): rotor inertia must be >= 0, got %g", s.joint,
+                            joint.getName().c_str(), s.rotor);
         return;
       }
       scale += s.rotor;
       // The joint axis is fixed in the child body, so in the tip frame it does not depend on q.
-      const KDL::Twist t = seg.twist(0.0, 1.0);           // root axes, tip reference point
+      const KDL::Twist t = seg.twist(0.0, 1.0);            // root axes, tip reference point
       const KDL::Rotation Rt = seg.pose(0.0).M.Inverse();  // root axes -> tip axes
       const KDL::Vector v = Rt * t.vel, w = Rt * t.rot;
       s.S << v.x(), v.y(), v.z(), w.x(), w.y(), w.z();
@@ -196,8 +206,8 @@ void ChainHdSolver::buildModel() {
       s.v2 = s.S.head<3>().squaredNorm();
       s.w2 = s.S.tail<3>().squaredNorm();
       if (!s.S.allFinite() || s.S.norm() == 0.0) {
-        model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite",
-                            s.joint, joint.getName().c_str());
+        model_error_ = fail(E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite", s.joint,
+                            joint.getName().c_str());
         return;
       }
     }
@@ -215,10 +225,8 @@ void ChainHdSolver::buildModel() {
 }
 
 int ChainHdSolver::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q,
-                               const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-                               const Eigen::Ref<const Matrix6X>& alfa,
-                               const Eigen::Ref<const Eigen::VectorXd>& beta,
-                               const Eigen::Ref<const Matrix6X>& f_ext,
+                               const Eigen::Ref<const Eigen::VectorXd>& q_dot, const Eigen::Ref<const Matrix6X>& alfa,
+                               const Eigen::Ref<const Eigen::VectorXd>& beta, const Eigen::Ref<const Matrix6X>& f_ext,
                                const Eigen::Ref<const Eigen::VectorXd>& ff_torques, int max_columns) {
   if (model_error_ != E_NOERROR) {
     error = model_error_;
@@ -229,17 +237,15 @@ int ChainHdSolver::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (q_dot.size() != nj)
     return fail(E_SIZE_MISMATCH, "q_dot has %ld entries, expected %ld (joints)", (long)q_dot.size(), nj);
   if (ff_torques.size() != nj && ff_torques.size() != 0)
-    return fail(E_SIZE_MISMATCH, "ff_torques has %ld entries, expected %ld (joints) or 0",
-                (long)ff_torques.size(), nj);
+    return fail(E_SIZE_MISMATCH, "ff_torques has %ld entries, expected %ld (joints) or 0", (long)ff_torques.size(), nj);
   if (f_ext.cols() != ns && f_ext.cols() != 0)
-    return fail(E_SIZE_MISMATCH, "f_ext has %ld wrenches, expected %ld (segments) or 0",
-                (long)f_ext.cols(), ns);
+    return fail(E_SIZE_MISMATCH, "f_ext has %ld wrenches, expected %ld (segments) or 0", (long)f_ext.cols(), ns);
   if (alfa.cols() > max_columns)
-    return fail(E_TOO_MANY_CONSTRAINTS, "alfa has %ld columns, at most %d constraints are supported",
-                (long)alfa.cols(), max_columns);
+    return fail(E_TOO_MANY_CONSTRAINTS, "alfa has %ld columns, at most %d constraints are supported", (long)alfa.cols(),
+                max_columns);
   if (beta.size() != alfa.cols())
-    return fail(E_SIZE_MISMATCH, "beta has %ld entries, expected %ld (one per alfa column)",
-                (long)beta.size(), (long)alfa.cols());
+    return fail(E_SIZE_MISMATCH, "beta has %ld entries, expected %ld (one per alfa column)", (long)beta.size(),
+                (long)alfa.cols());
   if (!allFinite(q)) return fail(E_NONFINITE_INPUT, "q contains NaN or Inf");
   if (!allFinite(q_dot)) return fail(E_NONFINITE_INPUT, "q_dot contains NaN or Inf");
   if (!allFinite(ff_torques)) return fail(E_NONFINITE_INPUT, "ff_torques contains NaN or Inf");
@@ -318,13 +324,20 @@ void ChainHdSolver::outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q,
 int ChainHdSolver::inwardSweep(const Eigen::Ref<const Matrix6X>& alfa,
                                const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   switch (alfa.cols()) {
-    case 0: return inwardSweepT<0>(alfa, ff_torques);
-    case 1: return inwardSweepT<1>(alfa, ff_torques);
-    case 2: return inwardSweepT<2>(alfa, ff_torques);
-    case 3: return inwardSweepT<3>(alfa, ff_torques);
-    case 4: return inwardSweepT<4>(alfa, ff_torques);
-    case 5: return inwardSweepT<5>(alfa, ff_torques);
-    default: return inwardSweepT<6>(alfa, ff_torques);
+    case 0:
+      return inwardSweepT<0>(alfa, ff_torques);
+    case 1:
+      return inwardSweepT<1>(alfa, ff_torques);
+    case 2:
+      return inwardSweepT<2>(alfa, ff_torques);
+    case 3:
+      return inwardSweepT<3>(alfa, ff_torques);
+    case 4:
+      return inwardSweepT<4>(alfa, ff_torques);
+    case 5:
+      return inwardSweepT<5>(alfa, ff_torques);
+    default:
+      return inwardSweepT<6>(alfa, ff_torques);
   }
 }
 
@@ -362,7 +375,8 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
         // |e_c| = |v.f_c + w.n_c| <= |v||f_c| + |w||n_c|, so sum_c e_c^2 <= 2 (|v|^2 |F|^2 +
         // |w|^2 |N|^2): a bound in consistent units (|S|^2 |A|^2 would mix N with N m and
         // inflate at small lengths), without square roots in the sweep.
-        kappa += 2.0 * s.Dinv * (s.v2 * A.template topRows<3>().squaredNorm() + s.w2 * A.template bottomRows<3>().squaredNorm());
+        kappa += 2.0 * s.Dinv *
+                 (s.v2 * A.template topRows<3>().squaredNorm() + s.w2 * A.template bottomRows<3>().squaredNorm());
         Aproj = A;
         Aproj.noalias() -= s.Dinv * s.u * e;
       }
@@ -401,14 +415,17 @@ int ChainHdSolver::inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa,
 // coupling matrix (kappa >= trace K; e.g. alfa columns of size 1e200) would be truncated to rank 0,
 // silently dropping the task. Inf and NaN propagate outward through the link accelerations: the
 // last one tells.
-int ChainHdSolver::checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+int ChainHdSolver::checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu,
+                                const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                                 const Eigen::Ref<const Eigen::VectorXd>& beta, const Eigen::Ref<const Matrix6X>& f_ext,
                                 const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   bool finite = std::isfinite(kappa_) && detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(nu);
   if (finite && ns_ > 0) finite = detail::bounded(segs_[ns_ - 1].xdd);
   if (finite) return E_NOERROR;
-  return fail(E_NONFINITE_RESULT, "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
-              "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)", q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
+  return fail(E_NONFINITE_RESULT,
+              "the results overflow (Inf/NaN or beyond 1e150): inputs too large (max |q_dot| %g, "
+              "max |ff_torques| %g, max |f_ext| %g, max |beta| %g)",
+              q_dot.size() ? q_dot.cwiseAbs().maxCoeff() : 0.0,
               ff_torques.size() ? ff_torques.cwiseAbs().maxCoeff() : 0.0,
               f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
 }
@@ -433,9 +450,8 @@ template <int M>
 void ChainHdSolver::finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   Eigen::Matrix<double, M, 1> nu;
   if (M > 0) nu = nu_;
-  finalSweep(ff_torques, [&nu](int, const Segment& s) {
-    return M > 0 ? s.e.template leftCols<M>().dot(nu.transpose()) : 0.0;
-  });
+  finalSweep(ff_torques,
+             [&nu](int, const Segment& s) { return M > 0 ? s.e.template leftCols<M>().dot(nu.transpose()) : 0.0; });
 }
 
 void ChainHdSolver::factorizeCoupling() {
@@ -538,12 +554,9 @@ int ChainHdSolver::commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu,
   return E_NOERROR;
 }
 
-int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
-                         const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-                         const Eigen::Ref<const Matrix6X>& alfa,
-                         const Eigen::Ref<const Eigen::VectorXd>& beta,
-                         const Eigen::Ref<const Matrix6X>& f_ext,
-                         const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                         const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                         const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   solved_ = false;
   general_ = false;
   int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques, kMaxConstraints);
@@ -557,18 +570,32 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
   // Balance of acceleration energy at the base: A_0^T Xdd_0 + U_0 + L_0 nu = beta.
   factorizeCoupling();
   const int m = m_;
-  VectorC rhs = U0_ - beta;  // nu = L0^-1 (beta - U0) = K^+ (U0 - beta), K = -L0
+  VectorC rhs = U0_ - beta;                 // nu = L0^-1 (beta - U0) = K^+ (U0 - beta), K = -L0
   if (pt_used_) rhs -= pt_energy_.head(m);  // the drivers' parts that pass through
   applyCouplingInverse(rhs, nu_);
 
   switch (m) {
-    case 0: finalSweepT<0>(ff_torques); break;
-    case 1: finalSweepT<1>(ff_torques); break;
-    case 2: finalSweepT<2>(ff_torques); break;
-    case 3: finalSweepT<3>(ff_torques); break;
-    case 4: finalSweepT<4>(ff_torques); break;
-    case 5: finalSweepT<5>(ff_torques); break;
-    default: finalSweepT<6>(ff_torques); break;
+    case 0:
+      finalSweepT<0>(ff_torques);
+      break;
+    case 1:
+      finalSweepT<1>(ff_torques);
+      break;
+    case 2:
+      finalSweepT<2>(ff_torques);
+      break;
+    case 3:
+      finalSweepT<3>(ff_torques);
+      break;
+    case 4:
+      finalSweepT<4>(ff_torques);
+      break;
+    case 5:
+      finalSweepT<5>(ff_torques);
+      break;
+    default:
+      finalSweepT<6>(ff_torques);
+      break;
   }
   commandFromNu(nu_, tau_cmd_);
   rc = checkBounded(nu_, q_dot, beta, f_ext, ff_torques);
@@ -578,15 +605,13 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q,
   return E_NOERROR;
 }
 
-int ChainHdSolver::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot,
-                             KDL::JntArray& q_dotdot, const KDL::Jacobian& alfa,
-                             const KDL::JntArray& beta, const KDL::Wrenches& f_ext,
+int ChainHdSolver::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot,
+                             const KDL::Jacobian& alfa, const KDL::JntArray& beta, const KDL::Wrenches& f_ext,
                              const KDL::JntArray& ff_torques, KDL::JntArray& command_torques) {
   if (q_dotdot.rows() != nj_)
     return fail(E_SIZE_MISMATCH, "q_dotdot has %u entries, expected %u", q_dotdot.rows(), nj_);
   if (command_torques.rows() != nj_)
-    return fail(E_SIZE_MISMATCH, "command_torques has %u entries, expected %u",
-                command_torques.rows(), nj_);
+    return fail(E_SIZE_MISMATCH, "command_torques has %u entries, expected %u", command_torques.rows(), nj_);
   if (f_ext.size() != ns_)
     return fail(E_SIZE_MISMATCH, "f_ext has %zu wrenches, expected %u (segments)", f_ext.size(), ns_);
   if (ff_torques.rows() != nj_)
@@ -626,14 +651,18 @@ KDL::Twist toTwist(const Vector6& v) {
 
 KDL::Frame ChainHdSolver::linkLocalPose(unsigned int i) const {
   const Pose& X = segs_[i].X;
-  return KDL::Frame(KDL::Rotation(X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0),
-                                  X.R(2, 1), X.R(2, 2)),
-                    KDL::Vector(X.p(0), X.p(1), X.p(2)));
+  return KDL::Frame(
+      KDL::Rotation(X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1), X.R(2, 2)),
+      KDL::Vector(X.p(0), X.p(1), X.p(2)));
 }
 
-KDL::Twist ChainHdSolver::linkLocalVelocity(unsigned int i) const { return toTwist(segs_[i].v); }
+KDL::Twist ChainHdSolver::linkLocalVelocity(unsigned int i) const {
+  return toTwist(segs_[i].v);
+}
 
-KDL::Twist ChainHdSolver::linkLocalAcceleration(unsigned int i) const { return toTwist(segs_[i].xdd); }
+KDL::Twist ChainHdSolver::linkLocalAcceleration(unsigned int i) const {
+  return toTwist(segs_[i].xdd);
+}
 
 void ChainHdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot) const {
   x_dotdot.resize(ns_ + 1);
@@ -643,14 +672,13 @@ void ChainHdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_do
   }
 }
 
-int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints,
-                                   Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
+int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                                   Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
   return responseColumnsImpl(joints, dqdd, dtau_cmd, nullptr);
 }
 
-int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints,
-                                   Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd,
-                                   Eigen::Ref<Eigen::MatrixXd> dnu) {
+int ChainHdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                                   Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd> dnu) {
   if (solved_ && (dnu.rows() < m_ || dnu.cols() < joints.size()))
     return fail(E_SIZE_MISMATCH, "dnu is %ldx%ld, expected at least %dx%ld", (long)dnu.rows(), (long)dnu.cols(), m_,
                 (long)joints.size());
@@ -663,12 +691,11 @@ int ChainHdSolver::responseColumnsImpl(const Eigen::Ref<const Eigen::VectorXi>& 
   if (!solved_) return fail(E_NO_SOLUTION, "responseColumns() needs a successful solve() first");
   const long k = joints.size();
   if (dqdd.rows() != nj_ || dqdd.cols() != k)
-    return fail(E_SIZE_MISMATCH, "dqdd is %ldx%ld, expected %ux%ld", (long)dqdd.rows(),
-                (long)dqdd.cols(), nj_, k);
+    return fail(E_SIZE_MISMATCH, "dqdd is %ldx%ld, expected %ux%ld", (long)dqdd.rows(), (long)dqdd.cols(), nj_, k);
   const bool want_tau = !(dnu_out && dtau_cmd.size() == 0);  // empty beside dnu: not wanted
   if (want_tau && (dtau_cmd.rows() != nj_ || dtau_cmd.cols() != k))
-    return fail(E_SIZE_MISMATCH, "dtau_cmd is %ldx%ld, expected %ux%ld", (long)dtau_cmd.rows(),
-                (long)dtau_cmd.cols(), nj_, k);
+    return fail(E_SIZE_MISMATCH, "dtau_cmd is %ldx%ld, expected %ux%ld", (long)dtau_cmd.rows(), (long)dtau_cmd.cols(),
+                nj_, k);
   for (long c = 0; c < k; ++c) {
     if (joints(c) < 0 || joints(c) >= static_cast<int>(nj_))
       return fail(E_OUT_OF_RANGE, "joint index %d out of range [0, %u)", joints(c), nj_);

@@ -17,7 +17,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kZeroCurvature = 1e-10;
 // Gradient entries (accelerations) below this fraction of the gradient's scale are zero.
 constexpr double kGradientTolerance = 1e-11;
-}
+}  // namespace
 
 FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
     : hd_(chain, root_acc, options), free_(chain, root_acc, options) {
@@ -95,7 +95,8 @@ int FrictionSolver::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
   return rc;
 }
 
-int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
+                              const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                               const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
                               const Eigen::Ref<const Eigen::VectorXd>& beta,
                               const Eigen::Ref<const Eigen::VectorXi>* segments,
@@ -106,27 +107,35 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const 
   const Eigen::VectorXd& fs = friction.static_friction;
   const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
   if (fs.size() != n)
-    return fail(E_INVALID_FRICTION, "friction.static_friction has %ld entries, expected %ld (joints)", (long)fs.size(), n);
+    return fail(E_INVALID_FRICTION, "friction.static_friction has %ld entries, expected %ld (joints)", (long)fs.size(),
+                n);
   if (fk.size() != n)
-    return fail(E_INVALID_FRICTION, "friction.kinetic_friction has %ld entries, expected %ld (joints) or 0", (long)fk.size(), n);
+    return fail(E_INVALID_FRICTION, "friction.kinetic_friction has %ld entries, expected %ld (joints) or 0",
+                (long)fk.size(), n);
   if (!std::isfinite(friction.velocity_tolerance) || friction.velocity_tolerance < 0.0)
-    return fail(E_INVALID_FRICTION, "friction.velocity_tolerance must be finite and >= 0, got %g", friction.velocity_tolerance);
+    return fail(E_INVALID_FRICTION, "friction.velocity_tolerance must be finite and >= 0, got %g",
+                friction.velocity_tolerance);
   for (long j = 0; j < n; ++j) {
     if (!std::isfinite(fs(j)) || fs(j) < 0.0)
       return fail(E_INVALID_FRICTION, "friction.static_friction(%ld) must be finite and >= 0, got %g", j, fs(j));
     if (!std::isfinite(fk(j)) || fk(j) < 0.0 || fk(j) > fs(j))
-      return fail(E_INVALID_FRICTION, "friction.kinetic_friction(%ld) must be finite and in [0, static_friction = %g], got %g", j, fs(j), fk(j));
+      return fail(E_INVALID_FRICTION,
+                  "friction.kinetic_friction(%ld) must be finite and in [0, static_friction = %g], got %g", j, fs(j),
+                  fk(j));
   }
   const bool limits = friction.lower.size() != 0 || friction.upper.size() != 0;
   if (limits) {
     if (friction.lower.size() != n || friction.upper.size() != n)
-      return fail(E_INVALID_FRICTION, "friction.lower and friction.upper must have %ld entries each (or both be empty)", n);
+      return fail(E_INVALID_FRICTION, "friction.lower and friction.upper must have %ld entries each (or both be empty)",
+                  n);
     if (!std::isfinite(friction.limit_tolerance) || friction.limit_tolerance < 0.0)
-      return fail(E_INVALID_FRICTION, "friction.limit_tolerance must be finite and >= 0, got %g", friction.limit_tolerance);
+      return fail(E_INVALID_FRICTION, "friction.limit_tolerance must be finite and >= 0, got %g",
+                  friction.limit_tolerance);
     for (long j = 0; j < n; ++j)
       if (std::isnan(friction.lower(j)) || std::isnan(friction.upper(j)) || friction.lower(j) > friction.upper(j))
-        return fail(E_INVALID_FRICTION, "friction.lower(%ld) must be <= friction.upper(%ld), neither NaN, got %g and %g",
-                    j, j, friction.lower(j), friction.upper(j));
+        return fail(E_INVALID_FRICTION,
+                    "friction.lower(%ld) must be <= friction.upper(%ld), neither NaN, got %g and %g", j, j,
+                    friction.lower(j), friction.upper(j));
   }
   if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0)) {
     // Let the hybrid-dynamics solver report the size problem with its message.
@@ -447,8 +456,10 @@ int FrictionSolver::boxQp(int k) {
         bool changed = false;
         for (int i = 0; i < k; ++i) {
           if (state(i) == 0) {
-            if (x(i) > hi_(i)) state(i) = 1, changed = true;
-            else if (x(i) < lo_(i)) state(i) = -1, changed = true;
+            if (x(i) > hi_(i))
+              state(i) = 1, changed = true;
+            else if (x(i) < lo_(i))
+              state(i) = -1, changed = true;
           } else if ((state(i) < 0 ? -grad_(i) : grad_(i)) > tol_g) {
             state(i) = 0, changed = true;  // wrong-sign multiplier: release
           }
@@ -560,7 +571,7 @@ void FrictionSolver::leastCommand(int k) {
   double* t = ts_.data();
   double* lo = p_.data();    // bounds on St
   double* hi = eig_.data();  // (eig_ was the factorisation's scratch)
-  double yscale = 1e-300;  // torque scale of y and t (|y + t| <= |x* + t| bounds the optimum)
+  double yscale = 1e-300;    // torque scale of y and t (|y + t| <= |x* + t| bounds the optimum)
   for (int a = 0; a < ns; ++a) {
     const int i = st[a], j = rest_(i);
     const double cmd = tau_cmd_(j);  // tau_cmd_j at x*

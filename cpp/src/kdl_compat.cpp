@@ -81,8 +81,8 @@ int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::Jnt
   } else if (solver_.passThroughColumns() >= 0) {
     solver_.clearPassThrough();
   }
-  const int rc = solver_.solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_,
-                               ff_torques.data);
+  const int rc =
+      solver_.solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_, ff_torques.data);
   if (rc != E_NOERROR) return error = rc;
   q_dotdot.data = solver_.qdd();
   constraint_torques.data = solver_.commandTorques();
@@ -97,7 +97,8 @@ void ChainHdSolver_Vereshchagin::getTransformedLinkAcceleration(Twists& x_dotdot
   ensureSize(x_dotdot, ns_ + 1);
   const auto& acc = solver_.linkAccelerations();
   for (unsigned int i = 0; i <= ns_; ++i)
-    x_dotdot[i] = KDL::Twist(KDL::Vector(acc(0, i), acc(1, i), acc(2, i)), KDL::Vector(acc(3, i), acc(4, i), acc(5, i)));
+    x_dotdot[i] =
+        KDL::Twist(KDL::Vector(acc(0, i), acc(1, i), acc(2, i)), KDL::Vector(acc(3, i), acc(4, i), acc(5, i)));
 }
 
 void ChainHdSolver_Vereshchagin::getTotalTorque(KDL::JntArray& total_tau) {
@@ -105,7 +106,9 @@ void ChainHdSolver_Vereshchagin::getTotalTorque(KDL::JntArray& total_tau) {
   total_tau.data = total_;
 }
 
-void ChainHdSolver_Vereshchagin::getContraintForceMagnitude(Eigen::VectorXd& nu_out) { nu_out = nu_; }
+void ChainHdSolver_Vereshchagin::getContraintForceMagnitude(Eigen::VectorXd& nu_out) {
+  nu_out = nu_;
+}
 
 void ChainHdSolver_Vereshchagin::updateBasePoses() {
   KDL::Frame parent = KDL::Frame::Identity();

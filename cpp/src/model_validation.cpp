@@ -12,7 +12,9 @@ namespace detail {
 
 namespace {
 
-bool finite(const KDL::Vector& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+bool finite(const KDL::Vector& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
 
 }  // namespace
 
@@ -45,8 +47,7 @@ const char* segmentGeometryProblem(const KDL::Segment& segment) {
   return nullptr;
 }
 
-const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaCheck check, char* buf,
-                           std::size_t size) {
+const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaCheck check, char* buf, std::size_t size) {
   if (!std::isfinite(mass) || !I_com.allFinite()) return "inertial parameters are not finite";
   if (mass < 0.0) {
     std::snprintf(buf, size, "negative mass %g (must be >= 0)", mass);

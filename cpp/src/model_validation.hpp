@@ -25,8 +25,7 @@ const char* segmentGeometryProblem(const KDL::Segment& segment);
 // max(1, max |I_com|)). Physical also: every principal moment >= -1e-12 max(1, max |I_com|), and
 // I1 + I2 >= I3 - 1e-6 I3 for the sorted moments I1 <= I2 <= I3. The messages of the physical
 // check name the joint_space option.
-const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaCheck check, char* buf,
-                           std::size_t size);
+const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaCheck check, char* buf, std::size_t size);
 
 // Largest magnitude of a reported result: beyond it (or Inf / NaN) a solve fails with
 // E_NONFINITE_RESULT, so that products of two results (energies, powers, the Gauss value) stay

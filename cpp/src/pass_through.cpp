@@ -17,8 +17,10 @@ int ChainHdSolver::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext
                                   const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
   const long nf = f_ext_pass_through.size(), nt = ff_pass_through.size();
   if (nf != 0 && nt != 0 && nf != nt)
-    return fail(E_SIZE_MISMATCH, "f_ext_pass_through has %ld entries and ff_pass_through %ld: expected the same "
-                "number (one per constraint column) or an empty one", nf, nt);
+    return fail(E_SIZE_MISMATCH,
+                "f_ext_pass_through has %ld entries and ff_pass_through %ld: expected the same "
+                "number (one per constraint column) or an empty one",
+                nf, nt);
   const long m = std::max(nf, nt);
   if (m > mcap_)
     return fail(E_SIZE_MISMATCH, "pass-through weights have %ld entries, at most %d constraint columns", m, mcap_);
@@ -56,7 +58,8 @@ int ChainHdSolver::passThroughEnergy(const Eigen::Ref<const Matrix6X>& f_ext,
   const int m = m_;
   if (pt_m_ != m)
     return fail(E_SIZE_MISMATCH, "the pass-through weights are for %d constraint columns, alfa has %d", pt_m_, m);
-  const Eigen::Ref<const Eigen::VectorXd> tau = pt_driver_ ? Eigen::Ref<const Eigen::VectorXd>(*pt_driver_) : ff_torques;
+  const Eigen::Ref<const Eigen::VectorXd> tau =
+      pt_driver_ ? Eigen::Ref<const Eigen::VectorXd>(*pt_driver_) : ff_torques;
   const bool use_f = pt_f_any_ && f_ext.cols() != 0, use_t = pt_t_any_ && tau.size() != 0;
   if (!use_f && !use_t) return E_NOERROR;
   auto energy = pt_energy_.head(m);

@@ -22,11 +22,10 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
   solved_ = false;
   general_ = false;
   if (segments.size() != alfa.cols())
-    return fail(E_SIZE_MISMATCH, "segments has %ld entries, expected %ld (one per alfa column)",
-                (long)segments.size(), (long)alfa.cols());
+    return fail(E_SIZE_MISMATCH, "segments has %ld entries, expected %ld (one per alfa column)", (long)segments.size(),
+                (long)alfa.cols());
   bool last_only = alfa.cols() <= kMaxConstraints && ns_ > 0;
-  for (Eigen::Index c = 0; c < segments.size() && last_only; ++c)
-    last_only = segments(c) == static_cast<int>(ns_) - 1;
+  for (Eigen::Index c = 0; c < segments.size() && last_only; ++c) last_only = segments(c) == static_cast<int>(ns_) - 1;
   if (last_only) return solve(q, q_dot, alfa, beta, f_ext, ff_torques);  // the end-segment path
 
   int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques, mcap_);
@@ -48,7 +47,7 @@ int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
   factorizeCouplingGeneral();
   const int m = m_;
   for (int k = 0; k < m; ++k) rhs_g_(k) = ug_(k) - beta(order_(k));  // nu = K^+ (U - beta)
-  if (pt_used_) rhs_g_.head(m) -= pt_energy_.head(m);  // the drivers' parts that pass through
+  if (pt_used_) rhs_g_.head(m) -= pt_energy_.head(m);                // the drivers' parts that pass through
   couplingSolve(rhs_g_.head(m), nug_.head(m));
   finalSweepGeneral(ff_torques);
   for (int k = 0; k < m; ++k) nu_user_(order_(k)) = nug_(k);

@@ -7,9 +7,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <Eigen/Dense>
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
+#include <Eigen/Dense>
 
 #include "model_validation.hpp"
 
@@ -60,8 +60,7 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& xml, std::string& message
 KDL::Frame toFrame(const urdf::Pose& p) {
   double x, y, z, w;
   p.rotation.getQuaternion(x, y, z, w);
-  return KDL::Frame(KDL::Rotation::Quaternion(x, y, z, w),
-                    KDL::Vector(p.position.x, p.position.y, p.position.z));
+  return KDL::Frame(KDL::Rotation::Quaternion(x, y, z, w), KDL::Vector(p.position.x, p.position.y, p.position.z));
 }
 
 bool finitePose(const urdf::Pose& p) {
@@ -78,19 +77,25 @@ KDL::Frame jointOrigin(const urdf::Joint& j) {
 }
 
 bool isMoving(const urdf::Joint& j) {
-  return j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS ||
-         j.type == urdf::Joint::PRISMATIC;
+  return j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS || j.type == urdf::Joint::PRISMATIC;
 }
 
 const char* typeName(int type) {
   switch (type) {
-    case urdf::Joint::REVOLUTE: return "revolute";
-    case urdf::Joint::CONTINUOUS: return "continuous";
-    case urdf::Joint::PRISMATIC: return "prismatic";
-    case urdf::Joint::FLOATING: return "floating";
-    case urdf::Joint::PLANAR: return "planar";
-    case urdf::Joint::FIXED: return "fixed";
-    default: return "unknown";
+    case urdf::Joint::REVOLUTE:
+      return "revolute";
+    case urdf::Joint::CONTINUOUS:
+      return "continuous";
+    case urdf::Joint::PRISMATIC:
+      return "prismatic";
+    case urdf::Joint::FLOATING:
+      return "floating";
+    case urdf::Joint::PLANAR:
+      return "planar";
+    case urdf::Joint::FIXED:
+      return "fixed";
+    default:
+      return "unknown";
   }
 }
 
@@ -135,8 +140,7 @@ class Builder {
       if (leaves.size() != 1) {
         std::string list;
         for (const auto& l : leaves) list += (list.empty() ? "" : ", ") + l;
-        throw LoadError("the tree below '" + root_name + "' branches (leaves: " + list +
-                        "); give the tip link");
+        throw LoadError("the tree below '" + root_name + "' branches (leaves: " + list + "); give the tip link");
       }
       tip_name = leaves.front();
     }
@@ -194,8 +198,7 @@ class Builder {
       // Poses of the group's path links in the child link (joint) frame at q = 0.
       std::vector<KDL::Frame> in_child(end - k);
       in_child[0] = KDL::Frame::Identity();
-      for (size_t i = k + 1; i < end; ++i)
-        in_child[i - k] = in_child[i - k - 1] * jointOrigin(*path[i]->parent_joint);
+      for (size_t i = k + 1; i < end; ++i) in_child[i - k] = in_child[i - k - 1] * jointOrigin(*path[i]->parent_joint);
       const KDL::Frame child_to_tip = in_child[tip_index - k];
       const KDL::Frame tip_inv = child_to_tip.Inverse();
 
@@ -209,8 +212,7 @@ class Builder {
         for (const auto& child : path[i]->child_links) {
           if (i + 1 < end && child->name == path[i + 1]->name) continue;
           if (i + 1 == end && end < path.size() && child->name == path[end]->name) continue;
-          lumpSubtree(*child, link_in_tip * jointOrigin(*child->parent_joint), seg_index,
-                      inertia);
+          lumpSubtree(*child, link_in_tip * jointOrigin(*child->parent_joint), seg_index, inertia);
         }
       }
 
@@ -264,8 +266,8 @@ class Builder {
       throw LoadError(std::string("joint '") + j.name + "' (" + typeName(j.type) +
                       ") attaches a side branch to the chain; floating and planar joints are not supported");
     if (isMoving(j))
-      out_.notes.push_back("side branch through moving joint '" + j.name + "' lumped rigidly at position 0 into segment " +
-                           std::to_string(seg));
+      out_.notes.push_back("side branch through moving joint '" + j.name +
+                           "' lumped rigidly at position 0 into segment " + std::to_string(seg));
     out_.links.push_back({link.name, seg, pose});
     inertia = inertia + pose * linkInertia(link, check_);
     for (const auto& child : link.child_links)
@@ -275,8 +277,7 @@ class Builder {
   // Links hanging off the base (at joint positions 0): frames only, their inertia is irrelevant.
   void placeBaseSubtree(const urdf::Link& link, const KDL::Frame& pose) {
     out_.links.push_back({link.name, -1, pose});
-    for (const auto& child : link.child_links)
-      placeBaseSubtree(*child, pose * jointOrigin(*child->parent_joint));
+    for (const auto& child : link.child_links) placeBaseSubtree(*child, pose * jointOrigin(*child->parent_joint));
   }
 
   const urdf::ModelInterface& model_;

@@ -38,34 +38,82 @@ void* countedNewAligned(std::size_t n, std::align_val_t al) {
 }  // namespace
 
 // ---- counting replacements of the global allocation functions ----
-void* operator new(std::size_t n) { return countedNew(n); }
-void* operator new[](std::size_t n) { return countedNew(n); }
+void* operator new(std::size_t n) {
+  return countedNew(n);
+}
+void* operator new[](std::size_t n) {
+  return countedNew(n);
+}
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try { return countedNew(n); } catch (...) { return nullptr; }
+  try {
+    return countedNew(n);
+  } catch (...) {
+    return nullptr;
+  }
 }
 void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try { return countedNew(n); } catch (...) { return nullptr; }
+  try {
+    return countedNew(n);
+  } catch (...) {
+    return nullptr;
+  }
 }
-void* operator new(std::size_t n, std::align_val_t a) { return countedNewAligned(n, a); }
-void* operator new[](std::size_t n, std::align_val_t a) { return countedNewAligned(n, a); }
+void* operator new(std::size_t n, std::align_val_t a) {
+  return countedNewAligned(n, a);
+}
+void* operator new[](std::size_t n, std::align_val_t a) {
+  return countedNewAligned(n, a);
+}
 void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-  try { return countedNewAligned(n, a); } catch (...) { return nullptr; }
+  try {
+    return countedNewAligned(n, a);
+  } catch (...) {
+    return nullptr;
+  }
 }
 void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-  try { return countedNewAligned(n, a); } catch (...) { return nullptr; }
+  try {
+    return countedNewAligned(n, a);
+  } catch (...) {
+    return nullptr;
+  }
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
 
 #if defined(__GLIBC__)
 #define VERESHCHAGIN_TEST_COUNT_MALLOC 1
@@ -82,7 +130,9 @@ void* malloc(std::size_t n) noexcept {
   g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
   return __libc_malloc(n);
 }
-void free(void* p) noexcept { __libc_free(p); }
+void free(void* p) noexcept {
+  __libc_free(p);
+}
 void* calloc(std::size_t a, std::size_t b) noexcept {
   g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
   return __libc_calloc(a, b);
@@ -117,5 +167,7 @@ struct AllocCounts {
   long total() const { return news + mallocs; }
 };
 // Allocations so far: operator new calls and (on glibc) malloc-family calls.
-inline AllocCounts allocCounts() { return {g_new_calls.load(), g_malloc_calls.load()}; }
+inline AllocCounts allocCounts() {
+  return {g_new_calls.load(), g_malloc_calls.load()};
+}
 }  // namespace testutil

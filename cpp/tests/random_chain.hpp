@@ -30,9 +30,9 @@
 namespace testutil {
 
 struct ChainSpec {
-  int n_joints = 7;              // moving joints, 1..30 in the tests
-  bool allow_prismatic = true;   // TransX/Y/Z and TransAxis joints
-  bool rotor_inertia = true;     // random rotor inertias (else 0)
+  int n_joints = 7;             // moving joints, 1..30 in the tests
+  bool allow_prismatic = true;  // TransX/Y/Z and TransAxis joints
+  bool rotor_inertia = true;    // random rotor inertias (else 0)
   // A fixed segment (KDL::Joint::Fixed, random tip frame and inertia) is inserted before moving
   // joint k for every k listed here (k = n_joints appends it after the last moving segment).
   // Repeated entries insert several consecutive fixed segments.
@@ -94,16 +94,22 @@ class RandomGen {
     const int kind = integer(0, kinds - 1);
     const double r = rotorInertia(rotor);
     switch (kind) {
-      case 0: return KDL::Joint(name, KDL::Joint::RotX, 1.0, 0.0, r);
-      case 1: return KDL::Joint(name, KDL::Joint::RotY, 1.0, 0.0, r);
-      case 2: return KDL::Joint(name, KDL::Joint::RotZ, 1.0, 0.0, r);
+      case 0:
+        return KDL::Joint(name, KDL::Joint::RotX, 1.0, 0.0, r);
+      case 1:
+        return KDL::Joint(name, KDL::Joint::RotY, 1.0, 0.0, r);
+      case 2:
+        return KDL::Joint(name, KDL::Joint::RotZ, 1.0, 0.0, r);
       case 3: {
         const KDL::Vector origin = vector(-0.3, 0.3);
         return KDL::Joint(name, origin, unitVector(), KDL::Joint::RotAxis, 1.0, 0.0, r);
       }
-      case 4: return KDL::Joint(name, KDL::Joint::TransX, 1.0, 0.0, r);
-      case 5: return KDL::Joint(name, KDL::Joint::TransY, 1.0, 0.0, r);
-      case 6: return KDL::Joint(name, KDL::Joint::TransZ, 1.0, 0.0, r);
+      case 4:
+        return KDL::Joint(name, KDL::Joint::TransX, 1.0, 0.0, r);
+      case 5:
+        return KDL::Joint(name, KDL::Joint::TransY, 1.0, 0.0, r);
+      case 6:
+        return KDL::Joint(name, KDL::Joint::TransZ, 1.0, 0.0, r);
       default: {
         const KDL::Vector origin = vector(-0.3, 0.3);
         return KDL::Joint(name, origin, unitVector(), KDL::Joint::TransAxis, 1.0, 0.0, r);

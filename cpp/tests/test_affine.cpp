@@ -43,7 +43,8 @@ int main() {
     const bool damped = g.coin(0.15);
     const KDL::Chain chain = g.chain(spec);
     const unsigned int ns = chain.getNrOfSegments();
-    const KDL::Twist root_acc = g.coin() ? KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero()) : KDL::Twist::Zero();
+    const KDL::Twist root_acc =
+        g.coin() ? KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero()) : KDL::Twist::Zero();
     const KDL::JntArray q = g.q(n), qd = g.qdot(n), ff = g.torques(n);
     const Matrix6X fext = testutil::toMatrix(g.fext(ns));
     const Matrix6X alfa = g.alfa(nc).data;
@@ -51,8 +52,9 @@ int main() {
     const int k = g.integer(1, n + 2);
     Eigen::VectorXi joints(k);
     for (int c = 0; c < k; ++c) joints(c) = g.integer(0, n - 1);  // repeats allowed
-    const std::string tag = "sample " + str(s) + " (seed " + str(seed) + ", n=" + str(n) + ", fixed=" +
-                            str(spec.fixed_before.size()) + ", nc=" + str(nc) + ", damped=" + str(damped) + ")";
+    const std::string tag = "sample " + str(s) + " (seed " + str(seed) + ", n=" + str(n) +
+                            ", fixed=" + str(spec.fixed_before.size()) + ", nc=" + str(nc) + ", damped=" + str(damped) +
+                            ")";
 
     vereshchagin::SolverOptions opt;
     if (damped) {

@@ -46,8 +46,7 @@ class Checker {
       std::printf("%s: PASS (%ld checks) %s\n", name_.c_str(), checks_, summary.c_str());
       return 0;
     }
-    std::fprintf(stderr, "%s: FAIL (%d of %ld checks failed) %s\n", name_.c_str(), failures_, checks_,
-                 summary.c_str());
+    std::fprintf(stderr, "%s: FAIL (%d of %ld checks failed) %s\n", name_.c_str(), failures_, checks_, summary.c_str());
     return 1;
   }
 

@@ -105,9 +105,9 @@ int solveWith(Solver& s, const Inputs& in) {
 KDL::Chain planarArm() {
   KDL::Chain ch;
   for (int i = 0; i < 2; ++i) {
-    ch.addSegment(KDL::Segment("link" + str(i), KDL::Joint("joint" + str(i), KDL::Joint::RotZ),
-                               KDL::Frame(KDL::Vector(1, 0, 0)),
-                               KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(0.01, 0.08, 0.08))));
+    ch.addSegment(
+        KDL::Segment("link" + str(i), KDL::Joint("joint" + str(i), KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
+                     KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(0.01, 0.08, 0.08))));
   }
   return ch;
 }
@@ -178,16 +178,39 @@ int main() {
     return in;
   };
   for (int d : {-1, 1}) {
-    bad.push_back({"q size " + str(n + d), "q", with([&](Inputs& in) { in.q.resize(n + d); in.q.setZero(); }), Solver::E_SIZE_MISMATCH});
-    bad.push_back({"q_dot size " + str(n + d), "q_dot", with([&](Inputs& in) { in.qd.resize(n + d); in.qd.setZero(); }), Solver::E_SIZE_MISMATCH});
-    bad.push_back({"ff_torques size " + str(n + d), "ff_torques", with([&](Inputs& in) { in.ff.resize(n + d); in.ff.setZero(); }), Solver::E_SIZE_MISMATCH});
-    bad.push_back({"f_ext columns " + str(ns + d), "f_ext", with([&](Inputs& in) { in.fext = Matrix6X::Zero(6, ns + d); }), Solver::E_SIZE_MISMATCH});
-    bad.push_back({"beta size " + str(2 + d), "beta", with([&](Inputs& in) { in.beta = Eigen::VectorXd::Zero(2 + d); }), Solver::E_SIZE_MISMATCH});
+    bad.push_back({"q size " + str(n + d), "q", with([&](Inputs& in) {
+                     in.q.resize(n + d);
+                     in.q.setZero();
+                   }),
+                   Solver::E_SIZE_MISMATCH});
+    bad.push_back({"q_dot size " + str(n + d), "q_dot", with([&](Inputs& in) {
+                     in.qd.resize(n + d);
+                     in.qd.setZero();
+                   }),
+                   Solver::E_SIZE_MISMATCH});
+    bad.push_back({"ff_torques size " + str(n + d), "ff_torques", with([&](Inputs& in) {
+                     in.ff.resize(n + d);
+                     in.ff.setZero();
+                   }),
+                   Solver::E_SIZE_MISMATCH});
+    bad.push_back({"f_ext columns " + str(ns + d), "f_ext",
+                   with([&](Inputs& in) { in.fext = Matrix6X::Zero(6, ns + d); }), Solver::E_SIZE_MISMATCH});
+    bad.push_back({"beta size " + str(2 + d), "beta", with([&](Inputs& in) { in.beta = Eigen::VectorXd::Zero(2 + d); }),
+                   Solver::E_SIZE_MISMATCH});
   }
   bad.push_back({"q empty", "q", with([&](Inputs& in) { in.q.resize(0); }), Solver::E_SIZE_MISMATCH});
-  bad.push_back({"f_ext with one column per joint", "f_ext", with([&](Inputs& in) { in.fext = Matrix6X::Zero(6, n); }), Solver::E_SIZE_MISMATCH});
-  bad.push_back({"beta size 1 without constraints", "beta", with([&](Inputs& in) { in.alfa.resize(6, 0); in.beta = Eigen::VectorXd::Zero(1); }), Solver::E_SIZE_MISMATCH});
-  bad.push_back({"alfa with 7 columns", "alfa", with([&](Inputs& in) { in.alfa = g.alfa(7).data; in.beta = Eigen::VectorXd::Zero(7); }), Solver::E_TOO_MANY_CONSTRAINTS});
+  bad.push_back({"f_ext with one column per joint", "f_ext", with([&](Inputs& in) { in.fext = Matrix6X::Zero(6, n); }),
+                 Solver::E_SIZE_MISMATCH});
+  bad.push_back({"beta size 1 without constraints", "beta", with([&](Inputs& in) {
+                   in.alfa.resize(6, 0);
+                   in.beta = Eigen::VectorXd::Zero(1);
+                 }),
+                 Solver::E_SIZE_MISMATCH});
+  bad.push_back({"alfa with 7 columns", "alfa", with([&](Inputs& in) {
+                   in.alfa = g.alfa(7).data;
+                   in.beta = Eigen::VectorXd::Zero(7);
+                 }),
+                 Solver::E_TOO_MANY_CONSTRAINTS});
   const double nonfinite[] = {NAN, INFINITY, -INFINITY};
   for (double x : nonfinite) {
     const std::string xs = str(x);
@@ -195,8 +218,10 @@ int main() {
     bad.push_back({"q_dot has " + xs, "q_dot", with([&](Inputs& in) { in.qd(1) = x; }), Solver::E_NONFINITE_INPUT});
     bad.push_back({"alfa has " + xs, "alfa", with([&](Inputs& in) { in.alfa(4, 1) = x; }), Solver::E_NONFINITE_INPUT});
     bad.push_back({"beta has " + xs, "beta", with([&](Inputs& in) { in.beta(0) = x; }), Solver::E_NONFINITE_INPUT});
-    bad.push_back({"f_ext has " + xs, "f_ext", with([&](Inputs& in) { in.fext(5, ns - 1) = x; }), Solver::E_NONFINITE_INPUT});
-    bad.push_back({"ff_torques has " + xs, "ff_torques", with([&](Inputs& in) { in.ff(2) = x; }), Solver::E_NONFINITE_INPUT});
+    bad.push_back(
+        {"f_ext has " + xs, "f_ext", with([&](Inputs& in) { in.fext(5, ns - 1) = x; }), Solver::E_NONFINITE_INPUT});
+    bad.push_back(
+        {"ff_torques has " + xs, "ff_torques", with([&](Inputs& in) { in.ff(2) = x; }), Solver::E_NONFINITE_INPUT});
   }
   for (const Bad& b : bad) {
     const int rc = solveWith(solver, b.in);
@@ -221,8 +246,9 @@ int main() {
   // Every solver-specific code has its own description.
   for (int code : {Solver::E_NONFINITE_INPUT, Solver::E_INVALID_MODEL, Solver::E_DEGENERATE_INERTIA,
                    Solver::E_TOO_MANY_CONSTRAINTS, Solver::E_NO_SOLUTION, Solver::E_INVALID_OPTIONS}) {
-    ck.check(std::string(solver.strError(code)) != solver.strError(123456) && std::string(solver.strError(code)).size() > 0,
-             "strError(" + str(code) + ") is not specific");
+    ck.check(
+        std::string(solver.strError(code)) != solver.strError(123456) && std::string(solver.strError(code)).size() > 0,
+        "strError(" + str(code) + ") is not specific");
   }
 
   // Non-finite root acceleration.
@@ -266,7 +292,8 @@ int main() {
     };
     const std::vector<K> cases = {
         {"q_dotdot short", "q_dotdot", run(q, qd, shortj, alfa, beta, fext, ff, tau), Solver::E_SIZE_MISMATCH},
-        {"command_torques long", "command_torques", run(q, qd, qdd, alfa, beta, fext, ff, longj), Solver::E_SIZE_MISMATCH},
+        {"command_torques long", "command_torques", run(q, qd, qdd, alfa, beta, fext, ff, longj),
+         Solver::E_SIZE_MISMATCH},
         {"q short", "q", run(shortj, qd, qdd, alfa, beta, fext, ff, tau), Solver::E_SIZE_MISMATCH},
         {"q_dot long", "q_dot", run(q, longj, qdd, alfa, beta, fext, ff, tau), Solver::E_SIZE_MISMATCH},
         {"f_ext short", "f_ext", run(q, qd, qdd, alfa, beta, fshort, ff, tau), Solver::E_SIZE_MISMATCH},
@@ -277,13 +304,17 @@ int main() {
     };
     // (errorMessage() only holds the last error, so the message of each case is checked right after
     // it below by re-running it.)
-    for (const K& c : cases) ck.check(c.rc == c.code, "KDL entry point, " + c.what + ": expected " + str(c.code) + ", got " + str(c.rc));
+    for (const K& c : cases)
+      ck.check(c.rc == c.code, "KDL entry point, " + c.what + ": expected " + str(c.code) + ", got " + str(c.rc));
     run(q, qd, shortj, alfa, beta, fext, ff, tau);
-    ck.check(std::string(solver.errorMessage()).find("q_dotdot") != std::string::npos, "q_dotdot message: " + std::string(solver.errorMessage()));
+    ck.check(std::string(solver.errorMessage()).find("q_dotdot") != std::string::npos,
+             "q_dotdot message: " + std::string(solver.errorMessage()));
     run(q, qd, qdd, alfa, beta, fext, ff, longj);
-    ck.check(std::string(solver.errorMessage()).find("command_torques") != std::string::npos, "command_torques message: " + std::string(solver.errorMessage()));
+    ck.check(std::string(solver.errorMessage()).find("command_torques") != std::string::npos,
+             "command_torques message: " + std::string(solver.errorMessage()));
     run(q, qd, qdd, alfa, beta, flong, ff, tau);
-    ck.check(std::string(solver.errorMessage()).find("f_ext") != std::string::npos, "f_ext message: " + std::string(solver.errorMessage()));
+    ck.check(std::string(solver.errorMessage()).find("f_ext") != std::string::npos,
+             "f_ext message: " + std::string(solver.errorMessage()));
     KDL::JntArray qnan = q;
     qnan(0) = NAN;
     ck.check(run(qnan, qd, qdd, alfa, beta, fext, ff, tau) == Solver::E_NONFINITE_INPUT, "KDL entry point: NaN q");
@@ -304,8 +335,10 @@ int main() {
       ck.check(std::string(solver.errorMessage()).size() > 0, "responseColumns index: empty message");
     }
     j << 0, 1;
-    ck.check(quiet([&] { return solver.responseColumns(j, a_bad, b); }) == Solver::E_SIZE_MISMATCH, "responseColumns dqdd size");
-    ck.check(quiet([&] { return solver.responseColumns(j, a, b_bad); }) == Solver::E_SIZE_MISMATCH, "responseColumns dtau size");
+    ck.check(quiet([&] { return solver.responseColumns(j, a_bad, b); }) == Solver::E_SIZE_MISMATCH,
+             "responseColumns dqdd size");
+    ck.check(quiet([&] { return solver.responseColumns(j, a, b_bad); }) == Solver::E_SIZE_MISMATCH,
+             "responseColumns dtau size");
     ck.check(quiet([&] { return solver.responseColumns(j, a, b); }) == 0, "responseColumns valid call");
   }
 
@@ -334,15 +367,19 @@ int main() {
       return out;
     };
     const KDL::Segment& s1 = chain.getSegment(1);
-    modelCase("negative mass", replace(chain, 1, KDL::Segment(s1.getName(), s1.getJoint(), s1.getFrameToTip(),
-                                                              KDL::RigidBodyInertia(-1.0, KDL::Vector(0.1, 0, 0),
-                                                                                    KDL::RotationalInertia(0.1, 0.1, 0.1)))));
+    modelCase("negative mass", replace(chain, 1,
+                                       KDL::Segment(s1.getName(), s1.getJoint(), s1.getFrameToTip(),
+                                                    KDL::RigidBodyInertia(-1.0, KDL::Vector(0.1, 0, 0),
+                                                                          KDL::RotationalInertia(0.1, 0.1, 0.1)))));
     modelCase("negative-definite rotational inertia",
-              replace(chain, 1, KDL::Segment(s1.getName(), s1.getJoint(), s1.getFrameToTip(),
-                                             KDL::RigidBodyInertia(1.0, KDL::Vector(0.1, 0, 0), KDL::RotationalInertia(-0.1, 0.1, 0.1)))));
+              replace(chain, 1,
+                      KDL::Segment(
+                          s1.getName(), s1.getJoint(), s1.getFrameToTip(),
+                          KDL::RigidBodyInertia(1.0, KDL::Vector(0.1, 0, 0), KDL::RotationalInertia(-0.1, 0.1, 0.1)))));
     modelCase("negative rotor inertia",
-              replace(chain, 0, KDL::Segment("s0", KDL::Joint("j0", KDL::Joint::RotY, 1.0, 0.0, -0.2),
-                                             chain.getSegment(0).getFrameToTip(), chain.getSegment(0).getInertia())));
+              replace(chain, 0,
+                      KDL::Segment("s0", KDL::Joint("j0", KDL::Joint::RotY, 1.0, 0.0, -0.2),
+                                   chain.getSegment(0).getFrameToTip(), chain.getSegment(0).getInertia())));
   }
 
   // ---------------------------------------------------------------- invalid options
@@ -352,14 +389,16 @@ int main() {
     o.rcond = -1e-3;
     int rc = quiet([&] { return s.setOptions(o); });
     ck.check(rc == Solver::E_INVALID_OPTIONS, "negative rcond: got " + str(rc));
-    ck.check(std::string(s.errorMessage()).find("rcond") != std::string::npos, "negative rcond message: " + std::string(s.errorMessage()));
+    ck.check(std::string(s.errorMessage()).find("rcond") != std::string::npos,
+             "negative rcond message: " + std::string(s.errorMessage()));
     ck.check(s.options().rcond == vereshchagin::SolverOptions().rcond, "rejected options were applied");
     o.rcond = NAN;
     ck.check(quiet([&] { return s.setOptions(o); }) == Solver::E_INVALID_OPTIONS, "NaN rcond accepted");
     o = vereshchagin::SolverOptions();
     o.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
     o.damping = 0.0;
-    ck.check(quiet([&] { return s.setOptions(o); }) == Solver::E_INVALID_OPTIONS, "zero damping accepted for the damped policy");
+    ck.check(quiet([&] { return s.setOptions(o); }) == Solver::E_INVALID_OPTIONS,
+             "zero damping accepted for the damped policy");
     o.damping = -1.0;
     ck.check(quiet([&] { return s.setOptions(o); }) == Solver::E_INVALID_OPTIONS, "negative damping accepted");
     ck.check(solveWith(s, good) == 0 && s.qdd() == qdd_ok, "solver unusable after rejected options");
@@ -389,7 +428,8 @@ int main() {
       const std::string tag = what + (p ? " [damped]" : " [truncated]");
       const int rc = quiet([&] { return s.solve(q, qd, alfa, beta, fext, ff); });
       if (!ck.check(rc == 0, tag + ": solve returned " + str(rc) + " " + s.errorMessage())) continue;
-      ck.check(s.qdd().allFinite() && s.nu().allFinite() && s.commandTorques().allFinite() && s.linkAccelerations().allFinite(),
+      ck.check(s.qdd().allFinite() && s.nu().allFinite() && s.commandTorques().allFinite() &&
+                   s.linkAccelerations().allFinite(),
                tag + ": non-finite outputs: qdd " + testutil::mat(s.qdd()) + ", nu " + testutil::mat(s.nu()));
       ck.check(s.constraintCount() == nc, tag + ": constraintCount");
       if (p == 0) {
@@ -432,13 +472,18 @@ int main() {
       quiet([&] { return ref.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X::Zero(6, 2), tau_ref); });
       const Eigen::VectorXd beta_ref = a3.transpose() * ref.linkAccelerations().col(2);
       Solver s(arm, grav);
-      const int rc = quiet([&] { return s.solve(q, qd, a3, beta_ref, Matrix6X::Zero(6, 2), Eigen::VectorXd::LinSpaced(2, 1.0, -2.0)); });
-      ck.check(rc == 0 && s.constraintRank() == 2, "planar 2R, 3 consistent constraints: rc " + str(rc) + ", rank " + str(s.constraintRank()));
-      ck.check(relErr(s.qdd(), ref.qdd()) <= 1e-9, "planar 2R, 3 consistent constraints: qdd " + testutil::mat(s.qdd()) +
-                                                       " vs reference " + testutil::mat(ref.qdd()));
-      ck.check(relErr(a3.transpose() * s.linkAccelerations().col(2), beta_ref) <= 1e-9, "planar 2R, 3 consistent constraints: not met");
+      const int rc = quiet(
+          [&] { return s.solve(q, qd, a3, beta_ref, Matrix6X::Zero(6, 2), Eigen::VectorXd::LinSpaced(2, 1.0, -2.0)); });
+      ck.check(rc == 0 && s.constraintRank() == 2,
+               "planar 2R, 3 consistent constraints: rc " + str(rc) + ", rank " + str(s.constraintRank()));
+      ck.check(relErr(s.qdd(), ref.qdd()) <= 1e-9, "planar 2R, 3 consistent constraints: qdd " +
+                                                       testutil::mat(s.qdd()) + " vs reference " +
+                                                       testutil::mat(ref.qdd()));
+      ck.check(relErr(a3.transpose() * s.linkAccelerations().col(2), beta_ref) <= 1e-9,
+               "planar 2R, 3 consistent constraints: not met");
       ck.check(relErr(s.commandTorques(), Eigen::Vector2d(3.0, -1.5)) <= 1e-9,
-               "planar 2R, 3 consistent constraints: command torques " + testutil::mat(s.commandTorques()) + ", expected 3 -1.5");
+               "planar 2R, 3 consistent constraints: command torques " + testutil::mat(s.commandTorques()) +
+                   ", expected 3 -1.5");
     }
   }
   {
@@ -458,7 +503,8 @@ int main() {
     const int r2 = quiet([&] { return s2.solve(q, qd, a2, b2, Matrix6X::Zero(6, 6), ff); });
     const int r3 = quiet([&] { return s3.solve(q, qd, a_dup, b3, Matrix6X::Zero(6, 6), ff); });
     ck.check(r2 == 0 && r3 == 0, "duplicated columns: solves failed");
-    ck.check(relErr(s3.qdd(), s2.qdd()) <= 1e-8, "duplicated columns: qdd " + testutil::mat(s3.qdd()) + " vs " + testutil::mat(s2.qdd()));
+    ck.check(relErr(s3.qdd(), s2.qdd()) <= 1e-8,
+             "duplicated columns: qdd " + testutil::mat(s3.qdd()) + " vs " + testutil::mat(s2.qdd()));
     const Eigen::VectorXd w2 = a2 * s2.nu(), w3 = a_dup * s3.nu();
     ck.check(relErr(w3, w2) <= 1e-8, "duplicated columns: total constraint wrench differs");
     ck.check(relErr(s3.commandTorques(), s2.commandTorques()) <= 1e-8, "duplicated columns: command torques differ");
@@ -472,11 +518,12 @@ int main() {
     rankCase("stretched along x, constraint along the arm", arm, q0, unitColumns({vec6(1, 0, 0, 0, 0, 0)}), 0,
              [&](Solver& s, const Eigen::VectorXd&) {
                ck.check(relErr(s.qdd(), free0) <= 1e-9 && s.nu().cwiseAbs().maxCoeff() <= 1e-9,
-                        "stretched along x: an ineffective constraint changed the motion: qdd " + testutil::mat(s.qdd()) +
-                            " free " + testutil::mat(free0) + " nu " + testutil::mat(s.nu()));
+                        "stretched along x: an ineffective constraint changed the motion: qdd " +
+                            testutil::mat(s.qdd()) + " free " + testutil::mat(free0) + " nu " + testutil::mat(s.nu()));
              });
     rankCase("stretched along x, constraints along and across the arm", arm, q0,
-             unitColumns({vec6(1, 0, 0, 0, 0, 0), vec6(0, 1, 0, 0, 0, 0)}), 1, [&](Solver& s, const Eigen::VectorXd& beta) {
+             unitColumns({vec6(1, 0, 0, 0, 0, 0), vec6(0, 1, 0, 0, 0, 0)}), 1,
+             [&](Solver& s, const Eigen::VectorXd& beta) {
                ck.check(std::abs(s.linkAccelerations()(1, 2) - beta(1)) <= 1e-9 * std::max(1.0, std::abs(beta(1))),
                         "stretched along x: the satisfiable constraint (across) is not met");
              });
@@ -503,19 +550,22 @@ int main() {
       const Eigen::VectorXd free1 = freeQdd(tilted, q1);
       const std::string name = "tilted stretched arm (q1 = " + str(th) + ")";
       rankCase(name + ", constraint along the arm", tilted, q1,
-               unitColumns({vec6(along.x(), along.y(), along.z(), 0, 0, 0)}), 0, [&, name](Solver& s, const Eigen::VectorXd&) {
+               unitColumns({vec6(along.x(), along.y(), along.z(), 0, 0, 0)}), 0,
+               [&, name](Solver& s, const Eigen::VectorXd&) {
                  ck.check(relErr(s.qdd(), free1) <= 1e-9 && s.nu().cwiseAbs().maxCoeff() <= 1e-6,
                           name + ": an ineffective constraint changed the motion: qdd " + testutil::mat(s.qdd()) +
-                              " free " + testutil::mat(free1) + " nu " + testutil::mat(s.nu()) + " smallest eigenvalue " +
-                              str(s.smallestSingularValue()));
+                              " free " + testutil::mat(free1) + " nu " + testutil::mat(s.nu()) +
+                              " smallest eigenvalue " + str(s.smallestSingularValue()));
                });
       rankCase(name + ", constraints along and across the arm", tilted, q1,
-               unitColumns({vec6(along.x(), along.y(), along.z(), 0, 0, 0), vec6(across.x(), across.y(), across.z(), 0, 0, 0)}),
+               unitColumns(
+                   {vec6(along.x(), along.y(), along.z(), 0, 0, 0), vec6(across.x(), across.y(), across.z(), 0, 0, 0)}),
                1, [&, name, across](Solver& s, const Eigen::VectorXd& beta) {
                  const Eigen::Vector3d acr(across.x(), across.y(), across.z());
                  const double achieved = acr.dot(s.linkAccelerations().col(3).head<3>());
                  ck.check(std::abs(achieved - beta(1)) <= 1e-9 * std::max(1.0, std::abs(beta(1))),
-                          name + ": the satisfiable constraint (across) is not met: " + str(achieved) + " vs " + str(beta(1)));
+                          name + ": the satisfiable constraint (across) is not met: " + str(achieved) + " vs " +
+                              str(beta(1)));
                });
     }
   }
@@ -544,12 +594,14 @@ int main() {
     // Changing the caller's chain afterwards does not affect the solver.
     persistent.addSegment(KDL::Segment(KDL::Joint("extra", KDL::Joint::RotX), KDL::Frame::Identity(), gg.inertia()));
     const Eigen::VectorXd qdd_before = from_persistent.qdd();
-    ck.check(solveWith(from_persistent, in) == 0 && from_persistent.qdd() == qdd_before && from_persistent.nrOfJoints() == nn,
+    ck.check(solveWith(from_persistent, in) == 0 && from_persistent.qdd() == qdd_before &&
+                 from_persistent.nrOfJoints() == nn,
              "solver is affected by later changes to the caller's chain");
   }
 
   ck.check(g_output.empty(), "the solver printed: \"" + g_output + "\"");
   const std::string printed = whole_stdout.stop();
   ck.check(printed.empty(), "something was printed on stdout: \"" + printed + "\"");
-  return ck.finish(str(bad.size()) + " invalid-argument cases, " + str(rank_cases) + " rank-deficient tasks x 2 policies");
+  return ck.finish(str(bad.size()) + " invalid-argument cases, " + str(rank_cases) +
+                   " rank-deficient tasks x 2 policies");
 }

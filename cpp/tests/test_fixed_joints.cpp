@@ -104,7 +104,8 @@ KDL::Wrenches mergeWrenches(const Merged& m, const std::vector<KDL::Frame>& X, c
   return out;
 }
 
-KDL::Wrenches tipAxes(const std::vector<KDL::Frame>& X, const KDL::Wrenches& f, const KDL::Rotation& R0 = KDL::Rotation::Identity()) {
+KDL::Wrenches tipAxes(const std::vector<KDL::Frame>& X, const KDL::Wrenches& f,
+                      const KDL::Rotation& R0 = KDL::Rotation::Identity()) {
   KDL::Wrenches out(f.size());
   for (std::size_t i = 0; i < f.size(); ++i) out[i] = (R0 * X[i].M).Inverse() * f[i];
   return out;
@@ -139,7 +140,8 @@ struct Stats {
   double worst = 0.0;
 };
 
-void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testutil::RandomGen& g, const std::string& tag0) {
+void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testutil::RandomGen& g,
+               const std::string& tag0) {
   const Merged m = mergeFixed(orig);
   const unsigned int n = orig.getNrOfJoints(), ns = orig.getNrOfSegments(), nsm = m.chain.getNrOfSegments();
   if (!ck.check(m.chain.getNrOfJoints() == n && nsm == n, tag0 + ": merge bookkeeping")) return;
@@ -171,8 +173,9 @@ void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testuti
     const int r1 = id_o.CartToJnt(q, qd, qdd_any, tipAxes(X, fext), t_o);
     const std::vector<KDL::Frame> Xm = tipPoses(m.chain, q);
     const int r2 = id_m.CartToJnt(q, qd, qdd_any, tipAxes(Xm, fext_m), t_m);
-    ck.check(r1 == 0 && r2 == 0 && relErr(t_m.data, t_o.data) <= 1e-10,
-             tag + ": test bug: merged chain has different inverse dynamics, rel err " + str(relErr(t_m.data, t_o.data)));
+    ck.check(
+        r1 == 0 && r2 == 0 && relErr(t_m.data, t_o.data) <= 1e-10,
+        tag + ": test bug: merged chain has different inverse dynamics, rel err " + str(relErr(t_m.data, t_o.data)));
   }
 
   vereshchagin::ChainHdSolver so(orig, root_acc), sm(m.chain, root_acc_m);
@@ -184,8 +187,9 @@ void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testuti
   if (!ck.check(rc == 0, tag + ": original chain solve returned " + str(rc) + " " + so.errorMessage())) return;
   rc = sm.CartToJnt(q, qd, qdd_m, alfa_m, beta, fext_m, ff, tau_m);
   if (!ck.check(rc == 0, tag + ": merged chain solve returned " + str(rc) + " " + sm.errorMessage())) return;
-  ck.check(qdd_o.data.allFinite() && tau_o.data.allFinite() && so.nu().allFinite() && so.linkAccelerations().allFinite(),
-           tag + ": non-finite output");
+  ck.check(
+      qdd_o.data.allFinite() && tau_o.data.allFinite() && so.nu().allFinite() && so.linkAccelerations().allFinite(),
+      tag + ": non-finite output");
 
   const testutil::DenseModel dense = testutil::denseModel(m.chain, q);
   if (!testutil::wellConditioned(testutil::couplingEigenvalues(dense, alfa_m.data))) {
@@ -230,8 +234,8 @@ void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testuti
   kdl.getContraintForceMagnitude(nu_k);
   ++st.kdl_compared;
   ck.check(rc == 0 && relErr(qdd_o.data, qdd_k.data) <= 1e-10 && relErr(so.nu(), nu_k) <= 1e-10,
-           tag + ": chain with fixed joints vs KDL on the merged chain: qdd rel err " + str(relErr(qdd_o.data, qdd_k.data)) +
-               ", nu rel err " + str(relErr(so.nu(), nu_k)));
+           tag + ": chain with fixed joints vs KDL on the merged chain: qdd rel err " +
+               str(relErr(qdd_o.data, qdd_k.data)) + ", nu rel err " + str(relErr(so.nu(), nu_k)));
 }
 
 void degenerateCase(testutil::Checker& ck, const std::string& tag, const KDL::Chain& ch, int nc) {
@@ -264,13 +268,36 @@ int main() {
 
   const std::vector<Case> cases = {
       {"first", [](int, testutil::RandomGen&) { return std::vector<int>{0}; }, 1},
-      {"two-first", [](int, testutil::RandomGen&) { return std::vector<int>{0, 0}; }, 1},
+      {"two-first",
+       [](int, testutil::RandomGen&) {
+         return std::vector<int>{0, 0};
+       },
+       1},
       {"middle", [](int n, testutil::RandomGen& g) { return std::vector<int>{g.integer(1, n - 1)}; }, 2},
-      {"two-middle", [](int n, testutil::RandomGen& g) { int k = g.integer(1, n - 1); return std::vector<int>{k, k}; }, 2},
+      {"two-middle",
+       [](int n, testutil::RandomGen& g) {
+         int k = g.integer(1, n - 1);
+         return std::vector<int>{k, k};
+       },
+       2},
       {"last", [](int n, testutil::RandomGen&) { return std::vector<int>{n}; }, 1},
-      {"two-last", [](int n, testutil::RandomGen&) { return std::vector<int>{n, n}; }, 1},
-      {"first-middle-last", [](int n, testutil::RandomGen& g) { return std::vector<int>{0, g.integer(1, n - 1), n}; }, 2},
-      {"everywhere", [](int n, testutil::RandomGen&) { std::vector<int> v; for (int k = 0; k <= n; ++k) v.push_back(k); return v; }, 1},
+      {"two-last",
+       [](int n, testutil::RandomGen&) {
+         return std::vector<int>{n, n};
+       },
+       1},
+      {"first-middle-last",
+       [](int n, testutil::RandomGen& g) {
+         return std::vector<int>{0, g.integer(1, n - 1), n};
+       },
+       2},
+      {"everywhere",
+       [](int n, testutil::RandomGen&) {
+         std::vector<int> v;
+         for (int k = 0; k <= n; ++k) v.push_back(k);
+         return v;
+       },
+       1},
   };
 
   int ci = 0;
@@ -307,8 +334,8 @@ int main() {
     degenerateCase(ck, "1 joint, zero mass, no rotor, nc=1", one, 1);
 
     KDL::Chain one_fixed = one;  // a massless fixed segment does not help
-    one_fixed.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::Fixed), KDL::Frame(KDL::Vector(0, 1, 0)),
-                                      KDL::RigidBodyInertia::Zero()));
+    one_fixed.addSegment(
+        KDL::Segment(KDL::Joint(KDL::Joint::Fixed), KDL::Frame(KDL::Vector(0, 1, 0)), KDL::RigidBodyInertia::Zero()));
     degenerateCase(ck, "1 joint + massless fixed segment", one_fixed, 0);
 
     KDL::Chain on_axis;  // a point mass on the revolute axis: no inertia about it

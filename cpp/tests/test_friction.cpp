@@ -18,8 +18,9 @@ using testutil::str;
 // (Only the z moment matters; x and y are set so that the body is a rigid body: 1 + 1 >= 2.)
 KDL::Chain oneDof() {
   KDL::Chain ch;
-  ch.addSegment(KDL::Segment("link", KDL::Joint("j", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
-                             KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(1.0, 1.0, 2.0, 0, 0, 0))));
+  ch.addSegment(KDL::Segment(
+      "link", KDL::Joint("j", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
+      KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(1.0, 1.0, 2.0, 0, 0, 0))));
   return ch;
 }
 
@@ -34,9 +35,10 @@ void reportNumbers(testutil::Checker& ck) {
   // Scenario 1: -5 N m external torque, unconstrained: friction +5, qdd = 0.
   Eigen::VectorXd tau = Eigen::VectorXd::Constant(1, -5.0);
   ck.check(fs.solve(zero, zero, none, nobeta, none, tau, fm) == 0, "scenario 1 solves");
-  ck.check(std::abs(fs.frictionTorques()(0) - 5.0) < 1e-12 && std::abs(fs.qdd()(0)) < 1e-12 &&
-               fs.status()[0] == vereshchagin::FrictionSolver::Stick,
-           "scenario 1: friction +5 N m, qdd 0, stick (got " + str(fs.frictionTorques()(0)) + ", " + str(fs.qdd()(0)) + ")");
+  ck.check(
+      std::abs(fs.frictionTorques()(0) - 5.0) < 1e-12 && std::abs(fs.qdd()(0)) < 1e-12 &&
+          fs.status()[0] == vereshchagin::FrictionSolver::Stick,
+      "scenario 1: friction +5 N m, qdd 0, stick (got " + str(fs.frictionTorques()(0)) + ", " + str(fs.qdd()(0)) + ")");
   // Scenario 2: -11 N m: friction +10, qdd = -1 / 2.25.
   tau(0) = -11.0;
   ck.check(fs.solve(zero, zero, none, nobeta, none, tau, fm) == 0, "scenario 2 solves");
@@ -104,16 +106,17 @@ void randomChains(testutil::Checker& ck, int& compared) {
     KDL::JntArray torques(n), qdd_fd(n);
     torques.data = ff.data + fs.commandTorques() + fs.frictionTorques() + fs.limitTorques();
     fd.CartToJnt(q, qd, torques, fext_local, qdd_fd);
-    ck.check(testutil::relErr(qdd_fd.data, fs.qdd()) < 1e-9,
-             "trial " + str(trial) + ": FD(ff + tau_cmd + friction) != qdd, rel err " +
-                 str(testutil::relErr(qdd_fd.data, fs.qdd())));
+    ck.check(testutil::relErr(qdd_fd.data, fs.qdd()) < 1e-9, "trial " + str(trial) +
+                                                                 ": FD(ff + tau_cmd + friction) != qdd, rel err " +
+                                                                 str(testutil::relErr(qdd_fd.data, fs.qdd())));
     // The affine update equals a plain solve with the friction torques as feed-forward (qdd, nu,
     // tau_cmd), and the link accelerations (computed by that extra solve on request) agree.
     vereshchagin::ChainHdSolver plain(chain, root);
     const Eigen::VectorXd ff_total = ff.data + fs.limitTorques() + fs.frictionTorques();
     ck.check(plain.solve(q.data, qd.data, alfa.data, beta.data, testutil::toMatrix(fext), ff_total) == 0,
              "trial " + str(trial) + ": plain solve failed");
-    ck.check(testutil::relErr(plain.qdd(), fs.qdd()) < 1e-9 && testutil::relErr(plain.commandTorques(), fs.commandTorques()) < 1e-9 &&
+    ck.check(testutil::relErr(plain.qdd(), fs.qdd()) < 1e-9 &&
+                 testutil::relErr(plain.commandTorques(), fs.commandTorques()) < 1e-9 &&
                  testutil::relErr(plain.nu(), fs.nu()) < 1e-9,
              "trial " + str(trial) + ": affine update differs from a solve with the friction torques");
     ck.check(testutil::relErr(plain.linkAccelerations(), fs.linkAccelerations()) < 1e-9,

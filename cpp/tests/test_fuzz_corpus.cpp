@@ -49,7 +49,8 @@ int main(int argc, char** argv) {
     for (const std::string& f : files) {
       const std::string bytes = readFile(f);
       const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
-      const std::string bad = target == 0 ? fuzzutil::checkUrdf(data, bytes.size()) : fuzzutil::checkSolver(data, bytes.size());
+      const std::string bad =
+          target == 0 ? fuzzutil::checkUrdf(data, bytes.size()) : fuzzutil::checkSolver(data, bytes.size());
       ck.check(bad.empty(), f + ": " + bad);
       ++counts[target];
     }

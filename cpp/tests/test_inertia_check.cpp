@@ -28,7 +28,9 @@ using Matrix6X = Solver::Matrix6X;
 
 namespace {
 
-bool contains(const char* text, const std::string& part) { return std::string(text).find(part) != std::string::npos; }
+bool contains(const char* text, const std::string& part) {
+  return std::string(text).find(part) != std::string::npos;
+}
 
 vereshchagin::SolverOptions jointSpace() {
   vereshchagin::SolverOptions o;
@@ -95,8 +97,8 @@ void lwrFrictionChecks(testutil::Checker& ck) {
     const Eigen::VectorXd qd = Eigen::VectorXd::Zero(7);
     const Matrix6X alfa = g.alfa(2).data;
     const Eigen::VectorXd beta = g.beta(2).data;
-    if (!ck.check(fs.solve(q.data, qd, alfa, beta, Matrix6X(6, 0), ff.data, fm) == 0, "LWR friction solve " + str(k) +
-                                                                                        ": " + fs.errorMessage()))
+    if (!ck.check(fs.solve(q.data, qd, alfa, beta, Matrix6X(6, 0), ff.data, fm) == 0,
+                  "LWR friction solve " + str(k) + ": " + fs.errorMessage()))
       continue;
     KDL::ChainFdSolver_RNE fd(lwr, KDL::Vector(0, 0, -9.81));
     KDL::JntArray tau(7), qdd(7), qdv(7);
@@ -138,10 +140,12 @@ void triangleChecks(testutil::Checker& ck) {
 // H is positive definite for |cos q2| < 0.837 and indefinite near q2 = 0.
 KDL::Chain partlyDefinite() {
   KDL::Chain ch;
-  ch.addSegment(KDL::Segment("l1", KDL::Joint("shoulder", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
-                             KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(0.01, 0.01, -0.75))));
-  ch.addSegment(KDL::Segment("l2", KDL::Joint("elbow", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
-                             KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(0.01, 0.01, 0.1))));
+  ch.addSegment(
+      KDL::Segment("l1", KDL::Joint("shoulder", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
+                   KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(0.01, 0.01, -0.75))));
+  ch.addSegment(
+      KDL::Segment("l2", KDL::Joint("elbow", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
+                   KDL::RigidBodyInertia(1.0, KDL::Vector(-0.5, 0, 0), KDL::RotationalInertia(0.01, 0.01, 0.1))));
   return ch;
 }
 
@@ -189,7 +193,8 @@ void urdfChecks(testutil::Checker& ck) {
     const auto ok = vereshchagin::chainFromUrdfString(with(ixx), "", "", js);
     ck.check(ok.ok, std::string("URDF ixx = ") + ixx + " accepted under joint_space: " + ok.message);
   }
-  ck.check(contains(vereshchagin::chainFromUrdfString(with("0.1")).message.c_str(), "triangle"), "URDF triangle message");
+  ck.check(contains(vereshchagin::chainFromUrdfString(with("0.1")).message.c_str(), "triangle"),
+           "URDF triangle message");
   ck.check(vereshchagin::chainFromUrdfString(with("0.02")).ok, "URDF valid inertia accepted");
 }
 

@@ -128,8 +128,8 @@ void lwrTaskChecks(testutil::Checker& ck) {
   // End-effector accelerations along the enabled columns equal beta.
   const Eigen::Matrix<double, 6, 1> a_ours = toVec(ours.xdd[7]), a_kdl = toVec(kdl.xdd[7]);
   for (int c : {0, 1, 2, 5}) {
-    ck.check(std::abs(a_ours(c) - s.beta(c)) <= 1e-9, "LWR task: ours Xdd(" + str(c) + ") = " + str(a_ours(c)) +
-                                                           " vs beta " + str(s.beta(c)));
+    ck.check(std::abs(a_ours(c) - s.beta(c)) <= 1e-9,
+             "LWR task: ours Xdd(" + str(c) + ") = " + str(a_ours(c)) + " vs beta " + str(s.beta(c)));
     ck.check(std::abs(a_kdl(c) - s.beta(c)) <= 1e-3, "LWR task: KDL Xdd(" + str(c) + ") = " + str(a_kdl(c)));
   }
   // nu equals KDL's, and KDL's published regression values (its tests' tolerance 1e-3).
@@ -182,10 +182,12 @@ void randomChecks(testutil::Checker& ck) {
     const testutil::DenseModel d = testutil::denseModel(s.chain, s.q);
     Eigen::MatrixXd on(6, 0);
     for (int c = 0; c < nc; ++c)
-      if (!s.alfa.data.col(c).isZero(0.0)) on.conservativeResize(6, on.cols() + 1), on.rightCols(1) = s.alfa.data.col(c);
+      if (!s.alfa.data.col(c).isZero(0.0))
+        on.conservativeResize(6, on.cols() + 1), on.rightCols(1) = s.alfa.data.col(c);
     if (!testutil::wellConditioned(testutil::couplingEigenvalues(d, on))) continue;
     const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
-    const std::string tag = "random " + str(k) + " (n=" + str(n) + ", nc=" + str(nc) + ", enabled " + str(on.cols()) + ")";
+    const std::string tag =
+        "random " + str(k) + " (n=" + str(n) + ", nc=" + str(nc) + ", enabled " + str(on.cols()) + ")";
     ck.check(kdl.rc == 0 && ours.rc == 0, tag + ": return codes");
     const double e_qdd = relErr(ours.qdd, kdl.qdd), e_nu = relErr(ours.nu, kdl.nu);
     ck.check(e_qdd <= 1e-8 && e_nu <= 1e-8, tag + ": vs KDL rel err qdd " + str(e_qdd) + ", nu " + str(e_nu));
@@ -221,8 +223,7 @@ void getterChecks(testutil::Checker& ck) {
     fk.JntToCart(s.q, F, i + 1);
     fkv.JntToCart(qv, FV, i + 1);
     const KDL::Frame F_parent = i == 0 ? KDL::Frame::Identity() : pose_base[i - 1];
-    worst = std::max({worst,
-                      relErr(toVec(FV.GetTwist()), toVec(vel_base[i])),
+    worst = std::max({worst, relErr(toVec(FV.GetTwist()), toVec(vel_base[i])),
                       relErr(toVec(pose_base[i].M * vel_local[i]), toVec(vel_base[i])),
                       relErr(toVec(pose_base[i].M * acc_local[i]), toVec(acc_base[i])),
                       relErr(toVec(xdd[i + 1]), toVec(acc_base[i]))});
@@ -243,7 +244,8 @@ void driverWeightChecks(testutil::Checker& ck) {
   Ours passing(s.chain, s.root_acc, 6), plain(s.chain, s.root_acc, 6);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(6), one = Eigen::VectorXd::Ones(6);
   ck.check(passing.setDriverWeights(zero, one) == 0, "setDriverWeights accepted");
-  ck.check(passing.setDriverWeights(zero, Eigen::VectorXd::Ones(5)) == Ours::E_SIZE_MISMATCH, "5 weights for nc = 6 refused");
+  ck.check(passing.setDriverWeights(zero, Eigen::VectorXd::Ones(5)) == Ours::E_SIZE_MISMATCH,
+           "5 weights for nc = 6 refused");
   ck.check(passing.setDriverWeights(zero, 2.0 * one) == Ours::E_OUT_OF_RANGE, "weight 2 refused");
   KDL::JntArray qdd(7), tc(7), qdd0(7), tc0(7);
   ck.check(passing.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
@@ -271,7 +273,8 @@ void errorChecks(testutil::Checker& ck) {
   KDL::JntArray qdd(7), tc(7), short_q(6);
   KDL::Jacobian five(5);
   ck.check(solver.CartToJnt(short_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH, "q size");
-  ck.check(solver.CartToJnt(s.q, s.qd, qdd, five, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH, "alfa columns != nc");
+  ck.check(solver.CartToJnt(s.q, s.qd, qdd, five, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH,
+           "alfa columns != nc");
   KDL::JntArray bad_q = s.q;
   bad_q(2) = NAN;
   ck.check(solver.CartToJnt(bad_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) ==
@@ -286,12 +289,14 @@ void errorChecks(testutil::Checker& ck) {
   // updateInternalDataStructures re-reads the (changed) chain.
   Scenario grown = s;
   Ours follower(grown.chain, s.root_acc, 6);
-  grown.chain.addSegment(KDL::Segment("extra", KDL::Joint(KDL::Joint::RotZ), KDL::Frame(KDL::Vector(0, 0, 0.1)),
-                                      KDL::RigidBodyInertia(1.0, KDL::Vector(0, 0, 0.05), KDL::RotationalInertia(0.01, 0.01, 0.01))));
+  grown.chain.addSegment(
+      KDL::Segment("extra", KDL::Joint(KDL::Joint::RotZ), KDL::Frame(KDL::Vector(0, 0, 0.1)),
+                   KDL::RigidBodyInertia(1.0, KDL::Vector(0, 0, 0.05), KDL::RotationalInertia(0.01, 0.01, 0.01))));
   follower.updateInternalDataStructures();
   KDL::JntArray q8(8), qd8(8), qdd8(8), ff8(8), tc8(8);
   KDL::Wrenches f8(8, KDL::Wrench::Zero());
-  ck.check(follower.CartToJnt(q8, qd8, qdd8, s.alfa, s.beta, f8, ff8, tc8) == 0, "updateInternalDataStructures: 8 joints");
+  ck.check(follower.CartToJnt(q8, qd8, qdd8, s.alfa, s.beta, f8, ff8, tc8) == 0,
+           "updateInternalDataStructures: 8 joints");
 }
 
 }  // namespace

@@ -32,8 +32,8 @@ using testutil::str;
 int main() {
   testutil::Checker ck("test_kdl_oracle");
   const int kSamples = 1200;
-  int compared = 0, skipped_rank = 0, skipped_cond = 0, eligible = 0, kdl_defect_seen = 0,
-      kdl_defect_candidates = 0, fd_checked = 0;
+  int compared = 0, skipped_rank = 0, skipped_cond = 0, eligible = 0, kdl_defect_seen = 0, kdl_defect_candidates = 0,
+      fd_checked = 0;
   double worst_qdd = 0.0, worst_nu = 0.0, worst_acc = 0.0, worst_fd = 0.0;
 
   for (int s = 0; s < kSamples; ++s) {
@@ -72,8 +72,7 @@ int main() {
       rc = ours2.solve(q.data, qd.data, alfa.data, beta.data, fe, ff.data);
       ck.check(rc == 0, tag + ": solve returned " + str(rc));
       ck.check(ours2.qdd() == qdd.data && ours2.commandTorques() == tau_cmd.data && ours2.nu() == nu &&
-                   ours2.linkAccelerations() == ours.linkAccelerations() &&
-                   ours2.constraintCount() == nc,
+                   ours2.linkAccelerations() == ours.linkAccelerations() && ours2.constraintCount() == nc,
                tag + ": solve() and CartToJnt() disagree");
     }
     ck.check(static_cast<int>(nu.size()) == nc && acc.size() == ns + 1 &&
@@ -135,8 +134,8 @@ int main() {
     worst_acc = std::max(worst_acc, e_acc);
     ck.check(e_qdd <= 1e-10, tag + ": q_dotdot vs KDL rel err " + str(e_qdd) + "\n  ours " + testutil::mat(qdd.data) +
                                  "\n  kdl  " + testutil::mat(qdd_k.data));
-    ck.check(e_nu <= 1e-10, tag + ": nu vs KDL rel err " + str(e_nu) + "\n  ours " + testutil::mat(nu) +
-                                "\n  kdl  " + testutil::mat(nu_k));
+    ck.check(e_nu <= 1e-10, tag + ": nu vs KDL rel err " + str(e_nu) + "\n  ours " + testutil::mat(nu) + "\n  kdl  " +
+                                testutil::mat(nu_k));
     ck.check(e_acc <= 1e-10, tag + ": link accelerations vs KDL rel err " + str(e_acc));
 
     // Our command torques drive plain forward dynamics to our q_dotdot.
@@ -150,7 +149,8 @@ int main() {
     worst_fd = std::max(worst_fd, e_fd);
     ++fd_checked;
     ck.check(e_fd <= 1e-9, tag + ": forward dynamics with ff + command torques gives a different q_dotdot, rel err " +
-                               str(e_fd) + "\n  fd   " + testutil::mat(qdd_fd.data) + "\n  ours " + testutil::mat(qdd.data));
+                               str(e_fd) + "\n  fd   " + testutil::mat(qdd_fd.data) + "\n  ours " +
+                               testutil::mat(qdd.data));
 
     // KDL's constraint_torques are not such a command (KDL defect 1).
     if (nc > 0 && n >= 3) {
@@ -162,13 +162,14 @@ int main() {
   }
 
   ck.check(compared >= 600, "too few samples compared: " + str(compared));
-  ck.check(compared >= 0.8 * eligible, "too many ill-conditioned samples skipped: " + str(skipped_cond) + " of " +
-                                           str(eligible));
-  ck.check(kdl_defect_candidates > 0 && kdl_defect_seen > 0,
-           "KDL's constraint_torques reproduced q_dotdot in every sample: the forward-dynamics check does not discriminate");
+  ck.check(compared >= 0.8 * eligible,
+           "too many ill-conditioned samples skipped: " + str(skipped_cond) + " of " + str(eligible));
+  ck.check(
+      kdl_defect_candidates > 0 && kdl_defect_seen > 0,
+      "KDL's constraint_torques reproduced q_dotdot in every sample: the forward-dynamics check does not discriminate");
 
   return ck.finish(str(compared) + " samples compared with KDL (skipped: " + str(skipped_rank) + " nc>n, " +
                    str(skipped_cond) + " ill-conditioned); worst rel err qdd " + str(worst_qdd) + ", nu " +
-                   str(worst_nu) + ", acc " + str(worst_acc) + ", FD " + str(worst_fd) + "; KDL constraint_torques wrong in " +
-                   str(kdl_defect_seen) + "/" + str(kdl_defect_candidates));
+                   str(worst_nu) + ", acc " + str(worst_acc) + ", FD " + str(worst_fd) +
+                   "; KDL constraint_torques wrong in " + str(kdl_defect_seen) + "/" + str(kdl_defect_candidates));
 }

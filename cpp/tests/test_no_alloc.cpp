@@ -11,12 +11,13 @@
 #include "vereshchagin/friction_solver.hpp"
 #include "vereshchagin/kdl_compat.hpp"
 
-
 namespace {
 void* volatile g_sink = nullptr;  // keeps the deliberate allocations observable
 
 using Counts = testutil::AllocCounts;
-Counts now() { return testutil::allocCounts(); }
+Counts now() {
+  return testutil::allocCounts();
+}
 }  // namespace
 
 int main() {
@@ -36,7 +37,8 @@ int main() {
     g_sink = e->data();
     delete e;
     const Counts c2 = now();
-    if (VERESHCHAGIN_TEST_COUNT_MALLOC) ck.check(c2.mallocs - c1.mallocs >= 2, "malloc interposition does not count (Eigen)");
+    if (VERESHCHAGIN_TEST_COUNT_MALLOC)
+      ck.check(c2.mallocs - c1.mallocs >= 2, "malloc interposition does not count (Eigen)");
   }
 
   testutil::RandomGen g(777);
@@ -96,7 +98,8 @@ int main() {
   ck.check(failures == 0, "solver calls failed: " + str(failures));
   ck.check(std::isfinite(checksum), "non-finite results");
   ck.check(c1.news == c0.news, "operator new called " + str(c1.news - c0.news) + " times in 1000 iterations");
-  ck.check(c1.mallocs == c0.mallocs, "malloc family called " + str(c1.mallocs - c0.mallocs) + " times in 1000 iterations");
+  ck.check(c1.mallocs == c0.mallocs,
+           "malloc family called " + str(c1.mallocs - c0.mallocs) + " times in 1000 iterations");
 
   // Error paths (they format a message) do not allocate either.
   const Counts c2 = now();
@@ -148,9 +151,9 @@ int main() {
     const Counts f1 = now();
     ck.check(ffail == 0, "friction solves failed: " + str(ffail) + " (" + fsolver.errorMessage() + ")");
     ck.check(std::isfinite(fsum), "non-finite friction results");
-    ck.check(f1.news == f0.news && f1.mallocs == f0.mallocs,
-             "friction-aware solves allocated: operator new " + str(f1.news - f0.news) + ", malloc " +
-                 str(f1.mallocs - f0.mallocs) + " in 3000 solves");
+    ck.check(f1.news == f0.news && f1.mallocs == f0.mallocs, "friction-aware solves allocated: operator new " +
+                                                                 str(f1.news - f0.news) + ", malloc " +
+                                                                 str(f1.mallocs - f0.mallocs) + " in 3000 solves");
   }
 
   // Constraints on several segments (general path: Cholesky and Jacobi factorisations, both
@@ -173,22 +176,25 @@ int main() {
     const Counts g0 = now();
     for (int it = 0; it < 500; ++it) {
       const int s = it % kSets, m = 1 + it % 18;
-      if (solver.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), fext_m[s], ff[s].data) != 0) ++gfail;
+      if (solver.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), fext_m[s], ff[s].data) != 0)
+        ++gfail;
       if (solver.responseColumns(joints, dqdd, dtau, dnu) != 0) ++gfail;
       gsum += solver.qdd()(0) + solver.nu()(0) + dnu(0, 0) + solver.smallestSingularValue();
-      if (solver_dls.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), empty_fext, empty_tau) != 0) ++gfail;
+      if (solver_dls.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), empty_fext, empty_tau) != 0)
+        ++gfail;
       gsum += solver_dls.commandTorques()(1);
       const int mf = 1 + it % 7;  // at most n columns keeps the friction QP well posed
-      if (fsolver.solve(q[s].data, rest, A.leftCols(mf), b.head(mf), segs.head(mf), fext_m[s], ff[s].data, fm) != 0) ++gfail;
+      if (fsolver.solve(q[s].data, rest, A.leftCols(mf), b.head(mf), segs.head(mf), fext_m[s], ff[s].data, fm) != 0)
+        ++gfail;
       gsum += fsolver.qdd()(0) + fsolver.gaussValue();
     }
     const Counts g1 = now();
     ck.check(gfail == 0, "segment-constraint solves failed: " + str(gfail) + " (" + solver.errorMessage() + " / " +
                              fsolver.errorMessage() + ")");
     ck.check(std::isfinite(gsum), "non-finite segment-constraint results");
-    ck.check(g1.news == g0.news && g1.mallocs == g0.mallocs,
-             "segment-constraint solves allocated: operator new " + str(g1.news - g0.news) + ", malloc " +
-                 str(g1.mallocs - g0.mallocs));
+    ck.check(g1.news == g0.news && g1.mallocs == g0.mallocs, "segment-constraint solves allocated: operator new " +
+                                                                 str(g1.news - g0.news) + ", malloc " +
+                                                                 str(g1.mallocs - g0.mallocs));
   }
 
   // Driver pass-through (both paths, friction on top) and the KDL drop-in class (zero columns,
@@ -239,11 +245,12 @@ int main() {
     const Counts p1 = now();
     ck.check(pfail == 0, "pass-through / drop-in solves failed: " + str(pfail));
     ck.check(std::isfinite(psum), "non-finite pass-through results");
-    ck.check(p1.news == p0.news && p1.mallocs == p0.mallocs,
-             "pass-through / drop-in solves allocated: operator new " + str(p1.news - p0.news) + ", malloc " +
-                 str(p1.mallocs - p0.mallocs));
+    ck.check(p1.news == p0.news && p1.mallocs == p0.mallocs, "pass-through / drop-in solves allocated: operator new " +
+                                                                 str(p1.news - p0.news) + ", malloc " +
+                                                                 str(p1.mallocs - p0.mallocs));
   }
 
-  return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves + 2000 with segment constraints on a 7-joint chain, nc 0..6 (malloc counted too: ") +
+  return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves + 2000 with segment constraints on a "
+                               "7-joint chain, nc 0..6 (malloc counted too: ") +
                    (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no") + ")");
 }

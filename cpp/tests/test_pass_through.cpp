@@ -104,8 +104,8 @@ Dense denseFormula(const Problem& p, const Eigen::VectorXd& compensated) {
   const Eigen::MatrixXd HinvAt = Hlu.solve(A.transpose());
   const Eigen::MatrixXd K = A * HinvAt;
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(M);
-  const Eigen::VectorXd rhs = a_nat + (ones - p.p_f).cwiseProduct(out.a_fext) +
-                              (ones - p.p_t).cwiseProduct(out.a_ff) + a_comp - p.beta;
+  const Eigen::VectorXd rhs =
+      a_nat + (ones - p.p_f).cwiseProduct(out.a_fext) + (ones - p.p_t).cwiseProduct(out.a_ff) + a_comp - p.beta;
   out.nu = K.ldlt().solve(rhs);
   out.qdd = qdd_all - HinvAt * out.nu;
   return out;
@@ -134,7 +134,8 @@ Problem randomProblem(testutil::RandomGen& g, bool general) {
   if (general) {
     for (int k = 0; k < ns && static_cast<int>(seg_of_col.size()) < n; ++k) {
       if (!g.coin(0.4)) continue;
-      const int cap = std::min({6, k + 1 - static_cast<int>(seg_of_col.size()), n - static_cast<int>(seg_of_col.size())});
+      const int cap =
+          std::min({6, k + 1 - static_cast<int>(seg_of_col.size()), n - static_cast<int>(seg_of_col.size())});
       for (int c = 0, mk = cap > 0 ? g.integer(1, cap) : 0; c < mk; ++c) seg_of_col.push_back(k);
     }
   }
@@ -162,8 +163,8 @@ struct Worst {
 void oracleCase(testutil::Checker& ck, testutil::RandomGen& g, bool general, int sample, Worst& w) {
   const Problem p = randomProblem(g, general);
   const int n = static_cast<int>(p.chain.getNrOfJoints()), M = static_cast<int>(p.alfa.cols());
-  const std::string tag = std::string(general ? "general" : "end") + " sample " + str(sample) + " (n=" + str(n) +
-                          ", M=" + str(M) + ")";
+  const std::string tag =
+      std::string(general ? "general" : "end") + " sample " + str(sample) + " (n=" + str(n) + ", M=" + str(M) + ")";
   // Well-conditioned tasks only (as the other oracle tests): cond(K) <= 1e5.
   const testutil::DenseModel d = testutil::denseModel(p.chain, p.q);
   Eigen::MatrixXd A(M, n);
@@ -260,14 +261,16 @@ void badWeights(testutil::Checker& ck) {
   ck.check(s.setPassThrough(bad, good) == Solver::E_OUT_OF_RANGE, "weight 1.5 refused");
   bad(1) = NAN;
   ck.check(s.setPassThrough(good, bad) == Solver::E_OUT_OF_RANGE, "NaN weight refused");
-  ck.check(s.setPassThrough(good, Eigen::VectorXd::Zero(3)) == Solver::E_SIZE_MISMATCH, "weights of different sizes refused");
+  ck.check(s.setPassThrough(good, Eigen::VectorXd::Zero(3)) == Solver::E_SIZE_MISMATCH,
+           "weights of different sizes refused");
   ck.check(s.passThroughColumns() == -1, "refused weights leave none set");
   ck.check(s.setPassThrough(good, Eigen::VectorXd()) == 0 && s.passThroughColumns() == 2, "p_f alone accepted");
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(4);
   const Matrix6X alfa = g.alfa(3).data;
   const int rc = s.solve(q, q, alfa, Eigen::VectorXd::Zero(3), Matrix6X(6, 0), q);
   ck.check(rc == Solver::E_SIZE_MISMATCH && std::string(s.errorMessage()).find("pass-through") != std::string::npos,
-           "weights for 2 columns, alfa with 3: E_SIZE_MISMATCH naming the pass-through (" + std::string(s.errorMessage()) + ")");
+           "weights for 2 columns, alfa with 3: E_SIZE_MISMATCH naming the pass-through (" +
+               std::string(s.errorMessage()) + ")");
   s.clearPassThrough();
   ck.check(s.solve(q, q, alfa, Eigen::VectorXd::Zero(3), Matrix6X(6, 0), q) == 0, "cleared weights: solve works");
 }
@@ -288,7 +291,8 @@ int main() {
   }
   badWeights(ck);
   ck.check(w.compared >= 200, "too few well-conditioned samples: " + str(w.compared));
-  return ck.finish("(" + str(w.compared) + " compared, " + str(w.skipped) + " ill-conditioned skipped; worst rel err qdd " +
-                   str(w.qdd) + ", nu " + str(w.nu) + ", FD " + str(w.tau_fd) + ", alfa^T Xdd " + str(w.acc) +
-                   ", driver sum " + str(w.sum) + ", friction " + str(worst_friction) + ")");
+  return ck.finish("(" + str(w.compared) + " compared, " + str(w.skipped) +
+                   " ill-conditioned skipped; worst rel err qdd " + str(w.qdd) + ", nu " + str(w.nu) + ", FD " +
+                   str(w.tau_fd) + ", alfa^T Xdd " + str(w.acc) + ", driver sum " + str(w.sum) + ", friction " +
+                   str(worst_friction) + ")");
 }

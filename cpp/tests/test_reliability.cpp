@@ -32,15 +32,17 @@ KDL::Chain scaledArm(int n, double mass, double length) {
   for (int i = 0; i < n; ++i) {
     const double r = 0.1 * length;  // slender rod: inertia about the centre m (3 r^2 + L^2) / 12
     const double Ia = mass * r * r / 2, Ib = mass * (3 * r * r + length * length) / 12;
-    ch.addSegment(KDL::Segment("s" + str(i), KDL::Joint("j" + str(i), i % 2 ? KDL::Joint::RotZ : KDL::Joint::RotY),
-                               KDL::Frame(KDL::Rotation::RPY(0.3, 0.0, 0.0), KDL::Vector(length, 0, 0)),
-                               KDL::RigidBodyInertia(mass, KDL::Vector(-length / 2, 0, 0), KDL::RotationalInertia(Ia, Ib, Ib))));
+    ch.addSegment(
+        KDL::Segment("s" + str(i), KDL::Joint("j" + str(i), i % 2 ? KDL::Joint::RotZ : KDL::Joint::RotY),
+                     KDL::Frame(KDL::Rotation::RPY(0.3, 0.0, 0.0), KDL::Vector(length, 0, 0)),
+                     KDL::RigidBodyInertia(mass, KDL::Vector(-length / 2, 0, 0), KDL::RotationalInertia(Ia, Ib, Ib))));
   }
   return ch;
 }
 
 bool allFinite(const Solver& s) {
-  return s.qdd().allFinite() && s.commandTorques().allFinite() && s.nu().allFinite() && s.linkAccelerations().allFinite();
+  return s.qdd().allFinite() && s.commandTorques().allFinite() && s.nu().allFinite() &&
+         s.linkAccelerations().allFinite();
 }
 
 }  // namespace
@@ -67,8 +69,9 @@ int main() {
         {"Inf in tip rotation", KDL::Segment("bad", KDL::Joint("jb", KDL::Joint::RotZ), inf_rot, body)},
         {"non-orthonormal tip rotation", KDL::Segment("bad", KDL::Joint("jb", KDL::Joint::RotZ), skewed, body)},
         {"reflecting tip rotation", KDL::Segment("bad", KDL::Joint("jb", KDL::Joint::RotZ), reflect, body)},
-        {"NaN joint origin", KDL::Segment("bad", KDL::Joint("jb", KDL::Vector(NAN, 0, 0), KDL::Vector(0, 0, 1), KDL::Joint::RotAxis),
-                                          KDL::Frame::Identity(), body)},
+        {"NaN joint origin",
+         KDL::Segment("bad", KDL::Joint("jb", KDL::Vector(NAN, 0, 0), KDL::Vector(0, 0, 1), KDL::Joint::RotAxis),
+                      KDL::Frame::Identity(), body)},
     };
     for (const Case& c : cases) {
       KDL::Chain ch = scaledArm(2, 1.0, 0.5);
@@ -76,7 +79,8 @@ int main() {
       Solver s(ch, kGrav);
       const std::string msg = s.errorMessage();
       ck.check(s.modelError() == Solver::E_INVALID_MODEL, c.what + ": modelError " + str(s.modelError()));
-      ck.check(msg.find("segment 2 ('bad')") != std::string::npos, c.what + ": message does not name the segment: " + msg);
+      ck.check(msg.find("segment 2 ('bad')") != std::string::npos,
+               c.what + ": message does not name the segment: " + msg);
       const Eigen::VectorXd z = Eigen::VectorXd::Zero(3);
       ck.check(s.solve(z, z, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), z) == Solver::E_INVALID_MODEL,
                c.what + ": solve does not refuse");
@@ -103,14 +107,16 @@ int main() {
     for (const Huge& h : cases) {
       const int rc = s.solve(q, h.qd, alfa, h.beta, Matrix6X(6, 0), h.ff);
       ck.check(rc == Solver::E_NONFINITE_RESULT, h.what + ": expected E_NONFINITE_RESULT, got " + str(rc));
-      ck.check(std::string(s.errorMessage()).find("overflow") != std::string::npos, h.what + ": message " + s.errorMessage());
+      ck.check(std::string(s.errorMessage()).find("overflow") != std::string::npos,
+               h.what + ": message " + s.errorMessage());
       Eigen::MatrixXd a(4, 1), b(4, 1);
       Eigen::VectorXi j(1);
       j << 0;
       ck.check(s.responseColumns(j, a, b) == Solver::E_NO_SOLUTION, h.what + ": responseColumns after overflow");
     }
     ck.check(s.solve(q, z, alfa, beta0, Matrix6X(6, 0), z) == 0 && s.qdd() == qdd_ok, "solver unusable after overflow");
-    ck.check(std::string(s.strError(Solver::E_NONFINITE_RESULT)) != s.strError(123456), "E_NONFINITE_RESULT has no description");
+    ck.check(std::string(s.strError(Solver::E_NONFINITE_RESULT)) != s.strError(123456),
+             "E_NONFINITE_RESULT has no description");
   }
 
   // ------------------------------------------------------------ friction
@@ -145,8 +151,8 @@ int main() {
       const bool finite = fs.qdd().allFinite() && fs.frictionTorques().allFinite() && fs.commandTorques().allFinite();
       ck.check(rc == 0 && finite, "static friction " + str(f) + ": rc " + str(rc) + " " + fs.errorMessage());
       if (f >= 1e3) {
-        ck.check(fs.qdd().cwiseAbs().maxCoeff() <= 1e-9, "static friction " + str(f) + " does not hold the arm: qdd " +
-                                                              testutil::mat(fs.qdd()));
+        ck.check(fs.qdd().cwiseAbs().maxCoeff() <= 1e-9,
+                 "static friction " + str(f) + " does not hold the arm: qdd " + testutil::mat(fs.qdd()));
       } else {
         ck.check(fs.qdd().cwiseAbs().maxCoeff() > 1e-3, "zero friction holds the arm");
       }
@@ -170,7 +176,8 @@ int main() {
       vereshchagin::FrictionModel fm;
       fm.static_friction = none;
       const int rc = fs.solve(none, none, Matrix6X(6, 0), none, Matrix6X(6, 0), none, fm);
-      ck.check(rc == 0 && fs.qdd().size() == 0 && std::isfinite(fs.gaussValue()), tag + ": friction solve rc " + str(rc));
+      ck.check(rc == 0 && fs.qdd().size() == 0 && std::isfinite(fs.gaussValue()),
+               tag + ": friction solve rc " + str(rc));
       Matrix6X alfa = Matrix6X::Zero(6, 1);
       alfa(2, 0) = 1.0;
       ck.check(fs.solve(none, none, alfa, Eigen::VectorXd::Ones(1), Matrix6X(6, 0), none, fm) == 0 &&
@@ -202,7 +209,8 @@ int main() {
       ck.check(testutil::relErr(met, beta) <= 1e-8, tag + ": task not met: " + testutil::mat(met));
       rc = free.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), ff + s.commandTorques());
       ck.check(rc == 0 && testutil::relErr(free.qdd(), s.qdd()) <= 1e-8,
-               tag + ": command torques do not reproduce qdd: " + testutil::mat(free.qdd()) + " vs " + testutil::mat(s.qdd()));
+               tag + ": command torques do not reproduce qdd: " + testutil::mat(free.qdd()) + " vs " +
+                   testutil::mat(s.qdd()));
       // Determinism: another instance and a repeated call, bit for bit.
       Solver again(ch, kGrav);
       again.solve(q, qd, alfa, beta, Matrix6X(6, 0), ff);

@@ -92,7 +92,8 @@ int main() {
       for (int c = 0; c < mk; ++c) seg_of_col.push_back(chosen[k]);
     }
     // Interleave the columns of different segments (the solver must not assume grouping).
-    for (std::size_t c = seg_of_col.size(); c > 1; --c) std::swap(seg_of_col[c - 1], seg_of_col[g.integer(0, static_cast<int>(c) - 1)]);
+    for (std::size_t c = seg_of_col.size(); c > 1; --c)
+      std::swap(seg_of_col[c - 1], seg_of_col[g.integer(0, static_cast<int>(c) - 1)]);
     const int M = static_cast<int>(seg_of_col.size());
     const Matrix6X alfa = g.alfa(M).data;
     const Eigen::VectorXd beta = g.beta(M).data;
@@ -152,7 +153,8 @@ int main() {
     rc = ours.responseColumns(joints, dq, dt, dn);
     ck.check(rc == 0, tag + ": responseColumns " + str(rc));
     Eigen::VectorXd tau_of(n);
-    ck.check(ours.commandTorquesOf(nu, tau_of) == 0 && tau_of == tau, tag + ": commandTorquesOf(nu()) != commandTorques()");
+    ck.check(ours.commandTorquesOf(nu, tau_of) == 0 && tau_of == tau,
+             tag + ": commandTorquesOf(nu()) != commandTorques()");
     vereshchagin::ChainHdSolver other(chain, root_acc);
     for (int j = 0; j < n; j += 3) {
       Eigen::VectorXd ff2 = ff.data;
@@ -209,8 +211,8 @@ int main() {
     if (!ck.check(rc == 0, tag + ": general solve " + str(rc))) continue;
     const double e = std::max({relErr(gen.qdd(), end.qdd()), relErr(gen.commandTorques(), end.commandTorques()),
                                relErr(gen.nu().head(m), end.nu()), std::abs(gen.nu()(m))});
-    ck.check(gen.constraintRank() == end.constraintRank(), tag + ": rank " + str(gen.constraintRank()) + " vs " +
-                                                                str(end.constraintRank()));
+    ck.check(gen.constraintRank() == end.constraintRank(),
+             tag + ": rank " + str(gen.constraintRank()) + " vs " + str(end.constraintRank()));
     if (end.constraintRank() == m) {
       ck.check(e <= 1e-10, tag + ": general vs end-segment path rel err " + str(e));
       worst_path = std::max(worst_path, e);
@@ -243,7 +245,9 @@ int main() {
       ck.check(rc == 0, "conflicting constraints: rc " + str(rc));
       ck.check(solver.qdd().allFinite() && solver.nu().allFinite() && solver.commandTorques().allFinite(),
                "conflicting constraints: non-finite output");
-      if (policy == 0) ck.check(solver.constraintRank() == 5, "conflicting constraints: rank " + str(solver.constraintRank()) + ", expected 5 (5 joints)");
+      if (policy == 0)
+        ck.check(solver.constraintRank() == 5,
+                 "conflicting constraints: rank " + str(solver.constraintRank()) + ", expected 5 (5 joints)");
     }
     // Errors: segment out of range, more than 6 columns on one segment, size mismatch.
     vereshchagin::ChainHdSolver solver(chain, root_acc);
@@ -262,6 +266,7 @@ int main() {
   }
 
   return ck.finish("compared " + str(compared) + " (skipped ill-conditioned " + str(skipped) + "); worst rel err qdd " +
-                   str(worst_qdd) + ", nu " + str(worst_nu) + ", tau_cmd " + str(worst_tau) + ", KDL FD " + str(worst_fd) +
-                   ", response columns " + str(worst_cols) + ", general vs end path " + str(worst_path));
+                   str(worst_qdd) + ", nu " + str(worst_nu) + ", tau_cmd " + str(worst_tau) + ", KDL FD " +
+                   str(worst_fd) + ", response columns " + str(worst_cols) + ", general vs end path " +
+                   str(worst_path));
 }

@@ -20,7 +20,9 @@ void check(bool ok, const std::string& what) {
   }
 }
 
-bool near(double a, double b, double tol = 1e-12) { return std::abs(a - b) <= tol * std::max(1.0, std::abs(b)); }
+bool near(double a, double b, double tol = 1e-12) {
+  return std::abs(a - b) <= tol * std::max(1.0, std::abs(b));
+}
 
 bool nearFrame(const KDL::Frame& a, const KDL::Frame& b) {
   for (int r = 0; r < 3; ++r) {
@@ -112,14 +114,16 @@ void testStructure() {
   const KDL::RigidBodyInertia got_seg0 = ch.getSegment(0).getInertia();
   bool same0 = near(got_seg0.getMass(), 2.5) && near(got_seg0.getMass(), seg0.getMass());
   for (int k = 0; k < 3; ++k) same0 = same0 && near(got_seg0.getCOG()(k), seg0.getCOG()(k));
-  for (int k = 0; k < 9; ++k) same0 = same0 && near(got_seg0.getRotationalInertia().data[k], seg0.getRotationalInertia().data[k]);
+  for (int k = 0; k < 9; ++k)
+    same0 = same0 && near(got_seg0.getRotationalInertia().data[k], seg0.getRotationalInertia().data[k]);
   check(same0, "segment 0 inertia = l1 (moved into l1b's frame) + l1b");
   const KDL::RigidBodyInertia seg1 = tool_in_l2.Inverse() * diagInertia(1, KDL::Vector::Zero(), 0.01, 0.01, 0.01) +
                                      diagInertia(0.25, KDL::Vector::Zero(), 1e-4, 1e-4, 1e-4);
   const KDL::RigidBodyInertia got_seg1 = ch.getSegment(1).getInertia();
   bool same1 = near(got_seg1.getMass(), 1.25);
   for (int k = 0; k < 3; ++k) same1 = same1 && near(got_seg1.getCOG()(k), seg1.getCOG()(k));
-  for (int k = 0; k < 9; ++k) same1 = same1 && near(got_seg1.getRotationalInertia().data[k], seg1.getRotationalInertia().data[k]);
+  for (int k = 0; k < 9; ++k)
+    same1 = same1 && near(got_seg1.getRotationalInertia().data[k], seg1.getRotationalInertia().data[k]);
   check(same1, "segment 1 inertia = l2 (moved into the tool frame) + tool");
 }
 
@@ -141,9 +145,12 @@ void testErrors() {
   expectError(kArm, "nowhere", "", "root link 'nowhere' not found", "missing root");
   expectError(kArm, "", "nowhere", "tip link 'nowhere' not found", "missing tip");
   expectError(kArm, "l2", "l1", "is not below root", "tip above root");
-  expectError(replaced(kArm, "type=\"prismatic\"", "type=\"floating\""), "", "", "floating", "floating joint on the path");
-  expectError(replaced(kArm, "<mass value=\"0.5\"/>", "<mass value=\"-0.5\"/>"), "", "", "negative mass", "negative mass");
-  expectError(replaced(kArm, "ixx=\"0.001\"", "ixx=\"-0.5\""), "", "", "not positive semi-definite", "indefinite inertia");
+  expectError(replaced(kArm, "type=\"prismatic\"", "type=\"floating\""), "", "", "floating",
+              "floating joint on the path");
+  expectError(replaced(kArm, "<mass value=\"0.5\"/>", "<mass value=\"-0.5\"/>"), "", "", "negative mass",
+              "negative mass");
+  expectError(replaced(kArm, "ixx=\"0.001\"", "ixx=\"-0.5\""), "", "", "not positive semi-definite",
+              "indefinite inertia");
   expectError(replaced(kArm, "<mass value=\"1\"/>", "<mass value=\"abc\"/>"), "", "", "malformed URDF",
               "unparsable number (urdfdom would silently use 0)");
   const vereshchagin::UrdfResult missing = vereshchagin::chainFromUrdfFile("/nonexistent/robot.urdf");

@@ -170,8 +170,8 @@ double compareWithOurs(testutil::Checker& ck, const Task& t, Worst& worst) {
   ck.check(e_acc <= 1e-10, t.tag + ": link accelerations vs ours rel err " + str(e_acc));
   worst.add(worst.tau, e_tau);
   if (kPatched) {
-    ck.check(e_tau <= 1e-10, t.tag + ": constraint_torques vs our command torques rel err " + str(e_tau) +
-                                 "\n  kdl  " + testutil::mat(k.tau) + "\n  ours " + testutil::mat(o.tau));
+    ck.check(e_tau <= 1e-10, t.tag + ": constraint_torques vs our command torques rel err " + str(e_tau) + "\n  kdl  " +
+                                 testutil::mat(k.tau) + "\n  ours " + testutil::mat(o.tau));
     const double e_fd = relErr(forwardDynamics(t, k.tau), k.qdd);
     worst.add(worst.fd, e_fd);
     ck.check(e_fd <= 1e-9, t.tag + ": ChainFdSolver_RNE(ff + constraint_torques) != q_dotdot, rel err " + str(e_fd));
@@ -282,7 +282,8 @@ void checkFixedJoints(testutil::Checker& ck, std::string& summary) {
           testutil::ChainSpec spec;
           spec.n_joints = 7;
           spec.fixed_before = layouts[l];
-          const Task t = randomTask(g, g.chain(spec), nc, g.coin(), "fixed joints layout " + str(l) + " seed " + str(seed));
+          const Task t =
+              randomTask(g, g.chain(spec), nc, g.coin(), "fixed joints layout " + str(l) + " seed " + str(seed));
           if (!comparable(t)) continue;
           ++compared;
           compareWithOurs(ck, t, worst);
@@ -351,7 +352,8 @@ void checkFixedJoints(testutil::Checker& ck, std::string& summary) {
   for (int nc = 0; nc <= 2; ++nc) {
     testutil::RandomGen g(808 + nc);
     KDL::Chain chain = g.chain(4, true, false);
-    chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotY, 1.0, 0.0, 0.2), g.frame(), KDL::RigidBodyInertia::Zero()));
+    chain.addSegment(
+        KDL::Segment(KDL::Joint(KDL::Joint::RotY, 1.0, 0.0, 0.2), g.frame(), KDL::RigidBodyInertia::Zero()));
     const Task t = randomTask(g, chain, nc, true, "massless last link with rotor inertia");
     if (!comparable(t)) continue;
     ++compared;
@@ -369,8 +371,8 @@ void checkFixedJoints(testutil::Checker& ck, std::string& summary) {
 void checkNoAllocation(testutil::Checker& ck, std::string& summary) {
   std::string detail;
   long worst_allocs = 0;
-  const std::vector<std::vector<int>> layouts = kPatched ? std::vector<std::vector<int>>{{}, {0, 4, 9}}
-                                                         : std::vector<std::vector<int>>{{}};
+  const std::vector<std::vector<int>> layouts =
+      kPatched ? std::vector<std::vector<int>>{{}, {0, 4, 9}} : std::vector<std::vector<int>>{{}};
   for (std::size_t l = 0; l < layouts.size(); ++l) {
     for (int nc = 0; nc <= 6; ++nc) {
       testutil::RandomGen g(2024 + 10 * l + nc);
@@ -432,8 +434,8 @@ void checkRankDeficient(testutil::Checker& ck, std::string& summary) {
       } else {
         n = 3, nc = 2, expected_rank = 1, what = "stretched arm, constraint along it";
         for (int i = 0; i < n; ++i)
-          chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame(KDL::Vector(g.uniform(0.2, 0.6), 0, 0)),
-                                        g.inertia()));
+          chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ),
+                                        KDL::Frame(KDL::Vector(g.uniform(0.2, 0.6), 0, 0)), g.inertia()));
       }
       Task t = randomTask(g, scaledChain(chain, scale), nc, true, what + " k=" + str(k) + " scale " + str(scale));
       if (kind == 1) {  // third column: unit combination of the first two
@@ -453,7 +455,8 @@ void checkRankDeficient(testutil::Checker& ck, std::string& summary) {
       if (!(kept_min > 1e-5 * lmax && dropped_max < 1e-13 * lmax)) continue;
       const Result o = solveOurs(t);
       const Result kd = solveKdl(t);
-      if (!ck.check(o.rc == 0 && kd.rc == 0, t.tag + ": return codes ours " + str(o.rc) + ", KDL " + str(kd.rc))) continue;
+      if (!ck.check(o.rc == 0 && kd.rc == 0, t.tag + ": return codes ours " + str(o.rc) + ", KDL " + str(kd.rc)))
+        continue;
       ++compared;
       const double e = std::max({relErr(kd.qdd, o.qdd), relErr(kd.nu / scale, o.nu / scale), relErr(kd.acc, o.acc)});
       if (kPatched) {
@@ -493,7 +496,8 @@ void checkRankDeficient(testutil::Checker& ck, std::string& summary) {
     summary += ", worst rel err qdd " + str(worst.qdd) + ", nu/scale " + str(worst.nu) + ", torques/scale " +
                str(worst.tau) + "; NaN alfa -> E_SVD_FAILED\n";
   else
-    summary += ", unpatched wrong on " + str(wrong_unpatched) + "/" + str(light_cases) + " light-chain samples; NaN alfa -> rc 0\n";
+    summary += ", unpatched wrong on " + str(wrong_unpatched) + "/" + str(light_cases) +
+               " light-chain samples; NaN alfa -> rc 0\n";
 }
 
 }  // namespace

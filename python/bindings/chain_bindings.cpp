@@ -34,8 +34,7 @@ PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, co
 
 void PyChain::addSegment(const std::string& name, const py::object& joint, const py::object& tip,
                          const py::object& mass_obj, const py::object& com, const py::object& inertia,
-                         const py::object& rotor_obj, const std::string& joint_name,
-                         const std::string& inertia_check) {
+                         const py::object& rotor_obj, const std::string& joint_name, const std::string& inertia_check) {
   const bool physical =
       inertiaCheckArg(inertia_check, "segment '" + name + "': ") == vereshchagin::InertiaCheck::Physical;
   // Every failure names the segment and the argument: "segment 'link3': mass must be ...".
@@ -45,7 +44,8 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   for (const std::string& other : segmentNames())
     if (other == name) raise("name: a segment named '" + name + "' already exists (names must be unique)");
   for (const auto& j : robot.joints)
-    if (j.name == jname) raise(where + "joint_name: a joint named '" + jname + "' already exists (names must be unique)");
+    if (j.name == jname)
+      raise(where + "joint_name: a joint named '" + jname + "' already exists (names must be unique)");
   const double mass = scalarArg(mass_obj, (where + "mass").c_str());
   const double rotor_inertia = scalarArg(rotor_obj, (where + "rotor_inertia").c_str());
   JointSpec spec;
@@ -63,7 +63,8 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   if (!inertia.is_none()) {
     Array a = toArray(inertia, (where + "inertia").c_str());
     if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
-      raise(where + "inertia must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + shapeStr(a));
+      raise(where + "inertia must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " +
+            shapeStr(a));
     requireFinite(a, (where + "inertia").c_str());
     for (int r = 0; r < 3; ++r)
       for (int k = 0; k < 3; ++k) I(r, k) = a.at(r, k);
@@ -77,7 +78,8 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
           "); identified models with such inertias: inertia_check='joint_space'");
   if (physical && moments(0) + moments(1) < moments(2) - 1e-6 * std::abs(moments(2)))
     raise(where + "inertia's principal moments " + fmtDouble(moments(0)) + ", " + fmtDouble(moments(1)) + ", " +
-          fmtDouble(moments(2)) + " violate the triangle inequality I1 + I2 >= I3 (no rigid body has them); "
+          fmtDouble(moments(2)) +
+          " violate the triangle inequality I1 + I2 >= I3 (no rigid body has them); "
           "identified models: inertia_check='joint_space'");
   if (!std::isfinite(rotor_inertia) || rotor_inertia < 0.0)
     raise(where + "rotor_inertia must be finite and >= 0, got " + fmtDouble(rotor_inertia));
@@ -127,7 +129,8 @@ py::array_t<double> PyChain::rotorInertia() const {
 void PyChain::setRotorInertia(const py::object& values) {
   Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(robot.joints.size()));
   for (py::ssize_t k = 0; k < a.size(); ++k)
-    if (a.at(k) < 0.0) raise("rotor_inertia must be >= 0, got " + std::to_string(a.at(k)) + " at joint " + std::to_string(k));
+    if (a.at(k) < 0.0)
+      raise("rotor_inertia must be >= 0, got " + std::to_string(a.at(k)) + " at joint " + std::to_string(k));
   KDL::Chain rebuilt;
   size_t jk = 0;
   for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) {
@@ -234,7 +237,6 @@ KDL::JntArray jointArray(const py::object& obj, const char* name, unsigned int n
   return q;
 }
 
-
 }  // namespace
 
 py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segment) const {
@@ -318,10 +320,13 @@ py::tuple frameState(const KDL::Frame& f) {
 
 KDL::Frame frameFromState(const py::tuple& t) {
   auto d = [&](int k) { return t[k].cast<double>(); };
-  return KDL::Frame(KDL::Rotation(d(0), d(1), d(2), d(3), d(4), d(5), d(6), d(7), d(8)), KDL::Vector(d(9), d(10), d(11)));
+  return KDL::Frame(KDL::Rotation(d(0), d(1), d(2), d(3), d(4), d(5), d(6), d(7), d(8)),
+                    KDL::Vector(d(9), d(10), d(11)));
 }
 
-py::tuple vectorState(const KDL::Vector& v) { return py::make_tuple(v.x(), v.y(), v.z()); }
+py::tuple vectorState(const KDL::Vector& v) {
+  return py::make_tuple(v.x(), v.y(), v.z());
+}
 KDL::Vector vectorFromState(const py::tuple& t) {
   return KDL::Vector(t[0].cast<double>(), t[1].cast<double>(), t[2].cast<double>());
 }
@@ -333,9 +338,10 @@ py::tuple PyChain::getState() const {
   for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) {
     const KDL::Segment& s = robot.chain.getSegment(i);
     const KDL::Joint& j = s.getJoint();
-    segments.append(py::make_tuple(s.getName(), j.getName(), static_cast<int>(j.getType()), vectorState(j.JointOrigin()),
-                                   vectorState(j.JointAxis()), j.getInertia(), j.getDamping(), j.getStiffness(),
-                                   frameState(s.getFrameToTip()), inertiaState(s.getInertia())));
+    segments.append(py::make_tuple(s.getName(), j.getName(), static_cast<int>(j.getType()),
+                                   vectorState(j.JointOrigin()), vectorState(j.JointAxis()), j.getInertia(),
+                                   j.getDamping(), j.getStiffness(), frameState(s.getFrameToTip()),
+                                   inertiaState(s.getInertia())));
   }
   for (const auto& j : robot.joints)
     joints.append(py::make_tuple(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction,
@@ -352,10 +358,11 @@ PyChain PyChain::fromState(const py::tuple& state) {
     const auto type = static_cast<KDL::Joint::JointType>(t[2].cast<int>());
     const std::string jname = t[1].cast<std::string>();
     const double rotor = t[5].cast<double>(), damping = t[6].cast<double>(), stiffness = t[7].cast<double>();
-    const KDL::Joint j = (type == KDL::Joint::RotAxis || type == KDL::Joint::TransAxis)
-                             ? KDL::Joint(jname, vectorFromState(t[3].cast<py::tuple>()), vectorFromState(t[4].cast<py::tuple>()),
-                                          type, 1.0, 0.0, rotor, damping, stiffness)
-                             : KDL::Joint(jname, type, 1.0, 0.0, rotor, damping, stiffness);
+    const KDL::Joint j =
+        (type == KDL::Joint::RotAxis || type == KDL::Joint::TransAxis)
+            ? KDL::Joint(jname, vectorFromState(t[3].cast<py::tuple>()), vectorFromState(t[4].cast<py::tuple>()), type,
+                         1.0, 0.0, rotor, damping, stiffness)
+            : KDL::Joint(jname, type, 1.0, 0.0, rotor, damping, stiffness);
     c.robot.chain.addSegment(KDL::Segment(t[0].cast<std::string>(), j, frameFromState(t[8].cast<py::tuple>()),
                                           inertiaFromState(t[9].cast<py::tuple>())));
   }
@@ -390,16 +397,27 @@ a translation along, the line through ``origin`` along ``axis`` (root-frame coor
 ``Joint.fixed()`` a rigid connection. The strings ``'rot_x'`` ... ``'trans_z'`` and ``'fixed'``
 name the axis-aligned cases.
 )doc")
-      .def_static("revolute", [](const py::object& axis, const py::object& origin) {
-        return makeAxisJoint(KDL::Joint::RotAxis, axis, origin); }, py::arg("axis"), py::arg("origin") = py::none(),
-        "Rotation about the line through ``origin`` (3,), m, along ``axis`` (3,), normalised; root-frame coordinates.")
-      .def_static("prismatic", [](const py::object& axis, const py::object& origin) {
-        return makeAxisJoint(KDL::Joint::TransAxis, axis, origin); }, py::arg("axis"), py::arg("origin") = py::none(),
-        "Translation along ``axis`` (3,), normalised, root-frame coordinates (``origin`` only places the axis line).")
-      .def_static("fixed", []() { return JointSpec(); }, "A rigid connection (no joint variable).")
+      .def_static(
+          "revolute",
+          [](const py::object& axis, const py::object& origin) {
+            return makeAxisJoint(KDL::Joint::RotAxis, axis, origin);
+          },
+          py::arg("axis"), py::arg("origin") = py::none(),
+          "Rotation about the line through ``origin`` (3,), m, along ``axis`` (3,), normalised; root-frame "
+          "coordinates.")
+      .def_static(
+          "prismatic",
+          [](const py::object& axis, const py::object& origin) {
+            return makeAxisJoint(KDL::Joint::TransAxis, axis, origin);
+          },
+          py::arg("axis"), py::arg("origin") = py::none(),
+          "Translation along ``axis`` (3,), normalised, root-frame coordinates (``origin`` only places the axis line).")
+      .def_static(
+          "fixed", []() { return JointSpec(); }, "A rigid connection (no joint variable).")
       .def("__repr__", &JointSpec::repr);
 
-  py::class_<PyChain>(mod, "Chain", R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
+  py::class_<PyChain>(mod, "Chain",
+                      R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
 
 Build it segment by segment with :meth:`add_segment`, or from a URDF with :meth:`from_urdf`
 (fixed joints merged into their parent links). Joint metadata (limits, friction, damping, rotor
@@ -436,18 +454,22 @@ inertia_check : {'physical', 'joint_space'}
     the triangle inequality). 'joint_space': any symmetric inertia (identified models); a
     ``Solver(..., inertia_check='joint_space')`` then checks that H(q) is positive definite at
     each solve.
-)doc", py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(),
-           py::arg("mass") = 0.0, py::arg("com") = py::none(), py::arg("inertia") = py::none(),
-           py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "", py::arg("inertia_check") = "physical")
-      .def_static("from_urdf", [](const py::object& source, const std::string& root, const std::string& tip,
-                                  const std::string& inertia_check) {
-        const py::object os = py::module_::import("os");
-        if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
-          raise("source must be URDF XML text or a file path");
-        return PyChain::fromUrdf(py::str(os.attr("fspath")(source)).cast<std::string>(), root, tip,
-                                 inertiaCheckArg(inertia_check, ""));
-      }, py::arg("source"), py::arg("root") = "", py::arg("tip") = "", py::arg("inertia_check") = "physical",
-                  R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
+)doc",
+           py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(), py::arg("mass") = 0.0,
+           py::arg("com") = py::none(), py::arg("inertia") = py::none(), py::arg("rotor_inertia") = 0.0,
+           py::arg("joint_name") = "", py::arg("inertia_check") = "physical")
+      .def_static(
+          "from_urdf",
+          [](const py::object& source, const std::string& root, const std::string& tip,
+             const std::string& inertia_check) {
+            const py::object os = py::module_::import("os");
+            if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
+              raise("source must be URDF XML text or a file path");
+            return PyChain::fromUrdf(py::str(os.attr("fspath")(source)).cast<std::string>(), root, tip,
+                                     inertiaCheckArg(inertia_check, ""));
+          },
+          py::arg("source"), py::arg("root") = "", py::arg("tip") = "", py::arg("inertia_check") = "physical",
+          R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
 
 Fixed joints are merged into their parent link (masses and inertias combined); the last
 segment's tip frame is the ``tip`` link's frame. Defaults: the URDF's root link and its single
@@ -457,34 +479,77 @@ link inertia that no rigid body has (not PSD, or principal moments violating the
 inequality); ``inertia_check='joint_space'`` accepts identified models (any symmetric inertia;
 use ``Solver(..., inertia_check='joint_space')`` with them).
 )doc")
-      .def_property_readonly("n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); }, "int: number of moving joints n (the length of q, qd, tau_ff).")
-      .def_property_readonly("n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); }, "int: number of segments (moving joints plus fixed-joint segments; rows of f_ext).")
-      .def_property_readonly("segment_names", &PyChain::segmentNames, "list of str: segment names, base to tip (a URDF segment is named after its link).")
+      .def_property_readonly(
+          "n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); },
+          "int: number of moving joints n (the length of q, qd, tau_ff).")
+      .def_property_readonly(
+          "n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); },
+          "int: number of segments (moving joints plus fixed-joint segments; rows of f_ext).")
+      .def_property_readonly("segment_names", &PyChain::segmentNames,
+                             "list of str: segment names, base to tip (a URDF segment is named after its link).")
       .def_property_readonly("joint_names", &PyChain::jointNames, "list of str: moving joint names in q order.")
-      .def_property_readonly("lower", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::lower); }, "ndarray (n,): lower position limits, rad or m (-inf: none; URDF continuous joints have none).")
-      .def_property_readonly("upper", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::upper); }, "ndarray (n,): upper position limits, rad or m (+inf: none).")
-      .def_property_readonly("velocity_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::velocity_limit); }, "ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver.")
-      .def_property_readonly("effort_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::effort_limit); }, "ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver.")
-      .def_property_readonly("friction", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::friction); }, "ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>); used by friction=True.")
-      .def_property_readonly("damping", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::damping); }, "ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not applied by the solver.")
-      .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia, "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg (settable; added to the joint's articulated inertia).")
-      .def_property_readonly("joint_types", [](const PyChain& c) {
-        std::vector<std::string> t;
-        for (const auto& j : c.robot.joints) t.push_back(j.type);
-        return t; }, "list of str: 'revolute', 'continuous' or 'prismatic' per moving joint.")
-      .def_property_readonly("segment_masses", [](const PyChain& c) {
-        py::array_t<double> m(static_cast<py::ssize_t>(c.robot.chain.getNrOfSegments()));
-        for (unsigned int i = 0; i < c.robot.chain.getNrOfSegments(); ++i)
-          m.mutable_data()[i] = c.robot.chain.getSegment(i).getInertia().getMass();
-        return m; }, "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.")
-      .def_property_readonly("root_link", [](const PyChain& c) { return c.robot.root_link; }, "str: name of the base link (the base frame); the base is addressed by this name only.")
-      .def_property_readonly("notes", [](const PyChain& c) { return c.robot.notes; }, "list of str: approximations made while building the chain (lumped branches, merged links).")
-      .def_property_readonly("link_names", [](const PyChain& c) {
-        std::vector<std::string> t;
-        for (const auto& l : c.robot.links) t.push_back(l.link);
-        return t; }, "list of str: every URDF link folded into the chain (segments, merged links, base links); segment and merged link names address frames in fk, jacobian, twist, constraints= and f_ext dicts; base links only in fk, jacobian and twist.")
-      .def("segment_index", [](const PyChain& c, const py::object& which) {
-        return c.resolveMoving(which.ptr(), "segment_index").segment; }, py::arg("name"), R"doc(Index of a segment.
+      .def_property_readonly(
+          "lower", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::lower); },
+          "ndarray (n,): lower position limits, rad or m (-inf: none; URDF continuous joints have none).")
+      .def_property_readonly(
+          "upper", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::upper); },
+          "ndarray (n,): upper position limits, rad or m (+inf: none).")
+      .def_property_readonly(
+          "velocity_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::velocity_limit); },
+          "ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver.")
+      .def_property_readonly(
+          "effort_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::effort_limit); },
+          "ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver.")
+      .def_property_readonly(
+          "friction", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::friction); },
+          "ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>); used by "
+          "friction=True.")
+      .def_property_readonly(
+          "damping", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::damping); },
+          "ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not applied by the "
+          "solver.")
+      .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia,
+                    "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg (settable; added to the "
+                    "joint's articulated inertia).")
+      .def_property_readonly(
+          "joint_types",
+          [](const PyChain& c) {
+            std::vector<std::string> t;
+            for (const auto& j : c.robot.joints) t.push_back(j.type);
+            return t;
+          },
+          "list of str: 'revolute', 'continuous' or 'prismatic' per moving joint.")
+      .def_property_readonly(
+          "segment_masses",
+          [](const PyChain& c) {
+            py::array_t<double> m(static_cast<py::ssize_t>(c.robot.chain.getNrOfSegments()));
+            for (unsigned int i = 0; i < c.robot.chain.getNrOfSegments(); ++i)
+              m.mutable_data()[i] = c.robot.chain.getSegment(i).getInertia().getMass();
+            return m;
+          },
+          "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.")
+      .def_property_readonly(
+          "root_link", [](const PyChain& c) { return c.robot.root_link; },
+          "str: name of the base link (the base frame); the base is addressed by this name only.")
+      .def_property_readonly(
+          "notes", [](const PyChain& c) { return c.robot.notes; },
+          "list of str: approximations made while building the chain (lumped branches, merged links).")
+      .def_property_readonly(
+          "link_names",
+          [](const PyChain& c) {
+            std::vector<std::string> t;
+            for (const auto& l : c.robot.links) t.push_back(l.link);
+            return t;
+          },
+          "list of str: every URDF link folded into the chain (segments, merged links, base links); segment and merged "
+          "link names address frames in fk, jacobian, twist, constraints= and f_ext dicts; base links only in fk, "
+          "jacobian and twist.")
+      .def(
+          "segment_index",
+          [](const PyChain& c, const py::object& which) {
+            return c.resolveMoving(which.ptr(), "segment_index").segment;
+          },
+          py::arg("name"), R"doc(Index of a segment.
 
 Parameters
 ----------
@@ -503,8 +568,10 @@ SolverError
     Unknown names, indices out of range, and the base link (it is no segment; ``fk``,
     ``jacobian`` and ``twist`` accept it by name).
 )doc")
-      .def("joint_index", [](const PyChain& c, const py::object& which) {
-        return c.resolveJoint(which.ptr(), "joint_index"); }, py::arg("name"), R"doc(Index of a moving joint in q.
+      .def(
+          "joint_index",
+          [](const PyChain& c, const py::object& which) { return c.resolveJoint(which.ptr(), "joint_index"); },
+          py::arg("name"), R"doc(Index of a moving joint in q.
 
 Parameters
 ----------
@@ -531,7 +598,8 @@ Returns
 ndarray, shape (4, 4)
     Homogeneous transform of the frame in the base frame (m).
 )doc")
-      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(), R"doc(Geometric Jacobian of a frame.
+      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(),
+           R"doc(Geometric Jacobian of a frame.
 
 Parameters
 ----------
@@ -545,7 +613,8 @@ ndarray, shape (6, n)
     Rows ``[linear; angular]``: the velocity of the frame's origin and the angular velocity,
     base-frame axes, per unit joint velocity (zero for the base).
 )doc")
-      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(), R"doc(Velocity of a frame.
+      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
+           R"doc(Velocity of a frame.
 
 Parameters
 ----------
@@ -562,12 +631,12 @@ ndarray, shape (6,)
       .def(py::pickle([](const PyChain& c) { return c.getState(); },
                       [](const py::tuple& t) { return PyChain::fromState(t); }))
       .def("__copy__", [](const PyChain& c) { return c; })
-      .def("__deepcopy__", [](const PyChain& c, const py::dict&) { return c; }, py::arg("memo"))
+      .def(
+          "__deepcopy__", [](const PyChain& c, const py::dict&) { return c; }, py::arg("memo"))
       .def("__repr__", [](const PyChain& c) {
         return "<vereshchagin.Chain with " + std::to_string(c.robot.chain.getNrOfSegments()) + " segments, " +
                std::to_string(c.robot.chain.getNrOfJoints()) + " joints>";
       });
-
 }
 
 }  // namespace vsbind

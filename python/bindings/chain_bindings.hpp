@@ -22,9 +22,9 @@ struct JointSpec {
   std::string repr() const {
     std::ostringstream s;
     if (type == KDL::Joint::Fixed) return "Joint.fixed()";
-    s << (type == KDL::Joint::RotAxis ? "Joint.revolute(" : "Joint.prismatic(") << "axis=[" << axis.x()
-      << ", " << axis.y() << ", " << axis.z() << "], origin=[" << origin.x() << ", " << origin.y()
-      << ", " << origin.z() << "])";
+    s << (type == KDL::Joint::RotAxis ? "Joint.revolute(" : "Joint.prismatic(") << "axis=[" << axis.x() << ", "
+      << axis.y() << ", " << axis.z() << "], origin=[" << origin.x() << ", " << origin.y() << ", " << origin.z()
+      << "])";
     return s.str();
   }
 };

@@ -6,8 +6,8 @@
 #include <pybind11/pybind11.h>
 
 #include <cmath>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include <Eigen/Dense>
@@ -21,7 +21,9 @@ struct SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-[[noreturn]] inline void raise(const std::string& msg) { throw SolverError(msg); }
+[[noreturn]] inline void raise(const std::string& msg) {
+  throw SolverError(msg);
+}
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
@@ -64,11 +66,13 @@ inline std::string fmtDouble(double v) {
 // A real scalar (Python int or float, numpy scalar, 0-d array); bool and everything else raise.
 inline double scalarArg(const py::handle& obj, const char* name) {
   if (py::isinstance<py::bool_>(obj) || py::isinstance<py::str>(obj) || py::isinstance<py::bytes>(obj) || obj.is_none())
-    raise(std::string(name) + " must be a real number, got " + std::string(py::str(py::type::of(obj).attr("__name__"))));
+    raise(std::string(name) + " must be a real number, got " +
+          std::string(py::str(py::type::of(obj).attr("__name__"))));
   PyObject* f = PyNumber_Float(obj.ptr());
   if (f == nullptr) {
     PyErr_Clear();
-    raise(std::string(name) + " must be a real number, got " + std::string(py::str(py::type::of(obj).attr("__name__"))));
+    raise(std::string(name) + " must be a real number, got " +
+          std::string(py::str(py::type::of(obj).attr("__name__"))));
   }
   const double v = PyFloat_AsDouble(f);
   Py_DECREF(f);
@@ -107,12 +111,10 @@ inline KDL::Frame frameFrom4x4(const py::handle& obj, const char* name) {
   Eigen::Matrix3d R;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R(r, c) = t(r, c);
-  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-9 ||
-      R.determinant() < 0.0) {
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-9 || R.determinant() < 0.0) {
     raise(std::string(name) + ": the upper-left 3x3 block must be a rotation matrix (orthonormal, det +1)");
   }
-  return KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0),
-                                  R(2, 1), R(2, 2)),
+  return KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
                     KDL::Vector(t(0, 3), t(1, 3), t(2, 3)));
 }
 

@@ -4,7 +4,8 @@
 namespace vsbind {
 namespace docs {
 
-inline constexpr const char* kSolve = R"doc(solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
+inline constexpr const char* kSolve =
+    R"doc(solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -71,12 +72,14 @@ The GIL is released during the solve. One solver serialises concurrent calls; us
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
 )doc";
 
-inline constexpr const char* kSolveBatch = R"doc(solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1)
+inline constexpr const char* kSolveBatch =
+    R"doc(solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 )doc";
 
-inline constexpr const char* kResponseColumns = R"doc(Affine response of the last solve to unit feed-forward torques (see the wrapper in vereshchagin.Solver).)doc";
+inline constexpr const char* kResponseColumns =
+    R"doc(Affine response of the last solve to unit feed-forward torques (see the wrapper in vereshchagin.Solver).)doc";
 
 inline constexpr const char* kGravity = R"doc(Physical gravity in the base frame, shape (3,), m/s^2 (settable).
 
@@ -93,7 +96,8 @@ accelerations about each segment's tip origin. Results pickle and deep-copy.
 )doc";
 
 inline constexpr const char* kQdd = R"doc(ndarray, shape (n,): joint accelerations, rad/s^2 or m/s^2.)doc";
-inline constexpr const char* kTauCommand = R"doc(ndarray, shape (n,): torques the motors add to ``tau_ff`` to realise ``qdd``, N m or N.
+inline constexpr const char* kTauCommand =
+    R"doc(ndarray, shape (n,): torques the motors add to ``tau_ff`` to realise ``qdd``, N m or N.
 
 ``-sum_i J_i^T alpha_i nu_i`` over the constrained segments; applied with ``tau_ff`` (and, with
 friction, the friction torques acting) to the unconstrained arm under the same gravity and
@@ -104,23 +108,32 @@ inline constexpr const char* kNu = R"doc(ndarray, shape (m,): constraint force m
 The wrench the constraints apply on their segment is ``-alpha @ nu``. Order: the end-segment
 ``alpha`` columns first, then each ``constraints`` entry's columns in dict order.
 )doc";
-inline constexpr const char* kLinkAcc = R"doc(ndarray, shape (n_segments + 1, 6): spatial accelerations ``[linear, angular]``.
+inline constexpr const char* kLinkAcc =
+    R"doc(ndarray, shape (n_segments + 1, 6): spatial accelerations ``[linear, angular]``.
 
 Row 0 is the base (its acceleration is ``-gravity``); row ``k + 1`` is segment k's tip frame:
 base-frame axes, tip origin, including ``-gravity`` (m/s^2, rad/s^2).
 )doc";
-inline constexpr const char* kConstraintRank = R"doc(int: rank of the coupling matrix ``K = A H^-1 A^T`` (``A = alpha^T J``) under the singularity policy.)doc";
-inline constexpr const char* kSmallestSingularValue = R"doc(float: smallest eigenvalue of ``K`` (0 when m = 0); small values flag a near-singular task.)doc";
-inline constexpr const char* kFrictionTorque = R"doc(ndarray, shape (n,) or None: physical friction torques acting on the joints (N m or N).
+inline constexpr const char* kConstraintRank =
+    R"doc(int: rank of the coupling matrix ``K = A H^-1 A^T`` (``A = alpha^T J``) under the singularity policy.)doc";
+inline constexpr const char* kSmallestSingularValue =
+    R"doc(float: smallest eigenvalue of ``K`` (0 when m = 0); small values flag a near-singular task.)doc";
+inline constexpr const char* kFrictionTorque =
+    R"doc(ndarray, shape (n,) or None: physical friction torques acting on the joints (N m or N).
 
 Opposes motion on moving joints (kinetic friction); on resting joints the max-min value with
 ``|torque| <= static``. None for solves without ``friction``.
 )doc";
-inline constexpr const char* kLimitTorque = R"doc(ndarray, shape (n,) or None: reactions of joint position limits on resting joints at a limit (N m or N).)doc";
-inline constexpr const char* kStatus = R"doc(ndarray of int32, shape (n,) or None: 0 moving, 1 sticking, 2 slipping +, 3 slipping - (joints at rest).)doc";
-inline constexpr const char* kGaussValue = R"doc(float or None: Gauss' function at the optimum, ``Z0(qdd) + sum f_j |qdd_j|`` over resting joints.)doc";
-inline constexpr const char* kIterations = R"doc(int or None: iterations of the friction max-min (bounded; see the docs).)doc";
-inline constexpr const char* kSegmentNu = R"doc(dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``.)doc";
+inline constexpr const char* kLimitTorque =
+    R"doc(ndarray, shape (n,) or None: reactions of joint position limits on resting joints at a limit (N m or N).)doc";
+inline constexpr const char* kStatus =
+    R"doc(ndarray of int32, shape (n,) or None: 0 moving, 1 sticking, 2 slipping +, 3 slipping - (joints at rest).)doc";
+inline constexpr const char* kGaussValue =
+    R"doc(float or None: Gauss' function at the optimum, ``Z0(qdd) + sum f_j |qdd_j|`` over resting joints.)doc";
+inline constexpr const char* kIterations =
+    R"doc(int or None: iterations of the friction max-min (bounded; see the docs).)doc";
+inline constexpr const char* kSegmentNu =
+    R"doc(dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``.)doc";
 
 }  // namespace docs
 }  // namespace vsbind

@@ -81,7 +81,8 @@ py::array_t<double> inverseDynamics(const PyChain& c, const py::object& q_obj, c
   const KDL::Wrenches wrenches = externalWrenches(f_ext, chain, q);
   KDL::JntArray tau(n);
   KDL::ChainIdSolver_RNE rne(chain, g);  // KDL takes physical gravity here (base accelerates by -g)
-  if (rne.CartToJnt(q, qd, qdd, wrenches, tau) < 0) raise("inverse dynamics failed: " + std::string(rne.strError(rne.getError())));
+  if (rne.CartToJnt(q, qd, qdd, wrenches, tau) < 0)
+    raise("inverse dynamics failed: " + std::string(rne.strError(rne.getError())));
   return jointTorques(tau, "inverse_dynamics");
 }
 
@@ -132,10 +133,11 @@ py::array_t<double> jacobianDotTimesQd(const PyChain& c, const py::object& q_obj
   const KDL::Frame& link_in_tip = target.link_in_tip;
   py::array_t<double> out(6);
   std::fill(out.mutable_data(), out.mutable_data() + 6, 0.0);
-  if (seg < 0) return out;  // a base link does not move
+  if (seg < 0) return out;                  // a base link does not move
   KDL::ChainJntToJacDotSolver jdot(chain);  // HYBRID: base axes, reference point the tip origin
   KDL::Twist at_tip;
-  if (jdot.JntToJacDot(state, at_tip, seg + 1) < 0) raise("Jdot qd failed: " + std::string(jdot.strError(jdot.getError())));
+  if (jdot.JntToJacDot(state, at_tip, seg + 1) < 0)
+    raise("Jdot qd failed: " + std::string(jdot.strError(jdot.getError())));
   KDL::ChainFkSolverVel_recursive fkv(chain);
   KDL::FrameVel tip;
   if (fkv.JntToCart(state, tip, seg + 1) < 0) raise("forward velocity kinematics failed");
@@ -152,7 +154,8 @@ py::array_t<double> jacobianDotTimesQd(const PyChain& c, const py::object& q_obj
 py::array_t<double> fkAll(const PyChain& c, const py::object& q_obj) {
   const KDL::Chain& chain = c.robot.chain;
   const std::vector<KDL::Frame> tips = tipFrames(chain, jointVector(q_obj, "q", chain.getNrOfJoints()));
-  py::array_t<double> out({static_cast<py::ssize_t>(tips.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
+  py::array_t<double> out(
+      {static_cast<py::ssize_t>(tips.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
   for (size_t i = 0; i < tips.size(); ++i) writeHomogeneous(tips[i], out.mutable_data() + 16 * i);
   return out;
 }
@@ -162,7 +165,8 @@ py::array_t<double> fkAll(const PyChain& c, const py::object& q_obj) {
 void bindDynamics(py::module_& mod) {
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
   chain.def("inverse_dynamics", &inverseDynamics, py::arg("q"), py::arg("qd"), py::arg("qdd"),
-            py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity, R"doc(Joint torques that realise ``qdd`` (recursive Newton-Euler, KDL's ChainIdSolver_RNE).
+            py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity,
+            R"doc(Joint torques that realise ``qdd`` (recursive Newton-Euler, KDL's ChainIdSolver_RNE).
 
 ``tau = M(q) qdd + C(q, qd) qd + g(q) - sum_i J_i(q)^T f_ext[i]``, rotor inertia included
 (``rotor_inertia * qdd`` on each joint's diagonal).
@@ -183,7 +187,8 @@ Returns
 ndarray, shape (n_joints,)
     Joint torques / forces, N m or N.
 )doc");
-  chain.def("mass_matrix", &massMatrix, py::arg("q"), R"doc(Joint-space mass matrix ``M(q)`` (KDL's ChainDynParam::JntToMass).
+  chain.def("mass_matrix", &massMatrix, py::arg("q"),
+            R"doc(Joint-space mass matrix ``M(q)`` (KDL's ChainDynParam::JntToMass).
 
 Parameters
 ----------
@@ -196,8 +201,9 @@ ndarray, shape (n_joints, n_joints)
     Symmetric positive definite, kg m^2 / kg m / kg; ``rotor_inertia`` is included on the diagonal
     (Pinocchio's ``armature``).
 )doc");
-  chain.def("gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
-            R"doc(Generalised gravity ``g(q)``: the torques that hold the chain still (KDL's ChainDynParam::JntToGravity).
+  chain.def(
+      "gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
+      R"doc(Generalised gravity ``g(q)``: the torques that hold the chain still (KDL's ChainDynParam::JntToGravity).
 
 Parameters
 ----------

@@ -43,11 +43,11 @@ struct RowInputs {
   const double* qd = nullptr;
   const ConstraintBlock* blocks = nullptr;  // end-segment alpha first (if any), then constraints=
   int n_blocks = 0;
-  bool general = false;                     // constraints= given: the segment-constraint entry point
-  const double* f_ext = nullptr;            // (n_segments, 6) or nullptr
+  bool general = false;           // constraints= given: the segment-constraint entry point
+  const double* f_ext = nullptr;  // (n_segments, 6) or nullptr
   const LinkWrench* link_wrenches = nullptr;
   int n_link_wrenches = 0;
-  const double* tau_ff = nullptr;           // (n_joints,) or nullptr
+  const double* tau_ff = nullptr;  // (n_joints,) or nullptr
   const vereshchagin::FrictionModel* friction = nullptr;
   // Driver pass-through weights per constraint column in nu's order (nullptr: 0), see
   // ChainHdSolver::setPassThrough.
@@ -85,10 +85,10 @@ class Engine {
   vereshchagin::FrictionSolver friction_;
   KDL::ChainFkSolverPos_recursive fk_;
   KDL::JntArray q_kdl_;
-  ChainHdSolver::Matrix6X alfa_;   // constraint columns of a solve (6 x maxConstraints())
+  ChainHdSolver::Matrix6X alfa_;  // constraint columns of a solve (6 x maxConstraints())
   Eigen::VectorXd beta_;
   Eigen::VectorXi segs_;
-  ChainHdSolver::Matrix6X fext_;   // f_ext when wrenches on merged links must be added
+  ChainHdSolver::Matrix6X fext_;  // f_ext when wrenches on merged links must be added
   int columns_ = 0;
   bool last_friction_ = false;
   bool last_general_ = false;

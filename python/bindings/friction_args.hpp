@@ -32,8 +32,7 @@ inline void checkFriction(const vereshchagin::FrictionModel& fm) {
     for (Eigen::Index j = 0; j < fm.lower.size() && j < fm.upper.size(); ++j)
       if (!(fm.lower(j) <= fm.upper(j)))
         raise("friction.lower[" + std::to_string(j) + "] and friction.upper[" + std::to_string(j) +
-              "] must satisfy lower <= upper, got " +
-              fmtDouble(fm.lower(j)) + " > " + fmtDouble(fm.upper(j)));
+              "] must satisfy lower <= upper, got " + fmtDouble(fm.lower(j)) + " > " + fmtDouble(fm.upper(j)));
   }
 }
 

@@ -18,7 +18,7 @@ PYBIND11_MODULE(_core, mod) {
   pybind11::register_exception<vsbind::SolverError>(mod, "SolverError", PyExc_ValueError);
   vsbind::bindChain(mod);
   vsbind::bindResultType(mod);
-  vsbind::bindDynamics(mod);      // adds methods to Chain
-  vsbind::bindSegmentSpec(mod);   // adds Chain.segment_spec
+  vsbind::bindDynamics(mod);     // adds methods to Chain
+  vsbind::bindSegmentSpec(mod);  // adds Chain.segment_spec
   vsbind::bindSolver(mod);
 }

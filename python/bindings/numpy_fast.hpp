@@ -73,7 +73,8 @@ inline F64View asF64(PyObject* obj, const char* name) {
   const char kind = any.dtype().kind();
   if (kind != 'f' && kind != 'i' && kind != 'u')
     raise(std::string(name) + " must hold real numbers (int or float), got dtype " + std::string(py::str(any.dtype())));
-  if (any.ndim() > 3) raise(std::string(name) + " has " + std::to_string(any.ndim()) + " dimensions; at most 3 are meaningful");
+  if (any.ndim() > 3)
+    raise(std::string(name) + " has " + std::to_string(any.ndim()) + " dimensions; at most 3 are meaningful");
   v.keep = Array::ensure(any);  // float64, C-contiguous copy
   if (!v.keep) {
     PyErr_Clear();
@@ -86,7 +87,8 @@ inline F64View asF64(PyObject* obj, const char* name) {
 inline void requireFiniteView(const F64View& v, const char* name) {
   const py::ssize_t n = v.size();
   for (py::ssize_t k = 0; k < n; ++k)
-    if (!std::isfinite(v.data[k])) raise(std::string(name) + " contains NaN or Inf (flat index " + std::to_string(k) + ")");
+    if (!std::isfinite(v.data[k]))
+      raise(std::string(name) + " contains NaN or Inf (flat index " + std::to_string(k) + ")");
 }
 
 // A checked (n,) vector argument (a scalar is accepted for n == 1 when scalar_ok).
@@ -116,7 +118,11 @@ inline py::array newDoubles(std::initializer_list<py::ssize_t> shape) {
 inline py::array newInts(std::initializer_list<py::ssize_t> shape) {
   return newArray(py::detail::npy_api::NPY_INT_, static_cast<int>(shape.size()), shape.begin());
 }
-inline double* doubles(const py::array& a) { return reinterpret_cast<double*>(py::detail::array_proxy(a.ptr())->data); }
-inline int* ints(const py::array& a) { return reinterpret_cast<int*>(py::detail::array_proxy(a.ptr())->data); }
+inline double* doubles(const py::array& a) {
+  return reinterpret_cast<double*>(py::detail::array_proxy(a.ptr())->data);
+}
+inline int* ints(const py::array& a) {
+  return reinterpret_cast<int*>(py::detail::array_proxy(a.ptr())->data);
+}
 
 }  // namespace vsbind

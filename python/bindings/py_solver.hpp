@@ -20,12 +20,12 @@ namespace vsbind {
 // and friction model that RowInputs points at.
 struct ParsedSolve {
   F64View q, qd, alpha, beta, f_ext, tau, f_ext_pass_through, tau_ff_pass_through;
-  std::vector<F64View> block_views;   // alpha_i, beta_i of constraints= entries (kept alive)
+  std::vector<F64View> block_views;  // alpha_i, beta_i of constraints= entries (kept alive)
   std::vector<ConstraintBlock> blocks;
   std::vector<py::object> block_keys;  // constraints= keys, in order (for segment_nu)
   std::vector<double> f_ext_dense;     // f_ext given as a dict: (n_segments, 6)
   std::vector<LinkWrench> link_wrenches;
-  py::object friction_owner;           // keeps a parsed friction's arrays alive
+  py::object friction_owner;  // keeps a parsed friction's arrays alive
   vereshchagin::FrictionModel friction_model;
   const vereshchagin::FrictionModel* friction = nullptr;
   RowInputs row;

@@ -19,16 +19,15 @@ enum View { kQdd, kTau, kNu, kLinkAcc, kFriction, kLimit, kStatus, kNumViews };
 // Array fields are views of it whose base is the result; they are not cached (a cache would be a
 // reference cycle), so each attribute access makes a new view of the same memory.
 struct ResultObject {
-  PyObject_VAR_HEAD
-  PyObject* segment_keys;       // tuple or NULL: constraints= keys
-  PyObject* segment_starts;     // tuple of int: first entry of each key's part of nu
-  PyObject* segment_counts;     // tuple of int: its length
+  PyObject_VAR_HEAD PyObject* segment_keys;  // tuple or NULL: constraints= keys
+  PyObject* segment_starts;                  // tuple of int: first entry of each key's part of nu
+  PyObject* segment_counts;                  // tuple of int: its length
   ResultLayout layout;
   int rank;
   double smin;
   double gauss;
   int iterations;
-  double data[1];               // bufferDoubles(layout) entries
+  double data[1];  // bufferDoubles(layout) entries
 };
 
 PyTypeObject* g_type = nullptr;
@@ -39,9 +38,13 @@ Py_ssize_t bufferDoubles(const ResultLayout& l) {
   return n;
 }
 
-ResultObject* self(PyObject* o) { return reinterpret_cast<ResultObject*>(o); }
+ResultObject* self(PyObject* o) {
+  return reinterpret_cast<ResultObject*>(o);
+}
 
-double* base(PyObject* o) { return self(o)->data; }
+double* base(PyObject* o) {
+  return self(o)->data;
+}
 
 void dealloc(PyObject* o) {
   ResultObject* r = self(o);
@@ -84,13 +87,20 @@ PyObject* makeView(ResultObject* r, Py_ssize_t offset_doubles, int nd, const Py_
 Py_ssize_t offsetOf(const ResultLayout& l, int which) {
   const Py_ssize_t nj = l.nj, link = 6 * (l.ns + 1);
   switch (which) {
-    case kQdd: return 0;
-    case kTau: return nj;
-    case kNu: return 2 * nj;
-    case kLinkAcc: return 2 * nj + l.m;
-    case kFriction: return 2 * nj + l.m + link;
-    case kLimit: return 3 * nj + l.m + link;
-    default: return 4 * nj + l.m + link;  // kStatus
+    case kQdd:
+      return 0;
+    case kTau:
+      return nj;
+    case kNu:
+      return 2 * nj;
+    case kLinkAcc:
+      return 2 * nj + l.m;
+    case kFriction:
+      return 2 * nj + l.m + link;
+    case kLimit:
+      return 3 * nj + l.m + link;
+    default:
+      return 4 * nj + l.m + link;  // kStatus
   }
 }
 
@@ -111,8 +121,12 @@ PyObject* getView(PyObject* o, void* closure) {
   return makeView(r, offsetOf(l, which), nd, dims, type);
 }
 
-PyObject* getRank(PyObject* o, void*) { return PyLong_FromLong(self(o)->rank); }
-PyObject* getSmin(PyObject* o, void*) { return PyFloat_FromDouble(self(o)->smin); }
+PyObject* getRank(PyObject* o, void*) {
+  return PyLong_FromLong(self(o)->rank);
+}
+PyObject* getSmin(PyObject* o, void*) {
+  return PyFloat_FromDouble(self(o)->smin);
+}
 PyObject* getGauss(PyObject* o, void*) {
   if (!self(o)->layout.friction) Py_RETURN_NONE;
   return PyFloat_FromDouble(self(o)->gauss);
@@ -147,8 +161,8 @@ PyObject* getSegmentNu(PyObject* o, void*) {
 
 PyObject* repr(PyObject* o) {
   const ResultObject* r = self(o);
-  const std::string s = "<vereshchagin.SolveResult n_joints=" + std::to_string(r->layout.nj) + " m=" +
-                        std::to_string(r->layout.m) + " rank=" + std::to_string(r->rank) +
+  const std::string s = "<vereshchagin.SolveResult n_joints=" + std::to_string(r->layout.nj) +
+                        " m=" + std::to_string(r->layout.m) + " rank=" + std::to_string(r->rank) +
                         (r->layout.friction ? " friction" : "") + ">";
   return PyUnicode_FromString(s.c_str());
 }
@@ -158,7 +172,11 @@ PyObject* stateTuple(PyObject* o) {
   PyObject* buf = PyBytes_FromStringAndSize(reinterpret_cast<const char*>(r->data),
                                             static_cast<Py_ssize_t>(sizeof(double)) * bufferDoubles(r->layout));
   if (buf == nullptr) return nullptr;
-  auto orNone = [](PyObject* x) { PyObject* v = x ? x : Py_None; Py_INCREF(v); return v; };
+  auto orNone = [](PyObject* x) {
+    PyObject* v = x ? x : Py_None;
+    Py_INCREF(v);
+    return v;
+  };
   return Py_BuildValue("(iiiiddiiNNNN)", r->layout.nj, r->layout.ns, r->layout.m, static_cast<int>(r->layout.friction),
                        r->smin, r->gauss, r->rank, r->iterations, buf, orNone(r->segment_keys),
                        orNone(r->segment_starts), orNone(r->segment_counts));
@@ -215,7 +233,9 @@ PyObject* copyResult(PyObject* o, PyObject*) {
   return r;
 }
 
-PyObject* deepcopyResult(PyObject* o, PyObject*) { return copyResult(o, nullptr); }
+PyObject* deepcopyResult(PyObject* o, PyObject*) {
+  return copyResult(o, nullptr);
+}
 
 PyGetSetDef g_getset[] = {
     {"qdd", getView, nullptr, docs::kQdd, reinterpret_cast<void*>(kQdd)},
@@ -232,11 +252,10 @@ PyGetSetDef g_getset[] = {
     {"segment_nu", getSegmentNu, nullptr, docs::kSegmentNu, nullptr},
     {nullptr, nullptr, nullptr, nullptr, nullptr}};
 
-PyMethodDef g_methods[] = {
-    {"__reduce__", reduce, METH_NOARGS, "Pickle support."},
-    {"__copy__", copyResult, METH_NOARGS, "An independent copy (its own data)."},
-    {"__deepcopy__", deepcopyResult, METH_O, "An independent copy (its own data)."},
-    {nullptr, nullptr, 0, nullptr}};
+PyMethodDef g_methods[] = {{"__reduce__", reduce, METH_NOARGS, "Pickle support."},
+                           {"__copy__", copyResult, METH_NOARGS, "An independent copy (its own data)."},
+                           {"__deepcopy__", deepcopyResult, METH_O, "An independent copy (its own data)."},
+                           {nullptr, nullptr, 0, nullptr}};
 
 PyMethodDef g_from_state_def = {"_result_from_state", fromState, METH_VARARGS, "Unpickle a SolveResult."};
 
@@ -268,9 +287,9 @@ py::object newResult(const ResultLayout& layout, PyObject* out) {
   ResultObject* r = self(out);
   const ResultLayout& l = r->layout;
   if (l.nj != layout.nj || l.ns != layout.ns || l.m != layout.m || l.friction != layout.friction)
-    throw SolverError("out does not fit this solve: it holds m = " + std::to_string(l.m) + (l.friction ? " with" : " without") +
-                      " friction, this solve has m = " + std::to_string(layout.m) +
-                      (layout.friction ? " with" : " without") + " friction");
+    throw SolverError("out does not fit this solve: it holds m = " + std::to_string(l.m) +
+                      (l.friction ? " with" : " without") + " friction, this solve has m = " +
+                      std::to_string(layout.m) + (layout.friction ? " with" : " without") + " friction");
   Py_CLEAR(r->segment_keys);
   Py_CLEAR(r->segment_starts);
   Py_CLEAR(r->segment_counts);

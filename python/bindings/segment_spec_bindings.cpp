@@ -12,19 +12,30 @@ namespace {
 
 const char* jointTypeName(KDL::Joint::JointType type) {
   switch (type) {
-    case KDL::Joint::RotX: return "rot_x";
-    case KDL::Joint::RotY: return "rot_y";
-    case KDL::Joint::RotZ: return "rot_z";
-    case KDL::Joint::TransX: return "trans_x";
-    case KDL::Joint::TransY: return "trans_y";
-    case KDL::Joint::TransZ: return "trans_z";
-    case KDL::Joint::RotAxis: return "revolute";
-    case KDL::Joint::TransAxis: return "prismatic";
-    default: return "fixed";
+    case KDL::Joint::RotX:
+      return "rot_x";
+    case KDL::Joint::RotY:
+      return "rot_y";
+    case KDL::Joint::RotZ:
+      return "rot_z";
+    case KDL::Joint::TransX:
+      return "trans_x";
+    case KDL::Joint::TransY:
+      return "trans_y";
+    case KDL::Joint::TransZ:
+      return "trans_z";
+    case KDL::Joint::RotAxis:
+      return "revolute";
+    case KDL::Joint::TransAxis:
+      return "prismatic";
+    default:
+      return "fixed";
   }
 }
 
-py::array_t<double> vector3(const KDL::Vector& v) { return copyVector(v.data, 3); }
+py::array_t<double> vector3(const KDL::Vector& v) {
+  return copyVector(v.data, 3);
+}
 
 // KDL keeps the rotational inertia about the tip origin; add_segment takes it about the centre of
 // mass: I_com = I_tip - m (|c|^2 E - c c^T) (parallel-axis theorem).
@@ -66,7 +77,8 @@ py::dict segmentSpec(const PyChain& c, const py::object& which) {
 
 void bindSegmentSpec(py::module_& mod) {
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
-  chain.def("segment_spec", &segmentSpec, py::arg("segment"), R"doc(One segment described by the arguments of :meth:`add_segment`.
+  chain.def("segment_spec", &segmentSpec, py::arg("segment"),
+            R"doc(One segment described by the arguments of :meth:`add_segment`.
 
 Parameters
 ----------

@@ -28,31 +28,40 @@ F64View alphaView(PyObject* obj, const std::string& name) {
   if (a.ndim != 2 || a.shape[0] != 6)
     raise(name + " must have shape (6, m) (columns: unit wrenches [force; moment]) or (6,) for one column, got " +
           a.shapeString());
-  if (a.shape[1] > 6) raise(name + " has " + std::to_string(a.shape[1]) + " columns; at most 6 constraints per segment");
+  if (a.shape[1] > 6)
+    raise(name + " has " + std::to_string(a.shape[1]) + " columns; at most 6 constraints per segment");
   requireFiniteView(a, name.c_str());
   return a;
 }
 
 namespace {
 
-bool given(PyObject* obj) { return obj != nullptr && obj != Py_None; }
+bool given(PyObject* obj) {
+  return obj != nullptr && obj != Py_None;
+}
 
-std::string keyRepr(PyObject* key) { return py::repr(key).cast<std::string>(); }
+std::string keyRepr(PyObject* key) {
+  return py::repr(key).cast<std::string>();
+}
 
 }  // namespace
 
 vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where) {
   if (value == "physical") return vereshchagin::InertiaCheck::Physical;
   if (value == "joint_space") return vereshchagin::InertiaCheck::JointSpace;
-  raise(where + "inertia_check must be 'physical' (every body a rigid body) or 'joint_space' (identified models: "
-        "any symmetric inertia, H(q) positive definite at each solve), got '" + value + "'");
+  raise(where +
+        "inertia_check must be 'physical' (every body a rigid body) or 'joint_space' (identified models: "
+        "any symmetric inertia, H(q) positive definite at each solve), got '" +
+        value + "'");
 }
 
 void checkWeights(const double* w, py::ssize_t m, const std::string& name) {
   for (py::ssize_t c = 0; c < m; ++c)
     if (!(w[c] >= 0.0 && w[c] <= 1.0))
-      raise(name + "[" + std::to_string(c) + "] must be in [0, 1] (0: the constraint compensates that driver, 1: "
-            "its effect passes through), got " + fmtDouble(w[c]));
+      raise(name + "[" + std::to_string(c) +
+            "] must be in [0, 1] (0: the constraint compensates that driver, 1: "
+            "its effect passes through), got " +
+            fmtDouble(w[c]));
 }
 
 void PySolver::parse(PyObject* const* a, ParsedSolve& p) {
@@ -115,7 +124,8 @@ void PySolver::parseFExt(PyObject* f_ext, ParsedSolve& p) const {
     if (p.f_ext.ndim != 2 || p.f_ext.shape[0] != static_cast<py::ssize_t>(ns) || p.f_ext.shape[1] != 6)
       raise("f_ext must have shape (" + std::to_string(ns) +
             ", 6): one row [fx, fy, fz, mx, my, mz] per segment (base axes, moment about the segment's tip "
-            "origin), or a dict {segment: wrench (6,)}; got " + p.f_ext.shapeString());
+            "origin), or a dict {segment: wrench (6,)}; got " +
+            p.f_ext.shapeString());
     requireFiniteView(p.f_ext, "f_ext");
     return;
   }
@@ -157,8 +167,7 @@ void PySolver::parseConstraints(PyObject* constraints, ParsedSolve& p) const {
         raise(label + ": the same frame as constraints[" + keyRepr(p.block_keys[k].ptr()) +
               "] (one entry per frame: put all its columns in one alpha)");
     }
-    if (!PyTuple_Check(value) && !PyList_Check(value))
-      raise(label + " must be a pair (alpha (6, m_i), beta (m_i,))");
+    if (!PyTuple_Check(value) && !PyList_Check(value)) raise(label + " must be a pair (alpha (6, m_i), beta (m_i,))");
     py::sequence pair = py::reinterpret_borrow<py::sequence>(value);
     if (pair.size() != 2) raise(label + " must be a pair (alpha (6, m_i), beta (m_i,))");
     F64View a = alphaView(pair[0].ptr(), label + " alpha");
@@ -211,7 +220,8 @@ bool PySolver::parseFriction(PyObject* friction, ParsedSolve& p) {
     fm.kinetic_friction = Eigen::Map<const Eigen::VectorXd>(fk.data, nj);
   }
   const py::object tol = py::getattr(fr, "velocity_tolerance", py::none());
-  fm.velocity_tolerance = tol.is_none() ? vereshchagin::FrictionModel().velocity_tolerance : scalarArg(tol, "friction.velocity_tolerance");
+  fm.velocity_tolerance =
+      tol.is_none() ? vereshchagin::FrictionModel().velocity_tolerance : scalarArg(tol, "friction.velocity_tolerance");
   const py::object lower = py::getattr(fr, "lower", py::none()), upper = py::getattr(fr, "upper", py::none());
   fm.lower.resize(0);
   fm.upper.resize(0);
@@ -231,7 +241,8 @@ bool PySolver::parseFriction(PyObject* friction, ParsedSolve& p) {
     limitArg(lower, "friction.lower", fm.lower);
     limitArg(upper, "friction.upper", fm.upper);
     const py::object ltol = py::getattr(fr, "limit_tolerance", py::none());
-    fm.limit_tolerance = ltol.is_none() ? vereshchagin::FrictionModel().limit_tolerance : scalarArg(ltol, "friction.limit_tolerance");
+    fm.limit_tolerance =
+        ltol.is_none() ? vereshchagin::FrictionModel().limit_tolerance : scalarArg(ltol, "friction.limit_tolerance");
   }
   if (cacheable) friction_cache_key_ = py::object();  // invalid until checked
   checkFriction(fm);

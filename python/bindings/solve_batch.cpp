@@ -103,10 +103,10 @@ struct BatchRunner {
   std::vector<Batched> alpha, beta;             // one per block (end segment first)
   std::vector<ConstraintBlock> block_template;  // segment, cols, offset per block
   std::vector<py::object> block_keys;
-  std::vector<int> key_block;                   // constraints= key k -> block index
+  std::vector<int> key_block;  // constraints= key k -> block index
   std::vector<Batched> link_wrench_rows;
   std::vector<LinkWrench> link_wrench_template;
-  std::vector<double> f_ext_dense;              // dict f_ext without merged links: (B or 1, ns, 6)
+  std::vector<double> f_ext_dense;  // dict f_ext without merged links: (B or 1, ns, 6)
   bool f_ext_dense_batched = false;
   bool general = false;
   std::vector<vereshchagin::FrictionModel> friction;  // empty, one shared, or one per row
@@ -198,7 +198,8 @@ struct BatchRunner {
       addBlock(t.segment, pair[0].ptr(), pair[1].ptr(), label, &t);
       per_segment[t.segment] += block_template.back().cols;
       if (per_segment[t.segment] > 6)
-        raise(label + ": more than 6 constraint columns on segment '" + s.chain_.robot.chain.getSegment(t.segment).getName() + "'");
+        raise(label + ": more than 6 constraint columns on segment '" +
+              s.chain_.robot.chain.getSegment(t.segment).getName() + "'");
     }
   }
 

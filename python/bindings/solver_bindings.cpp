@@ -2,8 +2,8 @@
 // written into `out`), response columns, pickling.
 #include <pybind11/stl.h>
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 
 #include <Eigen/QR>
@@ -137,7 +137,8 @@ Eigen::VectorXi jointList(const PyChain& chain, const py::object& joints) {
     py::array a = joints.cast<py::array>();
     const char kind = a.dtype().kind();
     if (a.ndim() != 1 || (a.size() > 0 && kind != 'i' && kind != 'u' && kind != 'U'))
-      raise(std::string(what) + ", got an array of shape " + shapeStr(a) + " and dtype " + std::string(py::str(a.dtype())));
+      raise(std::string(what) + ", got an array of shape " + shapeStr(a) + " and dtype " +
+            std::string(py::str(a.dtype())));
     seq = a.attr("tolist")();
   } else if (py::isinstance<py::sequence>(joints)) {
     seq = joints.cast<py::sequence>();
@@ -145,7 +146,8 @@ Eigen::VectorXi jointList(const PyChain& chain, const py::object& joints) {
     raise(what);
   }
   Eigen::VectorXi j(static_cast<Eigen::Index>(seq.size()));
-  for (Eigen::Index c = 0; c < j.size(); ++c) j(c) = chain.resolveJoint(seq[c].ptr(), "joints[" + std::to_string(c) + "]");
+  for (Eigen::Index c = 0; c < j.size(); ++c)
+    j(c) = chain.resolveJoint(seq[c].ptr(), "joints[" + std::to_string(c) + "]");
   return j;
 }
 
@@ -174,7 +176,8 @@ py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking
   Eigen::VectorXi held(0);
   if (hold_sticking && e.lastHadFriction()) {
     const auto& status = e.frictionSolver().status();
-    held.resize(static_cast<Eigen::Index>(std::count(status.begin(), status.end(), vereshchagin::FrictionSolver::Stick)));
+    held.resize(
+        static_cast<Eigen::Index>(std::count(status.begin(), status.end(), vereshchagin::FrictionSolver::Stick)));
     Eigen::Index a = 0;
     for (unsigned int j = 0; j < nj; ++j)
       if (status[j] == vereshchagin::FrictionSolver::Stick) held(a++) = static_cast<int>(j);
@@ -208,9 +211,17 @@ py::tuple PySolver::getState() const {
 // interned strings first (what the interpreter passes for literal keywords), then by value.
 namespace {
 
-constexpr const char* kSolveParams[] = {"q",           "qd",     "alpha",  "beta",
-                                        "f_ext",       "tau_ff", "friction", "constraints",
-                                        "f_ext_pass_through", "tau_ff_pass_through", "out"};
+constexpr const char* kSolveParams[] = {"q",
+                                        "qd",
+                                        "alpha",
+                                        "beta",
+                                        "f_ext",
+                                        "tau_ff",
+                                        "friction",
+                                        "constraints",
+                                        "f_ext_pass_through",
+                                        "tau_ff_pass_through",
+                                        "out"};
 constexpr int kOut = 10;
 constexpr int kNumSolveParams = sizeof(kSolveParams) / sizeof(kSolveParams[0]);
 PyObject* g_solve_names[kNumSolveParams];
@@ -305,9 +316,10 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
 
 PyMethodDef g_solve_def = {"solve", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(solveEntry)),
                            METH_FASTCALL | METH_KEYWORDS, docs::kSolve};
-PyMethodDef g_time_def = {"_time_cpp", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(timeCppEntry)),
-                          METH_FASTCALL | METH_KEYWORDS,
-                          "_time_cpp(reps, q, qd, ...) -> float: seconds per C++ solve of these arguments (benchmarks)."};
+PyMethodDef g_time_def = {
+    "_time_cpp", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(timeCppEntry)),
+    METH_FASTCALL | METH_KEYWORDS,
+    "_time_cpp(reps, q, qd, ...) -> float: seconds per C++ solve of these arguments (benchmarks)."};
 
 void addFastMethod(py::handle cls, PyMethodDef* def) {
   PyObject* descr = PyDescr_NewMethod(reinterpret_cast<PyTypeObject*>(cls.ptr()), def);
@@ -333,12 +345,16 @@ void bindSolver(py::module_& mod) {
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            docs::kResponseColumns)
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, docs::kGravity)
-      .def_property_readonly("n_joints", [](const PySolver& s) { return s.nj; }, "Number of moving joints n.")
-      .def_property_readonly("n_segments", [](const PySolver& s) { return s.ns; },
-                             "Number of segments (moving and fixed-joint segments of the chain).")
-      .def_property_readonly("chain", [](const PySolver& s) { return s.chain(); }, "A copy of the solver's Chain.")
-      .def_property_readonly("inertia_check", [](const PySolver& s) { return s.inertiaCheck(); },
-                             "str: 'physical' or 'joint_space' (see Solver).")
+      .def_property_readonly(
+          "n_joints", [](const PySolver& s) { return s.nj; }, "Number of moving joints n.")
+      .def_property_readonly(
+          "n_segments", [](const PySolver& s) { return s.ns; },
+          "Number of segments (moving and fixed-joint segments of the chain).")
+      .def_property_readonly(
+          "chain", [](const PySolver& s) { return s.chain(); }, "A copy of the solver's Chain.")
+      .def_property_readonly(
+          "inertia_check", [](const PySolver& s) { return s.inertiaCheck(); },
+          "str: 'physical' or 'joint_space' (see Solver).")
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
                         if (t.size() != 5) raise("Solver state must have 5 entries");

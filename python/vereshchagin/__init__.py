@@ -5,6 +5,7 @@ positions, velocities and an optional partial task (``alpha``, ``beta``), extern
 feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL's
 ``ChainHdSolver_Vereshchagin``; see :class:`Solver`.
 """
+
 from ._core import Chain, Joint, SolveResult, SolverError
 from . import robots, task
 from ._version import __version__ as __version__  # written once: CMakeLists.txt

@@ -1,4 +1,5 @@
 """Command line: ``python -m vereshchagin demo`` and ``python -m vereshchagin reproduce``."""
+
 from __future__ import annotations
 
 import argparse
@@ -45,9 +46,12 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    index = ["# vereshchagin: reproduced results", "",
-             f"Command: `python -m vereshchagin reproduce --out {out_dir}{' --quick' if quick else ''} --case {case}`",
-             ""]
+    index = [
+        "# vereshchagin: reproduced results",
+        "",
+        f"Command: `python -m vereshchagin reproduce --out {out_dir}{' --quick' if quick else ''} --case {case}`",
+        "",
+    ]
     ok = True
     if case in ("friction", "all"):
         from .experiments.friction_figures import run as run_friction
@@ -55,13 +59,20 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
         _say(f"[reproduce] Vukcevic (2018) friction figures -> {out}{' (quick)' if quick else ''}")
         res = run_friction(out, quick=quick, progress=_say)
         ok &= bool(res["ok"])
-        index += ["## Static joint friction on the 1-DOF arm (D. Vukcevic (2018), chapters 5-6)", "",
-                  f"Table: [{_rel(res['table_md'], out)}]({_rel(res['table_md'], out)}) "
-                  f"(CSV: [{_rel(res['table_csv'], out)}]({_rel(res['table_csv'], out)}))", ""]
+        index += [
+            "## Static joint friction on the 1-DOF arm (D. Vukcevic (2018), chapters 5-6)",
+            "",
+            f"Table: [{_rel(res['table_md'], out)}]({_rel(res['table_md'], out)}) "
+            f"(CSV: [{_rel(res['table_csv'], out)}]({_rel(res['table_csv'], out)}))",
+            "",
+        ]
         table = res["table_md"].read_text(encoding="utf-8").splitlines()
         index += [line for line in table if line.startswith("|")] + [""]
-        index += ["Figures (friction torque = -mu over [-f, f], f = 10 N m; the star is the exact optimum of "
-                  "`Solver.solve(..., friction=...)`):", ""]
+        index += [
+            "Figures (friction torque = -mu over [-f, f], f = 10 N m; the star is the exact optimum of "
+            "`Solver.solve(..., friction=...)`):",
+            "",
+        ]
         for num, what, path in res["figures"]:
             ref = f"report fig. {num}" if num else "no report figure"
             index.append(f"- [{_rel(path, out)}]({_rel(path, out)}): {what} ({ref})")
@@ -80,8 +91,16 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
         run_demo(out=out_line)
         demo_path = out / "demo.txt"
         demo_path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-        index += ["## Demonstration (7-joint arm)", "", f"Output: [{_rel(demo_path, out)}]({_rel(demo_path, out)})",
-                  "", "```text", *lines, "```", ""]
+        index += [
+            "## Demonstration (7-joint arm)",
+            "",
+            f"Output: [{_rel(demo_path, out)}]({_rel(demo_path, out)})",
+            "",
+            "```text",
+            *lines,
+            "```",
+            "",
+        ]
     if case in ("contact", "all"):
         from .contact.report import run as run_contact
 
@@ -112,12 +131,19 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="vereshchagin", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("demo", help="solve three tasks on a 7-joint arm and print the results")
-    rep = sub.add_parser("reproduce", help="reproduce the friction figures of Vukcevic (2018), the demo, the contact "
-                         "use cases of Lau (2023) and the friction-energy experiment into a folder")
+    rep = sub.add_parser(
+        "reproduce",
+        help="reproduce the friction figures of Vukcevic (2018), the demo, the contact "
+        "use cases of Lau (2023) and the friction-energy experiment into a folder",
+    )
     rep.add_argument("--out", default="results", help="output folder (default: ./results)")
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
-    rep.add_argument("--case", choices=("friction", "demo", "contact", "friction-energy", "all"), default="all",
-                     help="which experiments to run (default: all)")
+    rep.add_argument(
+        "--case",
+        choices=("friction", "demo", "contact", "friction-energy", "all"),
+        default="all",
+        help="which experiments to run (default: all)",
+    )
     args = parser.parse_args(argv)
     if args.command == "demo":
         from .demo import run

@@ -1,4 +1,5 @@
 """Type stubs of the compiled module vereshchagin._core."""
+
 import os
 from typing import Any, Mapping, Optional, Sequence, Union, final
 
@@ -72,9 +73,7 @@ class Chain:
     def __deepcopy__(self, memo: dict) -> Chain: ...
     def fk(self, q: ArrayLike, segment: str | int | None = None) -> NDArray[np.float64]: ...
     def jacobian(self, q: ArrayLike, segment: str | int | None = None) -> NDArray[np.float64]: ...
-    def twist(
-        self, q: ArrayLike, qd: ArrayLike, segment: str | int | None = None
-    ) -> NDArray[np.float64]: ...
+    def twist(self, q: ArrayLike, qd: ArrayLike, segment: str | int | None = None) -> NDArray[np.float64]: ...
     def inverse_dynamics(
         self,
         q: ArrayLike,
@@ -145,9 +144,7 @@ class Solver:
         f_ext: Optional[Union[ArrayLike, Mapping[Union[str, int], ArrayLike]]] = None,
         tau_ff: Optional[ArrayLike] = None,
         friction: object = None,
-        constraints: Optional[
-            Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]
-        ] = None,
+        constraints: Optional[Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]] = None,
         f_ext_pass_through: Optional[ArrayLike] = None,
         tau_ff_pass_through: Optional[ArrayLike] = None,
         out: Optional[SolveResult] = None,
@@ -162,9 +159,7 @@ class Solver:
         f_ext: Optional[Union[ArrayLike, Mapping[Union[str, int], ArrayLike]]] = None,
         tau_ff: Optional[ArrayLike] = None,
         friction: object = None,
-        constraints: Optional[
-            Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]
-        ] = None,
+        constraints: Optional[Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]] = None,
         f_ext_pass_through: Optional[ArrayLike] = None,
         tau_ff_pass_through: Optional[ArrayLike] = None,
         threads: int = 1,

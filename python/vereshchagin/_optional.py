@@ -1,4 +1,5 @@
 """Optional dependencies: which extra of the package brings a missing module."""
+
 from __future__ import annotations
 
 import importlib.util

@@ -1,4 +1,5 @@
 """A short demonstration on a 7-joint arm: free fall, a held tool, a fully constrained tool."""
+
 from __future__ import annotations
 
 import numpy as np

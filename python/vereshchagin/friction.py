@@ -1,4 +1,5 @@
 """Joint friction parameters for friction-aware solves."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -73,5 +74,7 @@ class Friction:
 
     def __reduce__(self):
         # Rebuilt through the constructor, so copies and unpickled objects stay read-only.
-        return (Friction, (self.static, self.kinetic, self.velocity_tolerance, self.lower, self.upper,
-                           self.limit_tolerance))
+        return (
+            Friction,
+            (self.static, self.kinetic, self.velocity_tolerance, self.lower, self.upper, self.limit_tolerance),
+        )

@@ -12,6 +12,7 @@ Not carried over: joint damping and stiffness (PyKDL does not expose them, and n
 dynamics solvers nor this library use them); a chain's URDF metadata (limits, friction, merged
 link names), which a PyKDL chain does not have.
 """
+
 from __future__ import annotations
 
 from typing import Any
@@ -21,8 +22,15 @@ import numpy as np
 from ._core import Chain, Joint, SolverError
 
 # PyKDL joint type name -> add_segment joint string (the axis types are handled separately).
-_AXIS_TYPES = {"RotX": "rot_x", "RotY": "rot_y", "RotZ": "rot_z",
-               "TransX": "trans_x", "TransY": "trans_y", "TransZ": "trans_z", "Fixed": "fixed"}
+_AXIS_TYPES = {
+    "RotX": "rot_x",
+    "RotY": "rot_y",
+    "RotZ": "rot_z",
+    "TransX": "trans_x",
+    "TransY": "trans_y",
+    "TransZ": "trans_z",
+    "Fixed": "fixed",
+}
 _KDL_UNNAMED = "NoName"  # KDL's default segment and joint name
 
 
@@ -32,7 +40,8 @@ def _pykdl():
     except ImportError as err:
         raise ImportError(
             "PyKDL is not importable from this interpreter: install Debian's python3-pykdl "
-            "(apt-get install python3-pykdl), which is built for /usr/bin/python3") from err
+            "(apt-get install python3-pykdl), which is built for /usr/bin/python3"
+        ) from err
     return PyKDL
 
 
@@ -63,12 +72,16 @@ def _check_unit_scale_zero_offset(kdl, joint, where: str, revolute: bool) -> Non
     rotation_at_zero = np.array([[pose0.M[r, c] for c in range(3)] for r in range(3)])
     t = joint.twist(1.0)
     rate = _vec(t.rot) if revolute else _vec(t.vel)
-    offset_free = (np.array_equal(rotation_at_zero, np.eye(3)) if revolute
-                   else np.array_equal(_vec(pose0.p), _vec(joint.JointOrigin())))
+    offset_free = (
+        np.array_equal(rotation_at_zero, np.eye(3))
+        if revolute
+        else np.array_equal(_vec(pose0.p), _vec(joint.JointOrigin()))
+    )
     if not offset_free or not np.array_equal(rate, axis):
         raise SolverError(
             f"{where}: the joint has a PyKDL scale or offset (KDL moves it by scale * q + offset); "
-            "vereshchagin.Chain supports scale 1 and offset 0 only")
+            "vereshchagin.Chain supports scale 1 and offset 0 only"
+        )
 
 
 def _rotor_inertia(kdl, joint) -> float:
@@ -111,9 +124,16 @@ def _segment_arguments(kdl, segment, index: int) -> dict[str, Any]:
         _check_unit_scale_zero_offset(kdl, joint, where, revolute=kind.startswith("Rot"))
     mass, com, inertia = _inertia_about_com(segment.getInertia())
     joint_name = joint.getName()
-    return dict(name=name, joint=spec, tip=_frame_to_matrix(segment.getFrameToTip()), mass=mass, com=com,
-                inertia=inertia, rotor_inertia=_rotor_inertia(kdl, joint) if moving else 0.0,
-                joint_name="" if joint_name == _KDL_UNNAMED else joint_name)
+    return dict(
+        name=name,
+        joint=spec,
+        tip=_frame_to_matrix(segment.getFrameToTip()),
+        mass=mass,
+        com=com,
+        inertia=inertia,
+        rotor_inertia=_rotor_inertia(kdl, joint) if moving else 0.0,
+        joint_name="" if joint_name == _KDL_UNNAMED else joint_name,
+    )
 
 
 def chain_from_kdl(kdl_chain, inertia_check: str = "physical") -> Chain:
@@ -199,6 +219,7 @@ def chain_to_kdl(chain: Chain):
     out = kdl.Chain()
     for i in range(chain.n_segments):
         spec = chain.segment_spec(i)
-        out.addSegment(kdl.Segment(spec["name"], _kdl_joint(kdl, spec), _kdl_frame(kdl, spec["tip"]),
-                                   _kdl_inertia(kdl, spec)))
+        out.addSegment(
+            kdl.Segment(spec["name"], _kdl_joint(kdl, spec), _kdl_frame(kdl, spec["tip"]), _kdl_inertia(kdl, spec))
+        )
     return out

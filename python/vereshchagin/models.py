@@ -1,4 +1,5 @@
 """Small built-in chains for demonstrations and tests."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -36,17 +37,20 @@ def seven_joint_arm() -> Chain:
         if k == len(lengths) - 1:
             roll = 0.0
         radius = 0.04
-        inertia = np.diag([
-            mass * (3 * radius**2 + length**2) / 12,
-            mass * (3 * radius**2 + length**2) / 12,
-            mass * radius**2 / 2,
-        ])
+        inertia = np.diag(
+            [
+                mass * (3 * radius**2 + length**2) / 12,
+                mass * (3 * radius**2 + length**2) / 12,
+                mass * radius**2 / 2,
+            ]
+        )
         # The link is a cylinder along the joint axis (z before the tip rotation).
         tip = _tip([0.0, 0.0, length], [roll, 0.0, 0.0])
         com_joint = np.array([0.0, 0.0, length / 2])
         R = tip[:3, :3]
         com_tip = R.T @ (com_joint - tip[:3, 3])
         inertia_tip = R.T @ inertia @ R
-        chain.add_segment(name=f"link{k + 1}", joint="rot_z", tip=tip, mass=mass, com=com_tip,
-                          inertia=inertia_tip, rotor_inertia=0.02)
+        chain.add_segment(
+            name=f"link{k + 1}", joint="rot_z", tip=tip, mass=mass, com=com_tip, inertia=inertia_tip, rotor_inertia=0.02
+        )
     return chain

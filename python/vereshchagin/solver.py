@@ -1,4 +1,5 @@
 """The Python face of the C++ solver: documentation and the batch result type."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -94,8 +95,20 @@ class Solver(_core.Solver):
     solving.
     """
 
-    def solve_batch(self, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None,
-                    f_ext_pass_through=None, tau_ff_pass_through=None, threads=1) -> BatchResult:
+    def solve_batch(
+        self,
+        q,
+        qd,
+        alpha=None,
+        beta=None,
+        f_ext=None,
+        tau_ff=None,
+        friction=None,
+        constraints=None,
+        f_ext_pass_through=None,
+        tau_ff_pass_through=None,
+        threads=1,
+    ) -> BatchResult:
         """Solve B states at once (each row exactly as :meth:`solve` would).
 
         Every argument is either shared by all rows (the shape :meth:`solve` takes) or has a
@@ -130,8 +143,21 @@ class Solver(_core.Solver):
             Shapes that do not fit (the message names the argument and its batch axis), or the
             first failing row (``"batch row 3: ..."``).
         """
-        return BatchResult(**super().solve_batch(q, qd, alpha, beta, f_ext, tau_ff, friction, constraints,
-                                                 f_ext_pass_through, tau_ff_pass_through, threads))
+        return BatchResult(
+            **super().solve_batch(
+                q,
+                qd,
+                alpha,
+                beta,
+                f_ext,
+                tau_ff,
+                friction,
+                constraints,
+                f_ext_pass_through,
+                tau_ff_pass_through,
+                threads,
+            )
+        )
 
     def response_columns(self, joints, hold_sticking=True):
         """Affine response of the last solve to unit feed-forward joint torques.

@@ -13,6 +13,7 @@ tip origin and in pose errors; these functions translate.
 
 Everything is plain numpy.
 """
+
 from __future__ import annotations
 
 from typing import Sequence, Union

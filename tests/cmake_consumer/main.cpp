@@ -8,9 +8,9 @@
 int main() {
   KDL::Chain chain;
   for (int i = 0; i < 2; ++i) {
-    chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotY), KDL::Frame(KDL::Vector(0.5, 0.0, 0.0)),
-                                  KDL::RigidBodyInertia(1.0, KDL::Vector(0.25, 0.0, 0.0),
-                                                        KDL::RotationalInertia(0.01, 0.02, 0.02))));
+    chain.addSegment(KDL::Segment(
+        KDL::Joint(KDL::Joint::RotY), KDL::Frame(KDL::Vector(0.5, 0.0, 0.0)),
+        KDL::RigidBodyInertia(1.0, KDL::Vector(0.25, 0.0, 0.0), KDL::RotationalInertia(0.01, 0.02, 0.02))));
   }
   vereshchagin::ChainHdSolver solver(chain, KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero()));
   KDL::JntArray q(2), qd(2), qdd(2), tau(2), cmd(2), beta(1);

@@ -46,10 +46,10 @@
 // invariant to the length scale) is the size K would have if no cancellation reduced the
 // couplings S_i^T A_i of the constraint wrenches A_i felt at the joints (so a constraint that no
 // joint can affect, e.g. along a stretched arm, counts as rank 0 even when it is the only one);
-// the rank reported counts the others. DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue lambda.
-// Both give finite outputs for any valid input. Fast path: when a Cholesky factor K = L L^T
-// proves every eigenvalue above the threshold (lambda_min >= 1 / ||L^-1||_F^2 > rcond * kappa),
-// K^+ = K^-1 is applied through L: the same solution at a fraction of the cost.
+// the rank reported counts the others. DampedLeastSquares uses lambda / (lambda^2 + damping^2) for every eigenvalue
+// lambda. Both give finite outputs for any valid input. Fast path: when a Cholesky factor K = L L^T proves every
+// eigenvalue above the threshold (lambda_min >= 1 / ||L^-1||_F^2 > rcond * kappa), K^+ = K^-1 is applied through L: the
+// same solution at a fraction of the cost.
 //
 // Affine structure: qdd and tau_cmd are affine in ff_torques. After a solve, responseColumns()
 // returns d(qdd)/d(tau_j) and d(tau_cmd)/d(tau_j) for requested joints j, O(n) per column, reusing
@@ -92,11 +92,11 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <kdl/chain.hpp>
+#include <kdl/chainidsolver.hpp>  // KDL::Wrenches
 #include <kdl/frames.hpp>
 #include <kdl/jacobian.hpp>
 #include <kdl/jntarray.hpp>
 #include <kdl/solveri.hpp>
-#include <kdl/chainidsolver.hpp>  // KDL::Wrenches
 
 #include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/spatial.hpp"
@@ -122,41 +122,38 @@ class ChainHdSolver : public KDL::SolverI {
  public:
   static constexpr int kMaxConstraints = 6;
   using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
-  using MatrixC = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstraints,
-                                kMaxConstraints>;
+  using MatrixC = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxConstraints, kMaxConstraints>;
   using VectorC = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxConstraints, 1>;
 
   // Error codes in addition to KDL::SolverI's (E_SIZE_MISMATCH = -4, E_OUT_OF_RANGE = -6, ...).
   enum {
-    E_NONFINITE_INPUT = -100,      // NaN or Inf in an input
-    E_INVALID_MODEL = -101,        // negative mass, inertia failing options.inertia_check, negative rotor inertia, ...
-    E_DEGENERATE_INERTIA = -102,   // a joint's articulated inertia D_j <= 0: no unique motion (zero),
-                                   // or H(q) not positive definite here (inertia_check JointSpace)
-    E_TOO_MANY_CONSTRAINTS = -103, // alfa has more than 6 columns
-    E_NO_SOLUTION = -104,          // responseColumns() called before a successful solve
-    E_INVALID_OPTIONS = -105,      // rcond < 0, damping <= 0 for the damped policy, non-finite
-    E_NONFINITE_RESULT = -106,     // finite inputs whose results overflow (Inf/NaN or > 1e150)
+    E_NONFINITE_INPUT = -100,       // NaN or Inf in an input
+    E_INVALID_MODEL = -101,         // negative mass, inertia failing options.inertia_check, negative rotor inertia, ...
+    E_DEGENERATE_INERTIA = -102,    // a joint's articulated inertia D_j <= 0: no unique motion (zero),
+                                    // or H(q) not positive definite here (inertia_check JointSpace)
+    E_TOO_MANY_CONSTRAINTS = -103,  // alfa has more than 6 columns
+    E_NO_SOLUTION = -104,           // responseColumns() called before a successful solve
+    E_INVALID_OPTIONS = -105,       // rcond < 0, damping <= 0 for the damped policy, non-finite
+    E_NONFINITE_RESULT = -106,      // finite inputs whose results overflow (Inf/NaN or > 1e150)
   };
 
   // The chain is copied. root_acc: base acceleration (gravity as +9.81 along up), see above.
   // Construction never throws for a bad model: the error is kept and returned by every solve
   // (check modelError()).
-  ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc,
-                const SolverOptions& options = SolverOptions());
+  ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options = SolverOptions());
 
   // KDL-compatible entry point. alfa: KDL::Jacobian (6 x m, m = 0..6); beta: m entries;
   // f_ext: one wrench per segment; command_torques: output tau_cmd (see above), must be sized
   // n_joints like q_dotdot. Returns 0 or an error code.
-  int CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot,
-                const KDL::Jacobian& alfa, const KDL::JntArray& beta, const KDL::Wrenches& f_ext,
-                const KDL::JntArray& ff_torques, KDL::JntArray& command_torques);
+  int CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot, const KDL::Jacobian& alfa,
+                const KDL::JntArray& beta, const KDL::Wrenches& f_ext, const KDL::JntArray& ff_torques,
+                KDL::JntArray& command_torques);
 
   // Eigen entry point. f_ext (6 x n_segments) and ff_torques (n_joints) may be empty (zero).
   // alfa may have 0 columns (plain forward dynamics); beta has as many entries as alfa columns.
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
             const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-            const Eigen::Ref<const Matrix6X>& f_ext,
-            const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+            const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
 
   // Constraints on any segments: column c of alfa (6 x M) acts on segment segments(c) (base axes,
   // moment about that segment's tip origin; see above); beta has M entries. At most 6 columns per
@@ -245,29 +242,29 @@ class ChainHdSolver : public KDL::SolverI {
   friend class FrictionSolver;  // sets pt_driver_ (its ff_torques carry friction too)
 
   struct Segment {
-    Pose X0;                // pose of this tip frame in the parent tip frame at q = 0
-    Pose X;                 // the same at the current q
-    Matrix3 R_base;         // orientation of this tip frame in the base frame
-    Vector6 S;              // joint motion axis in the tip frame (zero for fixed joints)
-    Matrix6 I;              // rigid-body inertia about the tip origin, tip frame
-    Matrix6 IA;             // articulated inertia
-    Vector6 v, c, pA;       // velocity, velocity-product acceleration, articulated bias force
-    Vector6 u;              // IA * S
-    Vector6 xdd;            // spatial acceleration (tip frame)
+    Pose X0;                                      // pose of this tip frame in the parent tip frame at q = 0
+    Pose X;                                       // the same at the current q
+    Matrix3 R_base;                               // orientation of this tip frame in the base frame
+    Vector6 S;                                    // joint motion axis in the tip frame (zero for fixed joints)
+    Matrix6 I;                                    // rigid-body inertia about the tip origin, tip frame
+    Matrix6 IA;                                   // articulated inertia
+    Vector6 v, c, pA;                             // velocity, velocity-product acceleration, articulated bias force
+    Vector6 u;                                    // IA * S
+    Vector6 xdd;                                  // spatial acceleration (tip frame)
     Eigen::Matrix<double, 6, kMaxConstraints> A;  // constraint wrenches felt by this segment
     Eigen::Matrix<double, 1, kMaxConstraints> e;  // S^T A
     double rotor = 0.0, D = 0.0, Dinv = 0.0;
-    double w_norm = 0.0;    // |angular part of S| (0 for prismatic joints)
+    double w_norm = 0.0;        // |angular part of S| (0 for prismatic joints)
     double v2 = 0.0, w2 = 0.0;  // |linear part of S|^2, |angular part of S|^2
-    int joint = -1;         // joint index or -1 for a fixed joint
+    int joint = -1;             // joint index or -1 for a fixed joint
   };
 
   int fail(int code, const char* fmt, ...);
   void buildModel();
   int checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                   const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-                  const Eigen::Ref<const Matrix6X>& f_ext,
-                  const Eigen::Ref<const Eigen::VectorXd>& ff_torques, int max_columns);
+                  const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
+                  int max_columns);
   // Joint part of segment i's inward step: u, D, 1/D; returns the free joint acceleration (parent
   // at rest, no constraint) and the apparent bias force pa; false if D is degenerate.
   inline bool articulate(Segment& s, double tau, Vector6& pa, double& free) const;
@@ -299,7 +296,8 @@ class ChainHdSolver : public KDL::SolverI {
   int inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   void factorizeCouplingGeneral();
   void finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
-  void commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_sorted, Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
+  void commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_sorted,
+                            Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
   // out = K^+ rhs for either path (vectors of length m_, sorted order on the general path).
   void couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const;
   void screwPose(Segment& s, double q) const;
@@ -332,7 +330,7 @@ class ChainHdSolver : public KDL::SolverI {
   // Workspace of responseColumns(): d tau_cmd / d nu (n_joints x m), per segment and column the
   // joint-axis component of the apparent force change (n_segments x n_joints), column blocks.
   Eigen::MatrixXd cmd_per_nu_, col_energy_, col_nu_, col_sdp_;
-  Matrix6X col_s0_, col_u0_;  // joint axes S and IA S in base axes, about each tip origin
+  Matrix6X col_s0_, col_u0_;                             // joint axes S and IA S in base axes, about each tip origin
   Eigen::Matrix<double, 3, Eigen::Dynamic> col_offset_;  // tip origin - parent's tip origin, base axes
   Matrix6X col_force_;
   Eigen::VectorXd col_row_;
@@ -351,33 +349,33 @@ class ChainHdSolver : public KDL::SolverI {
   bool use_cholesky_ = false;
   MatrixC chol_;  // lower Cholesky factor of K on the fast path
   Eigen::SelfAdjointEigenSolver<MatrixC> eig_;
-  VectorC inv_eigen_;   // per-eigenvalue multiplier of the policy
+  VectorC inv_eigen_;  // per-eigenvalue multiplier of the policy
   mutable bool sigma_known_ = false;
   mutable double sigma_min_ = 0.0;
   mutable Eigen::SelfAdjointEigenSolver<MatrixC> sigma_eig_;
 
   // General path: constraints on several segments (storage sized at construction).
-  bool general_ = false;             // the last solve used it
-  int mcap_ = kMaxConstraints;       // 6 per segment
-  Eigen::VectorXi order_;            // sorted position -> caller's column (distal segments first)
-  Eigen::VectorXi seg_count_;        // per segment: its number of columns
-  std::vector<int> active_;          // active_[i]: columns on segments >= i (n_segments + 1)
-  Matrix6X anew_;                    // each column's wrench in its own segment's tip axes (sorted)
-  Matrix6X acur_, aproj_;            // wrenches felt by the current segment / passed to the parent
-  Eigen::MatrixXd eg_;               // mcap x n_segments: column i = (S_i^T A_i)^T, zero past active_[i]
+  bool general_ = false;        // the last solve used it
+  int mcap_ = kMaxConstraints;  // 6 per segment
+  Eigen::VectorXi order_;       // sorted position -> caller's column (distal segments first)
+  Eigen::VectorXi seg_count_;   // per segment: its number of columns
+  std::vector<int> active_;     // active_[i]: columns on segments >= i (n_segments + 1)
+  Matrix6X anew_;               // each column's wrench in its own segment's tip axes (sorted)
+  Matrix6X acur_, aproj_;       // wrenches felt by the current segment / passed to the parent
+  Eigen::MatrixXd eg_;          // mcap x n_segments: column i = (S_i^T A_i)^T, zero past active_[i]
   Eigen::VectorXd ug_, nug_, nu_user_, rhs_g_;
   mutable Eigen::VectorXd tmp_g_;
-  Eigen::MatrixXd kg_, cholg_, vg_;  // coupling matrix, its Cholesky factor or eigenvectors
-  Eigen::VectorXd invg_;             // policy multiplier per eigenvalue
+  Eigen::MatrixXd kg_, cholg_, vg_;          // coupling matrix, its Cholesky factor or eigenvectors
+  Eigen::VectorXd invg_;                     // policy multiplier per eigenvalue
   mutable Eigen::MatrixXd work_g_, work_v_;  // Jacobi workspace for the smallest singular value
 
   // Driver pass-through (storage sized at construction).
-  Eigen::VectorXd pt_f_, pt_t_;      // weights per caller's column (mcap)
-  int pt_m_ = -1;                    // columns they are for; -1: none
+  Eigen::VectorXd pt_f_, pt_t_;               // weights per caller's column (mcap)
+  int pt_m_ = -1;                             // columns they are for; -1: none
   bool pt_f_any_ = false, pt_t_any_ = false;  // some weight is non-zero
-  bool pt_used_ = false;             // the last solve applied pt_energy_
-  Eigen::VectorXd pt_free_;          // driverFree() per joint (n_joints)
-  Eigen::VectorXd pt_energy_, pt_tmp_;  // p_f .* a_fext + p_t .* a_ff, and one driver's a (mcap)
+  bool pt_used_ = false;                      // the last solve applied pt_energy_
+  Eigen::VectorXd pt_free_;                   // driverFree() per joint (n_joints)
+  Eigen::VectorXd pt_energy_, pt_tmp_;        // p_f .* a_fext + p_t .* a_ff, and one driver's a (mcap)
   // The feed-forward driver when ff_torques also carry forces the constraints always compensate
   // (FrictionSolver's friction); nullptr: ff_torques.
   const Eigen::VectorXd* pt_driver_ = nullptr;

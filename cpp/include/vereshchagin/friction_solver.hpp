@@ -66,18 +66,17 @@ class FrictionSolver {
  public:
   enum JointStatus : signed char { Moving = 0, Stick = 1, SlipPositive = 2, SlipNegative = 3 };
   enum {
-    E_INVALID_FRICTION = -110,     // sizes, negative or non-finite values, kinetic > static
-    E_NOT_CONVERGED = -111,        // the iteration bound was exceeded (not expected), or the task
-                                   // drives a joint into its limit (unbounded reaction)
+    E_INVALID_FRICTION = -110,  // sizes, negative or non-finite values, kinetic > static
+    E_NOT_CONVERGED = -111,     // the iteration bound was exceeded (not expected), or the task
+                                // drives a joint into its limit (unbounded reaction)
   };
 
-  FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc,
-                 const SolverOptions& options = SolverOptions());
+  FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options = SolverOptions());
 
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
             const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-            const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
-            const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+            const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
+            const FrictionModel& friction);
   // The same with constraints on any segments (column c of alfa on segment segments(c); see
   // ChainHdSolver's overload).
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
@@ -102,7 +101,10 @@ class FrictionSolver {
   ChainHdSolver& hdSolver() { return hd_; }
   const char* errorMessage() const { return message_.data(); }
   int modelError() const { return hd_.modelError(); }
-  void setRootAcceleration(const KDL::Twist& root_acc) { hd_.setRootAcceleration(root_acc); free_.setRootAcceleration(root_acc); }
+  void setRootAcceleration(const KDL::Twist& root_acc) {
+    hd_.setRootAcceleration(root_acc);
+    free_.setRootAcceleration(root_acc);
+  }
   // Driver pass-through weights as ChainHdSolver::setPassThrough: they weight f_ext and
   // ff_torques only; friction (kinetic and the max-min's static) is always compensated along the
   // constraints. Returns ChainHdSolver's codes (message in errorMessage()).
@@ -121,14 +123,14 @@ class FrictionSolver {
   // The hybrid-dynamics solve of the current problem with joint torques tau (segments or not).
   int hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
               const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-              const Eigen::Ref<const Eigen::VectorXi>* segments,
-              const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& tau);
-  int boxQp(int k);                 // stage 1 on Q_, c_, lo_, hi_ -> x_
-  void leastCommand(int k);         // stage 2: tie-break on the optimal face
+              const Eigen::Ref<const Eigen::VectorXi>* segments, const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+              const Eigen::Ref<const Eigen::VectorXd>& tau);
+  int boxQp(int k);          // stage 1 on Q_, c_, lo_, hi_ -> x_
+  void leastCommand(int k);  // stage 2: tie-break on the optimal face
   // Stage 2's solvers on the sticking set (ns joints, Q_StSt = V_ V_^T of rank r < ns), from
   // ys_ = x*_St with target ts_ and bounds p_ / eig_ (see leastCommand).
-  void leastOnLine(int ns, int r);                        // ns - r = 1: closed form
-  void leastActiveSet(int ns, int r, double yscale);      // range-space primal active set
+  void leastOnLine(int ns, int r);                    // ns - r = 1: closed form
+  void leastActiveSet(int ns, int r, double yscale);  // range-space primal active set
   // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
@@ -149,8 +151,8 @@ class FrictionSolver {
   bool link_acc_known_ = false;
   std::vector<signed char> status_;
   int iterations_ = 0;
-  double qscale_ = 0.0;  // scale of Q (see solve())
-  double gscale_ = 0.0;  // scale of the QP gradient (see boxQp())
+  double qscale_ = 0.0;          // scale of Q (see solve())
+  double gscale_ = 0.0;          // scale of the QP gradient (see boxQp())
   bool free_full_rank_ = false;  // the last free-set factorisation had full rank
   bool solved_ = false;
   // Inputs kept for gaussValue().
@@ -159,7 +161,7 @@ class FrictionSolver {
   bool has_f_ = false;
   Eigen::VectorXd fstatic_;  // static friction of the last solve
   // Optimisation workspace (k <= n resting joints).
-  Eigen::VectorXi rest_;     // joint index of each resting joint
+  Eigen::VectorXi rest_;                    // joint index of each resting joint
   Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_;  // Tc_ stays empty (0 x 0): tau_cmd follows from nu
   Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_, invdiag_, dpiv_;
   // Free-set factor L D L^T kept across blocked steps (freeStep / factorDelete): valid for the

@@ -126,10 +126,10 @@ class ChainHdSolver_Vereshchagin : public KDL::SolverI {
   unsigned int nc_;
   ChainHdSolver solver_;
   unsigned int nj_ = 0, ns_ = 0;
-  int active_ = 0;                         // enabled (non-zero) alfa columns at the last solve
+  int active_ = 0;                           // enabled (non-zero) alfa columns at the last solve
   ChainHdSolver::Matrix6X alfa_on_, f_ext_;  // the enabled columns; f_ext as a 6 x n_segments matrix
   Eigen::VectorXd beta_on_, nu_, total_;
-  Eigen::VectorXi column_;                 // alfa column of each enabled one
+  Eigen::VectorXi column_;                       // alfa column of each enabled one
   Eigen::VectorXd w_f_, w_t_, w_f_on_, w_t_on_;  // pass-through weights (nc), of the enabled columns
   bool weighted_ = false;
   Frames poses_;

@@ -18,24 +18,24 @@ struct JointInfo {
   double upper = std::numeric_limits<double>::infinity();
   double velocity_limit = std::numeric_limits<double>::infinity();
   double effort_limit = std::numeric_limits<double>::infinity();
-  double friction = 0.0;  // static (breakaway) friction, the URDF <dynamics friction> value
-  double damping = 0.0;   // viscous damping, N m s/rad or N s/m
+  double friction = 0.0;     // static (breakaway) friction, the URDF <dynamics friction> value
+  double damping = 0.0;      // viscous damping, N m s/rad or N s/m
   unsigned int segment = 0;  // index of the chain segment this joint moves
 };
 
 // Where a link of the description ended up: links merged through fixed joints share a segment.
 struct LinkPlacement {
   std::string link;
-  int segment = -1;                    // segment whose rigid body holds the link (-1: the base)
-  KDL::Frame in_segment_tip;           // pose of the link frame in that segment's tip frame (base: root)
+  int segment = -1;           // segment whose rigid body holds the link (-1: the base)
+  KDL::Frame in_segment_tip;  // pose of the link frame in that segment's tip frame (base: root)
 };
 
 struct RobotChain {
   KDL::Chain chain;
-  std::vector<JointInfo> joints;        // one per moving joint, in chain order
-  std::vector<LinkPlacement> links;     // every link folded into the chain's segments
-  std::string root_link;                // the base frame
-  std::vector<std::string> notes;       // approximations made while building (e.g. lumped branches)
+  std::vector<JointInfo> joints;     // one per moving joint, in chain order
+  std::vector<LinkPlacement> links;  // every link folded into the chain's segments
+  std::string root_link;             // the base frame
+  std::vector<std::string> notes;    // approximations made while building (e.g. lumped branches)
 };
 
 }  // namespace vereshchagin

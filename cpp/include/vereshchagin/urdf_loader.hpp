@@ -36,9 +36,9 @@ struct UrdfOptions {
 
 // xml: the URDF document. root / tip: link names; empty root = the URDF's root link, empty tip =
 // the single leaf below root (an error names the leaves when the tree branches).
-UrdfResult chainFromUrdfString(const std::string& xml, const std::string& root = "",
-                               const std::string& tip = "", const UrdfOptions& options = UrdfOptions());
-UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root = "",
-                             const std::string& tip = "", const UrdfOptions& options = UrdfOptions());
+UrdfResult chainFromUrdfString(const std::string& xml, const std::string& root = "", const std::string& tip = "",
+                               const UrdfOptions& options = UrdfOptions());
+UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root = "", const std::string& tip = "",
+                             const UrdfOptions& options = UrdfOptions());
 
 }  // namespace vereshchagin

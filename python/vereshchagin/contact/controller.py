@@ -31,6 +31,7 @@ Contact detection: |v_z| of the end-effector below ``contact_threshold`` for
 ``contact_samples`` (10) consecutive samples, armed once the tool has moved (|v_z| above twice
 the threshold). On contact the gains switch to the contact set and the directions to "contact".
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -221,8 +222,11 @@ class CascadedController:
         if config.friction_mode not in FRICTION_MODES:
             raise ValueError(f"friction_mode must be one of {FRICTION_MODES}, got {config.friction_mode!r}")
         self.joint_friction = np.asarray(chain.friction, float)
-        self.friction = Friction(static=self.joint_friction, velocity_tolerance=config.friction_velocity_tolerance) \
-            if config.friction_mode == "maxmin" and np.any(self.joint_friction > 0) else None
+        self.friction = (
+            Friction(static=self.joint_friction, velocity_tolerance=config.friction_velocity_tolerance)
+            if config.friction_mode == "maxmin" and np.any(self.joint_friction > 0)
+            else None
+        )
         self.goal: Optional[np.ndarray] = None
         self.in_contact = False
         self.detect = False
@@ -331,8 +335,9 @@ class CascadedController:
         tau_ff = tau_motor_ff - self.damping * qd
         kw: dict[str, Any] = {}
         if self.extra_constraints:
-            kw["constraints"] = self.extra_constraints(q, qd) if callable(self.extra_constraints) \
-                else self.extra_constraints
+            kw["constraints"] = (
+                self.extra_constraints(q, qd) if callable(self.extra_constraints) else self.extra_constraints
+            )
 
         f_ext = None
         N = 0.0
@@ -358,8 +363,9 @@ class CascadedController:
         if self.support_share is not None:
             tau = tau - self.support_share(res, q)
         inputs = dict(q=q, qd=qd, alpha=alpha, beta=beta, f_ext=f_ext, tau_ff=tau_ff, motor_ff=tau_motor_ff, **kw)
-        return tau, CycleInfo(pose=T, twist=tw, error=e, normal_force_estimate=N, contact=self.in_contact,
-                              result=res, inputs=inputs)
+        return tau, CycleInfo(
+            pose=T, twist=tw, error=e, normal_force_estimate=N, contact=self.in_contact, result=res, inputs=inputs
+        )
 
     def _friction_feedforward(self, qd, qdd) -> np.ndarray:
         """Torque added for joint friction by the ``"sign"`` and ``"smooth"`` modes (zero otherwise)."""

@@ -25,6 +25,7 @@ Variants:
   force ``-nu_e`` at the elbow), is left to the support when that force pushes up (``nu_e < 0``).
   The plant's contact then supplies it: the motors carry the rest.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -130,17 +131,23 @@ def elbow(variant: str, quick: bool = False, progress=None):
     R0 = np.asarray(chain.fk(q0))[:3, :3]
     v = ctl.config.v_max
     duration = 0.5 if quick else 1.0
-    phases = [Phase("settle", lambda T: _shifted(T, R=R0), duration, contact=False),
-              Phase("slide", lambda T: _shifted(T, dx=ELBOW_DX, R=R0), SLIDE / v + (1.0 if quick else 1.5)),
-              Phase("hold", lambda T: _shifted(T, R=R0), duration)]
+    phases = [
+        Phase("settle", lambda T: _shifted(T, R=R0), duration, contact=False),
+        Phase("slide", lambda T: _shifted(T, dx=ELBOW_DX, R=R0), SLIDE / v + (1.0 if quick else 1.5)),
+        Phase("hold", lambda T: _shifted(T, R=R0), duration),
+    ]
     nu_log: list[float] = []
 
     def log_nu(k, command, info) -> None:
         nu_log.append(-float(np.asarray(info.result.nu)[N_TOOL]))
 
-    run = run_loop(robot, ctl, phases, "elbow", variant, (0.0, 0.0, 0.0), progress,
-                   on_cycle=None if variant == "plant" else log_nu)
+    run = run_loop(
+        robot, ctl, phases, "elbow", variant, (0.0, 0.0, 0.0), progress, on_cycle=None if variant == "plant" else log_nu
+    )
     elbow_z = np.array([np.asarray(chain.fk(q, segment=seg))[2, 3] for q in run.q])
-    run.info.update(elbow_z=elbow_z, support_top=None if support is None else 2 * support[0][2],
-                    support_force_model=np.array(nu_log[:len(run.t)]) if nu_log else np.full(len(run.t), np.nan))
+    run.info.update(
+        elbow_z=elbow_z,
+        support_top=None if support is None else 2 * support[0][2],
+        support_force_model=np.array(nu_log[: len(run.t)]) if nu_log else np.full(len(run.t), np.nan),
+    )
     return run

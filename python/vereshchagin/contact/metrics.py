@@ -14,6 +14,7 @@ For the samples of a window (sample period dt = 1 ms), per joint j:
 
 Torque is the motor torque the plant applied (after saturation), qd the measured velocity.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -42,8 +43,12 @@ def effort(run, mask=None) -> dict:
     dt = float(np.median(np.diff(run.t))) if len(run.t) > 1 else 1e-3
     p = tau * qd
     return dict(
-        mean_tau=tau.mean(0), mean_abs_tau=np.abs(tau).mean(0), mean_power=p.mean(0),
-        energy_abs=np.abs(p).sum(0) * dt, energy_tau2=(tau ** 2).sum(0) * dt, duration=m.sum() * dt,
+        mean_tau=tau.mean(0),
+        mean_abs_tau=np.abs(tau).mean(0),
+        mean_power=p.mean(0),
+        energy_abs=np.abs(p).sum(0) * dt,
+        energy_tau2=(tau**2).sum(0) * dt,
+        duration=m.sum() * dt,
     )
 
 

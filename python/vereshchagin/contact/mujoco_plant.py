@@ -21,6 +21,7 @@ table and the support but never itself. Contact friction (sliding) is ``Scene.fr
 contact (solref 0.02 s, damping ratio 1). Time step 1 ms, ``implicitfast`` integrator, gravity
 -9.81 m/s^2 along z.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -113,8 +114,13 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
         joint.solref_friction = [2e-3, 1.0]
         joint.solimp_friction = [0.99, 0.999, 1e-3, 0.5, 2.0]
         lim = float(chain.effort_limit[k])
-        spec.add_actuator(name=f"motor_{k + 1}", target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                          ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE, ctrlrange=[-lim, lim])
+        spec.add_actuator(
+            name=f"motor_{k + 1}",
+            target=name,
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
+            ctrlrange=[-lim, lim],
+        )
 
     # End-effector frame in the bracelet body (the URDF's fixed joints are fused into it).
     probe = spec.compile()
@@ -129,23 +135,56 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
     if scene.pen_direction is not None:
         grip = in_bracelet([0.0, 0.0, PEN_GRIP])
         tip = in_bracelet(pen_tip(scene.pen_direction))
-        bracelet.add_geom(name="pen", type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[PEN_RADIUS, 0, 0],
-                          fromto=np.concatenate([grip, tip]), contype=1, conaffinity=0, group=ARM,
-                          friction=fr, mass=0.0, rgba=[0.1, 0.1, 0.8, 1])
-    spec.body("forearm_link").add_geom(name="elbow", type=mujoco.mjtGeom.mjGEOM_SPHERE,
-                                       size=[ELBOW_RADIUS, 0, 0], pos=[0, 0, 0], contype=1,
-                                       conaffinity=0, group=ARM, friction=fr, mass=0.0)
+        bracelet.add_geom(
+            name="pen",
+            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+            size=[PEN_RADIUS, 0, 0],
+            fromto=np.concatenate([grip, tip]),
+            contype=1,
+            conaffinity=0,
+            group=ARM,
+            friction=fr,
+            mass=0.0,
+            rgba=[0.1, 0.1, 0.8, 1],
+        )
+    spec.body("forearm_link").add_geom(
+        name="elbow",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[ELBOW_RADIUS, 0, 0],
+        pos=[0, 0, 0],
+        contype=1,
+        conaffinity=0,
+        group=ARM,
+        friction=fr,
+        mass=0.0,
+    )
     world = spec.worldbody
     if scene.table_top is not None:
         (x0, x1), (y0, y1) = scene.table_x, scene.table_y
-        world.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_BOX,
-                       size=[(x1 - x0) / 2, (y1 - y0) / 2, 0.02],
-                       pos=[(x0 + x1) / 2, (y0 + y1) / 2, scene.table_top - 0.02],
-                       contype=0, conaffinity=1, group=ENV, friction=fr, rgba=[0.6, 0.45, 0.3, 1])
+        world.add_geom(
+            name="table",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[(x1 - x0) / 2, (y1 - y0) / 2, 0.02],
+            pos=[(x0 + x1) / 2, (y0 + y1) / 2, scene.table_top - 0.02],
+            contype=0,
+            conaffinity=1,
+            group=ENV,
+            friction=fr,
+            rgba=[0.6, 0.45, 0.3, 1],
+        )
     if scene.support is not None:
         center, half = scene.support
-        world.add_geom(name="support", type=mujoco.mjtGeom.mjGEOM_BOX, size=list(half), pos=list(center),
-                       contype=0, conaffinity=1, group=ENV, friction=fr, rgba=[0.3, 0.5, 0.3, 1])
+        world.add_geom(
+            name="support",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=list(half),
+            pos=list(center),
+            contype=0,
+            conaffinity=1,
+            group=ENV,
+            friction=fr,
+            rgba=[0.3, 0.5, 0.3, 1],
+        )
     model = spec.compile()
     # The pen and the elbow sphere are massless (mass=0 would make MuJoCo infer one from density).
     return model
@@ -189,7 +228,7 @@ class MujocoGen3:
             if gid >= 0:
                 self._env[gid] = name
         self._f6 = np.zeros(6)
-        self._frictionloss = model.dof_frictionloss[:self.n_joints].copy()
+        self._frictionloss = model.dof_frictionloss[: self.n_joints].copy()
 
     def read(self) -> JointState:
         """The simulation's current joint sample.

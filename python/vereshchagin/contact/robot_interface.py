@@ -21,6 +21,7 @@ Contract
 Nothing in the interface exposes the backend's internals; diagnostics only a simulator can give
 (contact forces, which bodies touch) live on the backend class itself.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

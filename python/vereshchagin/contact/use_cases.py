@@ -16,6 +16,7 @@ along +x. The tables are placed from that pose:
   below the tip, draw in the air with all six directions constrained;
 - resting elbow (:mod:`.elbow`).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -29,8 +30,17 @@ from ..solver import Solver
 from .controller import CascadedController, ControllerConfig
 from .mujoco_plant import MujocoGen3, Scene, build_model, pen_tip
 
-__all__ = ["JOINT_FRICTION", "JOINT_DAMPING", "Phase", "Run", "gen3_model", "grasp", "run_loop", "with_tool_link",
-           "writing"]
+__all__ = [
+    "JOINT_FRICTION",
+    "JOINT_DAMPING",
+    "Phase",
+    "Run",
+    "gen3_model",
+    "grasp",
+    "run_loop",
+    "with_tool_link",
+    "writing",
+]
 
 JOINT_FRICTION = (0.5, 0.5, 0.5, 0.5, 0.3, 0.3, 0.3)
 """Static (breakaway) joint friction, N m (Kinova publishes none; plausible harmonic-drive values)."""
@@ -98,13 +108,17 @@ def with_tool_link(urdf: str, name: str, xyz, mass: float = 0.0, radius: float =
     """
     inertial = ""
     if mass > 0.0:
-        i = 0.4 * mass * radius ** 2
-        inertial = (f'    <inertial>\n      <origin xyz="0 0 0" rpy="0 0 0"/>\n      <mass value="{mass!r}"/>\n'
-                    f'      <inertia ixx="{i!r}" ixy="0" ixz="0" iyy="{i!r}" iyz="0" izz="{i!r}"/>\n'
-                    '    </inertial>\n')
-    link = (f'  <joint name="{name}_joint" type="fixed">\n    <parent link="{robots.GEN3_TIP_LINK}"/>\n'
-            f'    <child link="{name}"/>\n    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="0 0 0"/>\n'
-            f'  </joint>\n  <link name="{name}">\n{inertial}  </link>\n')
+        i = 0.4 * mass * radius**2
+        inertial = (
+            f'    <inertial>\n      <origin xyz="0 0 0" rpy="0 0 0"/>\n      <mass value="{mass!r}"/>\n'
+            f'      <inertia ixx="{i!r}" ixy="0" ixz="0" iyy="{i!r}" iyz="0" izz="{i!r}"/>\n'
+            "    </inertial>\n"
+        )
+    link = (
+        f'  <joint name="{name}_joint" type="fixed">\n    <parent link="{robots.GEN3_TIP_LINK}"/>\n'
+        f'    <child link="{name}"/>\n    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="0 0 0"/>\n'
+        f'  </joint>\n  <link name="{name}">\n{inertial}  </link>\n'
+    )
     return urdf.replace("</robot>", link + "</robot>")
 
 
@@ -209,9 +223,16 @@ def _shifted(T, dx=0.0, dy=0.0, dz=0.0, R=None):
     return T
 
 
-def run_loop(robot, controller: CascadedController, phases, case: str, variant: str, tool_point,
-             progress: Optional[Callable[[float], None]] = None,
-             on_cycle: Optional[Callable[[int, np.ndarray, object], None]] = None) -> Run:
+def run_loop(
+    robot,
+    controller: CascadedController,
+    phases,
+    case: str,
+    variant: str,
+    tool_point,
+    progress: Optional[Callable[[float], None]] = None,
+    on_cycle: Optional[Callable[[int, np.ndarray, object], None]] = None,
+) -> Run:
     """Run the phases on ``robot`` (any :class:`~.robot_interface.RobotInterface`).
 
     Parameters
@@ -288,8 +309,23 @@ def run_loop(robot, controller: CascadedController, phases, case: str, variant: 
                 contact_time = s2.time
                 break
     sl = slice(0, k)
-    return Run(case, variant, t[sl], q[sl], qd[sl], tau[sl], tip[sl], tool[sl], ph[sl], cm[sl], tf[sl], sf[sl],
-               sorted(touch), list(phases), contact_time)
+    return Run(
+        case,
+        variant,
+        t[sl],
+        q[sl],
+        qd[sl],
+        tau[sl],
+        tip[sl],
+        tool[sl],
+        ph[sl],
+        cm[sl],
+        tf[sl],
+        sf[sl],
+        sorted(touch),
+        list(phases),
+        contact_time,
+    )
 
 
 def _lowest_arm_point(model, q) -> float:
@@ -312,8 +348,9 @@ def _lowest_arm_point(model, q) -> float:
         elif t == mujoco.mjtGeom.mjGEOM_SPHERE:
             ext = size[0]
         else:  # capsule / cylinder along local z
-            ext = abs(R[2, 2]) * size[1] + (size[0] if t == mujoco.mjtGeom.mjGEOM_CAPSULE
-                                             else size[0] * np.hypot(R[2, 0], R[2, 1]))
+            ext = abs(R[2, 2]) * size[1] + (
+                size[0] if t == mujoco.mjtGeom.mjGEOM_CAPSULE else size[0] * np.hypot(R[2, 0], R[2, 1])
+            )
         low = min(low, c[2] - ext)
     return float(low)
 
@@ -326,8 +363,9 @@ def _gripper_low_point(model, chain, q) -> np.ndarray:
     d.qpos[:] = q
     mujoco.mj_forward(model, d)
     bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "bracelet_link")
-    boxes = [g for g in range(model.ngeom) if model.geom_bodyid[g] == bid
-             and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
+    boxes = [
+        g for g in range(model.ngeom) if model.geom_bodyid[g] == bid and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
+    ]
     g = boxes[0]
     R = d.geom_xmat[g].reshape(3, 3)
     corner = d.geom_xpos[g] - R @ (np.sign(R[2]) * model.geom_size[g])
@@ -379,15 +417,21 @@ def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[f
     approach_time = descent / v + 2.0
     slide_time = SLIDE / v + 1.5
     if contact:
-        phases = [Phase("approach", lambda T: _shifted(T, dz=-(descent + 0.05), R=R0), approach_time, detect=True,
-                        contact=False),
-                  Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), slide_time),
-                  Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0)]
+        phases = [
+            Phase(
+                "approach", lambda T: _shifted(T, dz=-(descent + 0.05), R=R0), approach_time, detect=True, contact=False
+            ),
+            Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), slide_time),
+            Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0),
+        ]
     else:
-        phases = [Phase("approach", lambda T: _shifted(T, dz=-(descent - CLEARANCE), R=R0), approach_time - 0.5,
-                        contact=False),
-                  Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), slide_time),
-                  Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0)]
+        phases = [
+            Phase(
+                "approach", lambda T: _shifted(T, dz=-(descent - CLEARANCE), R=R0), approach_time - 0.5, contact=False
+            ),
+            Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), slide_time),
+            Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0),
+        ]
     run = run_loop(robot, ctl, phases, "grasp", "contact" if contact else "contactless", low, progress)
     run.info.update(table_top=scene.table_top, descent=descent, tool_point=low)
     return run
@@ -429,11 +473,15 @@ def writing(contact: bool, quick: bool = False, progress=None) -> Run:
     v = ctl.config.v_max
     draw_time = SLIDE / v + 1.5
     if contact:
-        phases = [Phase("approach", lambda T: _shifted(T, dz=-0.03, R=R0), 2.0, detect=True, contact=False),
-                  Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time)]
+        phases = [
+            Phase("approach", lambda T: _shifted(T, dz=-0.03, R=R0), 2.0, detect=True, contact=False),
+            Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time),
+        ]
     else:
-        phases = [Phase("settle", lambda T: _shifted(T, R=R0), 0.3, contact=False),
-                  Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time)]
+        phases = [
+            Phase("settle", lambda T: _shifted(T, R=R0), 0.3, contact=False),
+            Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time),
+        ]
     run = run_loop(robot, ctl, phases, "writing", "contact" if contact else "contactless", tip_ee, progress)
     run.info.update(table_top=scene.table_top, tool_point=tip_ee)
     return run

@@ -37,6 +37,7 @@ Tasks (:func:`tasks`), each a few seconds from the contact experiments' start po
   cannot;
 - ``reach``: a fast minimum-jerk reach (20 cm in 1 s along (1.5, 1, -1)), then hold, for contrast.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -50,8 +51,23 @@ from ..contact.mujoco_plant import MujocoGen3, Scene, build_model
 from ..contact.use_cases import Phase, Run, gen3_model, run_loop
 from ..solver import Solver
 
-__all__ = ["CONTROLLERS", "FRICTION_SCALES", "HOLD_BAND", "PARTIAL_POSE", "PAYLOAD", "REST_TOLERANCE", "Log", "TaskSpec",
-           "gravity_torques", "outcome", "run_all", "run_case", "simulate", "task_named", "tasks"]
+__all__ = [
+    "CONTROLLERS",
+    "FRICTION_SCALES",
+    "HOLD_BAND",
+    "PARTIAL_POSE",
+    "PAYLOAD",
+    "REST_TOLERANCE",
+    "Log",
+    "TaskSpec",
+    "gravity_torques",
+    "outcome",
+    "run_all",
+    "run_case",
+    "simulate",
+    "task_named",
+    "tasks",
+]
 
 CONTROLLERS = {
     "none": "friction-unaware",
@@ -135,7 +151,8 @@ def _min_jerk(offset, duration: float) -> Callable:
 
     def path(goal, t):
         s = min(t / duration, 1.0)
-        return _moved(goal, d * (10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5))
+        return _moved(goal, d * (10 * s**3 - 15 * s**4 + 6 * s**5))
+
     return path
 
 
@@ -154,22 +171,28 @@ def tasks(quick: bool = False) -> list[TaskSpec]:
         return [Phase("hold", _still, hold_s)]
 
     def slow(T0):
-        return [Phase("move", _still, slow_len / slow_v, path=_ramp(slow_len, slow_v, (1.0, 0.0, 0.0))),
-                Phase("hold", lambda T: _moved(T0, (slow_len, 0.0, 0.0)), settle)]
+        return [
+            Phase("move", _still, slow_len / slow_v, path=_ramp(slow_len, slow_v, (1.0, 0.0, 0.0))),
+            Phase("hold", lambda T: _moved(T0, (slow_len, 0.0, 0.0)), settle),
+        ]
 
     def reach(T0):
         off = REACH * np.array([1.5, 1.0, -1.0]) / np.sqrt(4.25)
-        return [Phase("move", _still, 1.0, path=_min_jerk(off, 1.0)),
-                Phase("hold", lambda T: _moved(T0, off), settle)]
+        return [Phase("move", _still, 1.0, path=_min_jerk(off, 1.0)), Phase("hold", lambda T: _moved(T0, off), settle)]
 
     return [
         TaskSpec("hold", "(a) hold the pose", hold),
         TaskSpec("hold_payload", "(a) hold the pose with a 1 kg payload", hold, payload=True),
         TaskSpec("slow", f"(b) slow motion, {100 * slow_len:.0f} cm along +x at 2 cm/s, then hold", slow),
-        TaskSpec("partial", "(c) hold tool height and orientation, x-y free", hold, q0=PARTIAL_POSE,
-                 directions=("z", "rx", "ry", "rz"), posture_gains=(0.0, 0.0)),
-        TaskSpec("reach", "(d) fast reach, 20 cm in 1 s (minimum jerk, peak 0.375 m/s), then hold", reach,
-                 v_max=0.5),
+        TaskSpec(
+            "partial",
+            "(c) hold tool height and orientation, x-y free",
+            hold,
+            q0=PARTIAL_POSE,
+            directions=("z", "rx", "ry", "rz"),
+            posture_gains=(0.0, 0.0),
+        ),
+        TaskSpec("reach", "(d) fast reach, 20 cm in 1 s (minimum jerk, peak 0.375 m/s), then hold", reach, v_max=0.5),
     ]
 
 
@@ -215,8 +238,14 @@ class Log:
 
 def _recorder(robot: MujocoGen3, total: int, n: int, keep_inputs: bool):
     """A :func:`run_loop` ``on_cycle`` hook filling a :class:`Log` of ``total`` samples."""
-    log = Log(np.zeros((total, n)), np.zeros((total, n)), np.zeros((total, 6)), np.zeros((total, n), bool),
-              np.zeros((total, n)), np.zeros((total, n), bool))
+    log = Log(
+        np.zeros((total, n)),
+        np.zeros((total, n)),
+        np.zeros((total, 6)),
+        np.zeros((total, n), bool),
+        np.zeros((total, n)),
+        np.zeros((total, n), bool),
+    )
 
     def on_cycle(k, command, info):
         res = info.result
@@ -228,6 +257,7 @@ def _recorder(robot: MujocoGen3, total: int, n: int, keep_inputs: bool):
             log.model_stick[k] = (np.asarray(res.status) != 0) & (np.abs(np.asarray(res.qdd)) <= 1e-9)
         if keep_inputs:
             log.inputs.append(info.inputs)
+
     return log, on_cycle
 
 
@@ -247,10 +277,15 @@ def simulate(task: TaskSpec, controller: str, friction_scale: float = 1.0, keep_
     if controller not in CONTROLLERS:
         raise ValueError(f"controller must be one of {list(CONTROLLERS)}, got {controller!r}")
     band = controller.endswith("_band")
-    config = ControllerConfig(free_gains=FREE_GAINS, friction_mode=controller.removesuffix("_band"),
-                              v_max=task.v_max, friction_velocity_tolerance=REST_TOLERANCE,
-                              posture_gains=task.posture_gains, free_directions=task.directions,
-                              hold_band=HOLD_BAND if band else None)
+    config = ControllerConfig(
+        free_gains=FREE_GAINS,
+        friction_mode=controller.removesuffix("_band"),
+        v_max=task.v_max,
+        friction_velocity_tolerance=REST_TOLERANCE,
+        posture_gains=task.posture_gains,
+        free_directions=task.directions,
+        hold_band=HOLD_BAND if band else None,
+    )
     ctl = CascadedController(chain, Solver(chain, gravity=[0.0, 0.0, -9.81]), config)
     phases = task.phases(np.asarray(chain.fk(q0)))
     total = int(round(sum(p.duration for p in phases) / robot.period)) + len(phases)
@@ -275,7 +310,7 @@ def gravity_torques(task: TaskSpec, q, friction_scale: float = 1.0) -> tuple[np.
     data = mujoco.MjData(model)
     data.qpos[:] = np.asarray(q, float)
     mujoco.mj_forward(model, data)
-    return data.qfrc_bias[:chain.n_joints].copy(), model.dof_frictionloss[:chain.n_joints].copy()
+    return data.qfrc_bias[: chain.n_joints].copy(), model.dof_frictionloss[: chain.n_joints].copy()
 
 
 def outcome(run: Run) -> dict:
@@ -305,11 +340,15 @@ def outcome(run: Run) -> dict:
     held = np.abs(run.tau[hold] + log.plant_friction[hold])
     limit = np.asarray(run.info["chain"].effort_limit, float)
     return dict(
-        tau2=float(e["energy_tau2"].sum()), work=float(e["energy_abs"].sum()), peak=float(np.abs(run.tau).max()),
-        rms_error=float(np.sqrt(np.mean(err ** 2))), final_error=float(err[-1]),
-        rms_rot=float(np.sqrt(np.mean(rot ** 2))),
+        tau2=float(e["energy_tau2"].sum()),
+        work=float(e["energy_abs"].sum()),
+        peak=float(np.abs(run.tau).max()),
+        rms_error=float(np.sqrt(np.mean(err**2))),
+        final_error=float(err[-1]),
+        rms_rot=float(np.sqrt(np.mean(rot**2))),
         drift=float(np.linalg.norm(tip[-1, free] - tip[0, free])),
-        stick_plant=float(log.plant_stick.sum(1).mean()), stick_model=float(log.model_stick.sum(1).mean()),
+        stick_plant=float(log.plant_stick.sum(1).mean()),
+        stick_model=float(log.model_stick.sum(1).mean()),
         friction_share=float(np.abs(log.plant_friction[hold]).sum() / max(held.sum(), 1e-12)),
         saturated=float((np.abs(log.command) > limit).any(1).mean()),
     )
@@ -321,8 +360,13 @@ def _trace(run: Run, every: int = 5) -> dict:
     task: TaskSpec = run.info["task"]
     lin = [i for i, d in enumerate(("x", "y", "z")) if d in task.directions]
     sl = slice(None, None, every)
-    return dict(t=run.t[sl] - run.t[0], tau=run.tau[sl], stick=log.plant_stick[sl].sum(1),
-                error=np.linalg.norm(log.error[sl][:, lin], axis=1), rot=np.linalg.norm(log.error[sl, 3:], axis=1))
+    return dict(
+        t=run.t[sl] - run.t[0],
+        tau=run.tau[sl],
+        stick=log.plant_stick[sl].sum(1),
+        error=np.linalg.norm(log.error[sl][:, lin], axis=1),
+        rot=np.linalg.norm(log.error[sl, 3:], axis=1),
+    )
 
 
 def run_case(task_name: str, controller: str, friction_scale: float, quick: bool) -> dict:
@@ -335,8 +379,15 @@ def run_case(task_name: str, controller: str, friction_scale: float, quick: bool
         ``held_q`` (joint angles at the end, rad), ``simulated`` (s).
     """
     run = simulate(task_named(task_name, quick), controller, friction_scale)
-    return dict(task=task_name, controller=controller, scale=friction_scale, outcome=outcome(run),
-                trace=_trace(run), held_q=run.q[-1].copy(), simulated=float(run.t[-1] - run.t[0]))
+    return dict(
+        task=task_name,
+        controller=controller,
+        scale=friction_scale,
+        outcome=outcome(run),
+        trace=_trace(run),
+        held_q=run.q[-1].copy(),
+        simulated=float(run.t[-1] - run.t[0]),
+    )
 
 
 def run_all(quick: bool = False, workers: int = 2, progress: Optional[Callable[[str], None]] = None) -> list[dict]:

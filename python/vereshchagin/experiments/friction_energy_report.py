@@ -13,6 +13,7 @@
 Savings are relative to the friction-unaware controller: ``100 (x / x_unaware - 1)`` %, negative =
 less effort.
 """
+
 from __future__ import annotations
 
 import time
@@ -64,7 +65,7 @@ def ideal_saving(g, f) -> float:
     ``1 - sum max(|g_j| - f_j, 0)^2 / sum g_j^2``: every joint held by friction at its bound.
     """
     g = np.asarray(g, float)
-    return float(1.0 - np.sum(np.maximum(np.abs(g) - np.asarray(f, float), 0.0) ** 2) / np.sum(g ** 2))
+    return float(1.0 - np.sum(np.maximum(np.abs(g) - np.asarray(f, float), 0.0) ** 2) / np.sum(g**2))
 
 
 def context(quick: bool) -> tuple[list, list, list]:
@@ -86,8 +87,15 @@ def context(quick: bool) -> tuple[list, list, list]:
         g, f = fe.gravity_torques(task, task.q0)
         for j in range(len(g)):
             ratio = f[j] / abs(g[j]) if abs(g[j]) > 1e-6 else float("inf")
-            rows.append([task.name, f"joint_{j + 1}", f"{g[j]:.3f}", f"{f[j]:.2f}",
-                         "inf" if not np.isfinite(ratio) else f"{ratio:.3f}"])
+            rows.append(
+                [
+                    task.name,
+                    f"joint_{j + 1}",
+                    f"{g[j]:.3f}",
+                    f"{f[j]:.2f}",
+                    "inf" if not np.isfinite(ratio) else f"{ratio:.3f}",
+                ]
+            )
         ideal = {s: ideal_saving(g, s * f) for s in fe.FRICTION_SCALES}
         big = np.argsort(-np.abs(g))[:3]
         lines.append(
@@ -95,15 +103,31 @@ def context(quick: bool) -> tuple[list, list, list]:
             f"(the rest below {np.sort(np.abs(g))[-4]:.2f}); friction could supply "
             f"{', '.join(f'{100 * min(f[j] / abs(g[j]), 1):.0f} %' for j in big)} of those; "
             f"ideal holding saving of ∫τ² with every joint stuck: "
-            + ", ".join(f"{100 * ideal[s]:.1f} % (friction x{s:g})" for s in fe.FRICTION_SCALES) + ".")
+            + ", ".join(f"{100 * ideal[s]:.1f} % (friction x{s:g})" for s in fe.FRICTION_SCALES)
+            + "."
+        )
     return header, rows, lines
 
 
 # -- tables ------------------------------------------------------------------------------------------
-SUMMARY_HEADER = ["task", "friction scale", "controller", "∫τ² [N² m² s]", "Δ∫τ² [%]", "∫|τ q̇| [J]", "Δ∫|τ q̇| [%]",
-                  "peak |τ| [N m]", "RMS error [mm]", "final error [mm]", "RMS rotation error [mrad]",
-                  "drift while holding [mm]", "joints stuck (plant)", "joints friction holds (max-min model)",
-                  "friction share of holding torque [%]", "samples saturated [%]"]
+SUMMARY_HEADER = [
+    "task",
+    "friction scale",
+    "controller",
+    "∫τ² [N² m² s]",
+    "Δ∫τ² [%]",
+    "∫|τ q̇| [J]",
+    "Δ∫|τ q̇| [%]",
+    "peak |τ| [N m]",
+    "RMS error [mm]",
+    "final error [mm]",
+    "RMS rotation error [mrad]",
+    "drift while holding [mm]",
+    "joints stuck (plant)",
+    "joints friction holds (max-min model)",
+    "friction share of holding torque [%]",
+    "samples saturated [%]",
+]
 
 
 def summary_rows(results) -> list[list]:
@@ -112,11 +136,26 @@ def summary_rows(results) -> list[list]:
     for r in results:
         o = r["outcome"]
         base = _select(results, r["task"], r["scale"])[BASE]["outcome"]
-        rows.append([r["task"], f"{r['scale']:g}", r["controller"], f"{o['tau2']:.2f}",
-                     f"{_pct(o['tau2'], base['tau2']):+.1f}", f"{o['work']:.4f}", f"{_pct(o['work'], base['work']):+.1f}",
-                     f"{o['peak']:.2f}", f"{1e3 * o['rms_error']:.3f}", f"{1e3 * o['final_error']:.3f}",
-                     f"{1e3 * o['rms_rot']:.2f}", f"{1e3 * o['drift']:.3f}", f"{o['stick_plant']:.2f}",
-                     f"{o['stick_model']:.2f}", f"{100 * o['friction_share']:.1f}", f"{100 * o['saturated']:.1f}"])
+        rows.append(
+            [
+                r["task"],
+                f"{r['scale']:g}",
+                r["controller"],
+                f"{o['tau2']:.2f}",
+                f"{_pct(o['tau2'], base['tau2']):+.1f}",
+                f"{o['work']:.4f}",
+                f"{_pct(o['work'], base['work']):+.1f}",
+                f"{o['peak']:.2f}",
+                f"{1e3 * o['rms_error']:.3f}",
+                f"{1e3 * o['final_error']:.3f}",
+                f"{1e3 * o['rms_rot']:.2f}",
+                f"{1e3 * o['drift']:.3f}",
+                f"{o['stick_plant']:.2f}",
+                f"{o['stick_model']:.2f}",
+                f"{100 * o['friction_share']:.1f}",
+                f"{100 * o['saturated']:.1f}",
+            ]
+        )
     return rows
 
 
@@ -124,16 +163,37 @@ def task_table(results, task: str) -> list[str]:
     """Markdown table of one task at the nominal friction (the key columns)."""
     runs = _select(results, task, 1.0)
     base = runs[BASE]["outcome"]
-    header = ["controller", "∫τ² [N² m² s]", "Δ∫τ²", "∫\\|τ q̇\\| [J]", "Δ∫\\|τ q̇\\|", "peak \\|τ\\| [N m]",
-              "RMS / final error [mm]", "RMS rot. error [mrad]", "drift [mm]", "joints stuck (plant)",
-              "friction's share of holding"]
+    header = [
+        "controller",
+        "∫τ² [N² m² s]",
+        "Δ∫τ²",
+        "∫\\|τ q̇\\| [J]",
+        "Δ∫\\|τ q̇\\|",
+        "peak \\|τ\\| [N m]",
+        "RMS / final error [mm]",
+        "RMS rot. error [mrad]",
+        "drift [mm]",
+        "joints stuck (plant)",
+        "friction's share of holding",
+    ]
     rows = []
     for c, r in runs.items():
         o = r["outcome"]
-        rows.append([fe.CONTROLLERS[c], f"{o['tau2']:.1f}", f"{_pct(o['tau2'], base['tau2']):+.1f} %", f"{o['work']:.3f}",
-                     _pct_work(o["work"], base["work"]), f"{o['peak']:.2f}",
-                     f"{1e3 * o['rms_error']:.3f} / {1e3 * o['final_error']:.3f}", f"{1e3 * o['rms_rot']:.2f}",
-                     f"{1e3 * o['drift']:.2f}", f"{o['stick_plant']:.1f}", f"{100 * o['friction_share']:.1f} %"])
+        rows.append(
+            [
+                fe.CONTROLLERS[c],
+                f"{o['tau2']:.1f}",
+                f"{_pct(o['tau2'], base['tau2']):+.1f} %",
+                f"{o['work']:.3f}",
+                _pct_work(o["work"], base["work"]),
+                f"{o['peak']:.2f}",
+                f"{1e3 * o['rms_error']:.3f} / {1e3 * o['final_error']:.3f}",
+                f"{1e3 * o['rms_rot']:.2f}",
+                f"{1e3 * o['drift']:.2f}",
+                f"{o['stick_plant']:.1f}",
+                f"{100 * o['friction_share']:.1f} %",
+            ]
+        )
     return md_table(header, rows)
 
 
@@ -148,8 +208,10 @@ def scale_table(results) -> list[str]:
             if not runs:
                 continue
             base = runs[BASE]["outcome"]["tau2"]
-            rows.append([task.name, f"x{s:g}"] + [f"{_pct(runs[c]['outcome']['tau2'], base):+.1f} %"
-                                                    for c in fe.CONTROLLERS if c != BASE])
+            rows.append(
+                [task.name, f"x{s:g}"]
+                + [f"{_pct(runs[c]['outcome']['tau2'], base):+.1f} %" for c in fe.CONTROLLERS if c != BASE]
+            )
     return md_table(header, rows)
 
 
@@ -167,17 +229,22 @@ def verdicts(results, task: str, scale: float = 1.0) -> list[str]:
         o = r["outcome"]
         words = []
         if not _completes(o):
-            words.append(f"does not complete the task (final error {1e3 * o['final_error']:.2f} mm, RMS rotation "
-                         f"error {1e3 * o['rms_rot']:.1f} mrad)")
+            words.append(
+                f"does not complete the task (final error {1e3 * o['final_error']:.2f} mm, RMS rotation "
+                f"error {1e3 * o['rms_rot']:.1f} mrad)"
+            )
         if c != BASE:
             d = _pct(o["tau2"], base["tau2"])
             words.append(f"saves {-d:.1f} % of ∫τ²" if d < SAVES else f"saves nothing (∫τ² {d:+.1f} %)")
             if o["rms_error"] > LOSES[0] * base["rms_error"] + LOSES[1]:
-                words.append(f"loses accuracy (RMS error {1e3 * o['rms_error']:.3f} mm vs "
-                             f"{1e3 * base['rms_error']:.3f} mm)")
+                words.append(
+                    f"loses accuracy (RMS error {1e3 * o['rms_error']:.3f} mm vs {1e3 * base['rms_error']:.3f} mm)"
+                )
         if task == "partial" and o["drift"] > FREE_DRIFT:
-            words.append(f"lets the arm move {1e3 * o['drift']:.0f} mm in the free x-y directions (lower gravity "
-                         "torques there, not a saving by friction)")
+            words.append(
+                f"lets the arm move {1e3 * o['drift']:.0f} mm in the free x-y directions (lower gravity "
+                "torques there, not a saving by friction)"
+            )
         if words:
             lines.append(f"- {fe.CONTROLLERS[c]}: " + "; ".join(words) + ".")
     return lines
@@ -199,16 +266,23 @@ def findings(results) -> list[str]:
         f"0.05 mm / 0.5 mrad) ∫τ² changes by {_pct(band['tau2'], base['tau2']):+.1f} % at an RMS error of "
         f"{1e3 * band['rms_error']:.3f} mm (unaware {1e3 * base['rms_error']:.3f} mm): inside the band it commands "
         "the least torque, which asks friction for its full breakaway value; the plant's friction then sits at its "
-        "bound, the joints creep out of the band, and each correction from rest pays +f again (figure).")
-    stalls = [t.name for t in fe.tasks() if t.name != "partial" and t.name in {r["task"] for r in results}
-              and not _completes(_select(results, t.name, 1.0)[BASE]["outcome"])]
+        "bound, the joints creep out of the band, and each correction from rest pays +f again (figure)."
+    )
+    stalls = [
+        t.name
+        for t in fe.tasks()
+        if t.name != "partial"
+        and t.name in {r["task"] for r in results}
+        and not _completes(_select(results, t.name, 1.0)[BASE]["outcome"])
+    ]
     if stalls:
         lines.append(
             f"- The friction-unaware controller does not complete the moving tasks ({', '.join(stalls)}). With the "
             "desired twist saturated, the cascaded P asks for at most k_vel v_max = 1.5 m/s^2 (slow task) and "
             "k_vel w_max = 20 rad/s^2 in rotation: at the shoulder (joint_2, slow task) and the last wrist joint "
             "(joint_7, reach) that is less torque than static friction, so the joint stays stuck and the error "
-            "grows; every friction-aware command breaks it free.")
+            "grows; every friction-aware command breaks it free."
+        )
     part = _select(results, "partial", 1.0)
     if part:
         pm, pb = part["maxmin"]["outcome"], part[BASE]["outcome"]
@@ -216,7 +290,8 @@ def findings(results) -> list[str]:
             f"- Partial task: the max-min lets friction hold {pm['stick_model']:.1f} joints (the free "
             f"directions) and keeps the arm within {1e3 * pm['drift']:.2f} mm in x-y; the plain solve predicts the "
             f"self-motion gravity would cause, which the plant's friction prevents, so its commands are wrong "
-            f"in the constrained directions too (RMS error {1e3 * pb['rms_error']:.2f} mm vs {1e3 * pm['rms_error']:.3f} mm).")
+            f"in the constrained directions too (RMS error {1e3 * pb['rms_error']:.2f} mm vs {1e3 * pm['rms_error']:.3f} mm)."
+        )
     return lines
 
 
@@ -271,7 +346,8 @@ def plot_task(path: Path, results, task: fe.TaskSpec) -> None:
 # -- the whole section ------------------------------------------------------------------------------
 def _intro(quick: bool) -> list[str]:
     return [
-        "## How much motor effort does exact static friction save? (Gen3, MuJoCo)", "",
+        "## How much motor effort does exact static friction save? (Gen3, MuJoCo)",
+        "",
         "Vukcevic (TR 03-2018) motivates the static-friction max-min by energy: motors should not fight what "
         "friction can hold. Measured here in closed loop: the MuJoCo Gen3 + rigid gripper of the contact "
         "experiments (1 kHz), our solver inside the same cascaded P controller with the same gains "
@@ -279,16 +355,19 @@ def _intro(quick: bool) -> list[str]:
         "joint posture term (20, 3) except in the partial task), controllers differing only in how joint friction "
         "enters: friction-unaware (plain solve), naive sign compensation (+f sign(q̇), at rest the sign of the "
         "commanded q̈), smoothed compensation (+f tanh(q̇/0.01 rad/s): the chatter-free scheme a reviewer "
-        "would ask for; it separates \"do not fight friction at rest\" from \"let friction hold\"), the exact "
+        'would ask for; it separates "do not fight friction at rest" from "let friction hold"), the exact '
         "max-min with the least-command rule (`friction=`, rest below 0.01 rad/s), and the max-min with a hold "
         "band (inside 0.05 mm / 0.5 mrad the task asks for zero acceleration; this one also changes the task "
-        "feedback).", "",
+        "feedback).",
+        "",
         f"Joint friction (plant frictionloss and model): {list(JOINT_FRICTION)} N m (joints 1-4, 5-7), viscous damping "
         f"{list(JOINT_DAMPING)} N m s/rad. **These are assumptions**: Kinova publishes no friction, damping or rotor "
         "inertia for the Gen3 (its URDF has none); the values are plausible for harmonic-drive actuators of this "
         "size and are the contact experiments' choice, hence the runs with friction x0.5 and x2. Plant and model "
         "have the same friction (a correct friction model). Mode: "
-        + ("quick (shorter tasks, nominal friction only)." if quick else "full."), ""]
+        + ("quick (shorter tasks, nominal friction only)." if quick else "full."),
+        "",
+    ]
 
 
 def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None, workers: int = 2) -> dict:
@@ -308,19 +387,42 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     write_csv(files[0], SUMMARY_HEADER, summary_rows(results))
     c_header, c_rows, c_lines = context(quick)
     write_csv(files[1], c_header, c_rows)
-    idx = _intro(quick) + ["### Friction against gravity at the held poses", "", *c_lines, "",
-                           "Per joint: [friction_energy/context.csv](friction_energy/context.csv).", ""]
+    idx = _intro(quick) + [
+        "### Friction against gravity at the held poses",
+        "",
+        *c_lines,
+        "",
+        "Per joint: [friction_energy/context.csv](friction_energy/context.csv).",
+        "",
+    ]
     for task in fe.tasks(quick):
         png = out / f"{task.name}.png"
         plot_task(png, results, task)
         files.append(png)
-        idx += [f"### {task.title}", "", *task_table(results, task.name), "", *verdicts(results, task.name), "",
-                f"Figure: [friction_energy/{png.name}](friction_energy/{png.name})", ""]
+        idx += [
+            f"### {task.title}",
+            "",
+            *task_table(results, task.name),
+            "",
+            *verdicts(results, task.name),
+            "",
+            f"Figure: [friction_energy/{png.name}](friction_energy/{png.name})",
+            "",
+        ]
     idx += ["### Findings (nominal friction)", "", *findings(results), ""]
-    idx += ["### Δ∫τ² against the friction-unaware controller, per friction scale", "", *scale_table(results), "",
-            "All metrics of every run: [friction_energy/summary.csv](friction_energy/summary.csv).", ""]
+    idx += [
+        "### Δ∫τ² against the friction-unaware controller, per friction scale",
+        "",
+        *scale_table(results),
+        "",
+        "All metrics of every run: [friction_energy/summary.csv](friction_energy/summary.csv).",
+        "",
+    ]
     ok = all(np.isfinite(list(r["outcome"].values())).all() for r in results)
     secs = time.perf_counter() - t0
-    idx += [f"Friction-energy experiment: {len(results)} runs, {sum(r['simulated'] for r in results):.1f} s simulated "
-            f"in {secs:.1f} s wall time.", ""]
+    idx += [
+        f"Friction-energy experiment: {len(results)} runs, {sum(r['simulated'] for r in results):.1f} s simulated "
+        f"in {secs:.1f} s wall time.",
+        "",
+    ]
     return dict(index=idx, results=results, files=files, ok=ok, seconds=secs)

@@ -13,6 +13,7 @@ motor command and the Gauss function g (:mod:`.gauss`, the report's sampling); t
 in the figures and listed in the table is the exact one of ``Solver.solve(..., friction=...)``.
 Sign convention: the plotted friction torque is the physical one, ``-mu`` (``friction_torque``).
 """
+
 from __future__ import annotations
 
 import csv
@@ -39,8 +40,9 @@ def arm_1dof() -> Chain:
     chain = Chain()
     tip = np.eye(4)
     tip[0, 3] = 1.0
-    chain.add_segment(name="link1", joint="rot_z", tip=tip, mass=1.0, com=[-0.5, 0.0, 0.0],
-                      inertia=np.diag([1.0, 1.0, 2.0]))
+    chain.add_segment(
+        name="link1", joint="rot_z", tip=tip, mass=1.0, com=[-0.5, 0.0, 0.0], inertia=np.diag([1.0, 1.0, 2.0])
+    )
     return chain
 
 
@@ -118,15 +120,34 @@ class Case:
 
 
 CASES = (
-    Case("scenario1", "Scenario 1: tip force -5 N, no task", tip_force=-5.0,
-         figures={"energy": "6.2", "acceleration": "6.3", "torques": "6.4", "surface": "5.2"},
-         friction=5.0, qdd=0.0, net=0.0),
-    Case("scenario2", "Scenario 2: tip force -11 N, no task", tip_force=-11.0,
-         figures={"energy": "6.5", "acceleration": "6.6", "torques": "6.7"},
-         friction=10.0, qdd=-0.444, qdd_digits=3, net=-1.0),
-    Case("constrained", "Fully constrained: task qdd = 5 rad/s²", task_qdd=5.0,
-         figures={"energy": "5.5", "acceleration": "", "torques": ""},
-         friction=-10.0, qdd=5.0, tau_command=21.25),
+    Case(
+        "scenario1",
+        "Scenario 1: tip force -5 N, no task",
+        tip_force=-5.0,
+        figures={"energy": "6.2", "acceleration": "6.3", "torques": "6.4", "surface": "5.2"},
+        friction=5.0,
+        qdd=0.0,
+        net=0.0,
+    ),
+    Case(
+        "scenario2",
+        "Scenario 2: tip force -11 N, no task",
+        tip_force=-11.0,
+        figures={"energy": "6.5", "acceleration": "6.6", "torques": "6.7"},
+        friction=10.0,
+        qdd=-0.444,
+        qdd_digits=3,
+        net=-1.0,
+    ),
+    Case(
+        "constrained",
+        "Fully constrained: task qdd = 5 rad/s²",
+        task_qdd=5.0,
+        figures={"energy": "5.5", "acceleration": "", "torques": ""},
+        friction=-10.0,
+        qdd=5.0,
+        tau_command=21.25,
+    ),
 )
 
 _KIND_TITLES = {
@@ -180,8 +201,9 @@ def _sweep(solver, chain, case: Case, points: int) -> dict:
 def _optimum(solver, chain, case: Case, grid_points: int) -> dict:
     """The exact optimum (friction-aware solve) and the slow references next to it."""
     q = qd = np.zeros(1)
-    res = solver.solve(q, qd, alpha=case.alpha, beta=case.beta, f_ext=case.f_ext,
-                       friction=Friction(static=np.array([F_BREAKAWAY])))
+    res = solver.solve(
+        q, qd, alpha=case.alpha, beta=case.beta, f_ext=case.f_ext, friction=Friction(static=np.array([F_BREAKAWAY]))
+    )
     phi = float(res.friction_torque[0])
     load = float(_load_torque(chain, q, case.f_ext)[0])
     grid = brute_force_grid(solver, q, qd, F_BREAKAWAY, [0], case.alpha, case.beta, case.f_ext, points=grid_points)
@@ -238,16 +260,23 @@ def _new_figure(three_d: bool = False):
 
 def _mark_report(ax, case: Case):
     if case.friction is not None:
-        ax.axvline(case.friction, color="0.45", ls="--", lw=1.0,
-                   label=f"report: friction torque {case.friction:+g} N m")
+        ax.axvline(
+            case.friction, color="0.45", ls="--", lw=1.0, label=f"report: friction torque {case.friction:+g} N m"
+        )
 
 
 def _plot_energy(case, sw, opt, path):
     fig, ax = _new_figure()
     ax.plot(sw["phi"], sw["g"], color="tab:red", lw=2, label=r"$g$ (one frictionless solve per sample)")
     _mark_report(ax, case)
-    ax.plot(opt["friction_torque"], opt["gauss_value"], "k*", ms=14, zorder=5,
-            label=f"optimum (solver): {opt['friction_torque']:+.4g} N m, g = {opt['gauss_value']:.4g}")
+    ax.plot(
+        opt["friction_torque"],
+        opt["gauss_value"],
+        "k*",
+        ms=14,
+        zorder=5,
+        label=f"optimum (solver): {opt['friction_torque']:+.4g} N m, g = {opt['gauss_value']:.4g}",
+    )
     ax.set_xlim(-1.04 * F_BREAKAWAY, 1.04 * F_BREAKAWAY)
     ax.set_xlabel(_XLABEL)
     ax.set_ylabel(_GLABEL)
@@ -263,10 +292,24 @@ def _plot_acceleration(case, sw, opt, path):
     ax.axhline(0.0, color="0.7", lw=0.8)
     _mark_report(ax, case)
     if case.qdd is not None and case.friction is not None:
-        ax.plot(case.friction, case.qdd, "o", mfc="none", mec="0.3", ms=11, mew=1.5,
-                label=f"report: qdd = {case.qdd:+g} rad/s$^2$")
-    ax.plot(opt["friction_torque"], opt["qdd"], "k*", ms=14, zorder=5,
-            label=f"optimum (solver): qdd = {opt['qdd']:+.4g} rad/s$^2$")
+        ax.plot(
+            case.friction,
+            case.qdd,
+            "o",
+            mfc="none",
+            mec="0.3",
+            ms=11,
+            mew=1.5,
+            label=f"report: qdd = {case.qdd:+g} rad/s$^2$",
+        )
+    ax.plot(
+        opt["friction_torque"],
+        opt["qdd"],
+        "k*",
+        ms=14,
+        zorder=5,
+        label=f"optimum (solver): qdd = {opt['qdd']:+.4g} rad/s$^2$",
+    )
     ax.set_xlim(-1.04 * F_BREAKAWAY, 1.04 * F_BREAKAWAY)
     ax.set_xlabel(_XLABEL)
     ax.set_ylabel(_QLABEL)
@@ -281,15 +324,28 @@ def _plot_torques(case, sw, opt, path):
     phi = sw["phi"]
     ax.plot(phi, phi, color="tab:blue", lw=2, label=r"friction torque $-\mu$")
     ax.plot(phi, sw["command"], color="tab:green", lw=2, label="motor command (tau_command)")
-    ax.plot(phi, np.full_like(phi, sw["load"]), color="tab:purple", lw=1.5, ls=":",
-            label=f"external load {sw['load']:+g} N m")
+    ax.plot(
+        phi,
+        np.full_like(phi, sw["load"]),
+        color="tab:purple",
+        lw=1.5,
+        ls=":",
+        label=f"external load {sw['load']:+g} N m",
+    )
     ax.plot(phi, sw["net"], color="black", lw=1.5, ls="-.", label=r"net = load + friction + command ($= H\ddot q$)")
     ax.axhline(0.0, color="0.7", lw=0.8)
     _mark_report(ax, case)
     x = opt["friction_torque"]
-    ax.plot([x, x, x], [x, opt["tau_command"], opt["net_torque"]], "k*", ms=13, zorder=5,
-            label=(f"optimum (solver): friction {x:+.4g}, command {opt['tau_command']:+.4g}, "
-                   f"net {opt['net_torque']:+.4g} N m"))
+    ax.plot(
+        [x, x, x],
+        [x, opt["tau_command"], opt["net_torque"]],
+        "k*",
+        ms=13,
+        zorder=5,
+        label=(
+            f"optimum (solver): friction {x:+.4g}, command {opt['tau_command']:+.4g}, net {opt['net_torque']:+.4g} N m"
+        ),
+    )
     ax.set_xlim(-1.04 * F_BREAKAWAY, 1.04 * F_BREAKAWAY)
     ax.set_xlabel(_XLABEL)
     ax.set_ylabel("joint torque [N m]")
@@ -315,10 +371,22 @@ def _plot_surface(case, solver, sw, opt, path):
     fig, ax = _new_figure(three_d=True)
     ax.plot_wireframe(P, A, Z, color="0.55", lw=0.5, rstride=2, cstride=2, label=r"$Z(\ddot q, \mu)$")
     ax.plot(sw["phi"], sw["qdd"], sw["g"], color="tab:red", lw=3, label=r"$g(\mu) = \min_{\ddot q} Z$")
-    ax.plot(sw["phi"], sw["qdd"], np.full_like(sw["phi"], Z.min()), color="tab:orange", lw=2,
-            label=r"characteristic line $\ddot q(\mu)$ (projected)")
-    ax.plot([opt["friction_torque"]], [opt["qdd"]], [opt["gauss_value"]], "k*", ms=14,
-            label=f"max-min (solver): {opt['friction_torque']:+.4g} N m, qdd = {opt['qdd']:+.3f} rad/s$^2$")
+    ax.plot(
+        sw["phi"],
+        sw["qdd"],
+        np.full_like(sw["phi"], Z.min()),
+        color="tab:orange",
+        lw=2,
+        label=r"characteristic line $\ddot q(\mu)$ (projected)",
+    )
+    ax.plot(
+        [opt["friction_torque"]],
+        [opt["qdd"]],
+        [opt["gauss_value"]],
+        "k*",
+        ms=14,
+        label=f"max-min (solver): {opt['friction_torque']:+.4g} N m, qdd = {opt['qdd']:+.3f} rad/s$^2$",
+    )
     ax.set_xticks(np.linspace(-F_BREAKAWAY, F_BREAKAWAY, 5))
     ax.view_init(elev=22, azim=-50)
     ax.set_xlabel(r"friction torque $-\mu$ [N m]", fontsize=8)
@@ -332,10 +400,27 @@ def _plot_surface(case, solver, sw, opt, path):
 # ------------------------------------------------------------------------------------------------
 # Tables
 # ------------------------------------------------------------------------------------------------
-_CSV_FIELDS = ["case", "report_figure", "friction_torque", "friction_torque_report", "qdd", "qdd_report",
-               "tau_command", "tau_command_report", "net_torque", "net_torque_report", "gauss_value",
-               "g_reference", "status", "grid_friction_torque", "grid_g", "grid_points",
-               "vertex_friction_torque", "vertex_g", "check"]
+_CSV_FIELDS = [
+    "case",
+    "report_figure",
+    "friction_torque",
+    "friction_torque_report",
+    "qdd",
+    "qdd_report",
+    "tau_command",
+    "tau_command_report",
+    "net_torque",
+    "net_torque_report",
+    "gauss_value",
+    "g_reference",
+    "status",
+    "grid_friction_torque",
+    "grid_g",
+    "grid_points",
+    "vertex_friction_torque",
+    "vertex_g",
+    "check",
+]
 
 
 def _fmt(x, spec="+.6f"):
@@ -348,14 +433,15 @@ def _write_tables(rows: list, out: Path) -> tuple:
         w = csv.DictWriter(fh, fieldnames=_CSV_FIELDS)
         w.writeheader()
         for r in rows:
-            w.writerow({k: ("" if r[k] is None else repr(r[k]) if isinstance(r[k], float) else r[k])
-                        for k in _CSV_FIELDS})
+            w.writerow(
+                {k: ("" if r[k] is None else repr(r[k]) if isinstance(r[k], float) else r[k]) for k in _CSV_FIELDS}
+            )
     md = [
         "# Static friction on the 1-DOF arm of Vukcevic (2018): the optimum",
         "",
         "Arm: rot_z, 1 m, 1 kg, COM 0.5 m, joint-axis inertia 2.25 kg m^2, no gravity, at rest; "
         f"breakaway friction f = {F_BREAKAWAY:g} N m. Optimum from `Solver.solve(..., friction=...)`; "
-        "\"report\" columns are the report's published values (— not published). Friction torque is the "
+        '"report" columns are the report\'s published values (— not published). Friction torque is the '
         "physical one, −μ (μ: Vereshchagin's multiplier). Net torque = external load + friction + motor "
         "command (= H qdd here). g(μ*) reference: `experiments.gauss.gauss_function` (one frictionless "
         "solve); grid: the report's sampling; vertex: the best of the box vertices ±f.",
@@ -366,18 +452,26 @@ def _write_tables(rows: list, out: Path) -> tuple:
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---|",
     ]
     for r in rows:
-        qrep = None if r["qdd_report"] is None else (
-            format(r["qdd_report"], f"+.{r['_qdd_digits']}f") if r["_qdd_digits"] else _fmt(r["qdd_report"]))
+        qrep = (
+            None
+            if r["qdd_report"] is None
+            else (format(r["qdd_report"], f"+.{r['_qdd_digits']}f") if r["_qdd_digits"] else _fmt(r["qdd_report"]))
+        )
         md.append(
             f"| {r['_label']} | {r['report_figure']} | {_fmt(r['friction_torque'])} "
             f"| {_fmt(r['friction_torque_report'])} | {_fmt(r['qdd'])} | {qrep if qrep else '—'} "
             f"| {_fmt(r['tau_command'])} | {_fmt(r['tau_command_report'])} | {_fmt(r['net_torque'])} "
             f"| {_fmt(r['net_torque_report'])} | {_fmt(r['gauss_value'], '.6f')} | {_fmt(r['g_reference'], '.6f')} "
             f"| {r['status']} | {_fmt(r['grid_friction_torque'], '+.3f')} ({r['grid_points']} pts) "
-            f"| {_fmt(r['vertex_friction_torque'], '+g')} | {r['check']} |")
-    md += ["", "Checks: friction torque, motor command and net torque within 1e-9 of the report; qdd "
-           "within 1e-9, or equal after rounding to the report's digits (scenario 2: -0.444); "
-           "gauss_value = g(μ*) within 1e-9; no grid sample above the exact optimum.", ""]
+            f"| {_fmt(r['vertex_friction_torque'], '+g')} | {r['check']} |"
+        )
+    md += [
+        "",
+        "Checks: friction torque, motor command and net torque within 1e-9 of the report; qdd "
+        "within 1e-9, or equal after rounding to the report's digits (scenario 2: -0.444); "
+        "gauss_value = g(μ*) within 1e-9; no grid sample above the exact optimum.",
+        "",
+    ]
     md_path = out / "friction_optimum.md"
     md_path.write_text("\n".join(md), encoding="utf-8")
     return md_path, csv_path
@@ -428,8 +522,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         say(f"[friction] {case.label}")
         sw = _sweep(solver, chain, case, points)
         opt = _optimum(solver, chain, case, grid_points)
-        for kind, plot in (("energy", _plot_energy), ("acceleration", _plot_acceleration),
-                           ("torques", _plot_torques)):
+        for kind, plot in (("energy", _plot_energy), ("acceleration", _plot_acceleration), ("torques", _plot_torques)):
             path = out / f"{case.key}_{kind}.png"
             plot(case, sw, opt, path)
             figures.append((case.figures.get(kind, ""), f"{case.label}: {_lower_first(_KIND_TITLES[kind])}", path))
@@ -440,16 +533,27 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
             figures.append((case.figures["surface"], f"{case.label}: {_lower_first(_KIND_TITLES['surface'])}", path))
             say(f"[friction]   wrote {path}")
         bad = _checks(case, opt)
-        rows.append(dict(
-            case=case.key, report_figure=", ".join(v for v in case.figures.values() if v) or "—",
-            friction_torque_report=case.friction, qdd_report=case.qdd,
-            tau_command_report=case.tau_command, net_torque_report=case.net,
-            check="ok" if not bad else "MISMATCH: " + ", ".join(bad),
-            _label=case.label, _qdd_digits=case.qdd_digits, **opt))
-        say(f"[friction]   optimum: friction {opt['friction_torque']:+.6g} N m, qdd {opt['qdd']:+.6g} rad/s^2, "
-            f"command {opt['tau_command']:+.6g} N m, g {opt['gauss_value']:.6g} -> {rows[-1]['check']}")
+        rows.append(
+            dict(
+                case=case.key,
+                report_figure=", ".join(v for v in case.figures.values() if v) or "—",
+                friction_torque_report=case.friction,
+                qdd_report=case.qdd,
+                tau_command_report=case.tau_command,
+                net_torque_report=case.net,
+                check="ok" if not bad else "MISMATCH: " + ", ".join(bad),
+                _label=case.label,
+                _qdd_digits=case.qdd_digits,
+                **opt,
+            )
+        )
+        say(
+            f"[friction]   optimum: friction {opt['friction_torque']:+.6g} N m, qdd {opt['qdd']:+.6g} rad/s^2, "
+            f"command {opt['tau_command']:+.6g} N m, g {opt['gauss_value']:.6g} -> {rows[-1]['check']}"
+        )
     md_path, csv_path = _write_tables(rows, out)
     say(f"[friction] wrote {md_path} and {csv_path}")
     public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
-    return dict(figures=figures, table_md=md_path, table_csv=csv_path, rows=public,
-                ok=all(r["check"] == "ok" for r in rows))
+    return dict(
+        figures=figures, table_md=md_path, table_csv=csv_path, rows=public, ok=all(r["check"] == "ok" for r in rows)
+    )

@@ -13,6 +13,7 @@ against and the data behind the report's figures:
 Sign convention: mu is Vereshchagin's multiplier; the physical friction torque on joint j is
 ``-mu_j`` (what ``SolveResult.friction_torque`` reports).
 """
+
 from __future__ import annotations
 
 import itertools
@@ -125,8 +126,9 @@ def free_accelerations(solver, q, qd, f_ext=None, tau_ff=None) -> np.ndarray:
     return np.asarray(solver.solve(q, qd, f_ext=f_ext, tau_ff=_tau_ff(solver, tau_ff)).qdd, float)
 
 
-def evaluate(solver, q, qd, mu, resting, alpha=None, beta=None, f_ext=None, tau_ff=None,
-             qdd_free: Optional[np.ndarray] = None) -> GaussSample:
+def evaluate(
+    solver, q, qd, mu, resting, alpha=None, beta=None, f_ext=None, tau_ff=None, qdd_free: Optional[np.ndarray] = None
+) -> GaussSample:
     """Evaluate g(mu) and the motion it gives by one frictionless solve.
 
     Parameters
@@ -207,8 +209,9 @@ def _best(solver, q, qd, candidates, resting, alpha, beta, f_ext, tau_ff) -> Bes
     return Best(best_mu, best_g)
 
 
-def brute_force_grid(solver, q, qd, f, resting, alpha=None, beta=None, f_ext=None, tau_ff=None,
-                     points: int = 201) -> Best:
+def brute_force_grid(
+    solver, q, qd, f, resting, alpha=None, beta=None, f_ext=None, tau_ff=None, points: int = 201
+) -> Best:
     """Maximise g over a regular grid of the box |mu_j| <= f_j (the report's implementation).
 
     Parameters
@@ -265,4 +268,3 @@ def vertex_enumeration(solver, q, qd, f, resting, alpha=None, beta=None, f_ext=N
     fb = _bounds(solver, f, idx)
     vertices = itertools.product(*[(-fj, fj) for fj in fb])
     return _best(solver, q, qd, vertices, idx, alpha, beta, f_ext, tau_ff)
-

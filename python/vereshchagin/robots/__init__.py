@@ -4,6 +4,7 @@
 numbers of Kinova's ``ros2_kortex`` description (see :mod:`vereshchagin.robots.gen3`);
 :func:`gen3` loads it as a :class:`vereshchagin.Chain`.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -62,8 +63,8 @@ def example_robot_urdf(name: str) -> str:
         dist = metadata.distribution("example-robot-data")
     except metadata.PackageNotFoundError:
         raise ModuleNotFoundError(
-            "example_robot_urdf needs the PyPI package example-robot-data: "
-            "pip install example-robot-data") from None
+            "example_robot_urdf needs the PyPI package example-robot-data: pip install example-robot-data"
+        ) from None
     robots = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
     if not robots.is_dir():
         raise ModuleNotFoundError(f"example-robot-data is installed but {robots} is missing")
@@ -73,7 +74,10 @@ def example_robot_urdf(name: str) -> str:
         stem = _ALIASES.get(name, name)
         matches = sorted(robots.glob(f"*/*/{stem}.urdf"))
     if len(matches) != 1:
-        found = "several: " + ", ".join(str(m.relative_to(robots)) for m in matches) if matches \
+        found = (
+            "several: " + ", ".join(str(m.relative_to(robots)) for m in matches)
+            if matches
             else "none; available: " + ", ".join(sorted(p.stem for p in robots.glob("*/*/*.urdf")))
+        )
         raise FileNotFoundError(f"example-robot-data URDF {name!r}: {found}")
     return str(matches[0])
