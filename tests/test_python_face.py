@@ -473,3 +473,32 @@ def test_cli_names_the_extra_when_an_optional_package_is_missing(case, module, e
     assert proc.returncode == 2, proc.stdout + proc.stderr
     assert f"vereshchagin[{extra}]" in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
     assert not any(tmp_path.iterdir()), "nothing is run or written when a dependency is missing"
+
+
+def test_response_columns_after_a_batch_refers_to_its_last_row_whatever_the_threads():
+    rng = np.random.default_rng(5)
+    n = 6
+    rc = random_chain(rng, n)
+    Q = rng.uniform(-1, 1, (7, n))
+    QD = rng.uniform(-1, 1, (7, n))
+    fr = vs.Friction(static=np.full(n, 0.8))
+    QD[:, 1::2] = 0.0  # resting joints: some stick
+    ref = vs.Solver(rc.chain)
+    ref.solve(Q[-1], QD[-1], friction=fr)
+    expected = ref.response_columns([0, n - 1])
+    for threads in (1, 2, 3):
+        solver = vs.Solver(rc.chain)
+        solver.solve_batch(Q, QD, friction=fr, threads=threads)
+        got = solver.response_columns([0, n - 1])
+        np.testing.assert_array_equal(got[0], expected[0])
+        np.testing.assert_array_equal(got[1], expected[1])
+        # a failing batch leaves no state to linearise around
+        with pytest.raises(vs.SolverError, match="row 0.*overflow"):  # fails while solving
+            solver.solve_batch(Q[:2], QD[:2], tau_ff=np.full((2, n), 1e308), threads=threads)
+        with pytest.raises(vs.SolverError, match="last successful solve"):
+            solver.response_columns([0])
+        # a batch that fails its argument checks runs no row: the state stands
+        solver.solve(Q[-1], QD[-1], friction=fr)
+        with pytest.raises(vs.SolverError):
+            solver.solve_batch(Q[:, :2], QD)
+        np.testing.assert_array_equal(solver.response_columns([0, n - 1])[0], expected[0])

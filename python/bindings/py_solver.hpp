@@ -32,6 +32,8 @@ struct ParsedSolve {
   void clear();
 };
 
+struct BatchRunner;  // solve_batch.cpp
+
 class PySolver {
  public:
   PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping,
@@ -71,6 +73,7 @@ class PySolver {
   void parseConstraints(PyObject* constraints, ParsedSolve& p) const;
   bool parseFriction(PyObject* friction, ParsedSolve& p);
   Engine& engine(std::size_t k);
+  void keepLastRow(BatchRunner& br, long threads);
 
   PyChain chain_;
   KDL::Vector gravity_;
@@ -81,6 +84,9 @@ class PySolver {
   py::object friction_cache_key_;               // the last vereshchagin.Friction parsed
   vereshchagin::FrictionModel friction_cache_;
   std::mutex mutex_;
+  // Engine 0 holds the state of the last successful solve() or of the last row of the last
+  // successful solve_batch(): response_columns() linearises around it.
+  bool last_state_ = false;
 };
 
 // "physical" or "joint_space" (raises otherwise, naming `where`).

@@ -264,6 +264,20 @@ struct BatchRunner {
   }
 };
 
+// response_columns() after a batch linearises around its last row: engine 0 solved it unless the
+// rows were spread over threads; then it solves it once more (bit-identical rows).
+void PySolver::keepLastRow(BatchRunner& br, long threads) {
+  if (br.B == 0) return;
+  if (threads > 1) {
+    std::vector<ConstraintBlock> blocks = br.block_template;
+    std::vector<LinkWrench> wrenches = br.link_wrench_template;
+    const RowInputs row = br.rowInputs(br.B - 1, blocks, wrenches);
+    py::gil_scoped_release release;
+    if (engines_[0]->run(row) != ChainHdSolver::E_NOERROR) return;
+  }
+  last_state_ = true;
+}
+
 py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj, const py::object& alpha_obj,
                               const py::object& beta_obj, const py::object& f_ext_obj, const py::object& tau_obj,
                               const py::object& friction_obj, const py::object& constraints_obj,
@@ -351,6 +365,7 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
       }
     }
   };
+  last_state_ = false;  // until engine 0 holds the last row's state
   {
     py::gil_scoped_release release;
     if (threads <= 1) {
@@ -366,6 +381,7 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
   }
   for (const Failure& f : failures)  // rows are in thread order: the first failure is the lowest row
     if (f.row >= 0) raise("batch row " + std::to_string(f.row) + ": " + f.message);
+  keepLastRow(br, threads);
   py::dict out;
   out["qdd"] = qdd;
   out["tau_command"] = tau;

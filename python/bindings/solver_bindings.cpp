@@ -73,7 +73,8 @@ void PySolver::runParsed(const ParsedSolve& p) {
     py::gil_scoped_release release;
     rc = e.run(p.row);
   }
-  if (rc != ChainHdSolver::E_NOERROR) raise(e.errorMessage());
+  last_state_ = rc == ChainHdSolver::E_NOERROR;
+  if (!last_state_) raise(e.errorMessage());
 }
 
 py::object PySolver::result(const ParsedSolve& p, PyObject* out) {
@@ -172,6 +173,10 @@ void holdJoints(Eigen::MatrixXd& dq, Eigen::MatrixXd& dt, const Eigen::VectorXi&
 py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking) {
   const Eigen::VectorXi requested = jointList(chain_, joints);
   auto lk = lock();
+  if (!last_state_)
+    raise(
+        "response_columns() linearises around the last successful solve() (or the last row of solve_batch()): "
+        "call solve() at the state first");
   Engine& e = *engines_[0];
   Eigen::VectorXi held(0);
   if (hold_sticking && e.lastHadFriction()) {

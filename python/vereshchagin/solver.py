@@ -174,6 +174,10 @@ class Solver(_core.Solver):
         joints keep their friction torque fixed. ``hold_sticking=False`` gives the columns of
         the frictionless problem at that state (friction torques as fixed inputs).
 
+        It refers to the last successful :meth:`solve`, or to the last row of the last
+        successful :meth:`solve_batch` (whatever ``threads``); after a failed solve or batch
+        it raises :class:`SolverError` until the next successful one.
+
         Parameters
         ----------
         joints : sequence of int or str, length k
