@@ -98,6 +98,28 @@ def case_rows(label, segs, seed, batches, batch_s):
     return rows
 
 
+def readme_calls(solve, calls, outs):
+    """The Python variants (py, py + qdd, out=) with the keyword arguments written out as the
+    README writes them: a ``**kw`` dict would add CPython's dict unpacking to every call, and a
+    shared loop with branches would add its own bytecode. Each loop is generated for its case."""
+    kw0 = calls[0][2]
+    keywords = (["alpha=a", "beta=b"] if "alpha" in kw0 else []) + ["tau_ff=t"]
+    keywords += ["friction=f"] if "friction" in kw0 else []
+    rows = [
+        (q, qd, kw.get("alpha"), kw.get("beta"), kw["tau_ff"], kw.get("friction"), out)
+        for (q, qd, kw, _, _), out in zip(calls, outs)
+    ]
+
+    def loop(extra, suffix):
+        call = f"solve(q, qd, {', '.join(keywords + extra)}){suffix}"
+        src = f"def run(reps):\n    for q, qd, a, b, t, f, out in rows:\n        for _ in range(reps):\n            {call}\n"
+        scope = {"rows": rows, "solve": solve}
+        exec(src, scope)  # noqa: S102 - a benchmark loop written out per case
+        return scope["run"]
+
+    return loop([], ""), loop([], ".qdd"), loop(["out=out"], "")
+
+
 def make_variants(solver, calls, model, data, fid, pin_variant, m):
     """The timed variants of one case; each repeats every state `reps` times in a row, as
     _time_cpp does, so all see the same sequence of states (and the same branch history)."""
@@ -107,20 +129,7 @@ def make_variants(solver, calls, model, data, fid, pin_variant, m):
         for q, qd, kw, _, _ in calls:
             solver._time_cpp(reps, q, qd, **kw)
 
-    def py(reps):
-        for q, qd, kw, _, _ in calls:
-            for _ in range(reps):
-                solver.solve(q, qd, **kw)
-
-    def py_read(reps):
-        for q, qd, kw, _, _ in calls:
-            for _ in range(reps):
-                _ = solver.solve(q, qd, **kw).qdd
-
-    def py_out(reps):
-        for (q, qd, kw, _, _), out in zip(calls, outs):
-            for _ in range(reps):
-                solver.solve(q, qd, out=out, **kw)
+    py, py_read, py_out = readme_calls(solver.solve, calls, outs)
 
     def pipeline(q, qd, tau, alpha, beta):
         pin.computeAllTerms(model, data, q, qd)
