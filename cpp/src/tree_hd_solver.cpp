@@ -1,0 +1,90 @@
+// TreeHdSolver: a KDL::Tree below a root segment as HdCore's model source (depth-first
+// preorder, parent array, joints in q_nr order). Conventions in tree_hd_solver.hpp.
+#include "vereshchagin/tree_hd_solver.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "hd_core.hpp"
+
+namespace vereshchagin {
+
+namespace {
+
+using Element = KDL::SegmentMap::const_iterator;
+
+// Depth-first preorder below `root` (children in the tree's order), without recursion.
+void preorder(Element root, std::vector<Element>& order, std::vector<int>& parent) {
+  std::vector<std::pair<Element, int>> stack;  // element, parent index
+  const auto& top = GetTreeElementChildren(root->second);
+  for (auto it = top.rbegin(); it != top.rend(); ++it) stack.emplace_back(*it, -1);
+  while (!stack.empty()) {
+    const auto [element, p] = stack.back();
+    stack.pop_back();
+    const int index = static_cast<int>(order.size());
+    order.push_back(element);
+    parent.push_back(p);
+    const auto& children = GetTreeElementChildren(element->second);
+    for (auto it = children.rbegin(); it != children.rend(); ++it) stack.emplace_back(*it, index);
+  }
+}
+
+detail::ModelSource treeSource(const KDL::Tree& tree, const std::string& root_name) {
+  detail::ModelSource src;
+  const std::string name = root_name.empty() ? tree.getRootSegment()->first : root_name;
+  const auto root = tree.getSegment(name);
+  if (root == tree.getSegments().end()) {
+    src.problem = "the tree has no segment '" + name + "' to use as the root";
+    return src;
+  }
+  std::vector<Element> order;
+  preorder(root, order, src.parent);
+  if (order.empty()) {
+    src.problem = "the tree has no segments below the root '" + name + "'";
+    return src;
+  }
+  // Joint indices: the moving joints' q_nr, ranked (a sub-tree's joints renumbered from 0).
+  std::vector<std::pair<unsigned int, int>> q_nr;  // q_nr, segment index
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const KDL::Segment& seg = GetTreeElementSegment(order[i]->second);
+    src.segments.push_back(seg);
+    src.joint.push_back(-1);
+    if (seg.getJoint().getType() != KDL::Joint::Fixed)
+      q_nr.emplace_back(GetTreeElementQNr(order[i]->second), static_cast<int>(i));
+  }
+  std::sort(q_nr.begin(), q_nr.end());
+  for (std::size_t j = 0; j < q_nr.size(); ++j) src.joint[q_nr[j].second] = static_cast<int>(j);
+  return src;
+}
+
+}  // namespace
+
+TreeHdSolver::TreeHdSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options,
+                           const std::string& root_segment)
+    : HdSolver(treeSource(tree, root_segment), root_acc, options), tree_(tree), root_name_(root_segment) {
+  if (root_name_.empty()) root_name_ = tree_.getRootSegment()->first;
+  updateNames();
+}
+
+void TreeHdSolver::updateNames() {
+  const detail::ModelSource& src = core().model.source;
+  segment_names_.clear();
+  joint_names_.assign(nrOfJoints(), std::string());
+  for (std::size_t i = 0; i < src.segments.size(); ++i) {
+    segment_names_.push_back(src.segments[i].getName());
+    if (src.joint[i] >= 0) joint_names_[src.joint[i]] = src.segments[i].getJoint().getName();
+  }
+  parent_ = src.parent;
+}
+
+int TreeHdSolver::segmentIndex(const std::string& name) const {
+  const auto it = std::find(segment_names_.begin(), segment_names_.end(), name);
+  return it == segment_names_.end() ? -1 : static_cast<int>(it - segment_names_.begin());
+}
+
+void TreeHdSolver::updateInternalDataStructures() {
+  rebuild(treeSource(tree_, root_name_));
+  updateNames();
+}
+
+}  // namespace vereshchagin
