@@ -1,5 +1,6 @@
 // TreeHdSolver: a KDL::Tree below a root segment as HdCore's model source (depth-first
-// preorder, parent array, joints in q_nr order). Conventions in tree_hd_solver.hpp.
+// preorder, parent array, joints in preorder = the q_nr order of KDL's tree solvers). Conventions in
+// tree_hd_solver.hpp.
 #include "vereshchagin/tree_hd_solver.hpp"
 
 #include <algorithm>
@@ -43,17 +44,14 @@ detail::ModelSource treeSource(const KDL::Tree& tree, const std::string& root_na
     src.problem = "the tree has no segments below the root '" + name + "'";
     return src;
   }
-  // Joint indices: the moving joints' q_nr, ranked (a sub-tree's joints renumbered from 0).
-  std::vector<std::pair<unsigned int, int>> q_nr;  // q_nr, segment index
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const KDL::Segment& seg = GetTreeElementSegment(order[i]->second);
+  // Joint indices: the moving joints in preorder, which is the q_nr order of a copy of the tree
+  // (KDL's tree solvers keep a copy, and a copy numbers q_nr depth-first).
+  int joint = 0;
+  for (const Element& element : order) {
+    const KDL::Segment& seg = GetTreeElementSegment(element->second);
     src.segments.push_back(seg);
-    src.joint.push_back(-1);
-    if (seg.getJoint().getType() != KDL::Joint::Fixed)
-      q_nr.emplace_back(GetTreeElementQNr(order[i]->second), static_cast<int>(i));
+    src.joint.push_back(seg.getJoint().getType() == KDL::Joint::Fixed ? -1 : joint++);
   }
-  std::sort(q_nr.begin(), q_nr.end());
-  for (std::size_t j = 0; j < q_nr.size(); ++j) src.joint[q_nr[j].second] = static_cast<int>(j);
   return src;
 }
 
@@ -61,14 +59,9 @@ detail::ModelSource treeSource(const KDL::Tree& tree, const std::string& root_na
 
 TreeHdSolver::TreeHdSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options,
                            const std::string& root_segment)
-    : HdSolver(treeSource(tree, root_segment), root_acc, options), tree_(tree), root_name_(root_segment) {
-  if (root_name_.empty()) root_name_ = tree_.getRootSegment()->first;
-  updateNames();
-}
-
-void TreeHdSolver::updateNames() {
+    : HdSolver(treeSource(tree, root_segment), root_acc, options), root_name_(root_segment) {
+  if (root_name_.empty()) root_name_ = tree.getRootSegment()->first;
   const detail::ModelSource& src = core().model.source;
-  segment_names_.clear();
   joint_names_.assign(nrOfJoints(), std::string());
   for (std::size_t i = 0; i < src.segments.size(); ++i) {
     segment_names_.push_back(src.segments[i].getName());
@@ -80,11 +73,6 @@ void TreeHdSolver::updateNames() {
 int TreeHdSolver::segmentIndex(const std::string& name) const {
   const auto it = std::find(segment_names_.begin(), segment_names_.end(), name);
   return it == segment_names_.end() ? -1 : static_cast<int>(it - segment_names_.begin());
-}
-
-void TreeHdSolver::updateInternalDataStructures() {
-  rebuild(treeSource(tree_, root_name_));
-  updateNames();
 }
 
 }  // namespace vereshchagin

@@ -12,7 +12,8 @@
 // Segment and joint order: segment i of the solver is the i-th segment of a depth-first preorder
 // walk from the base (for a chain: the chain's order); every segment's parent comes before it and
 // each subtree is a contiguous range of indices. Joint j is the j-th moving joint (fixed joints
-// have no index): for a chain in chain order, for a tree in KDL's q_nr order (see TreeHdSolver).
+// have no index), in the segment order: for a chain the chain's order, for a tree the q_nr order
+// of KDL's tree solvers (see tree_hd_solver.hpp).
 // Vectors q, q_dot, ff_torques, qdd, command torques have one entry per joint in that order;
 // f_ext and link accelerations one column per segment in the segment order.
 //

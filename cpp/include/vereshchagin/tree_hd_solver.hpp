@@ -10,9 +10,12 @@
 // (KDL's insertion order): segment i's parent parent(i) < i (-1: attached to the base), and the
 // subtree of i is the index range [i, i + size). f_ext has one column per segment in this order,
 // link accelerations one column per segment after the base's column 0.
-// Joint order: KDL's q_nr order (TreeElement::q_nr, stable: the order in which the moving joints
-// were added to the tree); for a sub-tree root, the moving joints below it keep their relative
-// q_nr order, renumbered from 0. Fixed joints have no index. jointNames() lists them.
+// Joint order: the moving joints in the segment order (fixed joints have no index), which is the
+// q_nr order KDL's tree solvers (TreeIdSolver_RNE, TreeJntToJacSolver, TreeFkSolverPos_recursive)
+// use: they keep a copy of the tree, and copying a KDL::Tree numbers q_nr depth-first in this
+// order. A tree built by adding segments in depth-first order (as kdl_parser does from URDF) has
+// these q_nr already; a tree built in another order has other q_nr in the original object but
+// not in its copies. jointNames() lists the order; for a sub-tree root, the joints below it.
 // Constraint columns act on segments by this segment order (segmentIndex(name) finds one); the
 // solve() overload without `segments` puts them on the last segment of the preorder (the last
 // leaf), which is rarely meant for a tree: pass `segments`.
@@ -29,7 +32,7 @@ namespace vereshchagin {
 
 class TreeHdSolver : public HdSolver {
  public:
-  // The tree is copied. root_segment: name of the segment that serves as the base (empty: the
+  // The segments are copied. root_segment: name of the segment that serves as the base (empty: the
   // tree's root). An unknown root name, a root without moving joints below it or invalid
   // parameters give modelError() E_INVALID_MODEL with the reason in errorMessage().
   TreeHdSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options = SolverOptions(),
@@ -45,14 +48,8 @@ class TreeHdSolver : public HdSolver {
   int segmentIndex(const std::string& name) const;
   // Name of the base (root) segment.
   const std::string& rootName() const { return root_name_; }
-  const KDL::Tree& tree() const { return tree_; }
-
-  // The tree has changed: recompute the model data (KDL::SolverI interface).
-  void updateInternalDataStructures() override;
 
  private:
-  void updateNames();
-  KDL::Tree tree_;
   std::string root_name_;
   std::vector<std::string> joint_names_, segment_names_;
   std::vector<int> parent_;
