@@ -1,30 +1,32 @@
-// The per-segment articulated-body step of ChainHdSolver's inward sweep and its final outward
-// sweep, shared by the end-segment path (chain_hd_solver.cpp) and the several-segment path
-// (segment_constraints.cpp).
+// The per-segment articulated-body step of HdCore's inward sweeps and its final outward sweep,
+// shared by the fast path (hd_core.cpp) and the several-segment path (segment_constraints.cpp).
 #pragma once
 
-#include "vereshchagin/chain_hd_solver.hpp"
+#include "hd_core.hpp"
 
 namespace vereshchagin {
+namespace detail {
 
 // u = IA S, D = rotor + S^T u; free = (tau - S^T (pA + IA c)) / D is the joint acceleration with
 // the parent at rest and no constraint; pa = pA + IA c + u free is the apparent bias force.
-inline bool ChainHdSolver::articulate(Segment& s, double tau, Vector6& pa, double& free) const {
-  s.u.noalias() = s.IA * s.S;
-  s.D = s.rotor + s.S.dot(s.u);
-  if (!(s.D > d_tolerance_)) return false;
+inline bool HdCore::articulate(int i, double tau, Vector6& pa, double& free) {
+  const SegmentModel& sm = model.seg[i];
+  SegmentState& s = ws.seg[i];
+  s.u.noalias() = s.IA * sm.S;
+  s.D = sm.rotor + sm.S.dot(s.u);
+  if (!(s.D > model.d_tolerance)) return false;
   s.Dinv = 1.0 / s.D;
   const Vector6 IAc = s.IA * s.c;
-  free = s.Dinv * (tau - s.S.dot(s.pA + IAc));
+  free = s.Dinv * (tau - sm.S.dot(s.pA + IAc));
   pa = s.pA + IAc + s.u * free;
   return true;
 }
 
 // Apparent inertia IA - u u^T / D (IA for a fixed joint) and bias force pa moved to the parent.
-inline void ChainHdSolver::passToParent(int i, const Vector6& pa) {
-  Segment& s = segs_[i];
-  Segment& p = segs_[i - 1];
-  if (s.joint >= 0) {
+inline void HdCore::passToParent(int i, const Vector6& pa) {
+  SegmentState& s = ws.seg[i];
+  SegmentState& p = ws.seg[model.parent(i)];
+  if (model.seg[i].joint >= 0) {
     Matrix6 Ia = s.IA;
     Ia.noalias() -= s.Dinv * s.u * s.u.transpose();
     addInertiaToParent(s.X, Ia, p.IA);
@@ -35,28 +37,29 @@ inline void ChainHdSolver::passToParent(int i, const Vector6& pa) {
 }
 
 // Final outward sweep: joint and link accelerations given the constraint magnitudes.
-// constraint_force(i, s) is segment i's joint-axis share of the constraint forces, S^T A nu (the
+// constraint_force(i) is segment i's joint-axis share of the constraint forces, S^T A nu (the
 // only part in which the two paths differ).
 template <typename ConstraintForce>
-inline void ChainHdSolver::finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
-                                      const ConstraintForce& constraint_force) {
+inline void HdCore::finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
+                               const ConstraintForce& constraint_force) {
   const bool has_tau = ff_torques.size() != 0;
-  Vector6 xdd_parent = root_acc_;
-  link_acc_known_ = false;
-  for (unsigned int i = 0; i < ns_; ++i) {
-    Segment& s = segs_[i];
-    Vector6 a = motionToChild(s.X, xdd_parent);
+  res.link_acc_known = false;
+  for (unsigned int i = 0; i < model.ns; ++i) {
+    const SegmentModel& sm = model.seg[i];
+    SegmentState& s = ws.seg[i];
+    const int p = model.parent(i);
+    Vector6 a = motionToChild(s.X, p >= 0 ? ws.seg[p].xdd : root_acc);
     a += s.c;
-    if (s.joint >= 0) {
-      const double tau = has_tau ? ff_torques(s.joint) : 0.0;
-      const double f = s.S.dot(s.pA) + s.u.dot(a) + constraint_force(i, s);  // S^T IA a = u^T a
+    if (sm.joint >= 0) {
+      const double tau = has_tau ? ff_torques(sm.joint) : 0.0;
+      const double f = sm.S.dot(s.pA) + s.u.dot(a) + constraint_force(i);  // S^T IA a = u^T a
       const double qdd = s.Dinv * (tau - f);
-      qdd_(s.joint) = qdd;
-      a += s.S * qdd;
+      res.qdd(sm.joint) = qdd;
+      a += sm.S * qdd;
     }
     s.xdd = a;
-    xdd_parent = a;
   }
 }
 
+}  // namespace detail
 }  // namespace vereshchagin

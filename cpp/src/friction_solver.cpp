@@ -5,8 +5,10 @@
 #include <cstdarg>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 #include "dense_small.hpp"
+#include "hd_core.hpp"
 #include "model_validation.hpp"
 
 namespace vereshchagin {
@@ -20,7 +22,16 @@ constexpr double kGradientTolerance = 1e-11;
 }  // namespace
 
 FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
-    : hd_(chain, root_acc, options), free_(chain, root_acc, options) {
+    : FrictionSolver(std::make_unique<ChainHdSolver>(chain, root_acc, options),
+                     std::make_unique<ChainHdSolver>(chain, root_acc, options)) {}
+
+FrictionSolver::FrictionSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options,
+                               const std::string& root_segment)
+    : FrictionSolver(std::make_unique<TreeHdSolver>(tree, root_acc, options, root_segment),
+                     std::make_unique<TreeHdSolver>(tree, root_acc, options, root_segment)) {}
+
+FrictionSolver::FrictionSolver(std::unique_ptr<HdSolver> hd, std::unique_ptr<HdSolver> free)
+    : hd_owner_(std::move(hd)), free_owner_(std::move(free)), hd_(*hd_owner_), free_(*free_owner_) {
   nj_ = hd_.nrOfJoints();
   const int n = static_cast<int>(nj_);
   qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = ff_driver_ = Eigen::VectorXd::Zero(n);
@@ -88,10 +99,10 @@ int FrictionSolver::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
                             const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
                             const Eigen::Ref<const Eigen::VectorXd>& tau) {
   // The pass-through's feed-forward driver is ff_torques alone, not the friction in tau.
-  hd_.pt_driver_ = &ff_driver_;
+  hd_.core().ws.pt.driver = &ff_driver_;
   const int rc =
       segments ? hd_.solve(q, q_dot, alfa, beta, *segments, f_ext, tau) : hd_.solve(q, q_dot, alfa, beta, f_ext, tau);
-  hd_.pt_driver_ = nullptr;
+  hd_.core().ws.pt.driver = nullptr;
   return rc;
 }
 

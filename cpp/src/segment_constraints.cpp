@@ -1,215 +1,240 @@
-// Constraints on any segments (Shakhimardanov's extension of the Popov-Vereshchagin recursion):
-// the general path of ChainHdSolver::solve(). Conventions in chain_hd_solver.hpp.
+// Constraints on any segments of a chain or a tree (Shakhimardanov's extension of the
+// Popov-Vereshchagin recursion, on a parent array): HdCore's several-segment path. Conventions
+// in hd_solver.hpp, the column ordering in hd_core.hpp.
 //
-// Columns are sorted by segment, most distal first, so that the columns felt by segment i are a
-// prefix [0, active_[i]) of the sorted order: a constraint on segment k acts on segments <= k
-// only. In the inward sweep segment i's own columns (alfa in its tip axes) join the wrenches
-// passed from its child; each column then goes through the same projection A <- A - u e / D as on
-// the end-segment path, and K = sum_i D_i^-1 e_i e_i^T with e_i = A_i^T S_i couples every pair.
+// Columns are sorted by segment, highest index first, so that the columns felt by segment i
+// (those on its subtree [i, subtree_end[i])) are the contiguous range [lo_i, active[i]) of the
+// sorted order. In the inward sweep segment i's own columns (alfa in its tip axes) join the
+// wrenches its children passed (each child's range, already in i's frame); each column then goes
+// through the same projection A <- A - u e / D as on the fast path, and K = sum_i D_i^-1 e_i e_i^T
+// with e_i = A_i^T S_i couples every pair felt by a common segment, block-wise.
 #include <algorithm>
 #include <cmath>
 
 #include "articulated_step.hpp"
 #include "dense_small.hpp"
+#include "hd_core.hpp"
 #include "model_validation.hpp"
 
 namespace vereshchagin {
+namespace detail {
 
-int ChainHdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+int HdCore::solveSegments(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                          const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                          const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
+                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  res.solved = false;
+  res.general = false;
+  if (segments.size() != alfa.cols())
+    return fail(KDL::SolverI::E_SIZE_MISMATCH, "segments has %ld entries, expected %ld (one per alfa column)",
+                (long)segments.size(), (long)alfa.cols());
+  const int last = static_cast<int>(model.ns) - 1;
+  bool last_only = model.is_chain && alfa.cols() <= kMaxConstraints && model.ns > 0;
+  for (Eigen::Index c = 0; c < segments.size() && last_only; ++c) last_only = segments(c) == last;
+  if (last_only) return solveLast(q, q_dot, alfa, beta, f_ext, ff_torques);  // the fast path
+  return solveGeneral(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
+}
+
+int HdCore::solveGeneral(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                          const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                          const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  solved_ = false;
-  general_ = false;
-  if (segments.size() != alfa.cols())
-    return fail(E_SIZE_MISMATCH, "segments has %ld entries, expected %ld (one per alfa column)", (long)segments.size(),
-                (long)alfa.cols());
-  bool last_only = alfa.cols() <= kMaxConstraints && ns_ > 0;
-  for (Eigen::Index c = 0; c < segments.size() && last_only; ++c) last_only = segments(c) == static_cast<int>(ns_) - 1;
-  if (last_only) return solve(q, q_dot, alfa, beta, f_ext, ff_torques);  // the end-segment path
-
-  int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques, mcap_);
-  if (rc != E_NOERROR) return rc;
+  res.solved = false;
+  res.general = false;
+  int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques, mcap);
+  if (rc != 0) return rc;
   rc = sortColumns(segments);
-  if (rc != E_NOERROR) return rc;
-  general_ = true;
+  if (rc != 0) return rc;
+  res.general = true;
   outwardSweep(q, q_dot, f_ext);
   rc = inwardSweepGeneral(alfa, ff_torques);
-  if (rc != E_NOERROR) {
-    general_ = false;
-    return rc;
-  }
-  rc = passThroughEnergy(f_ext, ff_torques);
-  if (rc != E_NOERROR) {
-    general_ = false;
+  if (rc == 0) rc = passThroughEnergy(f_ext, ff_torques);
+  if (rc != 0) {
+    res.general = false;
     return rc;
   }
   factorizeCouplingGeneral();
-  const int m = m_;
-  for (int k = 0; k < m; ++k) rhs_g_(k) = ug_(k) - beta(order_(k));  // nu = K^+ (U - beta)
-  if (pt_used_) rhs_g_.head(m) -= pt_energy_.head(m);                // the drivers' parts that pass through
-  couplingSolve(rhs_g_.head(m), nug_.head(m));
+  CouplingGeneral& g = ws.general;
+  const int m = res.m;
+  for (int k = 0; k < m; ++k) g.rhs(k) = g.ug(k) - beta(g.order(k));  // nu = K^+ (U - beta)
+  if (ws.pt.used) g.rhs.head(m) -= ws.pt.energy.head(m);              // the drivers' parts that pass through
+  couplingSolve(g.rhs.head(m), g.nug.head(m));
   finalSweepGeneral(ff_torques);
-  for (int k = 0; k < m; ++k) nu_user_(order_(k)) = nug_(k);
-  commandFromNuGeneral(nug_.head(m), tau_cmd_);
-  rc = checkBounded(nu_user_.head(m), q_dot, beta, f_ext, ff_torques);
-  if (rc != E_NOERROR) return rc;
-  solved_ = true;
-  error = E_NOERROR;
-  return E_NOERROR;
+  for (int k = 0; k < m; ++k) res.nu_user(g.order(k)) = g.nug(k);
+  commandFromNuGeneral(g.nug.head(m), res.tau_cmd);
+  rc = checkBounded(res.nu_user.head(m), q_dot, beta, f_ext, ff_torques);
+  if (rc != 0) return rc;
+  res.solved = true;
+  return 0;
 }
 
-// Counting sort of the columns by segment, distal first (stable within a segment).
-int ChainHdSolver::sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments) {
+// Counting sort of the columns by segment, highest index first (stable within a segment).
+int HdCore::sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments) {
   const int m = static_cast<int>(segments.size());
-  seg_count_.setZero();
+  const int ns = static_cast<int>(model.ns);
+  CouplingGeneral& g = ws.general;
+  g.seg_count.setZero();
   for (int c = 0; c < m; ++c) {
     const int s = segments(c);
-    if (s < 0 || s >= static_cast<int>(ns_))
-      return fail(E_OUT_OF_RANGE, "segments(%d) = %d is out of range [0, %u)", c, s, ns_);
-    if (++seg_count_(s) > kMaxConstraints)
-      return fail(E_TOO_MANY_CONSTRAINTS, "segment %d ('%s') has more than %d constraint columns", s,
-                  chain_.getSegment(s).getName().c_str(), kMaxConstraints);
+    if (s < 0 || s >= ns)
+      return fail(KDL::SolverI::E_OUT_OF_RANGE, "segments(%d) = %d is out of range [0, %d)", c, s, ns);
+    if (++g.seg_count(s) > kMaxConstraints)
+      return fail(HdSolver::E_TOO_MANY_CONSTRAINTS, "segment %d ('%s') has more than %d constraint columns", s,
+                  model.source.segments[s].getName().c_str(), kMaxConstraints);
   }
-  active_[ns_] = 0;
-  for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) active_[i] = active_[i + 1] + seg_count_(i);
-  for (unsigned int i = 0; i < ns_; ++i) seg_count_(i) = active_[i + 1];  // next free position
-  for (int c = 0; c < m; ++c) order_(seg_count_(segments(c))++) = c;
-  m_ = m;
-  return E_NOERROR;
+  g.active[ns] = 0;
+  for (int i = ns - 1; i >= 0; --i) g.active[i] = g.active[i + 1] + g.seg_count(i);
+  for (int i = 0; i < ns; ++i) g.seg_count(i) = g.active[i + 1];  // next free position
+  for (int c = 0; c < m; ++c) g.order(g.seg_count(segments(c))++) = c;
+  res.m = m;
+  return 0;
 }
 
-int ChainHdSolver::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
-                                      const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  const int M = m_;
-  ug_.head(M).setZero();
-  kg_.topLeftCorner(M, M).setZero();
+// Segment i's own columns: alfa in its tip axes (the moment is already about its origin).
+void HdCore::addOwnColumns(int i, const Eigen::Ref<const Matrix6X>& alfa) {
+  CouplingGeneral& g = ws.general;
+  const Matrix3& R = ws.seg[i].R_base;
+  for (int k = g.active[i + 1]; k < g.active[i]; ++k) {
+    const auto a = alfa.col(g.order(k));
+    g.anew.col(k).head<3>().noalias() = R.transpose() * a.head<3>();
+    g.anew.col(k).tail<3>().noalias() = R.transpose() * a.tail<3>();
+    g.acur.col(k) = g.anew.col(k);
+  }
+}
+
+int HdCore::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
+                               const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  CouplingGeneral& g = ws.general;
+  const int M = res.m;
+  g.ug.head(M).setZero();
+  g.kg.topLeftCorner(M, M).setZero();
   double kappa = 0.0;
   const bool has_tau = ff_torques.size() != 0;
-  for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
-    Segment& s = segs_[i];
-    const int c0 = active_[i + 1], c = active_[i];
-    // This segment's own columns: alfa in its tip axes (the moment is already about its origin).
-    for (int k = c0; k < c; ++k) {
-      const auto a = alfa.col(order_(k));
-      anew_.col(k).head<3>().noalias() = s.R_base.transpose() * a.head<3>();
-      anew_.col(k).tail<3>().noalias() = s.R_base.transpose() * a.tail<3>();
-      acur_.col(k) = anew_.col(k);
-    }
-    auto A = acur_.leftCols(c);
-    auto Ap = aproj_.leftCols(c);
+  for (int i = static_cast<int>(model.ns) - 1; i >= 0; --i) {
+    const SegmentModel& sm = model.seg[i];
+    SegmentState& s = ws.seg[i];
+    addOwnColumns(i, alfa);
+    const int lo = g.lo(model, i), w = g.active[i] - lo;  // the columns felt here: [lo, lo + w)
+    auto A = g.acur.middleCols(lo, w);
+    auto Ap = g.aproj.middleCols(lo, w);
     Vector6 pa;
-    eg_.col(i).head(M).setZero();
-    if (s.joint >= 0) {
+    g.eg.col(i).head(M).setZero();
+    if (sm.joint >= 0) {
       double free = 0.0;
-      if (!articulate(s, has_tau ? ff_torques(s.joint) : 0.0, pa, free)) return degenerate(i);
-      if (c > 0) {
-        auto e = eg_.col(i).head(c);  // A^T S
-        e.noalias() = A.transpose().lazyProduct(s.S);
-        const Vector6 bias = s.c + s.S * free;
-        ug_.head(c).noalias() += A.transpose().lazyProduct(bias);
-        kg_.topLeftCorner(c, c).noalias() += s.Dinv * e.lazyProduct(e.transpose());
-        // The end-segment path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
-        kappa += 2.0 * s.Dinv * (s.v2 * A.topRows<3>().squaredNorm() + s.w2 * A.bottomRows<3>().squaredNorm());
+      if (!articulate(i, has_tau ? ff_torques(sm.joint) : 0.0, pa, free)) return degenerate(i);
+      if (w > 0) {
+        auto e = g.eg.col(i).segment(lo, w);  // A^T S
+        e.noalias() = A.transpose().lazyProduct(sm.S);
+        const Vector6 bias = s.c + sm.S * free;
+        g.ug.segment(lo, w).noalias() += A.transpose().lazyProduct(bias);
+        g.kg.block(lo, lo, w, w).noalias() += s.Dinv * e.lazyProduct(e.transpose());
+        // The fast path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
+        kappa += 2.0 * s.Dinv * (sm.v2 * A.topRows<3>().squaredNorm() + sm.w2 * A.bottomRows<3>().squaredNorm());
         Ap = A;
         Ap.noalias() -= (s.Dinv * s.u).lazyProduct(e.transpose());
       }
     } else {
       pa = s.pA;
-      if (c > 0) Ap = A;
+      if (w > 0) Ap = A;
     }
-    if (c > 0) {  // to the parent's frame (the base frame for i = 0): f = R f', n = R n' + p x f
+    if (w > 0) {  // to the parent's frame (the base frame at the root): f = R f', n = R n' + p x f
       A.topRows<3>().noalias() = s.X.R.lazyProduct(Ap.topRows<3>());
       A.bottomRows<3>().noalias() = s.X.R.lazyProduct(Ap.bottomRows<3>());
       A.bottomRows<3>().noalias() += skew(s.X.p).lazyProduct(A.topRows<3>());
     }
-    if (i > 0) {
+    if (model.parent(i) >= 0) {
       passToParent(i, pa);
-    } else if (c > 0) {
-      ug_.head(c).noalias() += A.transpose().lazyProduct(root_acc_);
+    } else if (w > 0) {
+      g.ug.segment(lo, w).noalias() += A.transpose().lazyProduct(root_acc);
     }
   }
-  kappa_ = kappa;
-  return E_NOERROR;
+  ws.kappa = kappa;
+  return 0;
 }
 
-// K = kg_ (M x M): certified Cholesky (truncation policy, every eigenvalue provably above the
+// K = kg (M x M): certified Cholesky (truncation policy, every eigenvalue provably above the
 // threshold) else a Jacobi eigen-decomposition with the policy's multipliers.
-void ChainHdSolver::factorizeCouplingGeneral() {
-  const int m = m_;
-  rank_ = 0;
-  sigma_known_ = false;
-  use_cholesky_ = false;
+void HdCore::factorizeCouplingGeneral() {
+  CouplingGeneral& g = ws.general;
+  const int m = res.m;
+  res.rank = 0;
+  res.sigma_known = false;
+  ws.use_cholesky = false;
   if (m == 0) return;
-  const auto K = kg_.topLeftCorner(m, m);
-  if (options_.policy == SingularityPolicy::TruncatedPseudoInverse) {
-    auto L = cholg_.topLeftCorner(m, m);
+  const auto K = g.kg.topLeftCorner(m, m);
+  if (options.policy == SingularityPolicy::TruncatedPseudoInverse) {
+    auto L = g.cholg.topLeftCorner(m, m);
     L.setZero();
     if (detail::choleskyCertified(K, L, 0.0)) {
-      auto x = tmp_g_.head(m);
+      auto x = g.tmp.head(m);
       const double lower = 1.0 / detail::inverseFrobeniusSquared(L, x);  // <= lambda_min(K)
-      if (std::isfinite(lower) && lower > options_.rcond * kappa_) {
-        use_cholesky_ = true;
-        rank_ = m;
+      if (std::isfinite(lower) && lower > options.rcond * ws.kappa) {
+        ws.use_cholesky = true;
+        res.rank = m;
         return;
       }
     }
   }
-  auto W = work_g_.topLeftCorner(m, m);
-  auto V = vg_.topLeftCorner(m, m);
+  auto W = g.work_g.topLeftCorner(m, m);
+  auto V = g.vg.topLeftCorner(m, m);
   W = K;
   detail::jacobiEigen(W, V);
   const auto lam = W.diagonal();
-  const double cut = options_.rcond * std::max(std::max(lam.maxCoeff(), 0.0), kappa_);
-  sigma_min_ = std::max(lam.minCoeff(), 0.0);
-  sigma_known_ = true;
-  auto inv = invg_.head(m);
-  rank_ = detail::policyMultipliers(lam, inv, cut, options_.policy == SingularityPolicy::TruncatedPseudoInverse,
-                                    options_.damping);
+  const double cut = options.rcond * std::max(std::max(lam.maxCoeff(), 0.0), ws.kappa);
+  res.sigma_min = std::max(lam.minCoeff(), 0.0);
+  res.sigma_known = true;
+  auto inv = g.invg.head(m);
+  res.rank = detail::policyMultipliers(lam, inv, cut, options.policy == SingularityPolicy::TruncatedPseudoInverse,
+                                       options.damping);
 }
 
-void ChainHdSolver::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const {
-  const int m = m_;
-  if (!general_) {
+void HdCore::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const {
+  const int m = res.m;
+  if (!res.general) {
     VectorC r = rhs.head(m), o;
     applyCouplingInverse(r, o);
     out.head(m) = o;
     return;
   }
   if (m == 0) return;
-  if (use_cholesky_) {
+  const CouplingGeneral& g = ws.general;
+  if (ws.use_cholesky) {
     out.head(m) = rhs.head(m);
     auto x = out.head(m);
-    detail::choleskySolve(cholg_.topLeftCorner(m, m), x);
+    detail::choleskySolve(g.cholg.topLeftCorner(m, m), x);
     return;
   }
-  const auto V = vg_.topLeftCorner(m, m);
-  tmp_g_.head(m).noalias() = V.transpose().lazyProduct(rhs.head(m));
-  tmp_g_.head(m).array() *= invg_.head(m).array();
-  out.head(m).noalias() = V.lazyProduct(tmp_g_.head(m));
+  const auto V = g.vg.topLeftCorner(m, m);
+  g.tmp.head(m).noalias() = V.transpose().lazyProduct(rhs.head(m));
+  g.tmp.head(m).array() *= g.invg.head(m).array();
+  out.head(m).noalias() = V.lazyProduct(g.tmp.head(m));
 }
 
-// Final outward sweep of the several-segment path: the active columns felt by segment i.
-void ChainHdSolver::finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  finalSweep(ff_torques, [this](int i, const Segment&) {
-    const int c = active_[i];
-    return c > 0 ? eg_.col(i).head(c).dot(nug_.head(c)) : 0.0;
+// Final outward sweep of the several-segment path: the columns felt by segment i.
+void HdCore::finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  const CouplingGeneral& g = ws.general;
+  finalSweep(ff_torques, [this, &g](int i) {
+    const int lo = g.lo(model, i), w = g.active[i] - lo;
+    return w > 0 ? g.eg.col(i).segment(lo, w).dot(g.nug.segment(lo, w)) : 0.0;
   });
 }
 
 // tau_cmd = -sum_c J_c^T alfa_c nu_c: each segment adds the wrenches -alfa nu of its own columns
-// (tip axes, tip origin) to what its descendants pass, carried rigidly to the base.
-void ChainHdSolver::commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_sorted,
-                                         Eigen::Ref<Eigen::VectorXd> tau_cmd) const {
+// (tip axes, tip origin) to what its children pass, carried rigidly to the base.
+void HdCore::commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_sorted,
+                                  Eigen::Ref<Eigen::VectorXd> tau_cmd) const {
+  const CouplingGeneral& g = ws.general;
+  Matrix6X& f = g.seg_force;  // the wrench felt by each segment
   tau_cmd.setZero();
-  Vector6 f = Vector6::Zero();
-  for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
-    const Segment& s = segs_[i];
-    const int c0 = active_[i + 1], c = active_[i];
-    if (c > c0) f.noalias() -= anew_.middleCols(c0, c - c0).lazyProduct(nu_sorted.segment(c0, c - c0));
-    if (s.joint >= 0) tau_cmd(s.joint) = s.S.dot(f);
-    if (i > 0) f = forceToParent(s.X, f);
+  f.setZero();
+  for (int i = static_cast<int>(model.ns) - 1; i >= 0; --i) {
+    const SegmentModel& sm = model.seg[i];
+    const int c0 = g.active[i + 1], c = g.active[i];
+    if (c > c0) f.col(i).noalias() -= g.anew.middleCols(c0, c - c0).lazyProduct(nu_sorted.segment(c0, c - c0));
+    if (sm.joint >= 0) tau_cmd(sm.joint) = sm.S.dot(f.col(i));
+    if (model.parent(i) >= 0) f.col(model.parent(i)) += forceToParent(ws.seg[i].X, f.col(i));
   }
 }
 
+}  // namespace detail
 }  // namespace vereshchagin

@@ -115,7 +115,7 @@ int Engine::runWeighted(const RowInputs& in) {
 }
 
 void Engine::writeCore(double* qdd, double* tau_cmd, double* nu, double* link_acc, int* rank, double* smin) {
-  const ChainHdSolver& s = answered();
+  const vereshchagin::HdSolver& s = answered();
   if (last_friction_) {  // outputs at the friction optimum
     std::copy(friction_.qdd().data(), friction_.qdd().data() + nj, qdd);
     std::copy(friction_.commandTorques().data(), friction_.commandTorques().data() + nj, tau_cmd);

@@ -71,7 +71,7 @@ class Engine {
   void writeCore(double* qdd, double* tau_cmd, double* nu, double* link_acc, int* rank, double* smin);
   void writeFriction(double* friction_torque, double* limit_torque, int* status, double* gauss, int* iterations);
   bool lastHadFriction() const { return last_friction_; }
-  ChainHdSolver& answered() { return last_friction_ ? friction_.hdSolver() : hd_; }
+  vereshchagin::HdSolver& answered() { return last_friction_ ? friction_.hdSolver() : hd_; }
   vereshchagin::FrictionSolver& frictionSolver() { return friction_; }
 
   unsigned int nj, ns;

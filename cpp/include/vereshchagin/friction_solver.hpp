@@ -42,11 +42,14 @@
 // No heap allocation in solve() or gaussValue().
 #pragma once
 
+#include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "vereshchagin/chain_hd_solver.hpp"
+#include "vereshchagin/tree_hd_solver.hpp"
 
 namespace vereshchagin {
 
@@ -72,6 +75,10 @@ class FrictionSolver {
   };
 
   FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options = SolverOptions());
+  // The same on the tree below root_segment (empty: the tree's root), with TreeHdSolver's segment
+  // and joint order (tree_hd_solver.hpp).
+  FrictionSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options = SolverOptions(),
+                 const std::string& root_segment = std::string());
 
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
             const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
@@ -98,7 +105,7 @@ class FrictionSolver {
 
   // The underlying solver; after solve() it holds the solve without static friction (before
   // linkAccelerations() is called) — its responseColumns() are valid for the optimum too.
-  ChainHdSolver& hdSolver() { return hd_; }
+  HdSolver& hdSolver() { return hd_; }
   const char* errorMessage() const { return message_.data(); }
   int modelError() const { return hd_.modelError(); }
   void setRootAcceleration(const KDL::Twist& root_acc) {
@@ -114,6 +121,7 @@ class FrictionSolver {
   int setOptions(const SolverOptions& options);
 
  private:
+  FrictionSolver(std::unique_ptr<HdSolver> hd, std::unique_ptr<HdSolver> free);
   int fail(int code, const char* fmt, ...);
   int solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                 const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
@@ -137,7 +145,9 @@ class FrictionSolver {
   void gradient(int k);
   void factorDelete(int q, int nf);
 
-  ChainHdSolver hd_, free_;
+  std::unique_ptr<HdSolver> hd_owner_, free_owner_;  // the solver of the problem; one for qdd_free
+  HdSolver& hd_;
+  HdSolver& free_;
   unsigned int nj_ = 0;
   std::array<char, 512> message_{};
   Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;

@@ -1,0 +1,274 @@
+// The private side of HdSolver: the model (constant per robot), the per-solve workspace, the
+// results, and HdCore, the algorithm on them. Math and conventions in hd_solver.hpp.
+//
+// Notation in the comments: segment i has tip frame i and parent lambda(i) = model.parent[i]
+// (-1: the base); X_i is the pose of frame i in frame lambda(i), S_i the joint axis in frame i,
+// IA_i / pA_i the articulated inertia / bias force, A_i the constraint wrenches felt by segment i
+// (6 x columns), U the acceleration energy already produced by bias forces and torques along the
+// columns, K the coupling matrix (acceleration energy per unit constraint force).
+//
+// Segments are in depth-first preorder, so the subtree of i is [i, subtree_end[i]). On the
+// several-segment path the constraint columns are sorted by segment, the highest index first:
+// the columns felt by segment i (those on its subtree) are then the contiguous range
+// [active[subtree_end[i]], active[i]) of the sorted order, with active[i] the number of columns on
+// segments >= i. Children's ranges are disjoint, so one 6 x M buffer of felt wrenches serves every
+// branch and K accumulates block-wise. On a chain the range is [0, active[i]).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <kdl/segment.hpp>
+
+#include "vereshchagin/hd_solver.hpp"
+#include "vereshchagin/spatial.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+constexpr int kMaxConstraints = HdSolver::kMaxConstraints;
+using Matrix6X = HdSolver::Matrix6X;
+using Matrix3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+using MatrixC = HdSolver::MatrixC;
+using VectorC = HdSolver::VectorC;
+
+// What a model is built from: the segments in preorder, each one's parent (-1: the base) and its
+// joint index (-1 for a fixed joint; moving joints numbered 0..n_joints-1 in the caller's order).
+struct ModelSource {
+  std::vector<KDL::Segment> segments;
+  std::vector<int> parent;
+  std::vector<int> joint;
+  std::string problem;  // non-empty: the source itself is invalid (unknown root, ...)
+};
+
+// Constant data of one segment.
+struct SegmentModel {
+  Pose X0;                    // pose of this tip frame in the parent tip frame at q = 0
+  Vector6 S;                  // joint motion axis in the tip frame (zero for fixed joints)
+  Matrix6 I;                  // rigid-body inertia about the tip origin, tip frame
+  double rotor = 0.0;         // rotor inertia of the joint
+  double w_norm = 0.0;        // |angular part of S| (0 for prismatic joints)
+  double v2 = 0.0, w2 = 0.0;  // |linear part of S|^2, |angular part of S|^2
+  int joint = -1;             // joint index or -1 for a fixed joint
+};
+
+// The robot: constant per robot, validated when built.
+struct HdModel {
+  ModelSource source;
+  std::vector<SegmentModel> seg;
+  std::vector<int> subtree_end;    // one past the last segment of i's subtree
+  std::vector<int> branch_slot;    // per segment with >= 2 children: its slot in branch buffers, else -1
+  int n_branch = 0;                // segments with >= 2 children
+  std::vector<int> joint_segment;  // segment index of each joint
+  unsigned int nj = 0, ns = 0;
+  bool is_chain = true;      // parent[i] = i - 1 for every i: the chain's fast path applies
+  double d_tolerance = 0.0;  // articulated inertias at or below this are degenerate
+  int parent(int i) const { return source.parent[i]; }
+  const std::string& jointName(int segment) const { return source.segments[segment].getJoint().getName(); }
+};
+
+// Per-solve state of one segment.
+struct SegmentState {
+  Pose X;                                       // pose of this tip frame in the parent tip frame at q
+  Matrix3 R_base;                               // orientation of this tip frame in the base frame
+  Matrix6 IA;                                   // articulated inertia
+  Vector6 v, c, pA;                             // velocity, velocity-product acceleration, articulated bias force
+  Vector6 u;                                    // IA * S
+  Vector6 xdd;                                  // spatial acceleration (tip frame)
+  Eigen::Matrix<double, 6, kMaxConstraints> A;  // constraint wrenches felt by this segment (fast path)
+  Eigen::Matrix<double, 1, kMaxConstraints> e;  // S^T A (fast path)
+  double D = 0.0, Dinv = 0.0;                   // articulated joint inertia and its inverse
+};
+
+// Coupling matrix of the fast path (m <= 6 columns on the last segment of a chain).
+struct CouplingFast {
+  VectorC U0;
+  MatrixC L0, K;  // L0 = -K accumulated by the inward sweep
+  MatrixC chol;   // lower Cholesky factor of K on the certified path
+  Eigen::SelfAdjointEigenSolver<MatrixC> eig;
+  VectorC inv_eigen;  // per-eigenvalue multiplier of the policy
+  mutable Eigen::SelfAdjointEigenSolver<MatrixC> sigma_eig;
+};
+
+// The several-segment path (storage sized at construction, mcap columns).
+struct CouplingGeneral {
+  Eigen::VectorXi order;      // sorted position -> caller's column (highest segment first)
+  Eigen::VectorXi seg_count;  // per segment: its number of columns, then the next free position
+  std::vector<int> active;    // active[i]: columns on segments >= i (n_segments + 1)
+  Matrix6X anew;              // each column's wrench in its own segment's tip axes (sorted)
+  Matrix6X acur, aproj;       // wrenches felt by the current segment / passed to the parent
+  Eigen::MatrixXd eg;         // mcap x n_segments: column i = (S_i^T A_i)^T, zero outside i's range
+  Eigen::VectorXd ug, nug, rhs;
+  mutable Eigen::VectorXd tmp;
+  Eigen::MatrixXd kg, cholg, vg;             // coupling matrix, its Cholesky factor or eigenvectors
+  Eigen::VectorXd invg;                      // policy multiplier per eigenvalue
+  mutable Eigen::MatrixXd work_g, work_v;    // Jacobi workspace for the smallest singular value
+  mutable Matrix6X seg_force;                // per-segment wrench accumulators
+  int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
+  {
+    return active[model.subtree_end[i]];
+  }
+};
+
+// Workspace of responseColumns().
+struct ResponseWorkspace {
+  Eigen::MatrixXd cmd_per_nu;   // d tau_cmd / d nu (n_joints x mcap)
+  Eigen::MatrixXd energy;       // d U per requested column (mcap x n_joints)
+  Eigen::MatrixXd dnu;          // d nu per requested column (mcap x n_joints)
+  Eigen::MatrixXd sdp;          // S_i^T (apparent force change from the child), n_segments x n_joints
+  Matrix6X axis, axis_inertia;  // joint axes S and IA S per segment, base axes, about each tip origin
+  Matrix3X offset;              // tip origin - parent's tip origin, base axes
+  Matrix6X force;               // per requested column: apparent force change, then acceleration change
+  Matrix3X tmp3;
+  Eigen::VectorXi holder;  // per requested column: the segment whose tip its force change is about
+  Matrix6X branch_acc;     // per branching segment: its accelerations of every column (6 x n_joints slots)
+};
+
+// Workspace of the driver pass-through.
+struct PassThroughState {
+  Eigen::VectorXd f, t;                     // weights per caller's column (mcap)
+  int m = -1;                               // columns they are for; -1: none
+  bool f_any = false, t_any = false;        // some weight is non-zero
+  bool used = false;                        // the last solve applied energy
+  Eigen::VectorXd free;                     // driverFree() per joint (n_joints)
+  Eigen::VectorXd energy, tmp;              // p_f .* a_fext + p_t .* a_ff, and one driver's a (mcap)
+  const Eigen::VectorXd* driver = nullptr;  // ff driver if not ff_torques (FrictionSolver)
+};
+
+struct HdWorkspace {
+  std::vector<SegmentState> seg;
+  CouplingFast fast;
+  CouplingGeneral general;
+  ResponseWorkspace response;
+  PassThroughState pt;
+  double kappa = 0.0;         // scale of K: 2 sum_i D_i^-1 (|v_i|^2 |F_i|^2 + |w_i|^2 |N_i|^2) (>= trace K)
+  bool use_cholesky = false;  // K certified of full rank and factorised by Cholesky
+  Matrix6X zero_f_ext;        // 6 x n_segments zeros
+  Eigen::VectorXd zero_joints;
+  Matrix6 alfa_buf;
+};
+
+struct HdResults {
+  Eigen::VectorXd qdd, tau_cmd;
+  VectorC nu;                 // fast path
+  Eigen::VectorXd nu_user;    // several-segment path, caller's order
+  mutable Matrix6X link_acc;  // 6 x (n_segments + 1), on request
+  mutable bool link_acc_known = false;
+  int m = 0, rank = 0;
+  bool solved = false;
+  bool general = false;  // the last solve used the several-segment path
+  mutable bool sigma_known = false;
+  mutable double sigma_min = 0.0;
+};
+
+class HdCore {
+ public:
+  HdCore(const ModelSource& source, const Vector6& root_acc, const SolverOptions& options);
+  void rebuild(const ModelSource& source);
+
+  int solveLast(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  int solveSegments(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                    const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
+                    const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                      Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd>* dnu);
+  int commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
+  int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
+                     const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
+  void clearPassThrough();
+  int setOptions(const SolverOptions& options);
+  const Matrix6X& linkAccelerations() const;
+  double smallestSingularValue() const;
+  Eigen::Map<const Eigen::VectorXd> nu() const {
+    return Eigen::Map<const Eigen::VectorXd>(res.general ? res.nu_user.data() : res.nu.data(), res.m);
+  }
+  int fail(int code, const char* fmt, ...);
+
+  HdModel model;
+  HdWorkspace ws;
+  HdResults res;
+  SolverOptions options;
+  Vector6 root_acc = Vector6::Zero();
+  int model_error = 0;
+  int mcap = kMaxConstraints;  // 6 per segment
+  std::array<char, 512> message{};
+
+ private:
+  // Model (hd_model.cpp).
+  void buildModel();
+  int buildSegment(int i, double& scale);
+  void buildTopology();
+  void allocateWorkspace();
+  int checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                  const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                  const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
+                  int max_columns);
+  int checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                   const Eigen::Ref<const Eigen::VectorXd>& beta, const Eigen::Ref<const Matrix6X>& f_ext,
+                   const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  int degenerate(int i);
+
+  // Sweeps shared by both paths (hd_core.cpp, articulated_step.hpp).
+  void screwPose(const SegmentModel& sm, SegmentState& s, double q) const;
+  void outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Matrix6X>& f_ext);
+  // Joint part of segment i's inward step: u, D, 1/D; returns the free joint acceleration (parent
+  // at rest, no constraint) and the apparent bias force pa; false if D is degenerate.
+  inline bool articulate(int i, double tau, Vector6& pa, double& free);
+  // Apparent inertia and bias force of segment i added to its parent (which must exist).
+  inline void passToParent(int i, const Vector6& pa);
+  // Final outward sweep; constraint_force(i) gives segment i's S^T A nu.
+  template <typename ConstraintForce>
+  inline void finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const ConstraintForce& constraint_force);
+
+  // Fast path: m <= 6 columns on the last segment of a chain (hd_core.cpp).
+  int inwardSweep(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  template <int M>
+  int inwardSweepT(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  template <int M>
+  void finalSweepT(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void finalSweepFast(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void factorizeCoupling();
+  bool choleskyFullRank();
+  void applyCouplingInverse(const VectorC& rhs, VectorC& out) const;  // K^+ rhs under the policy
+  void commandFromNu(const VectorC& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
+
+  // Several-segment path, chains and trees (segment_constraints.cpp).
+  int solveGeneral(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                   const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                   const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
+                   const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  int sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments);
+  int inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void addOwnColumns(int i, const Eigen::Ref<const Matrix6X>& alfa);
+  void factorizeCouplingGeneral();
+  void finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_sorted,
+                            Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
+  // out = K^+ rhs for either path (vectors of length m, sorted order on the general path).
+  void couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const;
+
+  // Pass-through (pass_through.cpp).
+  int passThroughEnergy(const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void driverFree(const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& tau);
+  void driverEnergy(Eigen::Ref<Eigen::VectorXd> out) const;
+
+  // Response columns (response_columns.cpp).
+  int checkResponseArgs(const Eigen::Ref<const Eigen::VectorXi>& joints, const Eigen::Ref<Eigen::MatrixXd>& dqdd,
+                        const Eigen::Ref<Eigen::MatrixXd>& dtau_cmd, bool want_tau);
+  void commandPerNu();
+  void baseAxes();
+  void responseInward(const Eigen::Ref<const Eigen::VectorXi>& joints, long c0, long kc);
+  void responseCoupling(long c0, long kc, Eigen::Ref<Eigen::MatrixXd>* dnu_out);
+  void responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, long c0, long kc,
+                       Eigen::Ref<Eigen::MatrixXd> dqdd);
+};
+
+}  // namespace detail
+}  // namespace vereshchagin
