@@ -53,7 +53,8 @@ class Builder {
       throw LoadError("tip link '" + tip_name + "' is not below root link '" + root_name + "'");
     out_.root_link = root_name;
 
-    for (size_t k = 1; k < path.size(); ++k) urdfparts::requireSupported(*path[k]->parent_joint, "on the path", "");
+    for (size_t k = 1; k < path.size(); ++k)
+      urdfparts::requireSupported(*path[k]->parent_joint, "on the path", "", false);
 
     // Walk the path: fixed joints accumulate, each moving joint starts a segment.
     KDL::Frame prev_tip_to_link = KDL::Frame::Identity();  // current path link in the previous tip frame

@@ -199,11 +199,11 @@ JointInfo jointInfo(const urdf::Joint& j, unsigned int segment) {
   return info;
 }
 
-void requireSupported(const urdf::Joint& j, const std::string& where, const std::string& advice) {
+void requireSupported(const urdf::Joint& j, const std::string& where, const std::string& advice, bool allow_mimic) {
   if (!isMoving(j) && j.type != urdf::Joint::FIXED)
     throw LoadError(std::string("joint '") + j.name + "' " + where + " is " + typeName(j.type) +
                     "; only revolute, continuous, prismatic and fixed joints are supported" + advice);
-  if (j.mimic && isMoving(j))
+  if (j.mimic && isMoving(j) && !allow_mimic)
     throw LoadError("joint '" + j.name + "' " + where + " mimics joint '" + j.mimic->joint_name +
                     "'; mimic joints are not supported" + advice);
 }

@@ -44,9 +44,10 @@ KDL::RigidBodyInertia linkInertia(const urdf::Link& link, InertiaCheck check);
 KDL::Joint kdlJoint(const urdf::Joint& j, const KDL::Frame& origin);
 // Limits, velocity / effort limits, friction and damping of a moving joint, validated.
 JointInfo jointInfo(const urdf::Joint& j, unsigned int segment);
-// Throws unless `j` is revolute, continuous, prismatic or fixed and no moving mimic joint;
-// `where` ends the type message (e.g. "on the path").
-void requireSupported(const urdf::Joint& j, const std::string& where, const std::string& advice);
+// Throws unless `j` is revolute, continuous, prismatic or fixed (and, unless allow_mimic, no
+// moving mimic joint); `where` follows the joint's name (e.g. "on the path"), `advice` ends the
+// message.
+void requireSupported(const urdf::Joint& j, const std::string& where, const std::string& advice, bool allow_mimic);
 
 // One segment's rigid body being assembled: every link folded into it is placed (pose in the
 // segment's tip frame) and its inertia added, expressed in the tip frame.

@@ -80,7 +80,7 @@ class TreeBuilder {
   }
 
  private:
-  RigidGroup collectGroup(const urdf::Link& first) const {
+  RigidGroup collectGroup(const urdf::Link& first) {
     RigidGroup g;
     g.links.push_back(&first);
     g.parent.push_back(-1);
@@ -89,12 +89,15 @@ class TreeBuilder {
     return g;
   }
 
-  void visitChildren(int at, RigidGroup& g) const {
+  void visitChildren(int at, RigidGroup& g) {
     for (const urdf::Link* child : childrenByJointName(*g.links[static_cast<std::size_t>(at)])) {
       const urdf::Joint& j = *child->parent_joint;
       urdfparts::requireSupported(j, "in the tree below '" + out_.root_link + "'",
-                                  "; pick a sub-tree root below it (root='" + child->name + "')");
+                                  "; pick a sub-tree root below it (root='" + child->name + "')", true);
       if (urdfparts::isMoving(j)) {
+        if (j.mimic)
+          out_.notes.push_back("joint '" + j.name + "' mimics joint '" + j.mimic->joint_name +
+                               "': modelled as an independent joint");
         g.exits.push_back({&j, at});
         continue;
       }

@@ -260,7 +260,10 @@ void testErrors() {
   }
   std::string mimic = treeXml();
   mimic.insert(mimic.find("</joint>", mimic.find("name='d_head'")), "<mimic joint='a_torso'/>");
-  expectTreeError(mimic, "", {"joint 'd_head'", "mimic"}, "mimic joint");
+  const auto mimicked = vereshchagin::treeFromUrdfString(mimic);
+  check(mimicked.ok && mimicked.robot.joints.size() == 5 && mimicked.robot.notes.size() == 1 &&
+            mimicked.robot.notes[0].find("'d_head' mimics joint 'a_torso'") != std::string::npos,
+        "a mimic joint becomes an independent joint, with a note");
   expectTreeError(treeXml(), "nowhere", {"root link 'nowhere' not found"}, "unknown root");
   expectTreeError(treeXml(), "finger_a", {"no moving joint below root link 'finger_a'"}, "a leaf as root");
   expectTreeError("<robot name='x'><link name='a'>", "", {"malformed URDF"}, "malformed XML");

@@ -2,33 +2,27 @@
 
 #include <pybind11/stl.h>
 
-#include <cstring>
-#include <fstream>
-
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainfksolvervel_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include "model_state.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
-PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, const std::string& tip,
+PyChain PyChain::fromUrdf(const py::object& source, const std::string& root, const std::string& tip,
                           vereshchagin::InertiaCheck inertia_check) {
-  vereshchagin::UrdfResult r;
+  const UrdfSource src = urdfSourceArg(source);
   vereshchagin::UrdfOptions options;
   options.inertia_check = inertia_check;
-  if (source.find('<') != std::string::npos) {
-    r = vereshchagin::chainFromUrdfString(source, root, tip, options);
-  } else {
-    std::ifstream probe(source);
-    if (!probe) raise("URDF source is neither XML text nor a readable file: '" + source + "'");
-    r = vereshchagin::chainFromUrdfFile(source, root, tip, options);
-  }
+  const vereshchagin::UrdfResult r = src.is_text
+                                         ? vereshchagin::chainFromUrdfString(src.text_or_path, root, tip, options)
+                                         : vereshchagin::chainFromUrdfFile(src.text_or_path, root, tip, options);
   if (!r.ok) raise(r.message);
   PyChain c;
-  c.robot = std::move(r.robot);
+  c.robot = r.robot;
   return c;
 }
 
@@ -101,18 +95,6 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   }
 }
 
-std::vector<std::string> PyChain::segmentNames() const {
-  std::vector<std::string> out;
-  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) out.push_back(robot.chain.getSegment(i).getName());
-  return out;
-}
-
-std::vector<std::string> PyChain::jointNames() const {
-  std::vector<std::string> out;
-  for (const auto& j : robot.joints) out.push_back(j.name);
-  return out;
-}
-
 py::array_t<double> PyChain::jointField(double vereshchagin::JointInfo::*field) const {
   py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
   for (size_t k = 0; k < robot.joints.size(); ++k) a.mutable_data()[k] = robot.joints[k].*field;
@@ -148,84 +130,6 @@ void PyChain::setRotorInertia(const py::object& values) {
     rebuilt.addSegment(KDL::Segment(seg.getName(), nj, seg.getFrameToTip(), seg.getInertia()));
   }
   robot.chain = rebuilt;
-}
-
-namespace {
-
-std::string nameList(const std::vector<std::string>& names) {
-  std::string out;
-  for (std::size_t k = 0; k < names.size() && k < 12; ++k) out += (k ? ", '" : "'") + names[k] + "'";
-  if (names.size() > 12) out += ", ... (" + std::to_string(names.size()) + " in all)";
-  return out;
-}
-
-}  // namespace
-
-PyChain::Target PyChain::resolveTarget(PyObject* which, const std::string& label) const {
-  const int ns = static_cast<int>(robot.chain.getNrOfSegments());
-  Target t;
-  if (PyUnicode_Check(which)) {
-    const std::string name = py::handle(which).cast<std::string>();
-    for (int i = 0; i < ns; ++i) {
-      if (robot.chain.getSegment(i).getName() == name) {
-        t.segment = i;
-        return t;
-      }
-    }
-    for (const auto& l : robot.links) {
-      if (l.link == name) {
-        t.segment = l.segment;  // -1: a link of the base
-        t.link_in_tip = l.in_segment_tip;
-        t.merged = l.segment >= 0 && l.in_segment_tip.p.Norm() != 0.0;
-        return t;
-      }
-    }
-    if (!robot.root_link.empty() && name == robot.root_link) return t;  // the base
-    raise(label + ": no segment or link named '" + name + "' (segments: " + nameList(segmentNames()) +
-          (robot.root_link.empty() ? "" : "; base: '" + robot.root_link + "'") + ")");
-  }
-  if (PyBool_Check(which) || !PyIndex_Check(which))
-    raise(label + ": a segment is named by a str (segment or link name) or an int index, got " +
-          std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  const long long v = py::handle(which).cast<long long>();
-  if (v < -ns || v >= ns)
-    raise(label + ": segment index " + std::to_string(v) + " out of range for " + std::to_string(ns) +
-          " segments (valid " + std::to_string(-ns) + " .. " + std::to_string(ns - 1) +
-          "; the base is addressed by its name only)");
-  t.segment = static_cast<int>(v < 0 ? v + ns : v);
-  return t;
-}
-
-PyChain::Target PyChain::resolveOptional(const py::object& which, const std::string& label) const {
-  if (!which.is_none()) return resolveTarget(which.ptr(), label);
-  Target t;
-  t.segment = static_cast<int>(robot.chain.getNrOfSegments()) - 1;
-  return t;
-}
-
-PyChain::Target PyChain::resolveMoving(PyObject* which, const std::string& label) const {
-  Target t = resolveTarget(which, label);
-  if (t.segment < 0)
-    raise(label + ": '" + py::str(which).cast<std::string>() + "' is (part of) the fixed base, not a moving segment");
-  return t;
-}
-
-int PyChain::resolveJoint(PyObject* which, const std::string& label) const {
-  const int nj = static_cast<int>(robot.joints.size());
-  if (PyUnicode_Check(which)) {
-    const std::string name = py::handle(which).cast<std::string>();
-    for (int j = 0; j < nj; ++j)
-      if (robot.joints[j].name == name) return j;
-    raise(label + ": no joint named '" + name + "' (joints: " + nameList(jointNames()) + ")");
-  }
-  if (PyBool_Check(which) || !PyIndex_Check(which))
-    raise(label + ": a joint is named by a str or an int index, got " +
-          std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  const long long v = py::handle(which).cast<long long>();
-  if (v < -nj || v >= nj)
-    raise(label + ": joint index " + std::to_string(v) + " out of range for " + std::to_string(nj) + " joints (valid " +
-          std::to_string(-nj) + " .. " + std::to_string(nj - 1) + ")");
-  return static_cast<int>(v < 0 ? v + nj : v);
 }
 
 namespace {
@@ -290,100 +194,22 @@ py::array_t<double> PyChain::twist(const py::object& q_obj, const py::object& qd
   return out;
 }
 
-namespace {
-
-// KDL::RigidBodyInertia keeps (m, m c, I about the reference point); its public constructor takes
-// the inertia about the centre of mass and would round the stored values differently. The
-// state copies the 13 stored doubles so a pickled chain solves bit for bit like the original.
-static_assert(sizeof(KDL::RigidBodyInertia) == 13 * sizeof(double), "unexpected KDL::RigidBodyInertia layout");
-
-py::tuple inertiaState(const KDL::RigidBodyInertia& I) {
-  double raw[13];
-  std::memcpy(raw, static_cast<const void*>(&I), sizeof(raw));
-  py::tuple t(13);
-  for (int k = 0; k < 13; ++k) t[k] = raw[k];
-  return t;
-}
-
-KDL::RigidBodyInertia inertiaFromState(const py::tuple& t) {
-  double raw[13];
-  for (int k = 0; k < 13; ++k) raw[k] = t[k].cast<double>();
-  KDL::RigidBodyInertia I;
-  std::memcpy(static_cast<void*>(&I), raw, sizeof(raw));
-  return I;
-}
-
-py::tuple frameState(const KDL::Frame& f) {
-  return py::make_tuple(f.M(0, 0), f.M(0, 1), f.M(0, 2), f.M(1, 0), f.M(1, 1), f.M(1, 2), f.M(2, 0), f.M(2, 1),
-                        f.M(2, 2), f.p.x(), f.p.y(), f.p.z());
-}
-
-KDL::Frame frameFromState(const py::tuple& t) {
-  auto d = [&](int k) { return t[k].cast<double>(); };
-  return KDL::Frame(KDL::Rotation(d(0), d(1), d(2), d(3), d(4), d(5), d(6), d(7), d(8)),
-                    KDL::Vector(d(9), d(10), d(11)));
-}
-
-py::tuple vectorState(const KDL::Vector& v) {
-  return py::make_tuple(v.x(), v.y(), v.z());
-}
-KDL::Vector vectorFromState(const py::tuple& t) {
-  return KDL::Vector(t[0].cast<double>(), t[1].cast<double>(), t[2].cast<double>());
-}
-
-}  // namespace
-
 py::tuple PyChain::getState() const {
   py::list segments, joints, links;
-  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) {
-    const KDL::Segment& s = robot.chain.getSegment(i);
-    const KDL::Joint& j = s.getJoint();
-    segments.append(py::make_tuple(s.getName(), j.getName(), static_cast<int>(j.getType()),
-                                   vectorState(j.JointOrigin()), vectorState(j.JointAxis()), j.getInertia(),
-                                   j.getDamping(), j.getStiffness(), frameState(s.getFrameToTip()),
-                                   inertiaState(s.getInertia())));
-  }
-  for (const auto& j : robot.joints)
-    joints.append(py::make_tuple(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction,
-                                 j.damping, j.segment));
-  for (const auto& l : robot.links) links.append(py::make_tuple(l.link, l.segment, frameState(l.in_segment_tip)));
+  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i)
+    segments.append(segmentState(robot.chain.getSegment(i)));
+  for (const auto& j : robot.joints) joints.append(jointInfoState(j));
+  for (const auto& l : robot.links) links.append(linkState(l));
   return py::make_tuple(1, segments, joints, links, robot.root_link, py::cast(robot.notes));
 }
 
 PyChain PyChain::fromState(const py::tuple& state) {
   if (state.size() != 6 || state[0].cast<int>() != 1) raise("Chain state: unknown format");
   PyChain c;
-  for (const auto& item : state[1].cast<py::list>()) {
-    const py::tuple t = item.cast<py::tuple>();
-    const auto type = static_cast<KDL::Joint::JointType>(t[2].cast<int>());
-    const std::string jname = t[1].cast<std::string>();
-    const double rotor = t[5].cast<double>(), damping = t[6].cast<double>(), stiffness = t[7].cast<double>();
-    const KDL::Joint j =
-        (type == KDL::Joint::RotAxis || type == KDL::Joint::TransAxis)
-            ? KDL::Joint(jname, vectorFromState(t[3].cast<py::tuple>()), vectorFromState(t[4].cast<py::tuple>()), type,
-                         1.0, 0.0, rotor, damping, stiffness)
-            : KDL::Joint(jname, type, 1.0, 0.0, rotor, damping, stiffness);
-    c.robot.chain.addSegment(KDL::Segment(t[0].cast<std::string>(), j, frameFromState(t[8].cast<py::tuple>()),
-                                          inertiaFromState(t[9].cast<py::tuple>())));
-  }
-  for (const auto& item : state[2].cast<py::list>()) {
-    const py::tuple t = item.cast<py::tuple>();
-    vereshchagin::JointInfo j;
-    j.name = t[0].cast<std::string>();
-    j.type = t[1].cast<std::string>();
-    j.lower = t[2].cast<double>();
-    j.upper = t[3].cast<double>();
-    j.velocity_limit = t[4].cast<double>();
-    j.effort_limit = t[5].cast<double>();
-    j.friction = t[6].cast<double>();
-    j.damping = t[7].cast<double>();
-    j.segment = t[8].cast<unsigned int>();
-    c.robot.joints.push_back(j);
-  }
-  for (const auto& item : state[3].cast<py::list>()) {
-    const py::tuple t = item.cast<py::tuple>();
-    c.robot.links.push_back({t[0].cast<std::string>(), t[1].cast<int>(), frameFromState(t[2].cast<py::tuple>())});
-  }
+  for (const auto& item : state[1].cast<py::list>()) c.robot.chain.addSegment(segmentFromState(item.cast<py::tuple>()));
+  for (const auto& item : state[2].cast<py::list>())
+    c.robot.joints.push_back(jointInfoFromState(item.cast<py::tuple>()));
+  for (const auto& item : state[3].cast<py::list>()) c.robot.links.push_back(linkFromState(item.cast<py::tuple>()));
   c.robot.root_link = state[4].cast<std::string>();
   c.robot.notes = state[5].cast<std::vector<std::string>>();
   return c;
@@ -462,11 +288,7 @@ inertia_check : {'physical', 'joint_space'}
           "from_urdf",
           [](const py::object& source, const std::string& root, const std::string& tip,
              const std::string& inertia_check) {
-            const py::object os = py::module_::import("os");
-            if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
-              raise("source must be URDF XML text or a file path");
-            return PyChain::fromUrdf(py::str(os.attr("fspath")(source)).cast<std::string>(), root, tip,
-                                     inertiaCheckArg(inertia_check, ""));
+            return PyChain::fromUrdf(source, root, tip, inertiaCheckArg(inertia_check, ""));
           },
           py::arg("source"), py::arg("root") = "", py::arg("tip") = "", py::arg("inertia_check") = "physical",
           R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).

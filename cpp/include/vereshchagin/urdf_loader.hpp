@@ -22,8 +22,9 @@
 // visited in the alphabetical order of their joints' names (the order urdfdom stores them),
 // links fixed to a segment's body searched depth-first in that order too. The KDL::Tree is built
 // in that order, so its q_nr equals the segment index and RobotTree::joints[k].segment == k.
-// Floating, planar and moving mimic joints anywhere below the root are rejected (the message
-// names the joint and suggests a sub-tree root below it, root=...).
+// Floating and planar joints anywhere below the root are rejected (the message names the joint
+// and suggests a sub-tree root below it, root=...). Mimic joints (e.g. the second finger of a
+// gripper) become independent joints, each recorded in RobotTree::notes (a chain rejects them).
 //
 // Joint axes may point in any direction (normalised); revolute, continuous and prismatic joints
 // are supported on the path. Side branches that hang off the path through moving joints are
