@@ -19,6 +19,7 @@ import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
+from chains import assert_close
 from trees import pin_model, pin_q, pin_v_index, random_tree_urdf
 from vereshchagin.robots import example_robot_urdf
 
@@ -28,13 +29,8 @@ SEEDS = (1, 2, 3, 4, 5, 6)
 
 
 def assert_rel(actual, expected, what, rtol=RTOL):
-    """Norm-wise relative comparison ||a - e|| <= rtol * max(||e||, 1)."""
-    actual = np.asarray(actual, float)
-    expected = np.asarray(expected, float)
-    assert actual.shape == expected.shape, f"{what}: shape {actual.shape} != {expected.shape}"
-    err = np.linalg.norm(actual - expected)
-    scale = max(np.linalg.norm(expected), 1.0)
-    assert err <= rtol * scale, f"{what}: |error| {err:.3e} > {rtol:.0e} * {scale:.3e}"
+    """chains.assert_close with this file's tolerance and argument order."""
+    assert_close(actual, expected, rtol, what)
 
 
 def _source(name: str) -> str:

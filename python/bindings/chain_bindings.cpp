@@ -6,6 +6,7 @@
 #include <kdl/chainfksolvervel_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include "model_properties.hpp"
 #include "model_state.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg
 #include "vereshchagin/urdf_loader.hpp"
@@ -95,12 +96,6 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   }
 }
 
-py::array_t<double> PyChain::jointField(double vereshchagin::JointInfo::*field) const {
-  py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
-  for (size_t k = 0; k < robot.joints.size(); ++k) a.mutable_data()[k] = robot.joints[k].*field;
-  return a;
-}
-
 py::array_t<double> PyChain::rotorInertia() const {
   py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
   for (size_t k = 0; k < robot.joints.size(); ++k)
@@ -132,19 +127,8 @@ void PyChain::setRotorInertia(const py::object& values) {
   robot.chain = rebuilt;
 }
 
-namespace {
-
-KDL::JntArray jointArray(const py::object& obj, const char* name, unsigned int n) {
-  Array a = vectorArg(obj, name, n);
-  KDL::JntArray q(n);
-  for (unsigned int k = 0; k < n; ++k) q(k) = a.at(k);
-  return q;
-}
-
-}  // namespace
-
 py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segment) const {
-  const KDL::JntArray q = jointArray(q_obj, "q", robot.chain.getNrOfJoints());
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", robot.chain.getNrOfJoints());
   const Target t = resolveOptional(segment, "segment");
   const int seg = t.segment;
   const KDL::Frame& link_in_tip = t.link_in_tip;
@@ -158,7 +142,7 @@ py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segme
 
 py::array_t<double> PyChain::jacobian(const py::object& q_obj, const py::object& segment) const {
   const unsigned int n = robot.chain.getNrOfJoints();
-  const KDL::JntArray q = jointArray(q_obj, "q", n);
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
   const Target t = resolveOptional(segment, "segment");
   const int seg = t.segment;
   const KDL::Frame& link_in_tip = t.link_in_tip;
@@ -242,16 +226,19 @@ name the axis-aligned cases.
           "fixed", []() { return JointSpec(); }, "A rigid connection (no joint variable).")
       .def("__repr__", &JointSpec::repr);
 
-  py::class_<PyChain>(mod, "Chain",
-                      R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
+  py::class_<PyChain> cls(mod, "Chain",
+                          R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
 
 Build it segment by segment with :meth:`add_segment`, or from a URDF with :meth:`from_urdf`
 (fixed joints merged into their parent links). Joint metadata (limits, friction, damping, rotor
 inertia) and the names of merged links are kept. Frames are addressed by segment name, merged link
 name, or index (negative from the end); the base only by its link name (:attr:`root_link`).
 Chains pickle and copy.
-)doc")
-      .def(py::init<>())
+)doc");
+  bindJointData(cls);
+  bindNamesAndIndices(cls,
+                      "list of str: approximations made while building the chain (lumped branches, merged links).");
+  cls.def(py::init<>())
       .def("add_segment", &PyChain::addSegment, R"doc(Append a segment (a joint followed by a rigid body).
 
 Parameters
@@ -309,38 +296,9 @@ use ``Solver(..., inertia_check='joint_space')`` with them).
           "int: number of segments (moving joints plus fixed-joint segments; rows of f_ext).")
       .def_property_readonly("segment_names", &PyChain::segmentNames,
                              "list of str: segment names, base to tip (a URDF segment is named after its link).")
-      .def_property_readonly("joint_names", &PyChain::jointNames, "list of str: moving joint names in q order.")
-      .def_property_readonly(
-          "lower", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::lower); },
-          "ndarray (n,): lower position limits, rad or m (-inf: none; URDF continuous joints have none).")
-      .def_property_readonly(
-          "upper", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::upper); },
-          "ndarray (n,): upper position limits, rad or m (+inf: none).")
-      .def_property_readonly(
-          "velocity_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::velocity_limit); },
-          "ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver.")
-      .def_property_readonly(
-          "effort_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::effort_limit); },
-          "ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver.")
-      .def_property_readonly(
-          "friction", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::friction); },
-          "ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>); used by "
-          "friction=True.")
-      .def_property_readonly(
-          "damping", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::damping); },
-          "ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not applied by the "
-          "solver.")
       .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia,
                     "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg (settable; added to the "
                     "joint's articulated inertia).")
-      .def_property_readonly(
-          "joint_types",
-          [](const PyChain& c) {
-            std::vector<std::string> t;
-            for (const auto& j : c.robot.joints) t.push_back(j.type);
-            return t;
-          },
-          "list of str: 'revolute', 'continuous' or 'prismatic' per moving joint.")
       .def_property_readonly(
           "segment_masses",
           [](const PyChain& c) {
@@ -350,61 +308,6 @@ use ``Solver(..., inertia_check='joint_space')`` with them).
             return m;
           },
           "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.")
-      .def_property_readonly(
-          "root_link", [](const PyChain& c) { return c.robot.root_link; },
-          "str: name of the base link (the base frame); the base is addressed by this name only.")
-      .def_property_readonly(
-          "notes", [](const PyChain& c) { return c.robot.notes; },
-          "list of str: approximations made while building the chain (lumped branches, merged links).")
-      .def_property_readonly(
-          "link_names",
-          [](const PyChain& c) {
-            std::vector<std::string> t;
-            for (const auto& l : c.robot.links) t.push_back(l.link);
-            return t;
-          },
-          "list of str: every URDF link folded into the chain (segments, merged links, base links); segment and merged "
-          "link names address frames in fk, jacobian, twist, constraints= and f_ext dicts; base links only in fk, "
-          "jacobian and twist.")
-      .def(
-          "segment_index",
-          [](const PyChain& c, const py::object& which) {
-            return c.resolveMoving(which.ptr(), "segment_index").segment;
-          },
-          py::arg("name"), R"doc(Index of a segment.
-
-Parameters
-----------
-name : str or int
-    A segment name, the name of a link merged into a segment by fixed joints (its segment's
-    index), or an index (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_segments - 1``.
-
-Raises
-------
-SolverError
-    Unknown names, indices out of range, and the base link (it is no segment; ``fk``,
-    ``jacobian`` and ``twist`` accept it by name).
-)doc")
-      .def(
-          "joint_index",
-          [](const PyChain& c, const py::object& which) { return c.resolveJoint(which.ptr(), "joint_index"); },
-          py::arg("name"), R"doc(Index of a moving joint in q.
-
-Parameters
-----------
-name : str or int
-    A joint name or an index (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_joints - 1``.
-)doc")
       .def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(), R"doc(Pose of a frame in the base frame.
 
 Parameters

@@ -80,7 +80,6 @@ struct PyChain : Addressable {
   void addSegment(const std::string& name, const py::object& joint, const py::object& tip, const py::object& mass,
                   const py::object& com, const py::object& inertia, const py::object& rotor_inertia,
                   const std::string& joint_name, const std::string& inertia_check);
-  py::array_t<double> jointField(double vereshchagin::JointInfo::*field) const;
   py::array_t<double> rotorInertia() const;
   void setRotorInertia(const py::object& values);
   py::array_t<double> fk(const py::object& q, const py::object& segment) const;

@@ -3,13 +3,12 @@
 
 #include <pybind11/stl.h>
 
+#include "model_properties.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg
 
 namespace vsbind {
 
 namespace {
-
-using vereshchagin::JointInfo;
 
 const char* kTreeDoc = R"doc(A kinematic tree of segments (a joint followed by a rigid body), on a KDL::Tree.
 
@@ -112,24 +111,18 @@ Chain
     into the path, the arms of a two-arm robot become independent chains.
 )doc";
 
-void bindArrays(py::class_<PyTree>& cls) {
-  const auto field = [](double JointInfo::*f) { return [f](const PyTree& t) { return t.jointField(f); }; };
-  cls.def_property_readonly("lower", field(&JointInfo::lower),
-                            "ndarray (n,): lower position limits, rad or m (-inf: none; continuous joints have none).")
-      .def_property_readonly("upper", field(&JointInfo::upper),
-                             "ndarray (n,): upper position limits, rad or m (+inf: none).")
+// Tree-only properties: sizes, segment names, the parent array, segment masses, base_name.
+void bindStructure(py::class_<PyTree>& cls) {
+  cls.def_property_readonly(
+         "n_joints", [](const PyTree& t) { return t.robot.tree.getNrOfJoints(); },
+         "int: number of moving joints n (the length of q, qd).")
       .def_property_readonly(
-          "velocity_limit", field(&JointInfo::velocity_limit),
-          "ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver.")
-      .def_property_readonly("effort_limit", field(&JointInfo::effort_limit),
-                             "ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver.")
+          "n_segments", [](const PyTree& t) { return t.segmentCount(); },
+          "int: number of segments (one per moving joint).")
+      .def_property_readonly("segment_names", &PyTree::segmentNames,
+                             "list of str: segment names in segment order (a segment is named after its tip link).")
       .def_property_readonly(
-          "friction", field(&JointInfo::friction),
-          "ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>).")
-      .def_property_readonly(
-          "damping", field(&JointInfo::damping),
-          "ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not "
-          "applied by the solver.")
+          "base_name", [](const PyTree& t) { return t.robot.root_link; }, "str: the same as :attr:`root_link`.")
       .def_property_readonly(
           "parent",
           [](const PyTree& t) {
@@ -149,82 +142,6 @@ void bindArrays(py::class_<PyTree>& cls) {
           "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.");
 }
 
-void bindNames(py::class_<PyTree>& cls) {
-  cls.def_property_readonly(
-         "n_joints", [](const PyTree& t) { return t.robot.tree.getNrOfJoints(); },
-         "int: number of moving joints n (the length of q, qd).")
-      .def_property_readonly(
-          "n_segments", [](const PyTree& t) { return t.segmentCount(); },
-          "int: number of segments (one per moving joint).")
-      .def_property_readonly("segment_names", &PyTree::segmentNames,
-                             "list of str: segment names in segment order (a segment is named after its tip link).")
-      .def_property_readonly("joint_names", &PyTree::jointNames, "list of str: moving joint names in q order.")
-      .def_property_readonly(
-          "joint_types",
-          [](const PyTree& t) {
-            std::vector<std::string> types;
-            for (const auto& j : t.robot.joints) types.push_back(j.type);
-            return types;
-          },
-          "list of str: 'revolute', 'continuous' or 'prismatic' per moving joint.")
-      .def_property_readonly(
-          "root_link", [](const PyTree& t) { return t.robot.root_link; },
-          "str: name of the base link (the base frame); the base is addressed by this name only.")
-      .def_property_readonly(
-          "base_name", [](const PyTree& t) { return t.robot.root_link; }, "str: the same as :attr:`root_link`.")
-      .def_property_readonly(
-          "notes", [](const PyTree& t) { return t.robot.notes; },
-          "list of str: approximations made while building the tree (mimic joints modelled as independent joints).")
-      .def_property_readonly(
-          "link_names",
-          [](const PyTree& t) {
-            std::vector<std::string> names;
-            for (const auto& l : t.robot.links) names.push_back(l.link);
-            return names;
-          },
-          "list of str: every URDF link of the tree (segments' tip links, merged links, base links); each names a "
-          "frame "
-          "in fk, jacobian and twist.")
-      .def(
-          "segment_index",
-          [](const PyTree& t, const py::object& which) {
-            return t.resolveMoving(which.ptr(), "segment_index").segment;
-          },
-          py::arg("name"), R"doc(Index of a segment.
-
-Parameters
-----------
-name : str or int
-    A segment name, the name of a link merged into a segment (its segment's index), or an index
-    (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_segments - 1``.
-
-Raises
-------
-SolverError
-    Unknown names (the message lists the segments), indices out of range, and the base link.
-)doc")
-      .def(
-          "joint_index",
-          [](const PyTree& t, const py::object& which) { return t.resolveJoint(which.ptr(), "joint_index"); },
-          py::arg("name"), R"doc(Index of a moving joint in q.
-
-Parameters
-----------
-name : str or int
-    A joint name or an index (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_joints - 1``.
-)doc");
-}
-
 }  // namespace
 
 void bindTree(py::module_& mod) {
@@ -236,8 +153,11 @@ void bindTree(py::module_& mod) {
         return PyTree::fromUrdf(source, root_name, inertiaCheckArg(inertia_check, ""));
       },
       py::arg("source"), py::arg("root") = py::none(), py::arg("inertia_check") = "physical", kFromUrdfDoc);
-  bindNames(cls);
-  bindArrays(cls);
+  bindStructure(cls);
+  bindJointData(cls);
+  bindNamesAndIndices(cls,
+                      "list of str: approximations made while building the tree (mimic joints modelled as "
+                      "independent joints).");
   cls.def("fk", &PyTree::fk, py::arg("q"), py::arg("segment"), kFkDoc)
       .def("jacobian", &PyTree::jacobian, py::arg("q"), py::arg("segment"), kJacobianDoc)
       .def("twist", &PyTree::twist, py::arg("q"), py::arg("qd"), py::arg("segment"), kTwistDoc)

@@ -40,7 +40,6 @@ struct PyTree : Addressable {
   unsigned int qIndex(int index) const;
   // Segment indices from the base's child down to `index`.
   std::vector<int> pathTo(int index) const;
-  py::array_t<double> jointField(double vereshchagin::JointInfo::*field) const;
   py::array_t<double> fk(const py::object& q, const py::object& segment) const;
   py::array_t<double> jacobian(const py::object& q, const py::object& segment) const;
   py::array_t<double> twist(const py::object& q, const py::object& qd, const py::object& segment) const;

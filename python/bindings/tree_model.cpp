@@ -67,20 +67,7 @@ std::vector<int> PyTree::pathTo(int index) const {
   return path;
 }
 
-py::array_t<double> PyTree::jointField(double vereshchagin::JointInfo::*field) const {
-  py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
-  for (size_t k = 0; k < robot.joints.size(); ++k) a.mutable_data()[k] = robot.joints[k].*field;
-  return a;
-}
-
 namespace {
-
-KDL::JntArray jointArray(const py::object& obj, const char* name, unsigned int n) {
-  Array a = vectorArg(obj, name, n);
-  KDL::JntArray q(n);
-  for (unsigned int k = 0; k < n; ++k) q(k) = a.at(k);
-  return q;
-}
 
 bool isPrismatic(KDL::Joint::JointType type) {
   return type == KDL::Joint::TransAxis || type == KDL::Joint::TransX || type == KDL::Joint::TransY ||
@@ -90,7 +77,7 @@ bool isPrismatic(KDL::Joint::JointType type) {
 }  // namespace
 
 py::array_t<double> PyTree::fk(const py::object& q_obj, const py::object& which) const {
-  const KDL::JntArray q = jointArray(q_obj, "q", robot.tree.getNrOfJoints());
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", robot.tree.getNrOfJoints());
   const Target t = resolveTarget(which.ptr(), "segment");
   KDL::Frame f = KDL::Frame::Identity();
   if (t.segment >= 0)
@@ -100,7 +87,7 @@ py::array_t<double> PyTree::fk(const py::object& q_obj, const py::object& which)
 
 py::array_t<double> PyTree::jacobian(const py::object& q_obj, const py::object& which) const {
   const unsigned int n = robot.tree.getNrOfJoints();
-  const KDL::JntArray q = jointArray(q_obj, "q", n);
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
   const Target t = resolveTarget(which.ptr(), "segment");
   py::array_t<double> out({static_cast<py::ssize_t>(6), static_cast<py::ssize_t>(n)});
   auto o = out.mutable_unchecked<2>();
