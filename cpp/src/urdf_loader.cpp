@@ -26,7 +26,37 @@ class Builder {
   Builder(const urdf::ModelInterface& model, RobotChain& out, InertiaCheck check)
       : model_(model), out_(out), check_(check) {}
 
-  void build(const std::string& root_name, const std::string& tip_name_in) {
+  void build(const std::string& root_name, const std::string& tip_name) {
+    const std::vector<urdf::LinkConstSharedPtr> path = pathTo(root_name, tip_name);
+    out_.root_link = root_name;
+    for (size_t k = 1; k < path.size(); ++k)
+      urdfparts::requireSupported(*path[k]->parent_joint, "on the path", "", false);
+
+    // Walk the path: fixed joints accumulate, each moving joint starts a segment.
+    size_t first_moving = path.size();
+    for (size_t i = 1; i < path.size(); ++i) {
+      if (isMoving(*path[i]->parent_joint)) {
+        first_moving = i;
+        break;
+      }
+    }
+    if (first_moving == path.size())
+      throw LoadError("no moving joint between '" + root_name + "' and '" + path.back()->name + "'");
+    KDL::Frame prev_tip_to_link = placeBase(path, first_moving);  // current path link in the previous tip frame
+    size_t k = first_moving;
+    while (k < path.size()) {
+      // Group: child link plus following path links reached through fixed joints.
+      size_t end = k + 1;
+      while (end < path.size() && !isMoving(*path[end]->parent_joint)) ++end;
+      addSegment(path, k, end, prev_tip_to_link);
+      prev_tip_to_link = KDL::Frame::Identity();
+      k = end;
+    }
+  }
+
+ private:
+  // The links from root to tip (an empty tip: the single leaf below root).
+  std::vector<urdf::LinkConstSharedPtr> pathTo(const std::string& root_name, const std::string& tip_name_in) const {
     urdf::LinkConstSharedPtr root = model_.getLink(root_name);
     if (!root) throw LoadError("root link '" + root_name + "' not found in the URDF");
     std::string tip_name = tip_name_in;
@@ -42,8 +72,6 @@ class Builder {
     }
     urdf::LinkConstSharedPtr tip = model_.getLink(tip_name);
     if (!tip) throw LoadError("tip link '" + tip_name + "' not found in the URDF");
-
-    // Path root -> tip, as links.
     std::vector<urdf::LinkConstSharedPtr> path;
     for (urdf::LinkConstSharedPtr l = tip; l; l = l->getParent()) {
       path.insert(path.begin(), l);
@@ -51,72 +79,59 @@ class Builder {
     }
     if (path.front()->name != root_name)
       throw LoadError("tip link '" + tip_name + "' is not below root link '" + root_name + "'");
-    out_.root_link = root_name;
+    return path;
+  }
 
-    for (size_t k = 1; k < path.size(); ++k)
-      urdfparts::requireSupported(*path[k]->parent_joint, "on the path", "", false);
-
-    // Walk the path: fixed joints accumulate, each moving joint starts a segment.
-    KDL::Frame prev_tip_to_link = KDL::Frame::Identity();  // current path link in the previous tip frame
-    // Base group: path links before the first moving joint (and their fixed side branches).
-    size_t first_moving = path.size();
-    for (size_t i = 1; i < path.size(); ++i) {
-      if (isMoving(*path[i]->parent_joint)) {
-        first_moving = i;
-        break;
-      }
-    }
-    if (first_moving == path.size())
-      throw LoadError("no moving joint between '" + root_name + "' and '" + tip_name + "'");
+  // Base group: path links before the first moving joint (and their side branches), placed in
+  // the root frame. Returns the pose of the first moving joint's parent link in the root frame.
+  KDL::Frame placeBase(const std::vector<urdf::LinkConstSharedPtr>& path, size_t first_moving) {
+    KDL::Frame link_in_root = KDL::Frame::Identity();
     for (size_t i = 0; i < first_moving; ++i) {
-      if (i > 0) prev_tip_to_link = prev_tip_to_link * jointOrigin(*path[i]->parent_joint);
-      out_.links.push_back({path[i]->name, -1, prev_tip_to_link});
+      if (i > 0) link_in_root = link_in_root * jointOrigin(*path[i]->parent_joint);
+      out_.links.push_back({path[i]->name, -1, link_in_root});
       // Side branches of the base: fixed to the world, recorded for their frames only.
       for (const auto& child : path[i]->child_links) {
         if (i + 1 < path.size() && child->name == path[i + 1]->name) continue;
-        placeBaseSubtree(*child, prev_tip_to_link * jointOrigin(*child->parent_joint));
+        placeBaseSubtree(*child, link_in_root * jointOrigin(*child->parent_joint));
       }
     }
-    size_t k = first_moving;
-    while (k < path.size()) {
-      const urdf::Joint& j = *path[k]->parent_joint;
-      // Group: child link plus following path links reached through fixed joints.
-      size_t end = k + 1;
-      while (end < path.size() && !isMoving(*path[end]->parent_joint)) ++end;
-      const size_t tip_index = end - 1;
-      // Poses of the group's path links in the child link (joint) frame at q = 0.
-      std::vector<KDL::Frame> in_child(end - k);
-      in_child[0] = KDL::Frame::Identity();
-      for (size_t i = k + 1; i < end; ++i) in_child[i - k] = in_child[i - k - 1] * jointOrigin(*path[i]->parent_joint);
-      const KDL::Frame child_to_tip = in_child[tip_index - k];
-      const KDL::Frame tip_inv = child_to_tip.Inverse();
-
-      const int seg_index = static_cast<int>(out_.chain.getNrOfSegments());
-      RigidBody body;
-      body.segment = seg_index;
-      for (size_t i = k; i < end; ++i) {
-        const KDL::Frame link_in_tip = tip_inv * in_child[i - k];
-        foldLink(*path[i], link_in_tip, check_, body, out_.links);
-        // Side branches of this path link.
-        for (const auto& child : path[i]->child_links) {
-          if (i + 1 < end && child->name == path[i + 1]->name) continue;
-          if (i + 1 == end && end < path.size() && child->name == path[end]->name) continue;
-          lumpSubtree(*child, link_in_tip * jointOrigin(*child->parent_joint), body);
-        }
-      }
-
-      // Joint in the previous tip frame.
-      const KDL::Frame origin = prev_tip_to_link * jointOrigin(j);
-      const KDL::Joint kj = urdfparts::kdlJoint(j, origin);
-      out_.chain.addSegment(KDL::Segment(path[tip_index]->name, kj, origin * child_to_tip, body.inertia));
-      out_.joints.push_back(urdfparts::jointInfo(j, static_cast<unsigned int>(seg_index)));
-
-      prev_tip_to_link = KDL::Frame::Identity();
-      k = end;
-    }
+    return link_in_root;
   }
 
- private:
+  // The segment of path[k]'s moving joint: path links k .. end - 1 and their side branches
+  // merged; its tip frame is path[end - 1]'s. `prev_tip_to_link`: path[k - 1] in the previous
+  // segment's tip frame.
+  void addSegment(const std::vector<urdf::LinkConstSharedPtr>& path, size_t k, size_t end,
+                  const KDL::Frame& prev_tip_to_link) {
+    const urdf::Joint& j = *path[k]->parent_joint;
+    const size_t tip_index = end - 1;
+    // Poses of the group's path links in the child link (joint) frame at q = 0.
+    std::vector<KDL::Frame> in_child(end - k);
+    in_child[0] = KDL::Frame::Identity();
+    for (size_t i = k + 1; i < end; ++i) in_child[i - k] = in_child[i - k - 1] * jointOrigin(*path[i]->parent_joint);
+    const KDL::Frame child_to_tip = in_child[tip_index - k];
+    const KDL::Frame tip_inv = child_to_tip.Inverse();
+
+    const int seg_index = static_cast<int>(out_.chain.getNrOfSegments());
+    RigidBody body;
+    body.segment = seg_index;
+    for (size_t i = k; i < end; ++i) {
+      const KDL::Frame link_in_tip = tip_inv * in_child[i - k];
+      foldLink(*path[i], link_in_tip, check_, body, out_.links);
+      // Side branches of this path link.
+      for (const auto& child : path[i]->child_links) {
+        if (i + 1 < end && child->name == path[i + 1]->name) continue;
+        if (i + 1 == end && end < path.size() && child->name == path[end]->name) continue;
+        lumpSubtree(*child, link_in_tip * jointOrigin(*child->parent_joint), body);
+      }
+    }
+    // Joint in the previous tip frame.
+    const KDL::Frame origin = prev_tip_to_link * jointOrigin(j);
+    const KDL::Joint kj = urdfparts::kdlJoint(j, origin);
+    out_.chain.addSegment(KDL::Segment(path[tip_index]->name, kj, origin * child_to_tip, body.inertia));
+    out_.joints.push_back(urdfparts::jointInfo(j, static_cast<unsigned int>(seg_index)));
+  }
+
   // Fold a side branch (rooted at `link`, whose frame is `pose` in the segment tip frame) into
   // the segment's rigid body, rigidly at joint positions 0.
   void lumpSubtree(const urdf::Link& link, const KDL::Frame& pose, RigidBody& body) {
