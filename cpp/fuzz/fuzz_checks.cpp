@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <kdl/chain.hpp>
@@ -206,8 +207,40 @@ KDL::Joint drawJoint(ByteReader& r, const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+// The tree loader on the same text: ok with an empty message or a failure with one; a loaded
+// tree's segment order, parents, q_nr and joint metadata agree with each other.
+std::string checkUrdfTree(const std::string& xml) {
+  const vereshchagin::UrdfTreeResult res = vereshchagin::treeFromUrdfString(xml);
+  if (!res.ok) return res.message.empty() ? "URDF tree rejected with an empty message" : "";
+  if (!res.message.empty()) return "URDF tree loaded but with a message";
+  const vereshchagin::RobotTree& robot = res.robot;
+  const std::size_t ns = robot.segment_names.size();
+  if (robot.tree.getNrOfSegments() != ns || robot.tree.getNrOfJoints() != ns || robot.joints.size() != ns ||
+      robot.parent.size() != ns)
+    return "tree: segment, joint and parent counts differ";
+  std::vector<KDL::SegmentMap::const_iterator> order;
+  std::vector<int> parent;
+  vereshchagin::treeSegmentOrder(robot.tree, order, parent);
+  if (parent != robot.parent) return "tree: parent array differs from treeSegmentOrder";
+  for (std::size_t i = 0; i < ns; ++i) {
+    if (order[i]->first != robot.segment_names[i]) return "tree: segment order differs from treeSegmentOrder";
+    if (GetTreeElementQNr(order[i]->second) != i || robot.joints[i].segment != i) return "tree: q_nr is not preorder";
+    if (robot.parent[i] >= static_cast<int>(i)) return "tree: a parent follows its child";
+    const auto& j = robot.joints[i];
+    if (!(j.friction >= 0.0) || !std::isfinite(j.friction) || !(j.lower <= j.upper) || !(j.damping >= 0.0))
+      return "tree: loaded joint '" + j.name + "' has invalid friction, damping or limits";
+  }
+  return "";
+}
+
+}  // namespace
+
 std::string checkUrdf(const std::uint8_t* data, std::size_t size) {
   const std::string xml(reinterpret_cast<const char*>(data), size);
+  const std::string tree_violation = checkUrdfTree(xml);
+  if (!tree_violation.empty()) return tree_violation;
   const vereshchagin::UrdfResult res = vereshchagin::chainFromUrdfString(xml);
   if (!res.ok) return res.message.empty() ? "URDF rejected with an empty message" : "";
   if (!res.message.empty()) return "URDF loaded but with a message";

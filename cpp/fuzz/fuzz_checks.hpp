@@ -3,7 +3,9 @@
 //  * checkUrdf: any byte string as URDF text either loads with ok = true and an empty message, or
 //    fails with a non-empty message; a loaded chain either is rejected by the solvers with an error
 //    code and a message, or solves (frictionless, one constraint, with the URDF's friction and
-//    limits) to finite outputs.
+//    limits) to finite outputs. The same text through treeFromUrdfString: ok with an empty message
+//    or a failure with one; a loaded tree's segment order, parent array, q_nr and joint metadata
+//    agree (preorder, parents before children, finite friction and ordered limits).
 //  * checkSolver: the bytes describe a chain (0..8 segments of any joint type, inertias, frames,
 //    rotor inertias — values anywhere from plausible to NaN) and one call of each entry point
 //    (ChainHdSolver::solve / CartToJnt / responseColumns, FrictionSolver::solve / gaussValue /

@@ -1,4 +1,5 @@
-// libFuzzer target: URDF text -> chainFromUrdfString -> both solvers. Properties in fuzz_checks.hpp.
+// libFuzzer target: URDF text -> chainFromUrdfString (both solvers) and treeFromUrdfString. Properties in
+// fuzz_checks.hpp.
 #include <cstdio>
 #include <cstdlib>
 

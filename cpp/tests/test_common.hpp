@@ -73,6 +73,20 @@ inline double relErrCols(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen
   return e;
 }
 
+// |a - b| <= tol * max(1, |b|), and the same entrywise for frames.
+inline bool near(double a, double b, double tol = 1e-12) {
+  return std::abs(a - b) <= tol * std::max(1.0, std::abs(b));
+}
+
+inline bool nearFrame(const KDL::Frame& a, const KDL::Frame& b, double tol = 1e-12) {
+  for (int r = 0; r < 3; ++r) {
+    if (!near(a.p(r), b.p(r), tol)) return false;
+    for (int c = 0; c < 3; ++c)
+      if (!near(a.M(r, c), b.M(r, c), tol)) return false;
+  }
+  return true;
+}
+
 template <typename T>
 std::string str(const T& x) {
   std::ostringstream os;

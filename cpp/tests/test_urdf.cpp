@@ -6,32 +6,19 @@
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 
+#include "test_common.hpp"
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace {
 
-int failures = 0, checks = 0;
+testutil::Checker checker("test_urdf");
 
 void check(bool ok, const std::string& what) {
-  ++checks;
-  if (!ok) {
-    ++failures;
-    std::printf("[test_urdf] FAIL: %s\n", what.c_str());
-  }
+  checker.check(ok, what);
 }
 
-bool near(double a, double b, double tol = 1e-12) {
-  return std::abs(a - b) <= tol * std::max(1.0, std::abs(b));
-}
-
-bool nearFrame(const KDL::Frame& a, const KDL::Frame& b) {
-  for (int r = 0; r < 3; ++r) {
-    if (!near(a.p(r), b.p(r))) return false;
-    for (int c = 0; c < 3; ++c)
-      if (!near(a.M(r, c), b.M(r, c))) return false;
-  }
-  return true;
-}
+using testutil::near;
+using testutil::nearFrame;
 
 const char* kArm = R"(<robot name="arm">
   <link name="base"/>
@@ -162,10 +149,5 @@ void testErrors() {
 int main() {
   testStructure();
   testErrors();
-  if (failures) {
-    std::printf("test_urdf: FAIL (%d of %d checks failed)\n", failures, checks);
-    return 1;
-  }
-  std::printf("test_urdf: PASS (%d checks)\n", checks);
-  return 0;
+  return checker.finish("");
 }

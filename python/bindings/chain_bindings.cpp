@@ -2,33 +2,28 @@
 
 #include <pybind11/stl.h>
 
-#include <cstring>
-#include <fstream>
-
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainfksolvervel_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include "model_properties.hpp"
+#include "model_state.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
-PyChain PyChain::fromUrdf(const std::string& source, const std::string& root, const std::string& tip,
+PyChain PyChain::fromUrdf(const py::object& source, const std::string& root, const std::string& tip,
                           vereshchagin::InertiaCheck inertia_check) {
-  vereshchagin::UrdfResult r;
+  const UrdfSource src = urdfSourceArg(source);
   vereshchagin::UrdfOptions options;
   options.inertia_check = inertia_check;
-  if (source.find('<') != std::string::npos) {
-    r = vereshchagin::chainFromUrdfString(source, root, tip, options);
-  } else {
-    std::ifstream probe(source);
-    if (!probe) raise("URDF source is neither XML text nor a readable file: '" + source + "'");
-    r = vereshchagin::chainFromUrdfFile(source, root, tip, options);
-  }
+  const vereshchagin::UrdfResult r = src.is_text
+                                         ? vereshchagin::chainFromUrdfString(src.text_or_path, root, tip, options)
+                                         : vereshchagin::chainFromUrdfFile(src.text_or_path, root, tip, options);
   if (!r.ok) raise(r.message);
   PyChain c;
-  c.robot = std::move(r.robot);
+  c.robot = r.robot;
   return c;
 }
 
@@ -101,24 +96,6 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   }
 }
 
-std::vector<std::string> PyChain::segmentNames() const {
-  std::vector<std::string> out;
-  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) out.push_back(robot.chain.getSegment(i).getName());
-  return out;
-}
-
-std::vector<std::string> PyChain::jointNames() const {
-  std::vector<std::string> out;
-  for (const auto& j : robot.joints) out.push_back(j.name);
-  return out;
-}
-
-py::array_t<double> PyChain::jointField(double vereshchagin::JointInfo::*field) const {
-  py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
-  for (size_t k = 0; k < robot.joints.size(); ++k) a.mutable_data()[k] = robot.joints[k].*field;
-  return a;
-}
-
 py::array_t<double> PyChain::rotorInertia() const {
   py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
   for (size_t k = 0; k < robot.joints.size(); ++k)
@@ -150,97 +127,8 @@ void PyChain::setRotorInertia(const py::object& values) {
   robot.chain = rebuilt;
 }
 
-namespace {
-
-std::string nameList(const std::vector<std::string>& names) {
-  std::string out;
-  for (std::size_t k = 0; k < names.size() && k < 12; ++k) out += (k ? ", '" : "'") + names[k] + "'";
-  if (names.size() > 12) out += ", ... (" + std::to_string(names.size()) + " in all)";
-  return out;
-}
-
-}  // namespace
-
-PyChain::Target PyChain::resolveTarget(PyObject* which, const std::string& label) const {
-  const int ns = static_cast<int>(robot.chain.getNrOfSegments());
-  Target t;
-  if (PyUnicode_Check(which)) {
-    const std::string name = py::handle(which).cast<std::string>();
-    for (int i = 0; i < ns; ++i) {
-      if (robot.chain.getSegment(i).getName() == name) {
-        t.segment = i;
-        return t;
-      }
-    }
-    for (const auto& l : robot.links) {
-      if (l.link == name) {
-        t.segment = l.segment;  // -1: a link of the base
-        t.link_in_tip = l.in_segment_tip;
-        t.merged = l.segment >= 0 && l.in_segment_tip.p.Norm() != 0.0;
-        return t;
-      }
-    }
-    if (!robot.root_link.empty() && name == robot.root_link) return t;  // the base
-    raise(label + ": no segment or link named '" + name + "' (segments: " + nameList(segmentNames()) +
-          (robot.root_link.empty() ? "" : "; base: '" + robot.root_link + "'") + ")");
-  }
-  if (PyBool_Check(which) || !PyIndex_Check(which))
-    raise(label + ": a segment is named by a str (segment or link name) or an int index, got " +
-          std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  const long long v = py::handle(which).cast<long long>();
-  if (v < -ns || v >= ns)
-    raise(label + ": segment index " + std::to_string(v) + " out of range for " + std::to_string(ns) +
-          " segments (valid " + std::to_string(-ns) + " .. " + std::to_string(ns - 1) +
-          "; the base is addressed by its name only)");
-  t.segment = static_cast<int>(v < 0 ? v + ns : v);
-  return t;
-}
-
-PyChain::Target PyChain::resolveOptional(const py::object& which, const std::string& label) const {
-  if (!which.is_none()) return resolveTarget(which.ptr(), label);
-  Target t;
-  t.segment = static_cast<int>(robot.chain.getNrOfSegments()) - 1;
-  return t;
-}
-
-PyChain::Target PyChain::resolveMoving(PyObject* which, const std::string& label) const {
-  Target t = resolveTarget(which, label);
-  if (t.segment < 0)
-    raise(label + ": '" + py::str(which).cast<std::string>() + "' is (part of) the fixed base, not a moving segment");
-  return t;
-}
-
-int PyChain::resolveJoint(PyObject* which, const std::string& label) const {
-  const int nj = static_cast<int>(robot.joints.size());
-  if (PyUnicode_Check(which)) {
-    const std::string name = py::handle(which).cast<std::string>();
-    for (int j = 0; j < nj; ++j)
-      if (robot.joints[j].name == name) return j;
-    raise(label + ": no joint named '" + name + "' (joints: " + nameList(jointNames()) + ")");
-  }
-  if (PyBool_Check(which) || !PyIndex_Check(which))
-    raise(label + ": a joint is named by a str or an int index, got " +
-          std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  const long long v = py::handle(which).cast<long long>();
-  if (v < -nj || v >= nj)
-    raise(label + ": joint index " + std::to_string(v) + " out of range for " + std::to_string(nj) + " joints (valid " +
-          std::to_string(-nj) + " .. " + std::to_string(nj - 1) + ")");
-  return static_cast<int>(v < 0 ? v + nj : v);
-}
-
-namespace {
-
-KDL::JntArray jointArray(const py::object& obj, const char* name, unsigned int n) {
-  Array a = vectorArg(obj, name, n);
-  KDL::JntArray q(n);
-  for (unsigned int k = 0; k < n; ++k) q(k) = a.at(k);
-  return q;
-}
-
-}  // namespace
-
 py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segment) const {
-  const KDL::JntArray q = jointArray(q_obj, "q", robot.chain.getNrOfJoints());
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", robot.chain.getNrOfJoints());
   const Target t = resolveOptional(segment, "segment");
   const int seg = t.segment;
   const KDL::Frame& link_in_tip = t.link_in_tip;
@@ -254,7 +142,7 @@ py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segme
 
 py::array_t<double> PyChain::jacobian(const py::object& q_obj, const py::object& segment) const {
   const unsigned int n = robot.chain.getNrOfJoints();
-  const KDL::JntArray q = jointArray(q_obj, "q", n);
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
   const Target t = resolveOptional(segment, "segment");
   const int seg = t.segment;
   const KDL::Frame& link_in_tip = t.link_in_tip;
@@ -290,100 +178,22 @@ py::array_t<double> PyChain::twist(const py::object& q_obj, const py::object& qd
   return out;
 }
 
-namespace {
-
-// KDL::RigidBodyInertia keeps (m, m c, I about the reference point); its public constructor takes
-// the inertia about the centre of mass and would round the stored values differently. The
-// state copies the 13 stored doubles so a pickled chain solves bit for bit like the original.
-static_assert(sizeof(KDL::RigidBodyInertia) == 13 * sizeof(double), "unexpected KDL::RigidBodyInertia layout");
-
-py::tuple inertiaState(const KDL::RigidBodyInertia& I) {
-  double raw[13];
-  std::memcpy(raw, static_cast<const void*>(&I), sizeof(raw));
-  py::tuple t(13);
-  for (int k = 0; k < 13; ++k) t[k] = raw[k];
-  return t;
-}
-
-KDL::RigidBodyInertia inertiaFromState(const py::tuple& t) {
-  double raw[13];
-  for (int k = 0; k < 13; ++k) raw[k] = t[k].cast<double>();
-  KDL::RigidBodyInertia I;
-  std::memcpy(static_cast<void*>(&I), raw, sizeof(raw));
-  return I;
-}
-
-py::tuple frameState(const KDL::Frame& f) {
-  return py::make_tuple(f.M(0, 0), f.M(0, 1), f.M(0, 2), f.M(1, 0), f.M(1, 1), f.M(1, 2), f.M(2, 0), f.M(2, 1),
-                        f.M(2, 2), f.p.x(), f.p.y(), f.p.z());
-}
-
-KDL::Frame frameFromState(const py::tuple& t) {
-  auto d = [&](int k) { return t[k].cast<double>(); };
-  return KDL::Frame(KDL::Rotation(d(0), d(1), d(2), d(3), d(4), d(5), d(6), d(7), d(8)),
-                    KDL::Vector(d(9), d(10), d(11)));
-}
-
-py::tuple vectorState(const KDL::Vector& v) {
-  return py::make_tuple(v.x(), v.y(), v.z());
-}
-KDL::Vector vectorFromState(const py::tuple& t) {
-  return KDL::Vector(t[0].cast<double>(), t[1].cast<double>(), t[2].cast<double>());
-}
-
-}  // namespace
-
 py::tuple PyChain::getState() const {
   py::list segments, joints, links;
-  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) {
-    const KDL::Segment& s = robot.chain.getSegment(i);
-    const KDL::Joint& j = s.getJoint();
-    segments.append(py::make_tuple(s.getName(), j.getName(), static_cast<int>(j.getType()),
-                                   vectorState(j.JointOrigin()), vectorState(j.JointAxis()), j.getInertia(),
-                                   j.getDamping(), j.getStiffness(), frameState(s.getFrameToTip()),
-                                   inertiaState(s.getInertia())));
-  }
-  for (const auto& j : robot.joints)
-    joints.append(py::make_tuple(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction,
-                                 j.damping, j.segment));
-  for (const auto& l : robot.links) links.append(py::make_tuple(l.link, l.segment, frameState(l.in_segment_tip)));
+  for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i)
+    segments.append(segmentState(robot.chain.getSegment(i)));
+  for (const auto& j : robot.joints) joints.append(jointInfoState(j));
+  for (const auto& l : robot.links) links.append(linkState(l));
   return py::make_tuple(1, segments, joints, links, robot.root_link, py::cast(robot.notes));
 }
 
 PyChain PyChain::fromState(const py::tuple& state) {
   if (state.size() != 6 || state[0].cast<int>() != 1) raise("Chain state: unknown format");
   PyChain c;
-  for (const auto& item : state[1].cast<py::list>()) {
-    const py::tuple t = item.cast<py::tuple>();
-    const auto type = static_cast<KDL::Joint::JointType>(t[2].cast<int>());
-    const std::string jname = t[1].cast<std::string>();
-    const double rotor = t[5].cast<double>(), damping = t[6].cast<double>(), stiffness = t[7].cast<double>();
-    const KDL::Joint j =
-        (type == KDL::Joint::RotAxis || type == KDL::Joint::TransAxis)
-            ? KDL::Joint(jname, vectorFromState(t[3].cast<py::tuple>()), vectorFromState(t[4].cast<py::tuple>()), type,
-                         1.0, 0.0, rotor, damping, stiffness)
-            : KDL::Joint(jname, type, 1.0, 0.0, rotor, damping, stiffness);
-    c.robot.chain.addSegment(KDL::Segment(t[0].cast<std::string>(), j, frameFromState(t[8].cast<py::tuple>()),
-                                          inertiaFromState(t[9].cast<py::tuple>())));
-  }
-  for (const auto& item : state[2].cast<py::list>()) {
-    const py::tuple t = item.cast<py::tuple>();
-    vereshchagin::JointInfo j;
-    j.name = t[0].cast<std::string>();
-    j.type = t[1].cast<std::string>();
-    j.lower = t[2].cast<double>();
-    j.upper = t[3].cast<double>();
-    j.velocity_limit = t[4].cast<double>();
-    j.effort_limit = t[5].cast<double>();
-    j.friction = t[6].cast<double>();
-    j.damping = t[7].cast<double>();
-    j.segment = t[8].cast<unsigned int>();
-    c.robot.joints.push_back(j);
-  }
-  for (const auto& item : state[3].cast<py::list>()) {
-    const py::tuple t = item.cast<py::tuple>();
-    c.robot.links.push_back({t[0].cast<std::string>(), t[1].cast<int>(), frameFromState(t[2].cast<py::tuple>())});
-  }
+  for (const auto& item : state[1].cast<py::list>()) c.robot.chain.addSegment(segmentFromState(item.cast<py::tuple>()));
+  for (const auto& item : state[2].cast<py::list>())
+    c.robot.joints.push_back(jointInfoFromState(item.cast<py::tuple>()));
+  for (const auto& item : state[3].cast<py::list>()) c.robot.links.push_back(linkFromState(item.cast<py::tuple>()));
   c.robot.root_link = state[4].cast<std::string>();
   c.robot.notes = state[5].cast<std::vector<std::string>>();
   return c;
@@ -416,16 +226,19 @@ name the axis-aligned cases.
           "fixed", []() { return JointSpec(); }, "A rigid connection (no joint variable).")
       .def("__repr__", &JointSpec::repr);
 
-  py::class_<PyChain>(mod, "Chain",
-                      R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
+  py::class_<PyChain> cls(mod, "Chain",
+                          R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
 
 Build it segment by segment with :meth:`add_segment`, or from a URDF with :meth:`from_urdf`
 (fixed joints merged into their parent links). Joint metadata (limits, friction, damping, rotor
 inertia) and the names of merged links are kept. Frames are addressed by segment name, merged link
 name, or index (negative from the end); the base only by its link name (:attr:`root_link`).
 Chains pickle and copy.
-)doc")
-      .def(py::init<>())
+)doc");
+  bindJointData(cls);
+  bindNamesAndIndices(cls,
+                      "list of str: approximations made while building the chain (lumped branches, merged links).");
+  cls.def(py::init<>())
       .def("add_segment", &PyChain::addSegment, R"doc(Append a segment (a joint followed by a rigid body).
 
 Parameters
@@ -462,11 +275,7 @@ inertia_check : {'physical', 'joint_space'}
           "from_urdf",
           [](const py::object& source, const std::string& root, const std::string& tip,
              const std::string& inertia_check) {
-            const py::object os = py::module_::import("os");
-            if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
-              raise("source must be URDF XML text or a file path");
-            return PyChain::fromUrdf(py::str(os.attr("fspath")(source)).cast<std::string>(), root, tip,
-                                     inertiaCheckArg(inertia_check, ""));
+            return PyChain::fromUrdf(source, root, tip, inertiaCheckArg(inertia_check, ""));
           },
           py::arg("source"), py::arg("root") = "", py::arg("tip") = "", py::arg("inertia_check") = "physical",
           R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
@@ -487,38 +296,9 @@ use ``Solver(..., inertia_check='joint_space')`` with them).
           "int: number of segments (moving joints plus fixed-joint segments; rows of f_ext).")
       .def_property_readonly("segment_names", &PyChain::segmentNames,
                              "list of str: segment names, base to tip (a URDF segment is named after its link).")
-      .def_property_readonly("joint_names", &PyChain::jointNames, "list of str: moving joint names in q order.")
-      .def_property_readonly(
-          "lower", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::lower); },
-          "ndarray (n,): lower position limits, rad or m (-inf: none; URDF continuous joints have none).")
-      .def_property_readonly(
-          "upper", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::upper); },
-          "ndarray (n,): upper position limits, rad or m (+inf: none).")
-      .def_property_readonly(
-          "velocity_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::velocity_limit); },
-          "ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver.")
-      .def_property_readonly(
-          "effort_limit", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::effort_limit); },
-          "ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver.")
-      .def_property_readonly(
-          "friction", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::friction); },
-          "ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>); used by "
-          "friction=True.")
-      .def_property_readonly(
-          "damping", [](const PyChain& c) { return c.jointField(&vereshchagin::JointInfo::damping); },
-          "ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not applied by the "
-          "solver.")
       .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia,
                     "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg (settable; added to the "
                     "joint's articulated inertia).")
-      .def_property_readonly(
-          "joint_types",
-          [](const PyChain& c) {
-            std::vector<std::string> t;
-            for (const auto& j : c.robot.joints) t.push_back(j.type);
-            return t;
-          },
-          "list of str: 'revolute', 'continuous' or 'prismatic' per moving joint.")
       .def_property_readonly(
           "segment_masses",
           [](const PyChain& c) {
@@ -528,61 +308,6 @@ use ``Solver(..., inertia_check='joint_space')`` with them).
             return m;
           },
           "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.")
-      .def_property_readonly(
-          "root_link", [](const PyChain& c) { return c.robot.root_link; },
-          "str: name of the base link (the base frame); the base is addressed by this name only.")
-      .def_property_readonly(
-          "notes", [](const PyChain& c) { return c.robot.notes; },
-          "list of str: approximations made while building the chain (lumped branches, merged links).")
-      .def_property_readonly(
-          "link_names",
-          [](const PyChain& c) {
-            std::vector<std::string> t;
-            for (const auto& l : c.robot.links) t.push_back(l.link);
-            return t;
-          },
-          "list of str: every URDF link folded into the chain (segments, merged links, base links); segment and merged "
-          "link names address frames in fk, jacobian, twist, constraints= and f_ext dicts; base links only in fk, "
-          "jacobian and twist.")
-      .def(
-          "segment_index",
-          [](const PyChain& c, const py::object& which) {
-            return c.resolveMoving(which.ptr(), "segment_index").segment;
-          },
-          py::arg("name"), R"doc(Index of a segment.
-
-Parameters
-----------
-name : str or int
-    A segment name, the name of a link merged into a segment by fixed joints (its segment's
-    index), or an index (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_segments - 1``.
-
-Raises
-------
-SolverError
-    Unknown names, indices out of range, and the base link (it is no segment; ``fk``,
-    ``jacobian`` and ``twist`` accept it by name).
-)doc")
-      .def(
-          "joint_index",
-          [](const PyChain& c, const py::object& which) { return c.resolveJoint(which.ptr(), "joint_index"); },
-          py::arg("name"), R"doc(Index of a moving joint in q.
-
-Parameters
-----------
-name : str or int
-    A joint name or an index (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_joints - 1``.
-)doc")
       .def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(), R"doc(Pose of a frame in the base frame.
 
 Parameters

@@ -9,6 +9,7 @@
 #include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/robot_chain.hpp"
 
+#include "addressing.hpp"
 #include "common.hpp"
 
 namespace vsbind {
@@ -59,11 +60,19 @@ inline JointSpec jointFromString(const std::string& s) {
 }
 
 // The Python Chain: a RobotChain (KDL::Chain plus joint and link metadata), built segment by
-// segment or from a URDF.
-struct PyChain {
+// segment or from a URDF. Frames and joints are addressed by the rule of addressing.hpp.
+struct PyChain : Addressable {
   vereshchagin::RobotChain robot;
 
-  static PyChain fromUrdf(const std::string& source, const std::string& root, const std::string& tip,
+  int segmentCount() const override { return static_cast<int>(robot.chain.getNrOfSegments()); }
+  const std::string& segmentName(int index) const override {
+    return robot.chain.getSegment(static_cast<unsigned int>(index)).getName();
+  }
+  const std::vector<vereshchagin::LinkPlacement>& linkPlacements() const override { return robot.links; }
+  const std::vector<vereshchagin::JointInfo>& jointInfos() const override { return robot.joints; }
+  const std::string& rootLink() const override { return robot.root_link; }
+
+  static PyChain fromUrdf(const py::object& source, const std::string& root, const std::string& tip,
                           vereshchagin::InertiaCheck inertia_check);
   // Pickle state: every segment (joint, tip frame, inertia bit for bit), joint and link metadata.
   py::tuple getState() const;
@@ -71,27 +80,8 @@ struct PyChain {
   void addSegment(const std::string& name, const py::object& joint, const py::object& tip, const py::object& mass,
                   const py::object& com, const py::object& inertia, const py::object& rotor_inertia,
                   const std::string& joint_name, const std::string& inertia_check);
-  std::vector<std::string> segmentNames() const;
-  std::vector<std::string> jointNames() const;
-  py::array_t<double> jointField(double vereshchagin::JointInfo::*field) const;
   py::array_t<double> rotorInertia() const;
   void setRotorInertia(const py::object& values);
-  // One addressing rule for every call that names a frame (fk, jacobian, twist, segment_index,
-  // constraints=, f_ext dicts): a segment name, a link merged into a segment by fixed joints
-  // (link_in_tip: its pose in that segment's tip frame), the base link by its own name
-  // (segment -1), or an int index (negative from the end). `label` starts error messages.
-  struct Target {
-    int segment = -1;
-    KDL::Frame link_in_tip = KDL::Frame::Identity();
-    bool merged = false;  // a merged link away from the tip: moments must be moved
-  };
-  Target resolveTarget(PyObject* which, const std::string& label) const;
-  // The same for calls that need a moving segment: the base raises.
-  Target resolveMoving(PyObject* which, const std::string& label) const;
-  // resolveTarget, with None meaning the last segment (the default of fk, jacobian, ...).
-  Target resolveOptional(const py::object& which, const std::string& label) const;
-  // Joint index from a joint name or an int index (negative from the end).
-  int resolveJoint(PyObject* which, const std::string& label) const;
   py::array_t<double> fk(const py::object& q, const py::object& segment) const;
   py::array_t<double> jacobian(const py::object& q, const py::object& segment) const;
   py::array_t<double> twist(const py::object& q, const py::object& qd, const py::object& segment) const;

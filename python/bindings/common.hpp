@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 #include <kdl/frames.hpp>
+#include <kdl/jntarray.hpp>
 
 namespace vsbind {
 
@@ -95,6 +96,14 @@ inline Array vectorArg(const py::handle& obj, const char* name, py::ssize_t n) {
   }
   requireFinite(a, name);
   return a;
+}
+
+// A finite vector of shape (n,) as joint values.
+inline KDL::JntArray jntArrayArg(const py::handle& obj, const char* name, unsigned int n) {
+  const Array a = vectorArg(obj, name, n);
+  KDL::JntArray out(n);
+  for (unsigned int k = 0; k < n; ++k) out(k) = a.at(k);
+  return out;
 }
 
 inline KDL::Frame frameFrom4x4(const py::handle& obj, const char* name) {

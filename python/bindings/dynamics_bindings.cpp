@@ -23,13 +23,6 @@ namespace {
 
 const std::vector<double> kEarthGravity{0.0, 0.0, -9.81};
 
-KDL::JntArray jointVector(const py::object& obj, const char* name, unsigned int n) {
-  const Array a = vectorArg(obj, name, n);
-  KDL::JntArray out(n);
-  for (unsigned int k = 0; k < n; ++k) out(k) = a.at(k);
-  return out;
-}
-
 // Results of finite inputs can still overflow (e.g. |qd| = 1e160); never hand back Inf or NaN.
 void requireFiniteResult(const double* p, size_t n, const char* what) {
   for (size_t k = 0; k < n; ++k)
@@ -74,9 +67,9 @@ py::array_t<double> inverseDynamics(const PyChain& c, const py::object& q_obj, c
                                     const py::object& qdd_obj, const py::object& f_ext, const py::object& gravity) {
   const KDL::Chain& chain = c.robot.chain;
   const unsigned int n = chain.getNrOfJoints();
-  const KDL::JntArray q = jointVector(q_obj, "q", n);
-  const KDL::JntArray qd = jointVector(qd_obj, "qd", n);
-  const KDL::JntArray qdd = jointVector(qdd_obj, "qdd", n);
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
+  const KDL::JntArray qd = jntArrayArg(qd_obj, "qd", n);
+  const KDL::JntArray qdd = jntArrayArg(qdd_obj, "qdd", n);
   const KDL::Vector g = vec3(gravity, "gravity");
   const KDL::Wrenches wrenches = externalWrenches(f_ext, chain, q);
   KDL::JntArray tau(n);
@@ -89,7 +82,7 @@ py::array_t<double> inverseDynamics(const PyChain& c, const py::object& q_obj, c
 py::array_t<double> massMatrix(const PyChain& c, const py::object& q_obj) {
   const KDL::Chain& chain = c.robot.chain;
   const unsigned int n = chain.getNrOfJoints();
-  const KDL::JntArray q = jointVector(q_obj, "q", n);
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
   KDL::JntSpaceInertiaMatrix H(n);
   KDL::ChainDynParam dyn(chain, KDL::Vector::Zero());
   if (dyn.JntToMass(q, H) < 0) raise("mass matrix computation failed: " + std::string(dyn.strError(dyn.getError())));
@@ -103,7 +96,7 @@ py::array_t<double> massMatrix(const PyChain& c, const py::object& q_obj) {
 
 py::array_t<double> gravityTorques(const PyChain& c, const py::object& q_obj, const py::object& gravity) {
   const KDL::Chain& chain = c.robot.chain;
-  const KDL::JntArray q = jointVector(q_obj, "q", chain.getNrOfJoints());
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", chain.getNrOfJoints());
   KDL::JntArray tau(chain.getNrOfJoints());
   KDL::ChainDynParam dyn(chain, vec3(gravity, "gravity"));
   if (dyn.JntToGravity(q, tau) < 0) raise("gravity torques failed: " + std::string(dyn.strError(dyn.getError())));
@@ -113,8 +106,8 @@ py::array_t<double> gravityTorques(const PyChain& c, const py::object& q_obj, co
 py::array_t<double> coriolisTorques(const PyChain& c, const py::object& q_obj, const py::object& qd_obj) {
   const KDL::Chain& chain = c.robot.chain;
   const unsigned int n = chain.getNrOfJoints();
-  const KDL::JntArray q = jointVector(q_obj, "q", n);
-  const KDL::JntArray qd = jointVector(qd_obj, "qd", n);
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
+  const KDL::JntArray qd = jntArrayArg(qd_obj, "qd", n);
   KDL::JntArray tau(n);
   KDL::ChainDynParam dyn(chain, KDL::Vector::Zero());
   if (dyn.JntToCoriolis(q, qd, tau) < 0) raise("Coriolis torques failed: " + std::string(dyn.strError(dyn.getError())));
@@ -127,7 +120,7 @@ py::array_t<double> jacobianDotTimesQd(const PyChain& c, const py::object& q_obj
                                        const py::object& segment) {
   const KDL::Chain& chain = c.robot.chain;
   const unsigned int n = chain.getNrOfJoints();
-  const KDL::JntArrayVel state(jointVector(q_obj, "q", n), jointVector(qd_obj, "qd", n));
+  const KDL::JntArrayVel state(jntArrayArg(q_obj, "q", n), jntArrayArg(qd_obj, "qd", n));
   const PyChain::Target target = c.resolveOptional(segment, "segment");
   const int seg = target.segment;
   const KDL::Frame& link_in_tip = target.link_in_tip;
@@ -153,7 +146,7 @@ py::array_t<double> jacobianDotTimesQd(const PyChain& c, const py::object& q_obj
 
 py::array_t<double> fkAll(const PyChain& c, const py::object& q_obj) {
   const KDL::Chain& chain = c.robot.chain;
-  const std::vector<KDL::Frame> tips = tipFrames(chain, jointVector(q_obj, "q", chain.getNrOfJoints()));
+  const std::vector<KDL::Frame> tips = tipFrames(chain, jntArrayArg(q_obj, "q", chain.getNrOfJoints()));
   py::array_t<double> out(
       {static_cast<py::ssize_t>(tips.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
   for (size_t i = 0; i < tips.size(); ++i) writeHomogeneous(tips[i], out.mutable_data() + 16 * i);

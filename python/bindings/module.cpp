@@ -7,6 +7,7 @@
 
 namespace vsbind {
 void bindChain(py::module_& mod);
+void bindTree(py::module_& mod);
 void bindSolver(py::module_& mod);
 void bindResultType(py::module_& mod);
 void bindDynamics(py::module_& mod);
@@ -17,6 +18,7 @@ PYBIND11_MODULE(_core, mod) {
   mod.doc() = "C++ core of vereshchagin (Popov-Vereshchagin hybrid dynamics on KDL chains).";
   pybind11::register_exception<vsbind::SolverError>(mod, "SolverError", PyExc_ValueError);
   vsbind::bindChain(mod);
+  vsbind::bindTree(mod);
   vsbind::bindResultType(mod);
   vsbind::bindDynamics(mod);     // adds methods to Chain
   vsbind::bindSegmentSpec(mod);  // adds Chain.segment_spec

@@ -3,10 +3,11 @@
 Build a :class:`Chain`, wrap it in a :class:`Solver` and call :meth:`Solver.solve` with joint
 positions, velocities and an optional partial task (``alpha``, ``beta``), external wrenches and
 feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL's
-``ChainHdSolver_Vereshchagin``; see :class:`Solver`.
+``ChainHdSolver_Vereshchagin``; see :class:`Solver`. Branched robots load as a :class:`Tree`
+(``Tree.from_urdf``).
 """
 
-from ._core import Chain, Joint, SolveResult, SolverError
+from ._core import Chain, Joint, SolveResult, SolverError, Tree
 from . import robots, task
 from ._version import __version__ as __version__  # written once: CMakeLists.txt
 from .friction import Friction
@@ -35,4 +36,15 @@ def _to_kdl(self: Chain):
 setattr(Chain, "from_kdl", staticmethod(_chain_from_kdl))  # noqa: B010
 setattr(Chain, "to_kdl", _to_kdl)  # noqa: B010
 
-__all__ = ["BatchResult", "Chain", "Friction", "Joint", "SolveResult", "Solver", "SolverError", "robots", "task"]
+__all__ = [
+    "BatchResult",
+    "Chain",
+    "Friction",
+    "Joint",
+    "SolveResult",
+    "Solver",
+    "SolverError",
+    "Tree",
+    "robots",
+    "task",
+]

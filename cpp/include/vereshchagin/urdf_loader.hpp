@@ -1,5 +1,7 @@
-// URDF (parsed with urdfdom, no ROS) -> serial RobotChain from a root link to a tip link.
+// URDF (parsed with urdfdom, no ROS) -> serial RobotChain from a root link to a tip link, or the
+// whole RobotTree below a root link.
 //
+// Chains:
 // Frames: the chain's base frame is the root link's frame. Each moving joint on the path starts a
 // segment; the segment's rigid body is the joint's child link plus every link attached to it
 // through fixed joints (on the path up to the next moving joint, and fixed side branches), with
@@ -7,6 +9,22 @@
 // that rigid group: the parent link of the next moving joint, or the tip link for the last
 // segment. So constraints and wrenches on the last segment refer to the tip link's frame, and a
 // gripper attached by fixed joints adds its mass to the last moving link.
+//
+// Trees: fixed joints are merged the same way. Each moving joint below the root starts a
+// segment whose rigid body is its child link plus every link attached to it through fixed joints
+// (masses and inertias combined); moving joints leaving that group start child segments. The
+// segment's tip frame is the frame of the group's deepest link that lies on the way to every
+// moving joint leaving the group (to every leaf of the group when none leaves it): the parent
+// link of the single next moving joint, or the leaf link, exactly as for a chain. So each
+// root-to-leaf path without side branches gives the same segments as chainFromUrdf(root, leaf).
+// The root link and the links fixed to it form the base (LinkPlacement::segment -1, poses in the
+// root frame). Segment order: depth-first preorder from the root; at every link the children are
+// visited in the alphabetical order of their joints' names (the order urdfdom stores them),
+// links fixed to a segment's body searched depth-first in that order too. The KDL::Tree is built
+// in that order, so its q_nr equals the segment index and RobotTree::joints[k].segment == k.
+// Floating and planar joints anywhere below the root are rejected (the message names the joint
+// and suggests a sub-tree root below it, root=...). Mimic joints (e.g. the second finger of a
+// gripper) become independent joints, each recorded in RobotTree::notes (a chain rejects them).
 //
 // Joint axes may point in any direction (normalised); revolute, continuous and prismatic joints
 // are supported on the path. Side branches that hang off the path through moving joints are
@@ -17,6 +35,7 @@
 
 #include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/robot_chain.hpp"
+#include "vereshchagin/robot_tree.hpp"
 
 namespace vereshchagin {
 
@@ -24,6 +43,12 @@ struct UrdfResult {
   bool ok = false;
   std::string message;  // why loading failed (empty when ok)
   RobotChain robot;
+};
+
+struct UrdfTreeResult {
+  bool ok = false;
+  std::string message;  // why loading failed (empty when ok)
+  RobotTree robot;
 };
 
 struct UrdfOptions {
@@ -40,5 +65,12 @@ UrdfResult chainFromUrdfString(const std::string& xml, const std::string& root =
                                const UrdfOptions& options = UrdfOptions());
 UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root = "", const std::string& tip = "",
                              const UrdfOptions& options = UrdfOptions());
+
+// xml: the URDF document; root: a link name, empty = the URDF's root link. The tree holds every
+// link below root (see above for fixed-joint merging, segment order and joint order).
+UrdfTreeResult treeFromUrdfString(const std::string& xml, const std::string& root = "",
+                                  const UrdfOptions& options = UrdfOptions());
+UrdfTreeResult treeFromUrdfFile(const std::string& path, const std::string& root = "",
+                                const UrdfOptions& options = UrdfOptions());
 
 }  // namespace vereshchagin

@@ -1,0 +1,94 @@
+// The shared addressing rule of Chain and Tree (addressing.hpp).
+#include "addressing.hpp"
+
+namespace vsbind {
+
+std::string nameList(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t k = 0; k < names.size() && k < 12; ++k) out += (k ? ", '" : "'") + names[k] + "'";
+  if (names.size() > 12) out += ", ... (" + std::to_string(names.size()) + " in all)";
+  return out;
+}
+
+std::vector<std::string> Addressable::segmentNames() const {
+  std::vector<std::string> out;
+  for (int i = 0; i < segmentCount(); ++i) out.push_back(segmentName(i));
+  return out;
+}
+
+std::vector<std::string> Addressable::jointNames() const {
+  std::vector<std::string> out;
+  for (const auto& j : jointInfos()) out.push_back(j.name);
+  return out;
+}
+
+Addressable::Target Addressable::resolveTarget(PyObject* which, const std::string& label) const {
+  const int ns = segmentCount();
+  const std::string& root_link = rootLink();
+  Target t;
+  if (PyUnicode_Check(which)) {
+    const std::string name = py::handle(which).cast<std::string>();
+    for (int i = 0; i < ns; ++i) {
+      if (segmentName(i) == name) {
+        t.segment = i;
+        return t;
+      }
+    }
+    for (const auto& l : linkPlacements()) {
+      if (l.link == name) {
+        t.segment = l.segment;  // -1: a link of the base
+        t.link_in_tip = l.in_segment_tip;
+        t.merged = l.segment >= 0 && l.in_segment_tip.p.Norm() != 0.0;
+        return t;
+      }
+    }
+    if (!root_link.empty() && name == root_link) return t;  // the base
+    raise(label + ": no segment or link named '" + name + "' (segments: " + nameList(segmentNames()) +
+          (root_link.empty() ? "" : "; base: '" + root_link + "'") + ")");
+  }
+  if (PyBool_Check(which) || !PyIndex_Check(which))
+    raise(label + ": a segment is named by a str (segment or link name) or an int index, got " +
+          std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
+  const long long v = py::handle(which).cast<long long>();
+  if (v < -ns || v >= ns)
+    raise(label + ": segment index " + std::to_string(v) + " out of range for " + std::to_string(ns) +
+          " segments (valid " + std::to_string(-ns) + " .. " + std::to_string(ns - 1) +
+          "; the base is addressed by its name only)");
+  t.segment = static_cast<int>(v < 0 ? v + ns : v);
+  return t;
+}
+
+Addressable::Target Addressable::resolveOptional(const py::object& which, const std::string& label) const {
+  if (!which.is_none()) return resolveTarget(which.ptr(), label);
+  Target t;
+  t.segment = segmentCount() - 1;
+  return t;
+}
+
+Addressable::Target Addressable::resolveMoving(PyObject* which, const std::string& label) const {
+  Target t = resolveTarget(which, label);
+  if (t.segment < 0)
+    raise(label + ": '" + py::str(which).cast<std::string>() + "' is (part of) the fixed base, not a moving segment");
+  return t;
+}
+
+int Addressable::resolveJoint(PyObject* which, const std::string& label) const {
+  const std::vector<vereshchagin::JointInfo>& joints = jointInfos();
+  const int nj = static_cast<int>(joints.size());
+  if (PyUnicode_Check(which)) {
+    const std::string name = py::handle(which).cast<std::string>();
+    for (int j = 0; j < nj; ++j)
+      if (joints[j].name == name) return j;
+    raise(label + ": no joint named '" + name + "' (joints: " + nameList(jointNames()) + ")");
+  }
+  if (PyBool_Check(which) || !PyIndex_Check(which))
+    raise(label + ": a joint is named by a str or an int index, got " +
+          std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
+  const long long v = py::handle(which).cast<long long>();
+  if (v < -nj || v >= nj)
+    raise(label + ": joint index " + std::to_string(v) + " out of range for " + std::to_string(nj) + " joints (valid " +
+          std::to_string(-nj) + " .. " + std::to_string(nj - 1) + ")");
+  return static_cast<int>(v < 0 ? v + nj : v);
+}
+
+}  // namespace vsbind

@@ -1,0 +1,58 @@
+// One addressing rule for every Python call that names a frame or a joint, shared by Chain and
+// Tree: a segment name, a link merged into a segment by fixed joints (its pose in that segment's
+// tip frame), the base link by its own name (segment -1), or an int index (negative from the
+// end); joints by name or index. Error messages start with the caller's `label`.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <kdl/frames.hpp>
+
+#include "vereshchagin/robot_chain.hpp"  // JointInfo, LinkPlacement
+
+#include "common.hpp"
+
+namespace vsbind {
+
+// A frame resolved to a segment (-1: the base) and the frame's pose in that segment's tip frame.
+struct FrameTarget {
+  int segment = -1;
+  KDL::Frame link_in_tip = KDL::Frame::Identity();
+  bool merged = false;  // a merged link away from the tip: moments must be moved
+};
+
+// The names of a model (segments, links, joints, base) and the rule that resolves them.
+class Addressable {
+ public:
+  using Target = FrameTarget;
+  virtual ~Addressable() = default;
+
+  // The model's names, as the derived type stores them.
+  virtual int segmentCount() const = 0;
+  virtual const std::string& segmentName(int index) const = 0;
+  virtual const std::vector<vereshchagin::LinkPlacement>& linkPlacements() const = 0;
+  virtual const std::vector<vereshchagin::JointInfo>& jointInfos() const = 0;
+  virtual const std::string& rootLink() const = 0;
+
+  std::vector<std::string> segmentNames() const;
+  std::vector<std::string> jointNames() const;
+  // Any frame: segment, merged link, base link (segment -1) or index.
+  Target resolveTarget(PyObject* which, const std::string& label) const;
+  // The same for calls that need a moving segment: the base raises.
+  Target resolveMoving(PyObject* which, const std::string& label) const;
+  // resolveTarget, with None meaning the last segment (the default of Chain.fk, jacobian, ...).
+  Target resolveOptional(const py::object& which, const std::string& label) const;
+  // Joint index from a joint name or an int index (negative from the end).
+  int resolveJoint(PyObject* which, const std::string& label) const;
+
+ protected:
+  Addressable() = default;
+  Addressable(const Addressable&) = default;
+  Addressable& operator=(const Addressable&) = default;
+};
+
+// Up to 12 names, quoted, then "... (N in all)".
+std::string nameList(const std::vector<std::string>& names);
+
+}  // namespace vsbind

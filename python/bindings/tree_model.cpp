@@ -1,0 +1,162 @@
+// PyTree (tree_bindings.hpp): loading, pickle state, kinematics along a root-to-segment path and
+// the extraction of one path as a Chain.
+#include <algorithm>
+
+#include <pybind11/stl.h>
+
+#include "model_state.hpp"
+#include "tree_bindings.hpp"
+#include "vereshchagin/urdf_loader.hpp"
+
+namespace vsbind {
+
+PyTree PyTree::fromUrdf(const py::object& source, const std::string& root, vereshchagin::InertiaCheck inertia_check) {
+  const UrdfSource src = urdfSourceArg(source);
+  vereshchagin::UrdfOptions options;
+  options.inertia_check = inertia_check;
+  const vereshchagin::UrdfTreeResult r = src.is_text ? vereshchagin::treeFromUrdfString(src.text_or_path, root, options)
+                                                     : vereshchagin::treeFromUrdfFile(src.text_or_path, root, options);
+  if (!r.ok) raise(r.message);
+  PyTree t;
+  t.robot = r.robot;
+  return t;
+}
+
+py::tuple PyTree::getState() const {
+  py::list segments, joints, links;
+  for (int i = 0; i < segmentCount(); ++i) segments.append(py::make_tuple(segmentState(segment(i)), robot.parent[i]));
+  for (const auto& j : robot.joints) joints.append(jointInfoState(j));
+  for (const auto& l : robot.links) links.append(linkState(l));
+  return py::make_tuple(1, robot.root_link, segments, joints, links, py::cast(robot.notes));
+}
+
+PyTree PyTree::fromState(const py::tuple& state) {
+  if (state.size() != 6 || state[0].cast<int>() != 1) raise("Tree state: unknown format");
+  PyTree t;
+  t.robot.root_link = state[1].cast<std::string>();
+  t.robot.tree = KDL::Tree(t.robot.root_link);
+  for (const auto& item : state[2].cast<py::list>()) {
+    const py::tuple entry = item.cast<py::tuple>();
+    const KDL::Segment s = segmentFromState(entry[0].cast<py::tuple>());
+    const int parent = entry[1].cast<int>();
+    if (parent < -1 || parent >= t.segmentCount()) raise("Tree state: parent index out of range");
+    const std::string& hook = parent < 0 ? t.robot.root_link : t.robot.segment_names[static_cast<std::size_t>(parent)];
+    if (!t.robot.tree.addSegment(s, hook)) raise("Tree state: segment '" + s.getName() + "' cannot be added");
+    t.robot.segment_names.push_back(s.getName());
+    t.robot.parent.push_back(parent);
+  }
+  for (const auto& item : state[3].cast<py::list>())
+    t.robot.joints.push_back(jointInfoFromState(item.cast<py::tuple>()));
+  for (const auto& item : state[4].cast<py::list>()) t.robot.links.push_back(linkFromState(item.cast<py::tuple>()));
+  t.robot.notes = state[5].cast<std::vector<std::string>>();
+  return t;
+}
+
+const KDL::Segment& PyTree::segment(int index) const {
+  return robot.tree.getSegments().find(segmentName(index))->second.segment;
+}
+
+unsigned int PyTree::qIndex(int index) const {
+  return GetTreeElementQNr(robot.tree.getSegments().find(segmentName(index))->second);
+}
+
+std::vector<int> PyTree::pathTo(int index) const {
+  std::vector<int> path;
+  for (int s = index; s >= 0; s = robot.parent[static_cast<std::size_t>(s)]) path.push_back(s);
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+namespace {
+
+bool isPrismatic(KDL::Joint::JointType type) {
+  return type == KDL::Joint::TransAxis || type == KDL::Joint::TransX || type == KDL::Joint::TransY ||
+         type == KDL::Joint::TransZ;
+}
+
+}  // namespace
+
+py::array_t<double> PyTree::fk(const py::object& q_obj, const py::object& which) const {
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", robot.tree.getNrOfJoints());
+  const Target t = resolveTarget(which.ptr(), "segment");
+  KDL::Frame f = KDL::Frame::Identity();
+  if (t.segment >= 0)
+    for (int s : pathTo(t.segment)) f = f * segment(s).pose(q(qIndex(s)));
+  return homogeneous(f * t.link_in_tip);
+}
+
+py::array_t<double> PyTree::jacobian(const py::object& q_obj, const py::object& which) const {
+  const unsigned int n = robot.tree.getNrOfJoints();
+  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
+  const Target t = resolveTarget(which.ptr(), "segment");
+  py::array_t<double> out({static_cast<py::ssize_t>(6), static_cast<py::ssize_t>(n)});
+  auto o = out.mutable_unchecked<2>();
+  for (int r = 0; r < 6; ++r)
+    for (unsigned int c = 0; c < n; ++c) o(r, c) = 0.0;
+  if (t.segment < 0) return out;
+  const std::vector<int> path = pathTo(t.segment);
+  std::vector<KDL::Frame> root_of(path.size());  // each path segment's root frame in the base
+  KDL::Frame f = KDL::Frame::Identity();
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    root_of[k] = f;
+    f = f * segment(path[k]).pose(q(qIndex(path[k])));
+  }
+  const KDL::Vector point = f * t.link_in_tip.p;  // the reference point: the frame's origin
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const KDL::Joint& joint = segment(path[k]).getJoint();
+    if (joint.getType() == KDL::Joint::None) continue;
+    const KDL::Vector axis = root_of[k].M * joint.JointAxis();
+    const KDL::Vector linear = isPrismatic(joint.getType()) ? axis : axis * (point - root_of[k] * joint.JointOrigin());
+    const KDL::Vector angular = isPrismatic(joint.getType()) ? KDL::Vector::Zero() : axis;
+    const unsigned int c = qIndex(path[k]);
+    for (int r = 0; r < 3; ++r) {
+      o(r, c) = linear(r);
+      o(r + 3, c) = angular(r);
+    }
+  }
+  return out;
+}
+
+py::array_t<double> PyTree::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& which) const {
+  const unsigned int n = robot.tree.getNrOfJoints();
+  Array qd = vectorArg(qd_obj, "qd", n);
+  py::array_t<double> J = jacobian(q_obj, which);
+  auto j = J.unchecked<2>();
+  py::array_t<double> out(6);
+  for (int r = 0; r < 6; ++r) {
+    double v = 0.0;
+    for (unsigned int c = 0; c < n; ++c) v += j(r, c) * qd.at(c);
+    out.mutable_data()[r] = v;
+  }
+  return out;
+}
+
+PyChain PyTree::pathChain(const py::object& tip) const {
+  const std::vector<int> path = pathTo(resolveMoving(tip.ptr(), "tip").segment);
+  std::vector<int> chain_index(robot.segment_names.size(), -1);
+  PyChain c;
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    chain_index[static_cast<std::size_t>(path[k])] = static_cast<int>(k);
+    c.robot.chain.addSegment(segment(path[k]));
+  }
+  for (int s : path) {
+    for (const auto& j : robot.joints) {
+      if (static_cast<int>(j.segment) != s) continue;
+      vereshchagin::JointInfo info = j;
+      info.segment = static_cast<unsigned int>(chain_index[static_cast<std::size_t>(s)]);
+      c.robot.joints.push_back(info);
+    }
+  }
+  for (const auto& l : robot.links) {
+    if (l.segment >= 0 && chain_index[static_cast<std::size_t>(l.segment)] < 0) continue;
+    c.robot.links.push_back(
+        {l.link, l.segment < 0 ? -1 : chain_index[static_cast<std::size_t>(l.segment)], l.in_segment_tip});
+  }
+  c.robot.root_link = robot.root_link;
+  if (path.size() < robot.segment_names.size())
+    c.robot.notes.push_back("extracted from a tree: the " + std::to_string(robot.segment_names.size() - path.size()) +
+                            " segments off the path to '" + segmentName(path.back()) + "' are left out");
+  return c;
+}
+
+}  // namespace vsbind
