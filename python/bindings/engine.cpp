@@ -5,34 +5,77 @@
 
 namespace vsbind {
 
-Engine::Engine(const KDL::Chain& chain, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt)
-    : nj(chain.getNrOfJoints()),
-      ns(chain.getNrOfSegments()),
-      hd_(chain, KDL::Twist(-gravity, KDL::Vector::Zero()), opt),
-      friction_(chain, KDL::Twist(-gravity, KDL::Vector::Zero()), opt),
-      fk_(chain),
-      q_kdl_(chain.getNrOfJoints()) {
-  alfa_ = ChainHdSolver::Matrix6X::Zero(6, hd_.maxConstraints());
-  beta_ = Eigen::VectorXd::Zero(hd_.maxConstraints());
-  segs_ = Eigen::VectorXi::Zero(hd_.maxConstraints());
+namespace {
+
+std::unique_ptr<vereshchagin::HdSolver> makeSolver(const EngineModel& m, const KDL::Twist& up,
+                                                   const vereshchagin::SolverOptions& opt) {
+  if (m.chain) return std::make_unique<ChainHdSolver>(*m.chain, up, opt);
+  return std::make_unique<vereshchagin::TreeHdSolver>(*m.tree, up, opt, m.root);
+}
+
+std::unique_ptr<vereshchagin::FrictionSolver> makeFriction(const EngineModel& m, const KDL::Twist& up,
+                                                           const vereshchagin::SolverOptions& opt) {
+  if (m.chain) return std::make_unique<vereshchagin::FrictionSolver>(*m.chain, up, opt);
+  return std::make_unique<vereshchagin::FrictionSolver>(*m.tree, up, opt, m.root);
+}
+
+KDL::Twist upward(const KDL::Vector& gravity) {
+  return KDL::Twist(-gravity, KDL::Vector::Zero());
+}
+
+}  // namespace
+
+SegmentKinematics::SegmentKinematics(const EngineModel& model) {
+  if (model.chain) {
+    for (unsigned int i = 0; i < model.chain->getNrOfSegments(); ++i) {
+      segments_.push_back(model.chain->getSegment(i));
+      parent_.push_back(static_cast<int>(i) - 1);
+    }
+  } else {
+    const vereshchagin::TreeHdSolver probe(*model.tree, KDL::Twist::Zero(), vereshchagin::SolverOptions(), model.root);
+    for (const std::string& name : probe.segmentNames())
+      segments_.push_back(model.tree->getSegments().at(name).segment);
+    parent_ = probe.parent();
+  }
+  int joints = 0;  // joints are numbered in segment order, fixed joints skipped (hd_solver.hpp)
+  for (const KDL::Segment& s : segments_)
+    q_index_.push_back(s.getJoint().getType() == KDL::Joint::Fixed ? -1 : joints++);
+}
+
+KDL::Rotation SegmentKinematics::tipRotation(int segment, const double* q) const {
+  KDL::Rotation R = KDL::Rotation::Identity();
+  for (int i = segment; i >= 0; i = parent_[static_cast<std::size_t>(i)]) {
+    const int j = q_index_[static_cast<std::size_t>(i)];
+    R = segments_[static_cast<std::size_t>(i)].pose(j < 0 ? 0.0 : q[j]).M * R;
+  }
+  return R;
+}
+
+Engine::Engine(const EngineModel& model, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt)
+    : hd_(makeSolver(model, upward(gravity), opt)),
+      friction_(makeFriction(model, upward(gravity), opt)),
+      kinematics_(model) {
+  nj = hd_->nrOfJoints();
+  ns = hd_->nrOfSegments();
+  alfa_ = ChainHdSolver::Matrix6X::Zero(6, hd_->maxConstraints());
+  beta_ = Eigen::VectorXd::Zero(hd_->maxConstraints());
+  segs_ = Eigen::VectorXi::Zero(hd_->maxConstraints());
   fext_ = ChainHdSolver::Matrix6X::Zero(6, ns);
 }
 
 void Engine::setGravity(const KDL::Vector& gravity) {
-  const KDL::Twist up(-gravity, KDL::Vector::Zero());  // the base accelerates against gravity
-  hd_.setRootAcceleration(up);
-  friction_.setRootAcceleration(up);
+  const KDL::Twist up = upward(gravity);  // the base accelerates against gravity
+  hd_->setRootAcceleration(up);
+  friction_->setRootAcceleration(up);
 }
 
 const char* Engine::errorMessage() const {
-  return last_friction_ ? friction_.errorMessage() : hd_.errorMessage();
+  return last_friction_ ? friction_->errorMessage() : hd_->errorMessage();
 }
 
 // r = p_link - p_tip in base axes at the row's q (forward kinematics of the segment's tip).
-KDL::Vector Engine::tipOffsetInBase(int segment, const KDL::Vector& offset) {
-  KDL::Frame tip;
-  fk_.JntToCart(q_kdl_, tip, segment + 1);
-  return tip.M * offset;
+KDL::Vector Engine::tipOffsetInBase(int segment, const KDL::Vector& offset) const {
+  return kinematics_.tipRotation(segment, q_) * offset;
 }
 
 // Copies every block's columns into alfa_/beta_/segs_, moving moments from named links to tips.
@@ -83,12 +126,12 @@ int Engine::run(const RowInputs& in) {
   const MapV pf(in.f_ext_pass_through, in.f_ext_pass_through ? columns : 0);
   const MapV pt(in.tau_ff_pass_through, in.tau_ff_pass_through ? columns : 0);
   last_friction_ = in.friction != nullptr;  // errorMessage() of the right solver
-  int rc = in.friction ? friction_.setPassThrough(pf, pt) : hd_.setPassThrough(pf, pt);
+  int rc = in.friction ? friction_->setPassThrough(pf, pt) : hd_->setPassThrough(pf, pt);
   if (rc == ChainHdSolver::E_NOERROR) rc = runWeighted(in);
   if (in.friction)  // the weights hold for this row only
-    friction_.clearPassThrough();
+    friction_->clearPassThrough();
   else
-    hd_.clearPassThrough();
+    hd_->clearPassThrough();
   return rc;
 }
 
@@ -96,9 +139,7 @@ int Engine::runWeighted(const RowInputs& in) {
   using Map6X = Eigen::Map<const ChainHdSolver::Matrix6X>;
   using MapV = Eigen::Map<const Eigen::VectorXd>;
   const MapV q(in.q, nj), qd(in.qd, nj);
-  bool needs_fk = in.n_link_wrenches > 0;
-  for (int b = 0; b < in.n_blocks; ++b) needs_fk |= in.blocks[b].has_offset;
-  if (needs_fk) q_kdl_.data = q;
+  q_ = in.q;
   assembleColumns(in);
   const double* fp = assembleExternal(in);
   const Map6X f(fp, 6, fp ? ns : 0);
@@ -109,24 +150,25 @@ int Engine::runWeighted(const RowInputs& in) {
   last_general_ = in.general;
   if (in.general) {
     const auto sg = segs_.head(columns_);
-    return last_friction_ ? friction_.solve(q, qd, A, b, sg, f, tau, *in.friction) : hd_.solve(q, qd, A, b, sg, f, tau);
+    return last_friction_ ? friction_->solve(q, qd, A, b, sg, f, tau, *in.friction)
+                          : hd_->solve(q, qd, A, b, sg, f, tau);
   }
-  return last_friction_ ? friction_.solve(q, qd, A, b, f, tau, *in.friction) : hd_.solve(q, qd, A, b, f, tau);
+  return last_friction_ ? friction_->solve(q, qd, A, b, f, tau, *in.friction) : hd_->solve(q, qd, A, b, f, tau);
 }
 
 void Engine::writeCore(double* qdd, double* tau_cmd, double* nu, double* link_acc, int* rank, double* smin) {
   const vereshchagin::HdSolver& s = answered();
   if (last_friction_) {  // outputs at the friction optimum
-    std::copy(friction_.qdd().data(), friction_.qdd().data() + nj, qdd);
-    std::copy(friction_.commandTorques().data(), friction_.commandTorques().data() + nj, tau_cmd);
-    std::copy(friction_.nu().data(), friction_.nu().data() + columns_, nu);
+    std::copy(friction_->qdd().data(), friction_->qdd().data() + nj, qdd);
+    std::copy(friction_->commandTorques().data(), friction_->commandTorques().data() + nj, tau_cmd);
+    std::copy(friction_->nu().data(), friction_->nu().data() + columns_, nu);
   } else {
     std::copy(s.qdd().data(), s.qdd().data() + nj, qdd);
     std::copy(s.commandTorques().data(), s.commandTorques().data() + nj, tau_cmd);
     std::copy(s.nu().data(), s.nu().data() + columns_, nu);
   }
   if (link_acc) {
-    const ChainHdSolver::Matrix6X& acc = last_friction_ ? friction_.linkAccelerations() : s.linkAccelerations();
+    const ChainHdSolver::Matrix6X& acc = last_friction_ ? friction_->linkAccelerations() : s.linkAccelerations();
     std::copy(acc.data(), acc.data() + 6 * (ns + 1), link_acc);
   }
   *rank = s.constraintRank();
@@ -134,11 +176,11 @@ void Engine::writeCore(double* qdd, double* tau_cmd, double* nu, double* link_ac
 }
 
 void Engine::writeFriction(double* friction_torque, double* limit_torque, int* status, double* gauss, int* iterations) {
-  std::copy(friction_.frictionTorques().data(), friction_.frictionTorques().data() + nj, friction_torque);
-  std::copy(friction_.limitTorques().data(), friction_.limitTorques().data() + nj, limit_torque);
-  for (unsigned int j = 0; j < nj; ++j) status[j] = friction_.status()[j];
-  *gauss = friction_.gaussValue();
-  *iterations = friction_.iterations();
+  std::copy(friction_->frictionTorques().data(), friction_->frictionTorques().data() + nj, friction_torque);
+  std::copy(friction_->limitTorques().data(), friction_->limitTorques().data() + nj, limit_torque);
+  for (unsigned int j = 0; j < nj; ++j) status[j] = friction_->status()[j];
+  *gauss = friction_->gaussValue();
+  *iterations = friction_->iterations();
 }
 
 }  // namespace vsbind

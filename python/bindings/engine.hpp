@@ -1,16 +1,20 @@
-// One solve's worth of C++ state for the Python Solver: a ChainHdSolver, a FrictionSolver and the
-// buffers that turn numpy rows into their inputs. Solver.solve uses engine 0; solve_batch gives
-// each thread its own engine, so every row runs the same code as a single solve.
+// One solve's worth of C++ state for the Python Solver: a solver of the chain or tree (HdSolver),
+// a FrictionSolver and the buffers that turn numpy rows into their inputs. Solver.solve uses engine 0; solve_batch
+// gives each thread its own engine, so every row runs the same code as a single solve.
 #pragma once
 
+#include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
-#include <kdl/chainfksolverpos_recursive.hpp>
-#include <kdl/jntarray.hpp>
+#include <kdl/chain.hpp>
+#include <kdl/segment.hpp>
+#include <kdl/tree.hpp>
 
 #include "vereshchagin/chain_hd_solver.hpp"
 #include "vereshchagin/friction_solver.hpp"
+#include "vereshchagin/tree_hd_solver.hpp"
 
 namespace vsbind {
 
@@ -55,9 +59,29 @@ struct RowInputs {
   const double* tau_ff_pass_through = nullptr;
 };
 
+// The robot of a solver: a chain, or the tree below its root segment (segment order: preorder,
+// robot_tree.hpp).
+struct EngineModel {
+  const KDL::Chain* chain = nullptr;
+  const KDL::Tree* tree = nullptr;
+  std::string root;  // the tree's root segment (the base)
+};
+
+// Pose of a segment's tip in the base frame from the segments and the parent array (for moving
+// moments from merged links to tips before a solve); no allocation per call.
+class SegmentKinematics {
+ public:
+  explicit SegmentKinematics(const EngineModel& model);
+  KDL::Rotation tipRotation(int segment, const double* q) const;
+
+ private:
+  std::vector<KDL::Segment> segments_;
+  std::vector<int> parent_, q_index_;  // q_index_: -1 for a fixed joint
+};
+
 class Engine {
  public:
-  Engine(const KDL::Chain& chain, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt);
+  Engine(const EngineModel& model, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt);
 
   // Solves one row; returns 0 or the C++ error code (message in errorMessage()).
   int run(const RowInputs& in);
@@ -71,20 +95,20 @@ class Engine {
   void writeCore(double* qdd, double* tau_cmd, double* nu, double* link_acc, int* rank, double* smin);
   void writeFriction(double* friction_torque, double* limit_torque, int* status, double* gauss, int* iterations);
   bool lastHadFriction() const { return last_friction_; }
-  vereshchagin::HdSolver& answered() { return last_friction_ ? friction_.hdSolver() : hd_; }
-  vereshchagin::FrictionSolver& frictionSolver() { return friction_; }
+  vereshchagin::HdSolver& answered() { return last_friction_ ? friction_->hdSolver() : *hd_; }
+  vereshchagin::FrictionSolver& frictionSolver() { return *friction_; }
 
   unsigned int nj, ns;
 
  private:
   void assembleColumns(const RowInputs& in);
   const double* assembleExternal(const RowInputs& in);
-  KDL::Vector tipOffsetInBase(int segment, const KDL::Vector& offset);
+  KDL::Vector tipOffsetInBase(int segment, const KDL::Vector& offset) const;
 
-  ChainHdSolver hd_;
-  vereshchagin::FrictionSolver friction_;
-  KDL::ChainFkSolverPos_recursive fk_;
-  KDL::JntArray q_kdl_;
+  std::unique_ptr<vereshchagin::HdSolver> hd_;
+  std::unique_ptr<vereshchagin::FrictionSolver> friction_;
+  SegmentKinematics kinematics_;
+  const double* q_ = nullptr;     // the row being solved
   ChainHdSolver::Matrix6X alfa_;  // constraint columns of a solve (6 x maxConstraints())
   Eigen::VectorXd beta_;
   Eigen::VectorXi segs_;

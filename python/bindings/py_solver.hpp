@@ -13,6 +13,7 @@
 #include "engine.hpp"
 #include "numpy_fast.hpp"
 #include "result_type.hpp"
+#include "tree_bindings.hpp"
 
 namespace vsbind {
 
@@ -34,9 +35,15 @@ struct ParsedSolve {
 
 struct BatchRunner;  // solve_batch.cpp
 
+// Raised for alpha/beta (the end segment's constraint) on a tree solver.
+inline constexpr const char* kTreeAlpha =
+    "alpha and beta constrain a chain's last segment; a Tree has no last segment: pass constraints={segment or "
+    "link name: (alpha, beta)}";
+
 class PySolver {
  public:
-  PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping,
+  // model: a Chain or a Tree (copied).
+  PySolver(const py::object& model, const py::object& gravity, const py::object& rcond, const py::object& damping,
            const std::string& inertia_check);
 
   // Parses solve()'s arguments (objects may be null for "not given") into `p`.
@@ -62,7 +69,9 @@ class PySolver {
   // Locks the solver; waits with the GIL released if another thread holds it.
   std::unique_lock<std::mutex> lock();
 
-  const PyChain& chain() const { return chain_; }
+  // The solver's model: a copy of its Chain or Tree.
+  py::object model() const;
+  bool isTree() const { return tree_ != nullptr; }
   std::string inertiaCheck() const { return vereshchagin::inertiaCheckName(options_.inertia_check); }
   unsigned int nj = 0, ns = 0;
   ParsedSolve parsed;  // scratch of solve(), reused under the lock
@@ -75,7 +84,10 @@ class PySolver {
   Engine& engine(std::size_t k);
   void keepLastRow(BatchRunner& br, long threads);
 
-  PyChain chain_;
+  std::unique_ptr<PyChain> chain_;  // the model: one of these two
+  std::unique_ptr<PyTree> tree_;
+  const Addressable* model_ = nullptr;
+  EngineModel engine_model_;
   KDL::Vector gravity_;
   vereshchagin::SolverOptions options_;
   py::object damping_arg_;

@@ -72,6 +72,7 @@ void PySolver::parse(PyObject* const* a, ParsedSolve& p) {
   p.q = vectorView(q, "q", nj);
   p.qd = vectorView(qd, "qd", nj);
   if (given(alpha)) {
+    if (tree_) raise(kTreeAlpha);
     p.alpha = alphaView(alpha, "alpha");
     const py::ssize_t m = p.alpha.shape[1];
     if (!given(beta)) raise("beta is required when alpha is given (shape (" + std::to_string(m) + ",))");
@@ -134,7 +135,7 @@ void PySolver::parseFExt(PyObject* f_ext, ParsedSolve& p) const {
   Py_ssize_t pos = 0;
   while (PyDict_Next(f_ext, &pos, &key, &value)) {
     const std::string label = "f_ext[" + keyRepr(key) + "]";
-    const PyChain::Target t = chain_.resolveMoving(key, label);
+    const FrameTarget t = model_->resolveMoving(key, label);
     F64View w = vectorView(value, label.c_str(), 6);
     if (t.merged) {
       LinkWrench lw;
@@ -160,7 +161,7 @@ void PySolver::parseConstraints(PyObject* constraints, ParsedSolve& p) const {
   Py_ssize_t pos = 0;
   while (PyDict_Next(constraints, &pos, &key, &value)) {
     const std::string label = "constraints[" + keyRepr(key) + "]";
-    const PyChain::Target t = chain_.resolveMoving(key, label);
+    const FrameTarget t = model_->resolveMoving(key, label);
     for (std::size_t k = 0; k < p.block_keys.size(); ++k) {
       const ConstraintBlock& other = p.blocks[p.blocks.size() - p.block_keys.size() + k];
       if (other.segment == t.segment && (other.offset - t.link_in_tip.p).Norm() == 0.0)
@@ -174,8 +175,8 @@ void PySolver::parseConstraints(PyObject* constraints, ParsedSolve& p) const {
     F64View b = vectorView(pair[1].ptr(), (label + " beta").c_str(), a.shape[1], /*scalar_ok=*/true);
     per_segment[t.segment] += static_cast<int>(a.shape[1]);
     if (per_segment[t.segment] > 6)
-      raise(label + ": more than 6 constraint columns on segment '" +
-            chain_.robot.chain.getSegment(t.segment).getName() + "' (alpha and every key on it count)");
+      raise(label + ": more than 6 constraint columns on segment '" + model_->segmentName(t.segment) +
+            "' (alpha and every key on it count)");
     ConstraintBlock blk;
     blk.segment = t.segment;
     blk.cols = static_cast<int>(a.shape[1]);

@@ -126,7 +126,7 @@ struct BatchRunner {
     Py_ssize_t pos = 0;
     while (PyDict_Next(obj, &pos, &key, &value)) {
       const std::string label = "f_ext[" + py::repr(key).cast<std::string>() + "]";
-      const PyChain::Target t = s.chain_.resolveMoving(key, label);
+      const FrameTarget t = s.model_->resolveMoving(key, label);
       Batched w = batchedArg(value, label, 1, {6}, bs);
       if (t.merged) {
         LinkWrench lw;
@@ -158,7 +158,7 @@ struct BatchRunner {
     f_ext.batched = f_ext_dense_batched;
   }
 
-  void addBlock(int segment, PyObject* a_obj, PyObject* b_obj, const std::string& label, const PyChain::Target* t) {
+  void addBlock(int segment, PyObject* a_obj, PyObject* b_obj, const std::string& label, const FrameTarget* t) {
     py::ssize_t m = 0;
     Batched a = alphaArg(a_obj, label.empty() ? "alpha" : label + " alpha", bs, m);
     Batched b = betaArg(b_obj, label.empty() ? "beta" : label + " beta", m, bs);
@@ -184,7 +184,7 @@ struct BatchRunner {
     Py_ssize_t pos = 0;
     while (PyDict_Next(obj, &pos, &key, &value)) {
       const std::string label = "constraints[" + py::repr(key).cast<std::string>() + "]";
-      const PyChain::Target t = s.chain_.resolveMoving(key, label);
+      const FrameTarget t = s.model_->resolveMoving(key, label);
       for (std::size_t k = 0; k < key_block.size(); ++k) {
         const ConstraintBlock& other = block_template[key_block[k]];
         if (other.segment == t.segment && (other.offset - t.link_in_tip.p).Norm() == 0.0)
@@ -198,8 +198,7 @@ struct BatchRunner {
       addBlock(t.segment, pair[0].ptr(), pair[1].ptr(), label, &t);
       per_segment[t.segment] += block_template.back().cols;
       if (per_segment[t.segment] > 6)
-        raise(label + ": more than 6 constraint columns on segment '" +
-              s.chain_.robot.chain.getSegment(t.segment).getName() + "'");
+        raise(label + ": more than 6 constraint columns on segment '" + s.model_->segmentName(t.segment) + "'");
     }
   }
 
@@ -289,6 +288,7 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
   br.q = batchedArg(q_obj.ptr(), "q", 1, {n}, br.bs);
   br.qd = batchedArg(qd_obj.ptr(), "qd", 1, {n}, br.bs);
   if (!alpha_obj.is_none()) {
+    if (tree_) raise(kTreeAlpha);
     if (beta_obj.is_none()) raise("beta is required when alpha is given");
     br.addBlock(static_cast<int>(ns) - 1, alpha_obj.ptr(), beta_obj.ptr(), "", nullptr);
     if (br.block_template.back().cols == 0) {  // no columns: nothing to constrain

@@ -14,9 +14,22 @@
 
 namespace vsbind {
 
-PySolver::PySolver(const PyChain& chain, const py::object& gravity, const py::object& rcond, const py::object& damping,
-                   const std::string& inertia_check)
-    : chain_(chain), damping_arg_(damping) {
+PySolver::PySolver(const py::object& model, const py::object& gravity, const py::object& rcond,
+                   const py::object& damping, const std::string& inertia_check)
+    : damping_arg_(damping) {
+  if (py::isinstance<PyChain>(model)) {
+    chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
+    model_ = chain_.get();
+    engine_model_.chain = &chain_->robot.chain;
+  } else if (py::isinstance<PyTree>(model)) {
+    tree_ = std::make_unique<PyTree>(model.cast<const PyTree&>());
+    model_ = tree_.get();
+    engine_model_.tree = &tree_->robot.tree;
+    engine_model_.root = tree_->robot.root_link;
+  } else {
+    throw py::type_error("Solver(model): model must be a vereshchagin.Chain or vereshchagin.Tree, got " +
+                         std::string(Py_TYPE(model.ptr())->tp_name));
+  }
   options_.rcond = scalarArg(rcond, "rcond");
   options_.inertia_check = inertiaCheckArg(inertia_check, "");
   if (!damping.is_none()) {
@@ -24,18 +37,20 @@ PySolver::PySolver(const PyChain& chain, const py::object& gravity, const py::ob
     options_.damping = scalarArg(damping, "damping");
   }
   gravity_ = vec3(gravity, "gravity");
-  ChainHdSolver probe(chain.robot.chain, KDL::Twist::Zero(), options_);
-  if (probe.modelError() != ChainHdSolver::E_NOERROR) raise(std::string("invalid chain: ") + probe.errorMessage());
-  if (probe.setOptions(options_) != ChainHdSolver::E_NOERROR) raise(probe.errorMessage());
-  engines_.push_back(std::make_unique<Engine>(chain.robot.chain, gravity_, options_));
-  nj = probe.nrOfJoints();
-  ns = probe.nrOfSegments();
-  const auto n = static_cast<Eigen::Index>(chain.robot.joints.size());
+  auto probe = std::make_unique<Engine>(engine_model_, gravity_, options_);
+  const vereshchagin::HdSolver& hd = probe->answered();
+  if (hd.modelError() != ChainHdSolver::E_NOERROR)
+    raise(std::string(tree_ ? "invalid tree: " : "invalid chain: ") + hd.errorMessage());
+  engines_.push_back(std::move(probe));
+  nj = hd.nrOfJoints();
+  ns = hd.nrOfSegments();
+  const std::vector<vereshchagin::JointInfo>& joints = model_->jointInfos();
+  const auto n = static_cast<Eigen::Index>(joints.size());
   chain_friction_.static_friction = chain_friction_.lower = chain_friction_.upper = Eigen::VectorXd::Zero(n);
   for (Eigen::Index k = 0; k < n; ++k) {
-    chain_friction_.static_friction(k) = chain.robot.joints[k].friction;
-    chain_friction_.lower(k) = chain.robot.joints[k].lower;
-    chain_friction_.upper(k) = chain.robot.joints[k].upper;
+    chain_friction_.static_friction(k) = joints[k].friction;
+    chain_friction_.lower(k) = joints[k].lower;
+    chain_friction_.upper(k) = joints[k].upper;
   }
 }
 
@@ -49,7 +64,7 @@ std::unique_lock<std::mutex> PySolver::lock() {
 }
 
 Engine& PySolver::engine(std::size_t k) {
-  while (engines_.size() <= k) engines_.push_back(std::make_unique<Engine>(chain_.robot.chain, gravity_, options_));
+  while (engines_.size() <= k) engines_.push_back(std::make_unique<Engine>(engine_model_, gravity_, options_));
   return *engines_[k];
 }
 
@@ -130,7 +145,7 @@ double PySolver::timeCpp(const ParsedSolve& p, long reps) {
 
 namespace {
 
-Eigen::VectorXi jointList(const PyChain& chain, const py::object& joints) {
+Eigen::VectorXi jointList(const Addressable& chain, const py::object& joints) {
   const char* what = "joints must be a sequence of joint names or int indices";
   if (joints.is_none() || py::isinstance<py::str>(joints)) raise(what);
   py::sequence seq;
@@ -171,7 +186,7 @@ void holdJoints(Eigen::MatrixXd& dq, Eigen::MatrixXd& dt, const Eigen::VectorXi&
 }  // namespace
 
 py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking) {
-  const Eigen::VectorXi requested = jointList(chain_, joints);
+  const Eigen::VectorXi requested = jointList(*model_, joints);
   auto lk = lock();
   if (!last_state_)
     raise(
@@ -206,8 +221,12 @@ py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking
   return py::make_tuple(toNumpy(dq), toNumpy(dt));
 }
 
+py::object PySolver::model() const {
+  return tree_ ? py::cast(*tree_) : py::cast(*chain_);
+}
+
 py::tuple PySolver::getState() const {
-  return py::make_tuple(py::cast(chain_), gravity(), options_.rcond, damping_arg_,
+  return py::make_tuple(model(), gravity(), options_.rcond, damping_arg_,
                         vereshchagin::inertiaCheckName(options_.inertia_check));
 }
 
@@ -339,8 +358,8 @@ void bindSolver(py::module_& mod) {
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
   py::class_<PySolver> cls(mod, "Solver", docs::kSolverCore);
-  cls.def(py::init<const PyChain&, const py::object&, const py::object&, const py::object&, const std::string&>(),
-          py::arg("chain"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
+  cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const std::string&>(),
+          py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
           py::arg("damping") = py::none(), py::arg("inertia_check") = "physical")
       .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
@@ -354,17 +373,30 @@ void bindSolver(py::module_& mod) {
           "n_joints", [](const PySolver& s) { return s.nj; }, "Number of moving joints n.")
       .def_property_readonly(
           "n_segments", [](const PySolver& s) { return s.ns; },
-          "Number of segments (moving and fixed-joint segments of the chain).")
+          "Number of segments (moving and fixed-joint segments of the chain or tree).")
       .def_property_readonly(
-          "chain", [](const PySolver& s) { return s.chain(); }, "A copy of the solver's Chain.")
+          "model", [](const PySolver& s) { return s.model(); }, "A copy of the solver's Chain or Tree.")
+      .def_property_readonly(
+          "chain",
+          [](const PySolver& s) {
+            if (s.isTree()) raise("this Solver is for a Tree: use solver.tree (or solver.model)");
+            return s.model();
+          },
+          "A copy of the solver's Chain (SolverError for a Tree solver).")
+      .def_property_readonly(
+          "tree",
+          [](const PySolver& s) {
+            if (!s.isTree()) raise("this Solver is for a Chain: use solver.chain (or solver.model)");
+            return s.model();
+          },
+          "A copy of the solver's Tree (SolverError for a Chain solver).")
       .def_property_readonly(
           "inertia_check", [](const PySolver& s) { return s.inertiaCheck(); },
           "str: 'physical' or 'joint_space' (see Solver).")
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
                         if (t.size() != 5) raise("Solver state must have 5 entries");
-                        return std::make_unique<PySolver>(t[0].cast<PyChain>(), t[1], t[2], t[3],
-                                                          t[4].cast<std::string>());
+                        return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4].cast<std::string>());
                       }));
   addFastMethod(cls, &g_solve_def);
   addFastMethod(cls, &g_time_def);

@@ -60,12 +60,15 @@ class BatchResult:
 
 
 class Solver(_core.Solver):
-    """Acceleration-constrained hybrid dynamics (Popov-Vereshchagin) of a serial chain.
+    """Acceleration-constrained hybrid dynamics (Popov-Vereshchagin) of a serial chain or a tree.
 
     Parameters
     ----------
-    chain : Chain
-        Copied; later changes to ``chain`` do not affect the solver.
+    model : Chain or Tree
+        Copied; later changes to it do not affect the solver. On a :class:`Tree` the segments
+        and joints follow the tree's order (depth-first preorder, see :class:`Tree`); constraints
+        go through ``constraints=`` (a tree has no last segment for ``alpha``/``beta``), on any
+        segments or merged links of any branches, coupled through their common ancestors.
     gravity : array_like, shape (3,)
         Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``). Internally the base
         accelerates by ``-gravity``, so ``beta`` and ``link_acc`` include that acceleration.

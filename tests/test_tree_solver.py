@@ -1,0 +1,280 @@
+"""Solves on kinematic trees against Pinocchio reading the same URDF trees.
+
+Robots: Baxter (example-robot-data: head, two 7-joint arms, two-finger grippers, 19 joints) and
+Talos (``talos_reduced``: its 32 joints below ``base_link``, the floating base not modelled, i.e.
+``base_link`` held fixed), and random trees written as URDF text (``tests/trees.py``).
+
+Joint orders differ (ours: the tree's joint order, Pinocchio: its own depth-first order); every
+comparison maps by joint name. Every expected value comes from Pinocchio:
+
+* m = 0: ``qdd = pin.aba`` (also with wrenches on links as Pinocchio's ``fext``);
+* constraints on one or several frames of any branches: ``pin.forwardDynamics`` with the stacked
+  ``alpha_i^T J_i`` (LOCAL_WORLD_ALIGNED frame Jacobians) and
+  ``gamma_i = alpha_i^T (a0_i + [-g; 0]) - beta_i`` (a0_i the LWA frame acceleration at qdd = 0);
+  ``nu = -lambda``;
+* ``pin.aba(tau_ff + tau_command)`` gives ``qdd`` back; each task holds in Pinocchio's frame
+  accelerations of the result;
+* response columns against central differences of solves (qdd is affine in tau_ff).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import vereshchagin as vs
+from chains import well_conditioned_task
+from test_urdf_pinocchio import LWA, G, assert_rel
+from trees import pin_model, random_tree_urdf
+from vereshchagin.robots import example_robot_urdf
+
+UP = np.r_[-G, 0.0, 0.0, 0.0]  # the base's upward acceleration that stands for gravity
+
+
+class TreeCase:
+    """Our tree and Pinocchio's model of one URDF, with the joint maps between them."""
+
+    def __init__(self, name, source, tasks=()):
+        self.name = name
+        self.tree = vs.Tree.from_urdf(source)
+        self.model = pin_model(source)
+        self.model.gravity = pin.Motion(np.r_[G, 0.0, 0.0, 0.0])
+        self.tasks = tasks  # named sets of frames to constrain together
+        n = self.tree.n_joints
+        assert self.model.nv == n, f"{name}: {self.model.nv} Pinocchio joints, {n} ours"
+        joints = [self.model.joints[self.model.getJointId(j)] for j in self.tree.joint_names]
+        self.idx_v = np.array([j.idx_v for j in joints])
+        self.idx_q = np.array([j.idx_q for j in joints])
+        self.nq2 = np.array([j.nq == 2 for j in joints])
+
+    @property
+    def n(self):
+        return self.tree.n_joints
+
+    def pin_q(self, q):
+        pq = np.zeros(self.model.nq)
+        for k in range(self.n):
+            if self.nq2[k]:
+                pq[self.idx_q[k] : self.idx_q[k] + 2] = np.cos(q[k]), np.sin(q[k])
+            else:
+                pq[self.idx_q[k]] = q[k]
+        return pq
+
+    def pin_v(self, x):
+        """Ours (n,) -> Pinocchio's velocity-space order."""
+        out = np.zeros(self.model.nv)
+        out[self.idx_v] = x
+        return out
+
+    def ours(self, x):
+        """Pinocchio's velocity-space vector (nv,) or matrix (rows, nv) -> ours."""
+        x = np.asarray(x)
+        return x[..., self.idx_v]
+
+    def random_state(self, rng, qd_scale=1.5):
+        lo = np.maximum(np.asarray(self.tree.lower, float), -np.pi)
+        hi = np.minimum(np.asarray(self.tree.upper, float), np.pi)
+        return rng.uniform(lo, hi), rng.uniform(-qd_scale, qd_scale, self.n)
+
+    def solver(self):
+        return vs.Solver(self.tree, gravity=G)
+
+
+def _baxter():
+    return TreeCase(
+        "baxter",
+        example_robot_urdf("baxter"),
+        tasks={
+            "left hand": ("left_gripper",),
+            "both hands": ("left_gripper", "right_gripper"),
+            "hand and other elbow": ("left_gripper", "right_lower_elbow"),
+            "hand and own elbow": ("right_gripper", "right_upper_forearm"),
+            "hands and head": ("left_gripper", "right_gripper", "head"),
+        },
+    )
+
+
+def _talos():
+    return TreeCase(
+        "talos",
+        example_robot_urdf("talos_reduced"),
+        tasks={
+            "left hand": ("gripper_left_base_link",),
+            "both hands": ("gripper_left_base_link", "gripper_right_base_link"),
+            "hand and other elbow": ("gripper_left_base_link", "arm_right_4_link"),
+            "feet and a hand": ("left_sole_link", "right_sole_link", "gripper_right_base_link"),
+        },
+    )
+
+
+def _random(seed):
+    """A random tree (tests/trees.py) with tasks on leaves and inner links of different branches."""
+    drawn = random_tree_urdf(seed, n_links=16, p_fixed=0.2)
+    tree = vs.Tree.from_urdf(drawn.urdf)
+    parents = {j.parent for j in drawn.joints}
+    leaves = [link for link in drawn.links if link not in parents and link not in drawn.base_links]
+    # an inner link that is not an ancestor of the first leaf
+    path, link = set(), leaves[0]
+    by_child = {j.child: j.parent for j in drawn.joints}
+    while link in by_child:
+        path.add(link)
+        link = by_child[link]
+    inner = [x for x in parents if x not in path and x not in drawn.base_links] or [leaves[-1]]
+    assert len(leaves) >= 2 and tree.n_joints >= 8, "seed gives too small a tree"
+    return TreeCase(
+        f"random_{seed}",
+        drawn.urdf,
+        tasks={
+            "one leaf": (leaves[0],),
+            "two leaves": (leaves[0], leaves[-1]),
+            "leaf and inner link of another branch": (leaves[0], inner[0]),
+        },
+    )
+
+
+ROBOTS = {"baxter": _baxter, "talos": _talos, **{f"random_{s}": (lambda s=s: _random(s)) for s in (3, 8, 11)}}
+_CACHE = {}
+
+
+def robot(name):
+    if name not in _CACHE:
+        _CACHE[name] = ROBOTS[name]()
+    return _CACHE[name]
+
+
+def _frame_terms(case, data, pq, pv, frame):
+    """LWA Jacobian (6, n ours) and acceleration at qdd = 0 (6,) of a frame, from Pinocchio."""
+    fid = case.model.getFrameId(frame)
+    assert fid < len(case.model.frames), frame
+    J = pin.computeFrameJacobian(case.model, data, pq, fid, LWA)
+    pin.forwardKinematics(case.model, data, pq, pv, np.zeros(case.model.nv))
+    pin.updateFramePlacements(case.model, data)
+    a0 = pin.getFrameAcceleration(case.model, data, fid, LWA).vector
+    return J, a0
+
+
+def _frame_acc(case, data, pq, pv, pa, frame):
+    pin.forwardKinematics(case.model, data, pq, pv, pa)
+    pin.updateFramePlacements(case.model, data)
+    return pin.getFrameAcceleration(case.model, data, case.model.getFrameId(frame), LWA).vector + UP
+
+
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_unconstrained_tree_matches_aba(name):
+    case = robot(name)
+    rng = np.random.default_rng([21, len(name)])
+    data = case.model.createData()
+    for _ in range(6):
+        solver = case.solver()
+        q, qd = case.random_state(rng)
+        tau = rng.normal(size=case.n) * 5.0
+        res = solver.solve(q, qd, tau_ff=tau)
+        expected = pin.aba(case.model, data, case.pin_q(q), case.pin_v(qd), case.pin_v(tau))
+        assert_rel(res.qdd, case.ours(expected), f"{name}: qdd vs pin.aba", 1e-9)
+        assert res.nu.shape == (0,)
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_link_wrench_matches_aba_with_fext(name):
+    """A wrench on a named link (base axes, moment about the link origin) as Pinocchio's fext."""
+    case = robot(name)
+    rng = np.random.default_rng([23, len(name)])
+    data = case.model.createData()
+    solver = case.solver()
+    frame = next(iter(case.tasks.values()))[0]
+    fid = case.model.getFrameId(frame)
+    for _ in range(4):
+        q, qd = case.random_state(rng)
+        w = rng.normal(size=6) * 10.0
+        res = solver.solve(q, qd, f_ext={frame: w})
+        pq = case.pin_q(q)
+        pin.framesForwardKinematics(case.model, data, pq)
+        at_link = pin.SE3(np.eye(3), data.oMf[fid].translation)  # world axes, link origin
+        world = at_link.act(pin.Force(w[:3], w[3:]))
+        fext = [pin.Force.Zero() for _ in range(case.model.njoints)]
+        joint = case.model.frames[fid].parentJoint
+        fext[joint] = data.oMi[joint].actInv(world)
+        expected = pin.aba(case.model, data, pq, case.pin_v(qd), np.zeros(case.model.nv), fext)
+        assert_rel(res.qdd, case.ours(expected), f"{name}: qdd with a wrench on {frame}", 1e-9)
+
+
+def _task(case, rng, data, pq, pv, frames):
+    """Random unit constraint columns on each frame, their stacked rows A and gamma's a0 part."""
+    cols, rows, a0s = {}, [], []
+    for frame in frames:
+        m = int(rng.integers(1, 7)) if len(frames) > 1 else 6
+        alpha = rng.normal(size=(6, m))
+        alpha /= np.linalg.norm(alpha, axis=0)
+        J, a0 = _frame_terms(case, data, pq, pv, frame)
+        cols[frame] = alpha
+        rows.append(alpha.T @ J)
+        a0s.append(alpha.T @ (a0 + UP))
+    return cols, np.vstack(rows), np.concatenate(a0s)
+
+
+@pytest.mark.parametrize(
+    "name, task",
+    [(n, t) for n in sorted(ROBOTS) for t in robot(n).tasks],
+)
+def test_constraints_on_branches_match_forward_dynamics(name, task):
+    case = robot(name)
+    frames = case.tasks[task]
+    rng = np.random.default_rng([29, len(name), len(task)])
+    data = case.model.createData()
+    done = 0
+    for _ in range(60):
+        solver = case.solver()
+        q, qd = case.random_state(rng)
+        pq, pv = case.pin_q(q), case.pin_v(qd)
+        cols, A_pin, a0 = _task(case, rng, data, pq, pv, frames)
+        Minv = np.array(pin.computeMinverse(case.model, data, pq))
+        Minv = np.triu(Minv) + np.triu(Minv, 1).T
+        if not well_conditioned_task(A_pin, Minv):
+            continue
+        beta = {f: rng.normal(size=cols[f].shape[1]) * 3.0 for f in frames}
+        tau = rng.normal(size=case.n) * 5.0
+        res = solver.solve(q, qd, tau_ff=tau, constraints={f: (cols[f], beta[f]) for f in frames})
+
+        gamma = a0 - np.concatenate([beta[f] for f in frames])
+        ddq = pin.forwardDynamics(case.model, data, pq, pv, case.pin_v(tau), A_pin, gamma)
+        lam = np.array(data.lambda_c).reshape(-1)
+        assert_rel(res.qdd, case.ours(ddq), f"{name} {task}: qdd vs pin.forwardDynamics", 1e-9)
+        assert_rel(res.nu, -lam, f"{name} {task}: nu vs -lambda", 1e-8)
+        assert res.constraint_rank == A_pin.shape[0]
+        # command torques: -sum_i J_i^T alpha_i nu_i, and replayed through ABA
+        assert_rel(case.pin_v(res.tau_command), -A_pin.T @ res.nu, "tau_command = -A^T nu", 1e-9)
+        replay = pin.aba(case.model, data, pq, pv, case.pin_v(tau + res.tau_command))
+        assert_rel(case.ours(replay), res.qdd, "aba(tau_ff + tau_command) vs qdd", 1e-9)
+        # every task holds in Pinocchio's frame accelerations of our qdd
+        for f in frames:
+            acc = _frame_acc(case, data, pq, pv, case.pin_v(res.qdd), f)
+            assert_rel(cols[f].T @ acc, beta[f], f"{name} {task}: alpha^T a({f}) = beta", 1e-8)
+        done += 1
+        if done == 3:
+            break
+    assert done == 3, "too few well-conditioned samples"
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_response_columns_on_trees_are_the_derivative_of_solve(name):
+    case = robot(name)
+    frames = list(case.tasks.values())[1]  # two frames on two branches
+    rng = np.random.default_rng([31, len(name)])
+    data = case.model.createData()
+    solver = case.solver()
+    q, qd = case.random_state(rng)
+    cols, _, _ = _task(case, rng, data, case.pin_q(q), case.pin_v(qd), frames)
+    cons = {f: (cols[f], rng.normal(size=cols[f].shape[1])) for f in frames}
+    tau = rng.normal(size=case.n)
+    solver.solve(q, qd, tau_ff=tau, constraints=cons)
+    joints = [0, case.n // 2, case.n - 1]
+    dqdd, dtau = solver.response_columns(joints)
+    for c, j in enumerate(joints):
+        e = np.zeros(case.n)
+        e[j] = 1.0
+        plus = solver.solve(q, qd, tau_ff=tau + e, constraints=cons)
+        minus = solver.solve(q, qd, tau_ff=tau - e, constraints=cons)
+        assert_rel(dqdd[:, c], (plus.qdd - minus.qdd) / 2.0, f"dqdd/dtau_{j}", 1e-7)
+        assert_rel(dtau[:, c], (plus.tau_command - minus.tau_command) / 2.0, f"dtau_cmd/dtau_{j}", 1e-7)
