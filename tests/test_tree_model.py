@@ -138,7 +138,7 @@ def test_fk_jacobian_twist_of_every_segment_and_link(name):
 
 def test_talos_root_and_sub_tree():
     path = example_robot_urdf("talos_reduced")
-    tree = vs.Tree.from_urdf(path)
+    tree = vs.Tree.from_urdf(Path(path))  # os.PathLike as well as str
     assert tree.root_link == tree.base_name == "base_link" and tree.n_joints == 32
     arm = vs.Tree.from_urdf(path, root="arm_left_1_link")
     assert arm.root_link == "arm_left_1_link" and arm.n_joints == 7
