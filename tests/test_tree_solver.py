@@ -19,15 +19,18 @@ comparison maps by joint name. Every expected value comes from Pinocchio:
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
 from chains import well_conditioned_task
+from friction_oracles import STICK, FrictionProblem, OracleInfeasible, enumeration_oracle, pinocchio_problem
 from test_urdf_pinocchio import LWA, G, assert_rel
 from trees import pin_model, random_tree_urdf
-from vereshchagin.robots import example_robot_urdf
+from vereshchagin.robots import example_robot_urdf, gen3_urdf
 
 UP = np.r_[-G, 0.0, 0.0, 0.0]  # the base's upward acceleration that stands for gravity
 
@@ -108,9 +111,21 @@ def _talos():
     )
 
 
+def _every_joint_moves_mass(drawn):
+    """Every moving joint of the drawn tree carries some mass (from the drawn record)."""
+    for j in drawn.moving:
+        below = {j.child} | {k.child for k in drawn.below(j.child)}
+        if not any(drawn.masses[link] > 0.0 for link in below):
+            return False
+    return True
+
+
 def _random(seed):
     """A random tree (tests/trees.py) with tasks on leaves and inner links of different branches."""
     drawn = random_tree_urdf(seed, n_links=16, p_fixed=0.2)
+    while not _every_joint_moves_mass(drawn):  # else no unique motion: draw again
+        seed += 1000
+        drawn = random_tree_urdf(seed, n_links=16, p_fixed=0.2)
     tree = vs.Tree.from_urdf(drawn.urdf)
     parents = {j.parent for j in drawn.joints}
     leaves = [link for link in drawn.links if link not in parents and link not in drawn.base_links]
@@ -204,10 +219,11 @@ def _task(case, rng, data, pq, pv, frames):
     """Random unit constraint columns on each frame, their stacked rows A and gamma's a0 part."""
     cols, rows, a0s = {}, [], []
     for frame in frames:
-        m = int(rng.integers(1, 7)) if len(frames) > 1 else 6
+        J, a0 = _frame_terms(case, data, pq, pv, frame)
+        reach = min(6, int(np.count_nonzero(np.abs(J).sum(axis=0))))  # joints on the frame's path
+        m = int(rng.integers(1, reach + 1)) if len(frames) > 1 else reach
         alpha = rng.normal(size=(6, m))
         alpha /= np.linalg.norm(alpha, axis=0)
-        J, a0 = _frame_terms(case, data, pq, pv, frame)
         cols[frame] = alpha
         rows.append(alpha.T @ J)
         a0s.append(alpha.T @ (a0 + UP))
@@ -278,3 +294,130 @@ def test_response_columns_on_trees_are_the_derivative_of_solve(name):
         minus = solver.solve(q, qd, tau_ff=tau - e, constraints=cons)
         assert_rel(dqdd[:, c], (plus.qdd - minus.qdd) / 2.0, f"dqdd/dtau_{j}", 1e-7)
         assert_rel(dtau[:, c], (plus.tau_command - minus.tau_command) / 2.0, f"dtau_cmd/dtau_{j}", 1e-7)
+
+
+# ------------------------------------------------------------------------------------------------
+# Static friction on trees: the max-min against stick/slip enumeration of the same problem built
+# from Pinocchio's H, ABA and frame Jacobians (tests/friction_oracles.py)
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["baxter", "talos", "random_3"])
+def test_friction_on_trees_matches_enumeration(name):
+    case = robot(name)
+    frames = list(case.tasks.values())[1]  # two frames on two branches
+    rng = np.random.default_rng([37, len(name)])
+    data = case.model.createData()
+    solver = case.solver()
+    checked, statuses = 0, set()
+    for _ in range(40):
+        q, qd = case.random_state(rng)
+        resting = np.zeros(case.n, bool)
+        resting[rng.choice(case.n, size=min(6, case.n - 1), replace=False)] = True  # across branches
+        qd[resting] = 0.0
+        pq, pv = case.pin_q(q), case.pin_v(qd)
+        cols, A_pin, a0 = _task(case, rng, data, pq, pv, frames)
+        beta = {f: rng.normal(size=cols[f].shape[1]) for f in frames}
+        tau = rng.normal(size=case.n) * 3.0
+        static = rng.uniform(0.2, 4.0, case.n)
+        kinetic = static * rng.uniform(0.3, 1.0, case.n)
+        prob = pinocchio_problem(
+            case.model, data, pq, pv, tau_ff=case.pin_v(tau), static=case.pin_v(static), kinetic=case.pin_v(kinetic)
+        )
+        prob = FrictionProblem(
+            prob.H,
+            prob.qdd_free,
+            A_pin,
+            np.concatenate([beta[f] for f in frames]) - a0,
+            prob.resting,
+            prob.static,
+            prob.kinetic_torque,
+        )
+        Minv = np.linalg.inv(prob.H)
+        if not well_conditioned_task(A_pin, Minv):
+            continue
+        try:
+            oracle = enumeration_oracle(prob)
+        except OracleInfeasible:
+            continue
+        res = solver.solve(
+            q,
+            qd,
+            tau_ff=tau,
+            constraints={f: (cols[f], beta[f]) for f in frames},
+            friction=vs.Friction(static=static, kinetic=kinetic),
+        )
+        R = prob.rest_idx
+        slipping = np.abs(oracle.qdd[R])[oracle.status[R] != STICK]
+        if slipping.size and slipping.min() < 1e-6 * prob.accel_scale(oracle.qdd):
+            continue  # near a stick/slip boundary: the status is a matter of round-off
+        assert_rel(res.qdd, case.ours(oracle.qdd), f"{name}: qdd vs enumeration", 1e-8)
+        np.testing.assert_array_equal(res.status, case.ours(oracle.status))
+        assert_rel(res.gauss_value, oracle.objective, "Gauss value", 1e-8)
+        # the motion is the frictionless solve with the friction torques as feed-forward
+        plain = solver.solve(
+            q, qd, tau_ff=tau + res.friction_torque, constraints={f: (cols[f], beta[f]) for f in frames}
+        )
+        assert_rel(plain.qdd, res.qdd, "qdd = solve(tau_ff + friction_torque)", 1e-8)
+        statuses.update(int(s) for s in res.status[resting])
+        checked += 1
+        if checked == 4:
+            break
+    assert checked == 4, "too few usable samples"
+    assert STICK in statuses, "no sticking joint in the samples: the test would not see the max-min"
+
+
+# ------------------------------------------------------------------------------------------------
+# The Python face on trees
+# ------------------------------------------------------------------------------------------------
+def test_a_chain_loaded_as_a_tree_solves_as_the_chain():
+    urdf = gen3_urdf(False)  # a serial URDF (the gripper's fingers would branch)
+    chain, tree = vs.Chain.from_urdf(urdf), vs.Tree.from_urdf(urdf)
+    assert list(tree.joint_names) == list(chain.joint_names)
+    assert list(tree.segment_names) == list(chain.segment_names)
+    a, b = vs.Solver(chain), vs.Solver(tree)
+    rng = np.random.default_rng(41)
+    tip = chain.segment_names[-1]
+    for m in range(7):
+        q, qd, tau = rng.uniform(-2, 2, 7), rng.uniform(-1, 1, 7), rng.normal(size=7)
+        alpha, beta = rng.normal(size=(6, m)), rng.normal(size=m)
+        fr = vs.Friction(static=np.full(7, 0.5)) if m % 2 else None
+        qd[::3] = 0.0
+        ra = a.solve(q, qd, alpha, beta, tau_ff=tau, friction=fr)
+        rb = b.solve(q, qd, tau_ff=tau, constraints={tip: (alpha, beta)} if m else None, friction=fr)
+        for field in ("qdd", "tau_command", "nu", "link_acc"):
+            np.testing.assert_allclose(getattr(rb, field), getattr(ra, field), rtol=1e-12, atol=1e-12, err_msg=field)
+
+
+def test_tree_batch_rows_equal_solve_and_solver_pickles():
+    case = robot("baxter")
+    solver = case.solver()
+    rng = np.random.default_rng(43)
+    B = 9
+    Q = rng.uniform(-1, 1, (B, case.n))
+    QD = rng.uniform(-1, 1, (B, case.n))
+    alpha = rng.normal(size=(B, 6, 3))
+    beta = rng.normal(size=(B, 3))
+    cons = {"left_gripper": (alpha, beta), "right_lower_elbow": (np.eye(6)[:, :1], [9.81])}
+    batch = solver.solve_batch(Q, QD, constraints=cons, threads=2)
+    clone = pickle.loads(pickle.dumps(solver))
+    for k in range(B):
+        row = {"left_gripper": (alpha[k], beta[k]), "right_lower_elbow": cons["right_lower_elbow"]}
+        single = solver.solve(Q[k], QD[k], constraints=row)
+        np.testing.assert_array_equal(batch.qdd[k], single.qdd)
+        np.testing.assert_array_equal(batch.nu[k], single.nu)
+        np.testing.assert_array_equal(clone.solve(Q[k], QD[k], constraints=row).qdd, single.qdd)
+    assert isinstance(clone.tree, vs.Tree) and isinstance(solver.model, vs.Tree)
+
+
+def test_tree_solver_errors_name_the_remedy():
+    solver = robot("baxter").solver()
+    n = solver.n_joints
+    with pytest.raises(vs.SolverError, match="constraints="):
+        solver.solve(np.zeros(n), np.zeros(n), np.eye(6), np.zeros(6))
+    with pytest.raises(vs.SolverError, match="solver.tree"):
+        solver.chain  # noqa: B018
+    with pytest.raises(vs.SolverError, match="no_such_link"):
+        solver.solve(np.zeros(n), np.zeros(n), constraints={"no_such_link": (np.eye(6), np.zeros(6))})
+    with pytest.raises(vs.SolverError, match="base"):  # the base cannot be constrained
+        solver.solve(np.zeros(n), np.zeros(n), constraints={"base": (np.eye(6), np.zeros(6))})
+    with pytest.raises(TypeError, match="Chain or vereshchagin.Tree"):
+        vs.Solver("baxter")
