@@ -4,8 +4,8 @@
 Robots: Baxter (example-robot-data: head, two 7-joint arms, two-finger grippers, 19 joints) with
 6-D constraints on one hand (m = 6) or on both hands (m = 12), and m = 0 (plain forward dynamics);
 seeded random trees of 15, 30 and 60 moving joints (revolute, continuous, prismatic; tests/trees.py, written as URDF text and
-loaded by both libraries) with 6-D constraints on two leaves of different branches (m = 12), for
-the scaling in n at fixed m.
+loaded by both libraries) with 3-D constraints on two leaves of different branches (m = 6; random trees are shallow, so
+each leaf has 3 joints of its own, not 6), for the scaling in n at fixed m.
 
 Timed per call, from Python, 64 seeded states per robot, interleaved batches, medians:
   ours          solver.solve(q, qd, tau_ff=tau, constraints={hand: (alpha, beta), ...})
@@ -38,7 +38,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests"))
 from bench_pinocchio import LWA, N_STATES, UP, paired_ratio, rel_diff, time_group  # noqa: E402
-from trees import pin_q, pin_v_index, random_tree_urdf  # noqa: E402  (tests/trees.py)
+from trees import pin_q, pin_v_index, random_solvable_tree  # noqa: E402  (tests/trees.py)
 
 G = -UP[:3]
 RTOL = 1e-8
@@ -69,7 +69,7 @@ class Robot:
         return pin_q(self.model, list(self.tree.joint_names), q)
 
 
-def make_states(robot, frames, seed):
+def make_states(robot, frames, seed, cols):
     rng = np.random.default_rng(seed)
     lo = np.maximum(np.asarray(robot.tree.lower, float), -np.pi)
     hi = np.minimum(np.asarray(robot.tree.upper, float), np.pi)
@@ -79,7 +79,8 @@ def make_states(robot, frames, seed):
         cons = {}
         for f in frames:
             Q, _ = np.linalg.qr(rng.uniform(-1, 1, (6, 6)))
-            cons[f] = (np.ascontiguousarray(Q), Q.T @ UP + rng.uniform(-1, 1, 6))
+            alpha = np.ascontiguousarray(Q[:, :cols])
+            cons[f] = (alpha, alpha.T @ UP + rng.uniform(-1, 1, cols))
         states.append((q, qd, tau, cons))
     return states
 
@@ -98,8 +99,8 @@ def pipeline(robot, fids):
     return run
 
 
-def bench_case(robot, frames, seed, batches, batch_s):
-    states = make_states(robot, frames, seed)
+def bench_case(robot, frames, seed, batches, batch_s, cols=6):
+    states = make_states(robot, frames, seed, cols)
     pin_states = [(robot.to_pin_q(q), robot.to_pin(qd), robot.to_pin(tau), c) for q, qd, tau, c in states]
     fids = [robot.model.getFrameId(f) for f in frames]
     solve = robot.solver.solve
@@ -126,12 +127,12 @@ def bench_case(robot, frames, seed, batches, batch_s):
                 else:
                     pin.aba(model, data, pq, pv, pt)
 
-    print(f"timing {robot.label}, m = {6 * len(frames)} ...", file=sys.stderr, flush=True)
+    print(f"timing {robot.label}, m = {cols * len(frames)} ...", file=sys.stderr, flush=True)
     us = time_group({"ours": ours, "pin": theirs}, batches, batch_s)
     return dict(
         robot=robot.label,
         n=robot.n,
-        m=6 * len(frames),
+        m=cols * len(frames),
         frames=", ".join(frames) or "-",
         ours=statistics.median(us["ours"]),
         pin=statistics.median(us["pin"]),
@@ -141,11 +142,29 @@ def bench_case(robot, frames, seed, batches, batch_s):
 
 
 def random_robot(n, seed):
-    """A random tree of n moving joints (no fixed ones) and two of its leaves on different branches."""
-    drawn = random_tree_urdf(seed, n_links=n, p_fixed=0.0)
-    parents = {j.parent for j in drawn.joints}
-    leaves = [link for link in drawn.links if link not in parents]
-    return Robot(f"random tree, {n} joints", text=drawn.urdf), leaves
+    """A random tree of n moving joints (no fixed ones) and two leaves on different branches, each
+    with at least 3 joints of its own (not shared with the other's path), so that 3-D constraints on
+    both are independent."""
+    drawn = random_solvable_tree(seed, n_links=n, p_fixed=0.0)
+    parent = {j.child: j.parent for j in drawn.joints}
+
+    def path(link):
+        out = []
+        while link in parent:
+            out.append(link)
+            link = parent[link]
+        return out
+
+    leaves = [link for link in drawn.links if link not in set(parent.values())]
+    best = None
+    for a in leaves:
+        for b in leaves:
+            own_a, own_b = set(path(a)) - set(path(b)), set(path(b)) - set(path(a))
+            if a < b and min(len(own_a), len(own_b)) >= 3:
+                score = len(own_a) + len(own_b)
+                best = max(best or (0, a, b), (score, a, b))
+    assert best is not None, f"random tree {seed}: no two leaves with 3 joints of their own"
+    return Robot(f"random tree, {n} joints", text=drawn.urdf), best[1:]
 
 
 def report(rows, batches, batch_s, wall):
@@ -200,7 +219,7 @@ def main():
     ]
     for n in (15, 30, 60):
         robot, leaves = random_robot(n, 0x7EE0000 + n)
-        rows.append(bench_case(robot, (leaves[0], leaves[-1]), 400 + n, args.batches, batch_s))
+        rows.append(bench_case(robot, leaves, 400 + n, args.batches, batch_s, cols=3))
     text = report(rows, args.batches, batch_s, time.perf_counter() - t0)
     print(text)
     if args.out:

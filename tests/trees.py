@@ -177,6 +177,25 @@ def random_tree_urdf(seed: int, n_links: int = 14, p_fixed: float = 0.25) -> Ran
     return RandomTree(urdf=urdf, root="base", links=links, masses=masses, joints=joints)
 
 
+def every_joint_moves_mass(drawn: RandomTree) -> bool:
+    """Every moving joint of the drawn tree carries some mass (read from the drawn record), so the
+    tree's motion is unique (no zero articulated inertia)."""
+    for j in drawn.moving:
+        below = {j.child} | {k.child for k in drawn.below(j.child)}
+        if not any(drawn.masses[link] > 0.0 for link in below):
+            return False
+    return True
+
+
+def random_solvable_tree(seed: int, n_links: int = 14, p_fixed: float = 0.25) -> RandomTree:
+    """:func:`random_tree_urdf`, redrawn (seed + 1000, + 2000, ...) until every joint moves mass."""
+    drawn = random_tree_urdf(seed, n_links, p_fixed)
+    while not every_joint_moves_mass(drawn):
+        seed += 1000
+        drawn = random_tree_urdf(seed, n_links, p_fixed)
+    return drawn
+
+
 def pin_model(source: str | Path) -> pin.Model:
     """Pinocchio model of URDF text or a URDF file, the root link fixed (no free-flyer)."""
     text = str(source)
