@@ -10,10 +10,12 @@
 #include <kdl/chainidsolver.hpp>  // KDL::Wrenches
 #include <kdl/jacobian.hpp>
 #include <kdl/jntarray.hpp>
+#include <kdl/tree.hpp>
 
 #include "fuzz_input.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
 #include "vereshchagin/friction_solver.hpp"
+#include "vereshchagin/tree_hd_solver.hpp"
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace fuzzutil {
@@ -178,6 +180,68 @@ std::string exerciseChain(const KDL::Chain& chain, ByteReader& r, const Eigen::V
   return "";
 }
 
+// The same segments as a tree (each one's parent drawn among the earlier ones or the base) and
+// every entry point of TreeHdSolver and of FrictionSolver on it. Reads nothing unless the next
+// byte asks for a tree (inputs that end before it, as the chain-only corpus does, skip this).
+std::string exerciseTree(const std::vector<KDL::Segment>& segments, ByteReader& r) {
+  if (segments.empty() || r.byte() % 4 == 0) return "";
+  KDL::Tree tree("base");
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const int p = r.integer(-1, static_cast<int>(i) - 1);
+    tree.addSegment(segments[i], p < 0 ? "base" : segments[p].getName());
+  }
+  const KDL::Twist root_acc(KDL::Vector(r.value(-1, 1), r.value(-1, 1), 9.81), KDL::Vector(0, 0, r.value(-1, 1)));
+  vereshchagin::TreeHdSolver hd(tree, root_acc);
+  if (hd.modelError() != 0 && hd.errorMessage()[0] == '\0') return "tree modelError() set with an empty message";
+  const unsigned int n = hd.nrOfJoints(), ns = hd.nrOfSegments();
+  Eigen::VectorXd q(n), qd(n), ff(n);
+  for (unsigned int k = 0; k < n; ++k) {
+    q(k) = r.value(-3.2, 3.2);
+    qd(k) = r.byte() < 96 ? 0.0 : r.value(-3.0, 3.0);
+    ff(k) = r.value(-10.0, 10.0);
+  }
+  const int m = r.integer(0, 13);
+  Matrix6X alfa(6, m);
+  Eigen::VectorXd beta(m);
+  Eigen::VectorXi segs(m);
+  for (int c = 0; c < m; ++c) {
+    for (int k = 0; k < 6; ++k) alfa(k, c) = r.value(-1.0, 1.0);
+    beta(c) = r.value(-10.0, 10.0);
+    segs(c) = r.integer(-1, static_cast<int>(ns));
+  }
+  Matrix6X fext = Matrix6X::Zero(6, (r.byte() & 1) ? ns : 0);
+  for (Eigen::Index c = 0; c < fext.cols(); ++c)
+    for (int k = 0; k < 6; ++k) fext(k, c) = r.value(-5.0, 5.0);
+  const auto finite = [&] {
+    return hd.qdd().allFinite() && hd.commandTorques().allFinite() && hd.nu().allFinite() &&
+           hd.linkAccelerations().allFinite() && std::isfinite(hd.smallestSingularValue());
+  };
+  const int m_last = std::min(m, 7);
+  int rc = hd.solve(q, qd, alfa.leftCols(m_last), beta.head(m_last), fext, ff);
+  std::string bad = verdict("TreeHdSolver::solve", rc, hd.errorMessage(), finite);
+  if (!bad.empty()) return bad;
+  rc = hd.solve(q, qd, alfa, beta, segs, fext, ff);
+  bad = verdict("TreeHdSolver::solve(segments)", rc, hd.errorMessage(), finite);
+  if (!bad.empty()) return bad;
+  if (rc == 0 && n > 0) {
+    const Eigen::VectorXi all = Eigen::VectorXi::LinSpaced(n, 0, static_cast<int>(n) - 1);
+    Eigen::MatrixXd dqdd(n, n), dtau(n, n), dnu(std::max(m, 1), n);
+    rc = hd.responseColumns(all, dqdd, dtau, dnu);
+    bad = verdict("TreeHdSolver::responseColumns", rc, hd.errorMessage(),
+                  [&] { return dqdd.allFinite() && dtau.allFinite() && dnu.topRows(m).allFinite(); });
+    if (!bad.empty()) return bad;
+  }
+  vereshchagin::FrictionModel fm;
+  fm.static_friction.resize(n);
+  for (unsigned int k = 0; k < n; ++k) fm.static_friction(k) = r.value(0.0, 20.0);
+  FrictionSolver fs(tree, root_acc);
+  rc = fs.solve(q, qd, alfa, beta, segs, fext, ff, fm);
+  return verdict("FrictionSolver::solve(tree)", rc, fs.errorMessage(), [&] {
+    return fs.qdd().allFinite() && fs.commandTorques().allFinite() && fs.frictionTorques().allFinite() &&
+           fs.nu().allFinite() && fs.linkAccelerations().allFinite();
+  });
+}
+
 KDL::Joint drawJoint(ByteReader& r, const std::string& name) {
   const double rotor = r.byte() < 128 ? 0.0 : r.value(0.0, 0.5);
   switch (r.integer(0, 8)) {
@@ -279,7 +343,9 @@ std::string checkSolver(const std::uint8_t* data, std::size_t size) {
     chain.addSegment(KDL::Segment("s" + std::to_string(i), joint, tip,
                                   KDL::RigidBodyInertia(mass, com, KDL::RotationalInertia(a, b, c, xy, 0.0, 0.0))));
   }
-  return exerciseChain(chain, r, nullptr, nullptr, nullptr);
+  const std::string bad = exerciseChain(chain, r, nullptr, nullptr, nullptr);
+  if (!bad.empty()) return bad;
+  return exerciseTree(chain.segments, r);
 }
 
 }  // namespace fuzzutil

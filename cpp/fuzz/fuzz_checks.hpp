@@ -9,8 +9,10 @@
 //  * checkSolver: the bytes describe a chain (0..8 segments of any joint type, inertias, frames,
 //    rotor inertias — values anywhere from plausible to NaN) and one call of each entry point
 //    (ChainHdSolver::solve / CartToJnt / responseColumns, FrictionSolver::solve / gaussValue /
-//    linkAccelerations). Each call returns 0 with finite outputs, or an error code < 0 with a
-//    non-empty message.
+//    linkAccelerations); then, if bytes remain and ask for it, the same segments as a tree (parents
+//    drawn) through TreeHdSolver (both solve overloads, up to 13 columns on drawn segments,
+//    responseColumns) and FrictionSolver on the tree. Each call returns 0 with finite outputs, or
+//    an error code < 0 with a non-empty message.
 // Both return "" when the properties hold, else a description of the violation.
 #pragma once
 

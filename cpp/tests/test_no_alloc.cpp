@@ -6,10 +6,12 @@
 
 #include "alloc_counter.hpp"
 #include "random_chain.hpp"
+#include "random_tree.hpp"
 #include "test_common.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
 #include "vereshchagin/friction_solver.hpp"
 #include "vereshchagin/kdl_compat.hpp"
+#include "vereshchagin/tree_hd_solver.hpp"
 
 namespace {
 void* volatile g_sink = nullptr;  // keeps the deliberate allocations observable
@@ -250,7 +252,67 @@ int main() {
                                                                  str(p1.mallocs - p0.mallocs));
   }
 
+  // Trees (random branching, fixed joints): forward dynamics, constraints on two branches with
+  // the last-segment and segments overloads, pass-through, response columns (all joints and a
+  // shuffled subset) and friction on top.
+  {
+    testutil::RandomGen tg(77);
+    testutil::TreeSpec spec;
+    spec.n_joints = 12;
+    const KDL::Tree tree = testutil::randomTree(tg, spec);
+    vereshchagin::TreeHdSolver ts(tree, grav);
+    vereshchagin::FrictionSolver tf(tree, grav);
+    const int tn = static_cast<int>(ts.nrOfJoints()), tns = static_cast<int>(ts.nrOfSegments());
+    vereshchagin::FrictionModel fm;
+    fm.static_friction = Eigen::VectorXd::LinSpaced(tn, 0.5, 3.0);
+    const Eigen::VectorXd tq = Eigen::VectorXd::LinSpaced(tn, -1.0, 1.2),
+                          tqd = Eigen::VectorXd::LinSpaced(tn, 0.3, -0.4);
+    const Eigen::VectorXd tff = Eigen::VectorXd::LinSpaced(tn, -2.0, 2.0), trest = Eigen::VectorXd::Zero(tn);
+    const Matrix6X tfe = Matrix6X::Constant(6, tns, 0.3);
+    Eigen::VectorXi tsegs(9);  // the last segment and two others on other branches
+    for (int c = 0; c < 9; ++c) tsegs(c) = c < 3 ? tns - 1 : (c < 6 ? tns / 2 : 1);
+    Matrix6X tA(6, 9);
+    for (int c = 0; c < 9; ++c) tA.col(c) = alfa_m[6].col(c % 6);
+    const Eigen::VectorXd tb = Eigen::VectorXd::LinSpaced(9, -1.0, 1.0);
+    Eigen::VectorXi tall(tn), tsome(3);
+    for (int j = 0; j < tn; ++j) tall(j) = j;
+    tsome << tn - 1, 0, tn / 2;
+    Eigen::MatrixXd tdq(tn, tn), tdt(tn, tn), tdn(9, tn), tdq3(tn, 3), tdt3(tn, 3);
+    const Eigen::VectorXd w9 = Eigen::VectorXd::LinSpaced(9, 0.0, 1.0), w9r = w9.reverse();
+    ts.solve(tq, tqd, tA, tb, tsegs, tfe, tff);
+    ts.responseColumns(tall, tdq, tdt, tdn);
+    tf.solve(tq, trest, tA.leftCols(3), tb.head(3), tsegs.head(3), tfe, tff, fm);
+    double tsum = 0.0;
+    int tfail = 0;
+    const Counts t0 = now();
+    for (int it = 0; it < 300; ++it) {
+      const int m = 1 + it % 9;
+      if (ts.solve(tq, tqd, tA.leftCols(0), tb.head(0), tfe, tff) != 0) ++tfail;
+      tsum += ts.qdd()(0) + ts.linkAccelerations()(2, tns);
+      if (ts.solve(tq, tqd, tA.leftCols(it % 7), tb.head(it % 7), tfe, tff) != 0) ++tfail;
+      if (ts.solve(tq, tqd, tA.leftCols(m), tb.head(m), tsegs.head(m), tfe, tff) != 0) ++tfail;
+      if (ts.responseColumns(tall, tdq, tdt, tdn) != 0) ++tfail;
+      if (ts.responseColumns(tsome, tdq3, tdt3) != 0) ++tfail;
+      tsum += ts.commandTorques()(1) + tdq(0, 0) + tdq3(1, 1) + ts.smallestSingularValue();
+      if (it % 3 == 0) {
+        if (ts.setPassThrough(w9.head(m), w9r.head(m)) != 0) ++tfail;
+        if (ts.solve(tq, tqd, tA.leftCols(m), tb.head(m), tsegs.head(m), tfe, tff) != 0) ++tfail;
+        ts.clearPassThrough();
+      }
+      const int mf = 1 + it % 4;
+      if (tf.solve(tq, trest, tA.leftCols(mf), tb.head(mf), tsegs.head(mf), tfe, tff, fm) != 0) ++tfail;
+      tsum += tf.qdd()(0) + tf.gaussValue();
+    }
+    const Counts t1 = now();
+    ck.check(tfail == 0,
+             "tree solves failed: " + str(tfail) + " (" + ts.errorMessage() + " / " + tf.errorMessage() + ")");
+    ck.check(std::isfinite(tsum), "non-finite tree results");
+    ck.check(
+        t1.news == t0.news && t1.mallocs == t0.mallocs,
+        "tree solves allocated: operator new " + str(t1.news - t0.news) + ", malloc " + str(t1.mallocs - t0.mallocs));
+  }
+
   return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves + 2000 with segment constraints on a "
-                               "7-joint chain, nc 0..6 (malloc counted too: ") +
+                               "7-joint chain, nc 0..6, 2700 on a 12-joint tree (malloc counted too: ") +
                    (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no") + ")");
 }
