@@ -133,12 +133,25 @@ class FrictionSolver {
               const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
               const Eigen::Ref<const Eigen::VectorXi>* segments, const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
               const Eigen::Ref<const Eigen::VectorXd>& tau);
+  // The stages of solveImpl: the friction model's checks; the resting joints (rest_, their bounds
+  // lo_ / hi_, kinetic friction into tau0_), returning their number k; the max-min over them from
+  // hd_'s solve without static friction (boxQp, leastCommand, outputs updated affinely); the
+  // friction and limit torques and the status per joint.
+  int checkFriction(const FrictionModel& friction);
+  int restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+  int optimiseResting(int k);
+  void frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_dot, const FrictionModel& friction, int k);
   int boxQp(int k);          // stage 1 on Q_, c_, lo_, hi_ -> x_
   void leastCommand(int k);  // stage 2: tie-break on the optimal face
   // Stage 2's solvers on the sticking set (ns joints, Q_StSt = V_ V_^T of rank r < ns), from
   // ys_ = x*_St with target ts_ and bounds p_ / eig_ (see leastCommand).
   void leastOnLine(int ns, int r);                    // ns - r = 1: closed form
   void leastActiveSet(int ns, int r, double yscale);  // range-space primal active set
+  int projectOffRange(int ns, int r);                 // its steps (friction_solver.cpp)
+  bool stepToBound(int ns, double step_tol);
+  void faceMultipliers(int r, int rf);
+  int releaseIndex(int ns, int r, double mult_tol, bool bland) const;
   // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
