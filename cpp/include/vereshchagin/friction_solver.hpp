@@ -8,7 +8,7 @@
 //   mu*  = argmax_{|mu| <= f}  g(mu),  g(mu) = c^T mu - 1/2 mu^T Q mu,
 //
 // with Z0 the frictionless Gauss function, Q = W G W^T (G the constrained inverse inertia of
-// ChainHdSolver::responseColumns, W the selection of resting joints) and c = W qdd(0). Moving
+// HdSolver::responseColumns, W the selection of resting joints) and c = W qdd(0). Moving
 // joints get the kinetic (Coulomb) friction -fk_j sign(qd_j) as a feed-forward torque.
 //
 // Method: one full solve, the response columns of the resting joints (O(n) each, no
@@ -21,7 +21,8 @@
 // problem on the optimal face, solved in the range space of Q_StSt): static friction holds what
 // it can and the motors add only the rest.
 //
-// Units and frames are those of ChainHdSolver. Outputs after solve():
+// Units, frames, segment and joint order are those of the underlying HdSolver (ChainHdSolver for
+// a chain, TreeHdSolver for a tree; hd_solver.hpp). Outputs after solve():
 //  * qdd (n): joint accelerations.
 //  * commandTorques (n): tau_cmd = -J^T alfa nu at the optimum: what the motors add to
 //    ff_torques. Forward dynamics with ff_torques + tau_cmd + frictionTorques reproduces qdd.
@@ -30,7 +31,7 @@
 //  * limitTorques (n): the reaction of joint limits (>= 0 at a lower limit, <= 0 at an upper
 //    one): what friction cannot hold of the total -mu* at a joint resting on its limit.
 //  * status (n): Moving, Stick, SlipPositive (qdd > 0) or SlipNegative (qdd < 0).
-//  * nu, constraint rank: as ChainHdSolver at the optimum.
+//  * nu, constraint rank: as HdSolver at the optimum.
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
 //    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
 //    (computed on request: one extra O(n) solve). NaN before a successful solve, or when qdd_free
