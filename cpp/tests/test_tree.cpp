@@ -316,6 +316,15 @@ void testResponseColumns(testutil::Checker& ck) {
     const double e = std::max({relErr(dqdd, fq), relErr(dtau, ft), m ? relErr(dnu, fn) : 0.0});
     worst = std::max(worst, e);
     ck.check(e < kTol, "seed " + str(seed) + ": response columns vs differences " + str(e));
+    // More columns than joints (processed in chunks of n_joints): every joint twice.
+    Eigen::VectorXi twice(2 * nj);
+    twice << joints, joints;
+    Eigen::MatrixXd dq2(nj, 2 * nj), dt2(nj, 2 * nj);
+    s.solve(q, qd, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff);
+    rc = s.responseColumns(twice, dq2, dt2);
+    ck.check(rc == 0 && relErr(dq2.leftCols(nj), dqdd) < kTol && relErr(dq2.rightCols(nj), dqdd) < kTol &&
+                 relErr(dt2.rightCols(nj), dtau) < kTol,
+             "seed " + str(seed) + ": response columns in two chunks differ");
   }
   std::printf("  response columns vs differences in ff: worst %.2e\n", worst);
 }
