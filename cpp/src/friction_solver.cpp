@@ -106,14 +106,8 @@ int FrictionSolver::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
   return rc;
 }
 
-int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
-                              const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-                              const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
-                              const Eigen::Ref<const Eigen::VectorXd>& beta,
-                              const Eigen::Ref<const Eigen::VectorXi>* segments,
-                              const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
-                              const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
-  solved_ = false;
+// Stage 0: the friction model's sizes and values (0 or E_INVALID_FRICTION with a message).
+int FrictionSolver::checkFriction(const FrictionModel& friction) {
   const long n = nj_;
   const Eigen::VectorXd& fs = friction.static_friction;
   const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
@@ -134,39 +128,32 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
                   "friction.kinetic_friction(%ld) must be finite and in [0, static_friction = %g], got %g", j, fs(j),
                   fk(j));
   }
-  const bool limits = friction.lower.size() != 0 || friction.upper.size() != 0;
-  if (limits) {
-    if (friction.lower.size() != n || friction.upper.size() != n)
-      return fail(E_INVALID_FRICTION, "friction.lower and friction.upper must have %ld entries each (or both be empty)",
-                  n);
-    if (!std::isfinite(friction.limit_tolerance) || friction.limit_tolerance < 0.0)
-      return fail(E_INVALID_FRICTION, "friction.limit_tolerance must be finite and >= 0, got %g",
-                  friction.limit_tolerance);
-    for (long j = 0; j < n; ++j)
-      if (std::isnan(friction.lower(j)) || std::isnan(friction.upper(j)) || friction.lower(j) > friction.upper(j))
-        return fail(E_INVALID_FRICTION,
-                    "friction.lower(%ld) must be <= friction.upper(%ld), neither NaN, got %g and %g", j, j,
-                    friction.lower(j), friction.upper(j));
-  }
-  if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0)) {
-    // Let the hybrid-dynamics solver report the size problem with its message.
-    const int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
-    return fail(rc, "%s", hd_.errorMessage());
-  }
-  if (!q_dot.allFinite()) {
-    const int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
-    return fail(rc, "%s", hd_.errorMessage());
-  }
+  if (friction.lower.size() == 0 && friction.upper.size() == 0) return ChainHdSolver::E_NOERROR;
+  if (friction.lower.size() != n || friction.upper.size() != n)
+    return fail(E_INVALID_FRICTION, "friction.lower and friction.upper must have %ld entries each (or both be empty)",
+                n);
+  if (!std::isfinite(friction.limit_tolerance) || friction.limit_tolerance < 0.0)
+    return fail(E_INVALID_FRICTION, "friction.limit_tolerance must be finite and >= 0, got %g",
+                friction.limit_tolerance);
+  for (long j = 0; j < n; ++j)
+    if (std::isnan(friction.lower(j)) || std::isnan(friction.upper(j)) || friction.lower(j) > friction.upper(j))
+      return fail(E_INVALID_FRICTION, "friction.lower(%ld) must be <= friction.upper(%ld), neither NaN, got %g and %g",
+                  j, j, friction.lower(j), friction.upper(j));
+  return ChainHdSolver::E_NOERROR;
+}
 
-  // Kinetic friction of moving joints as feed-forward; collect the resting joints with friction
-  // or on a limit, and the bounds of their mu (friction torque -mu): [-f, f], opened to -inf at a
-  // lower limit (the reaction pushes up) and to +inf at an upper limit.
-  if (!q.allFinite()) {
-    const int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
-    return fail(rc, "%s", hd_.errorMessage());
-  }
+// Stage 1: kinetic friction of moving joints as feed-forward (into tau0_); the resting joints
+// with friction or on a limit into rest_, with the bounds of their mu (friction torque -mu):
+// [-f, f], opened to -inf at a lower limit (the reaction pushes up) and to +inf at an upper one.
+// Returns their number k.
+int FrictionSolver::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                  const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                                  const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
+  const Eigen::VectorXd& fs = friction.static_friction;
+  const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
+  const bool limits = friction.lower.size() != 0;
   int k = 0;
-  for (long j = 0; j < n; ++j) {
+  for (long j = 0; j < static_cast<long>(nj_); ++j) {
     tau0_(j) = ff_driver_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
     if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
       tau0_(j) -= fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
@@ -180,58 +167,50 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
       rest_(k++) = static_cast<int>(j);
     }
   }
-  int rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
+  return k;
+}
+
+// Stage 2: the max-min over the k resting joints, from the solve without static friction in hd_:
+// the box QP on Q = W G W^T, the least-command tie-break, and the outputs updated from the
+// response columns (they are affine in the friction torques: no new solve).
+int FrictionSolver::optimiseResting(int k) {
+  qdd0_ = hd_.qdd();
+  tau_cmd0_ = hd_.commandTorques();
+  nu0_.head(hd_.constraintCount()) = hd_.nu();
+  // d qdd and d nu per resting joint; tau_cmd follows from nu (commandTorquesOf), so its columns
+  // are not formed.
+  int rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), dnu_.leftCols(k));
   if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
-  q_keep_ = q;
-  qd_keep_ = q_dot;
-  has_f_ = f_ext.cols() != 0;
-  if (has_f_) f_keep_ = f_ext;
-  fstatic_ = fs;
-  iterations_ = 0;
-
-  if (k > 0) {
-    qdd0_ = hd_.qdd();
-    tau_cmd0_ = hd_.commandTorques();
-    nu0_.head(hd_.constraintCount()) = hd_.nu();
-    // d qdd and d nu per resting joint; tau_cmd follows from nu (commandTorquesOf), so its columns
-    // are not formed.
-    rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), dnu_.leftCols(k));
-    if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
-    for (int a = 0; a < k; ++a) {
-      c_(a) = qdd0_(rest_(a));
-      for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
-    }
-    // Scale of Q for every "is it zero" decision: max over the resting joints of Q_jj and of
-    // 1 / D_j <= (H^-1)_jj (a task can make Q vanish up to round-off; its entries are then no
-    // scale for themselves).
-    qscale_ = 0.0;
-    for (int a = 0; a < k; ++a)
-      qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_.articulatedInertia(static_cast<unsigned int>(rest_(a)))});
-    rc = boxQp(k);
-    if (rc != ChainHdSolver::E_NOERROR) return rc;
-    tau_cmd_known_ = false;
-    leastCommand(k);
-    // The outputs are affine in the friction torques: update them from the columns (no new solve).
-    qdd_ = qdd0_;
-    qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
-    const int m = hd_.constraintCount();
-    nu_.head(m) = nu0_.head(m);
-    nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);
-    if (!tau_cmd_known_) hd_.commandTorquesOf(nu_.head(m), tau_cmd_);  // (else kept by leastCommand)
-  } else {
-    qdd_ = hd_.qdd();
-    tau_cmd_ = hd_.commandTorques();
-    nu_.head(hd_.constraintCount()) = hd_.nu();
+  for (int a = 0; a < k; ++a) {
+    c_(a) = qdd0_(rest_(a));
+    for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
   }
-  m_keep_ = hd_.constraintCount();
-  alfa_keep_.leftCols(m_keep_) = alfa;
-  beta_keep_.head(m_keep_) = beta;
-  has_segments_ = segments != nullptr;
-  if (has_segments_) seg_keep_.head(m_keep_) = *segments;
-  k_ = k;
-  link_acc_known_ = k == 0;
+  // Scale of Q for every "is it zero" decision: max over the resting joints of Q_jj and of
+  // 1 / D_j <= (H^-1)_jj (a task can make Q vanish up to round-off; its entries are then no
+  // scale for themselves).
+  qscale_ = 0.0;
+  for (int a = 0; a < k; ++a)
+    qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_.articulatedInertia(static_cast<unsigned int>(rest_(a)))});
+  rc = boxQp(k);
+  if (rc != ChainHdSolver::E_NOERROR) return rc;
+  tau_cmd_known_ = false;
+  leastCommand(k);
+  qdd_ = qdd0_;
+  qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
+  const int m = hd_.constraintCount();
+  nu_.head(m) = nu0_.head(m);
+  nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);
+  if (!tau_cmd_known_) hd_.commandTorquesOf(nu_.head(m), tau_cmd_);  // (else kept by leastCommand)
+  return ChainHdSolver::E_NOERROR;
+}
 
-  // Friction torques and status.
+// Stage 3: friction and limit torques and the status of every joint at the optimum (k resting
+// joints in rest_ with their -mu in x_).
+void FrictionSolver::frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_dot, const FrictionModel& friction,
+                                     int k) {
+  const long n = nj_;
+  const Eigen::VectorXd& fs = friction.static_friction;
+  const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
   const double acc_scale = std::max(1.0, n ? qdd_.cwiseAbs().maxCoeff() : 0.0);  // (no joints: empty)
   int a = 0;
   for (long j = 0; j < n; ++j) {
@@ -252,13 +231,57 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
     const double acc = qdd_(j);
     status_[j] = std::abs(acc) <= 1e-9 * acc_scale ? Stick : (acc > 0.0 ? SlipPositive : SlipNegative);
   }
+}
+
+int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
+                              const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                              const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
+                              const Eigen::Ref<const Eigen::VectorXd>& beta,
+                              const Eigen::Ref<const Eigen::VectorXi>* segments,
+                              const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                              const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
+  solved_ = false;
+  const long n = nj_;
+  int rc = checkFriction(friction);
+  if (rc != ChainHdSolver::E_NOERROR) return rc;
+  if (q.size() != n || q_dot.size() != n || (ff_torques.size() != n && ff_torques.size() != 0) || !q_dot.allFinite() ||
+      !q.allFinite()) {
+    // Let the hybrid-dynamics solver report the size or value problem with its message.
+    rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
+    return fail(rc, "%s", hd_.errorMessage());
+  }
+  const int k = restingJoints(q, q_dot, ff_torques, friction);
+  rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
+  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  q_keep_ = q;
+  qd_keep_ = q_dot;
+  has_f_ = f_ext.cols() != 0;
+  if (has_f_) f_keep_ = f_ext;
+  fstatic_ = friction.static_friction;
+  iterations_ = 0;
+  if (k > 0) {
+    rc = optimiseResting(k);
+    if (rc != ChainHdSolver::E_NOERROR) return rc;
+  } else {
+    qdd_ = hd_.qdd();
+    tau_cmd_ = hd_.commandTorques();
+    nu_.head(hd_.constraintCount()) = hd_.nu();
+  }
+  m_keep_ = hd_.constraintCount();
+  alfa_keep_.leftCols(m_keep_) = alfa;
+  beta_keep_.head(m_keep_) = beta;
+  has_segments_ = segments != nullptr;
+  if (has_segments_) seg_keep_.head(m_keep_) = *segments;
+  k_ = k;
+  link_acc_known_ = k == 0;
+  frictionOutputs(q_dot, friction, k);
   // The optimum is affine in finite friction bounds, but huge values can still overflow.
   if (!(detail::bounded(qdd_) && detail::bounded(tau_cmd_) && detail::bounded(friction_) && detail::bounded(limit_) &&
         detail::bounded(nu_.head(m_keep_))))
     return fail(ChainHdSolver::E_NONFINITE_RESULT,
                 "the results overflow (Inf/NaN or beyond 1e150): friction or other inputs too large (max static "
                 "friction %g)",
-                n ? fs.cwiseAbs().maxCoeff() : 0.0);
+                n ? friction.static_friction.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   return ChainHdSolver::E_NOERROR;
 }
@@ -655,31 +678,152 @@ void FrictionSolver::leastOnLine(int ns, int r) {
   for (int a = 0; a < ns; ++a) y[a] += s * nv[a];
 }
 
-// Stage 2 by the range-space primal active set (see leastCommand): on ys_ (from x*_St, feasible),
-// ts_, the St bounds in p_ / eig_ and Q_StSt = V V^T (V_, rank r).
-void FrictionSolver::leastActiveSet(int ns, int r, double yscale) {
-  // Rows of W are masked (fm = 0) rather than gathered: V_F is V with W's rows zeroed, and every
-  // loop runs over all ns rows without index indirection.
+// Stage 2's projection (leastActiveSet): h = (I - P) fm .* (y + t), P the projector on range(V_F)
+// (V with the held rows masked by fm), so that the step -h keeps V_F^T d = 0. r = 1: lam_[0] =
+// v^T g / v^T v directly; else a column-pivoted modified Gram-Schmidt V_F = U R (column c of U
+// and R stays at V's column index c; cols_ holds the pivot order) and w = U^T (y_F + t_F). U R =
+// V_F holds to round-off even where U loses some orthogonality (~1e-16 cond(V_F)); the two sweeps
+// make h orthogonal to range(U) = range(V_F) regardless. Returns the numerical rank rf of V_F.
+int FrictionSolver::projectOffRange(int ns, int r) {
   const int n = static_cast<int>(nj_);
   const double* __restrict V = V_.data();
   double* __restrict U = U_.data();
   double* __restrict R = R_.data();
-  double* __restrict y = ys_.data();
+  const double* __restrict y = ys_.data();
   const double* __restrict t = ts_.data();
+  double* __restrict h = d_.data();
+  const double* __restrict fm = tmp_.data();
+  double* __restrict w = tmp2_.data();
+  int* __restrict cols = cols_.data();
+  const double col_tol2 = 1e-18 * qscale_;  // (1e-9 sqrt(Q's scale))^2: a dependent column of V_F
+  for (int a = 0; a < ns; ++a) h[a] = fm[a] * (y[a] + t[a]);
+  int rf = 0;
+  if (r == 1) {  // one equality (the usual case under a full tool task): P g = v (v^T g) / (v^T v)
+    double vv = 0.0, vg = 0.0;
+    for (int a = 0; a < ns; ++a) {
+      const double v = fm[a] * V[a];
+      vv += v * v;
+      vg += v * h[a];
+    }
+    rf = vv > col_tol2 ? 1 : 0;
+    lam_(0) = rf ? vg / vv : 0.0;
+    for (int a = 0; a < ns; ++a) h[a] -= fm[a] * V[a] * lam_(0);
+    return rf;
+  }
+  for (int c = 0; c < r; ++c) {
+    cols[c] = c;
+    for (int a = 0; a < ns; ++a) U[a + c * n] = fm[a] * V[a + c * n];
+  }
+  for (; rf < r; ++rf) {
+    int best = -1;
+    double best_norm2 = col_tol2;
+    for (int q = rf; q < r; ++q) {
+      const double* __restrict u = U + cols[q] * n;
+      double s = 0.0;
+      for (int a = 0; a < ns; ++a) s += u[a] * u[a];
+      if (s > best_norm2) best_norm2 = s, best = q;
+    }
+    if (best < 0) break;  // the remaining columns are (numerically) dependent
+    std::swap(cols[rf], cols[best]);
+    const int c = cols[rf];
+    double* __restrict u = U + c * n;
+    const double rjj = std::sqrt(best_norm2), inv = 1.0 / rjj;
+    R[rf + c * n] = rjj;
+    for (int a = 0; a < ns; ++a) u[a] *= inv;
+    for (int q = rf + 1; q < r; ++q) {
+      double* __restrict e = U + cols[q] * n;
+      double s = 0.0;
+      for (int a = 0; a < ns; ++a) s += u[a] * e[a];
+      for (int a = 0; a < ns; ++a) e[a] -= s * u[a];
+      R[rf + cols[q] * n] = s;
+    }
+  }
+  for (int j = 0; j < rf; ++j) w[j] = 0.0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int j = 0; j < rf; ++j) {
+      const double* __restrict u = U + cols[j] * n;
+      double s = 0.0;
+      for (int a = 0; a < ns; ++a) s += u[a] * h[a];
+      for (int a = 0; a < ns; ++a) h[a] -= s * u[a];
+      w[j] += s;
+    }
+  return rf;
+}
+
+// Stage 2's step y <- y - alpha h (alpha <= 1, the ratio test against the St bounds p_ / eig_; a
+// division only for a new candidate, the held entries of h are 0). Returns true when a bound
+// blocked the step: that coordinate joins the working set (side_, fm) at its bound.
+bool FrictionSolver::stepToBound(int ns, double step_tol) {
+  double* __restrict y = ys_.data();
   const double* __restrict lo = p_.data();
   const double* __restrict hi = eig_.data();
-  double* __restrict h = d_.data();     // (I - P)(y_F + t_F) on F, 0 on W: the step is -h
-  double* __restrict fm = tmp_.data();  // 1 free, 0 held at a bound
-  double* __restrict w = tmp2_.data();  // U^T (y_F + t_F), pivot order
+  const double* __restrict h = d_.data();
+  double alpha = 1.0;
+  int block = -1, bside = 0;
+  for (int a = 0; a < ns; ++a) {
+    const double s = -h[a];
+    if (s > step_tol) {
+      const double room = hi[a] - y[a];  // +inf without a bound
+      if (room < alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = 1;
+    } else if (s < -step_tol) {
+      const double room = lo[a] - y[a];
+      if (room > alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = -1;
+    }
+  }
+  for (int a = 0; a < ns; ++a) y[a] -= alpha * h[a];
+  if (block < 0) return false;
+  side_(block) = bside;
+  tmp_(block) = 0.0;
+  y[block] = bside > 0 ? hi[block] : lo[block];
+  return true;
+}
+
+// Stage 2's face multipliers: lambda from R lambda = w (basic solution: columns dropped as
+// dependent get 0; r = 1 has it already from projectOffRange).
+void FrictionSolver::faceMultipliers(int r, int rf) {
+  if (r <= 1) return;
+  const int n = static_cast<int>(nj_);
+  const double* __restrict R = R_.data();
+  const double* __restrict w = tmp2_.data();
   double* __restrict lam = lam_.data();
-  int* __restrict side = side_.data();  // 0 free, -1 at the lower bound, +1 at the upper bound
-  int* __restrict cols = cols_.data();
-  for (int a = 0; a < ns; ++a) side[a] = 0, fm[a] = 1.0;  // W empty
+  const int* __restrict cols = cols_.data();
+  for (int c = 0; c < r; ++c) lam[c] = 0.0;
+  for (int j = rf - 1; j >= 0; --j) {
+    const int c = cols[j];
+    double v = w[j];
+    for (int l = j + 1; l < rf; ++l) v -= R[j + cols[l] * n] * lam[cols[l]];
+    lam[c] = v / R[j + c * n];
+  }
+}
+
+// Stage 2's release: the held coordinate whose multiplier has the wrong sign by the most (the
+// smallest such index under Bland's rule), or -1 at the optimum.
+int FrictionSolver::releaseIndex(int ns, int r, double mult_tol, bool bland) const {
+  const int n = static_cast<int>(nj_);
+  int release = -1;
+  double worst = mult_tol;
+  for (int a = 0; a < ns; ++a) {
+    if (side_(a) == 0) continue;
+    double g = ys_(a) + ts_(a);
+    for (int c = 0; c < r; ++c) g -= V_.data()[a + c * n] * lam_(c);
+    const double violation = side_(a) < 0 ? -g : g;
+    if (violation > worst) {
+      worst = violation, release = a;
+      if (bland) break;  // smallest index
+    }
+  }
+  return release;
+}
+
+// Stage 2 by the range-space primal active set (see leastCommand): on ys_ (from x*_St, feasible),
+// ts_, the St bounds in p_ / eig_ and Q_StSt = V V^T (V_, rank r). Rows of the working set are
+// masked (tmp_ = 0) rather than gathered: every loop runs over all ns rows without indirection.
+void FrictionSolver::leastActiveSet(int ns, int r, double yscale) {
+  for (int a = 0; a < ns; ++a) side_(a) = 0, tmp_(a) = 1.0;  // working set empty
   // A step entry at or below step_tol is round-off (a coordinate the equality pins): it does not
   // block; the overshoot it may cause (<= step_tol) is clipped at the end.
   const double step_tol = 1e-12 * yscale;
   const double mult_tol = kGradientTolerance * yscale;
-  const double col_tol2 = 1e-18 * qscale_;  // (1e-9 sqrt(Q's scale))^2: a dependent column of V_F
   // Iteration bound (as stage 1's): between two face optima each iteration binds one more
   // coordinate or ends on the face optimum: at most ns + 1 iterations. The objective is strictly
   // convex and never increases along a step; from one face optimum to the next it strictly
@@ -694,116 +838,18 @@ void FrictionSolver::leastActiveSet(int ns, int r, double yscale) {
   bool bland = false;
   double last_face_value = kInf;
   for (long it = 0; it < max_iterations; ++it) {
-    for (int a = 0; a < ns; ++a) h[a] = fm[a] * (y[a] + t[a]);
-    int rf = 0;
-    if (r == 1) {
-      // One equality (the usual case under a full tool task): P g = v (v^T g) / (v^T v).
-      double vv = 0.0, vg = 0.0;
-      for (int a = 0; a < ns; ++a) {
-        const double v = fm[a] * V[a];
-        vv += v * v;
-        vg += v * h[a];
-      }
-      rf = vv > col_tol2 ? 1 : 0;
-      lam[0] = rf ? vg / vv : 0.0;
-      for (int a = 0; a < ns; ++a) h[a] -= fm[a] * V[a] * lam[0];
-    } else {
-      // Column-pivoted modified Gram-Schmidt V_F = U R (column c of U and R stays at V's column
-      // index c; cols holds the pivot order). U R = V_F holds to round-off even where U loses some
-      // orthogonality (~1e-16 cond(V_F)); the two sweeps below make h orthogonal to range(U) =
-      // range(V_F) regardless, so the step keeps V_F^T d = 0 and R lambda = w gives V_F lambda = U w.
-      for (int c = 0; c < r; ++c) {
-        cols[c] = c;
-        for (int a = 0; a < ns; ++a) U[a + c * n] = fm[a] * V[a + c * n];
-      }
-      for (; rf < r; ++rf) {
-        int best = -1;
-        double best_norm2 = col_tol2;
-        for (int q = rf; q < r; ++q) {
-          const double* __restrict u = U + cols[q] * n;
-          double s = 0.0;
-          for (int a = 0; a < ns; ++a) s += u[a] * u[a];
-          if (s > best_norm2) best_norm2 = s, best = q;
-        }
-        if (best < 0) break;  // the remaining columns are (numerically) dependent
-        std::swap(cols[rf], cols[best]);
-        const int c = cols[rf];
-        double* __restrict u = U + c * n;
-        const double rjj = std::sqrt(best_norm2), inv = 1.0 / rjj;
-        R[rf + c * n] = rjj;
-        for (int a = 0; a < ns; ++a) u[a] *= inv;
-        for (int q = rf + 1; q < r; ++q) {
-          double* __restrict e = U + cols[q] * n;
-          double s = 0.0;
-          for (int a = 0; a < ns; ++a) s += u[a] * e[a];
-          for (int a = 0; a < ns; ++a) e[a] -= s * u[a];
-          R[rf + cols[q] * n] = s;
-        }
-      }
-      for (int j = 0; j < rf; ++j) w[j] = 0.0;
-      for (int pass = 0; pass < 2; ++pass)
-        for (int j = 0; j < rf; ++j) {
-          const double* __restrict u = U + cols[j] * n;
-          double s = 0.0;
-          for (int a = 0; a < ns; ++a) s += u[a] * h[a];
-          for (int a = 0; a < ns; ++a) h[a] -= s * u[a];
-          w[j] += s;
-        }
-    }
-    double dmax = 0.0;
-    for (int a = 0; a < ns; ++a) dmax = std::max(dmax, std::abs(h[a]));
-    if (dmax > step_tol) {
-      // Ratio test along d = -h (a division only for a new candidate; W's entries are 0).
-      double alpha = 1.0;
-      int block = -1, bside = 0;
-      for (int a = 0; a < ns; ++a) {
-        const double s = -h[a];
-        if (s > step_tol) {
-          const double room = hi[a] - y[a];  // +inf without a bound
-          if (room < alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = 1;
-        } else if (s < -step_tol) {
-          const double room = lo[a] - y[a];
-          if (room > alpha * s) alpha = std::max(room / s, 0.0), block = a, bside = -1;
-        }
-      }
-      for (int a = 0; a < ns; ++a) y[a] -= alpha * h[a];
-      if (block >= 0) {
-        side[block] = bside;
-        fm[block] = 0.0;
-        y[block] = bside > 0 ? hi[block] : lo[block];
-        continue;
-      }
-    }
-    // Face optimum (full step, or none needed). lambda from R lambda = w (basic solution: columns
-    // dropped as dependent get 0; r = 1 has it already), then the working set's multipliers.
-    if (r > 1) {
-      for (int c = 0; c < r; ++c) lam[c] = 0.0;
-      for (int j = rf - 1; j >= 0; --j) {
-        const int c = cols[j];
-        double v = w[j];
-        for (int l = j + 1; l < rf; ++l) v -= R[j + cols[l] * n] * lam[cols[l]];
-        lam[c] = v / R[j + c * n];
-      }
-    }
-    double value = 0.0;
-    for (int a = 0; a < ns; ++a) value += (y[a] + t[a]) * (y[a] + t[a]);
+    const int rf = projectOffRange(ns, r);
+    const double dmax = d_.head(ns).cwiseAbs().maxCoeff();
+    if (dmax > step_tol && stepToBound(ns, step_tol)) continue;
+    // Face optimum (full step, or none needed): its multipliers decide a release.
+    faceMultipliers(r, rf);
+    const double value = (ys_.head(ns) + ts_.head(ns)).squaredNorm();
     if (!(value < last_face_value)) bland = true;
     last_face_value = value;
-    int release = -1;
-    double worst = mult_tol;
-    for (int a = 0; a < ns; ++a) {
-      if (side[a] == 0) continue;
-      double g = y[a] + t[a];
-      for (int c = 0; c < r; ++c) g -= V[a + c * n] * lam[c];
-      const double violation = side[a] < 0 ? -g : g;
-      if (violation > worst) {
-        worst = violation, release = a;
-        if (bland) break;  // smallest index
-      }
-    }
+    const int release = releaseIndex(ns, r, mult_tol, bland);
     if (release < 0) break;
-    side[release] = 0;
-    fm[release] = 1.0;
+    side_(release) = 0;
+    tmp_(release) = 1.0;
   }
 }
 

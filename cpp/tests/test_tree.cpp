@@ -176,16 +176,32 @@ Eigen::VectorXd up6() {
   return u;
 }
 
+// One random tree (2..max_joints moving joints, drawn from `seed`), its solver and the oracle.
+struct TreeCase {
+  TreeCase(unsigned long long seed, int max_joints)
+      : g(seed),
+        tree(draw(g, max_joints)),
+        s(tree, kGravityUp),
+        o(tree, s.segmentNames()),
+        nj(static_cast<int>(s.nrOfJoints())),
+        ns(static_cast<int>(s.nrOfSegments())) {}
+  static KDL::Tree draw(testutil::RandomGen& g, int max_joints) {
+    testutil::TreeSpec spec;
+    spec.n_joints = g.integer(2, max_joints);
+    return testutil::randomTree(g, spec);
+  }
+  testutil::RandomGen g;
+  KDL::Tree tree;
+  TreeHdSolver s;
+  Oracle o;
+  int nj, ns;
+};
+
 void testForwardDynamics(testutil::Checker& ck) {
   double worst = 0.0;
   for (int seed = 0; seed < 60; ++seed) {
-    testutil::RandomGen g(500 + seed);
-    testutil::TreeSpec spec;
-    spec.n_joints = g.integer(2, 40);
-    const KDL::Tree tree = testutil::randomTree(g, spec);
-    TreeHdSolver s(tree, kGravityUp);
-    Oracle o(tree, s.segmentNames());
-    const int nj = static_cast<int>(s.nrOfJoints()), ns = static_cast<int>(s.nrOfSegments());
+    TreeCase c(500 + seed, 40);
+    auto& [g, tree, s, o, nj, ns] = c;
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, ff = g.torques(nj).data;
     const Matrix6X f_ext = testutil::toMatrix(g.fext(ns));
     const int rc = s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), f_ext, ff);
@@ -203,13 +219,8 @@ void testConstraints(testutil::Checker& ck) {
   double worst_kkt = 0.0, worst_tau = 0.0, worst_beta = 0.0;
   int tested = 0;
   for (int seed = 0; seed < 120; ++seed) {
-    testutil::RandomGen g(2000 + seed);
-    testutil::TreeSpec spec;
-    spec.n_joints = g.integer(2, 40);
-    const KDL::Tree tree = testutil::randomTree(g, spec);
-    TreeHdSolver s(tree, kGravityUp);
-    Oracle o(tree, s.segmentNames());
-    const int nj = static_cast<int>(s.nrOfJoints()), ns = static_cast<int>(s.nrOfSegments());
+    TreeCase c(2000 + seed, 40);
+    auto& [g, tree, s, o, nj, ns] = c;
     const Task t = randomTask(g, s, tree, seed % 4);
     const Eigen::VectorXd q = g.q(nj).data, ff = g.torques(nj).data, zero = Eigen::VectorXd::Zero(nj);
     const Matrix6X f_ext = testutil::toMatrix(g.fext(ns));
@@ -251,13 +262,8 @@ void testConstraints(testutil::Checker& ck) {
 void testLinkAccelerations(testutil::Checker& ck) {
   double worst = 0.0;
   for (int seed = 0; seed < 30; ++seed) {
-    testutil::RandomGen g(7000 + seed);
-    testutil::TreeSpec spec;
-    spec.n_joints = g.integer(2, 25);
-    const KDL::Tree tree = testutil::randomTree(g, spec);
-    TreeHdSolver s(tree, kGravityUp);
-    Oracle o(tree, s.segmentNames());
-    const int nj = static_cast<int>(s.nrOfJoints()), ns = static_cast<int>(s.nrOfSegments());
+    TreeCase c(7000 + seed, 25);
+    auto& [g, tree, s, o, nj, ns] = c;
     const Task t = randomTask(g, s, tree, seed % 4);
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, ff = g.torques(nj).data;
     if (s.solve(q, qd, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff) != 0) continue;
@@ -285,13 +291,8 @@ void testLinkAccelerations(testutil::Checker& ck) {
 void testResponseColumns(testutil::Checker& ck) {
   double worst = 0.0;
   for (int seed = 0; seed < 40; ++seed) {
-    testutil::RandomGen g(9000 + seed);
-    testutil::TreeSpec spec;
-    spec.n_joints = g.integer(2, 30);
-    const KDL::Tree tree = testutil::randomTree(g, spec);
-    TreeHdSolver s(tree, kGravityUp);
-    Oracle o(tree, s.segmentNames());
-    const int nj = static_cast<int>(s.nrOfJoints());
+    TreeCase c(9000 + seed, 30);
+    auto& [g, tree, s, o, nj, ns] = c;
     const Task t = randomTask(g, s, tree, seed % 4);
     const int m = static_cast<int>(t.segments.size());
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, ff = g.torques(nj).data;
@@ -315,6 +316,15 @@ void testResponseColumns(testutil::Checker& ck) {
     const double e = std::max({relErr(dqdd, fq), relErr(dtau, ft), m ? relErr(dnu, fn) : 0.0});
     worst = std::max(worst, e);
     ck.check(e < kTol, "seed " + str(seed) + ": response columns vs differences " + str(e));
+    // More columns than joints (processed in chunks of n_joints): every joint twice.
+    Eigen::VectorXi twice(2 * nj);
+    twice << joints, joints;
+    Eigen::MatrixXd dq2(nj, 2 * nj), dt2(nj, 2 * nj);
+    s.solve(q, qd, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff);
+    rc = s.responseColumns(twice, dq2, dt2);
+    ck.check(rc == 0 && relErr(dq2.leftCols(nj), dqdd) < kTol && relErr(dq2.rightCols(nj), dqdd) < kTol &&
+                 relErr(dt2.rightCols(nj), dtau) < kTol,
+             "seed " + str(seed) + ": response columns in two chunks differ");
   }
   std::printf("  response columns vs differences in ff: worst %.2e\n", worst);
 }

@@ -8,7 +8,7 @@
 //   mu*  = argmax_{|mu| <= f}  g(mu),  g(mu) = c^T mu - 1/2 mu^T Q mu,
 //
 // with Z0 the frictionless Gauss function, Q = W G W^T (G the constrained inverse inertia of
-// ChainHdSolver::responseColumns, W the selection of resting joints) and c = W qdd(0). Moving
+// HdSolver::responseColumns, W the selection of resting joints) and c = W qdd(0). Moving
 // joints get the kinetic (Coulomb) friction -fk_j sign(qd_j) as a feed-forward torque.
 //
 // Method: one full solve, the response columns of the resting joints (O(n) each, no
@@ -21,7 +21,8 @@
 // problem on the optimal face, solved in the range space of Q_StSt): static friction holds what
 // it can and the motors add only the rest.
 //
-// Units and frames are those of ChainHdSolver. Outputs after solve():
+// Units, frames, segment and joint order are those of the underlying HdSolver (ChainHdSolver for
+// a chain, TreeHdSolver for a tree; hd_solver.hpp). Outputs after solve():
 //  * qdd (n): joint accelerations.
 //  * commandTorques (n): tau_cmd = -J^T alfa nu at the optimum: what the motors add to
 //    ff_torques. Forward dynamics with ff_torques + tau_cmd + frictionTorques reproduces qdd.
@@ -30,7 +31,7 @@
 //  * limitTorques (n): the reaction of joint limits (>= 0 at a lower limit, <= 0 at an upper
 //    one): what friction cannot hold of the total -mu* at a joint resting on its limit.
 //  * status (n): Moving, Stick, SlipPositive (qdd > 0) or SlipNegative (qdd < 0).
-//  * nu, constraint rank: as ChainHdSolver at the optimum.
+//  * nu, constraint rank: as HdSolver at the optimum.
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
 //    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
 //    (computed on request: one extra O(n) solve). NaN before a successful solve, or when qdd_free
@@ -133,12 +134,25 @@ class FrictionSolver {
               const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
               const Eigen::Ref<const Eigen::VectorXi>* segments, const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
               const Eigen::Ref<const Eigen::VectorXd>& tau);
+  // The stages of solveImpl: the friction model's checks; the resting joints (rest_, their bounds
+  // lo_ / hi_, kinetic friction into tau0_), returning their number k; the max-min over them from
+  // hd_'s solve without static friction (boxQp, leastCommand, outputs updated affinely); the
+  // friction and limit torques and the status per joint.
+  int checkFriction(const FrictionModel& friction);
+  int restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+  int optimiseResting(int k);
+  void frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_dot, const FrictionModel& friction, int k);
   int boxQp(int k);          // stage 1 on Q_, c_, lo_, hi_ -> x_
   void leastCommand(int k);  // stage 2: tie-break on the optimal face
   // Stage 2's solvers on the sticking set (ns joints, Q_StSt = V_ V_^T of rank r < ns), from
   // ys_ = x*_St with target ts_ and bounds p_ / eig_ (see leastCommand).
   void leastOnLine(int ns, int r);                    // ns - r = 1: closed form
   void leastActiveSet(int ns, int r, double yscale);  // range-space primal active set
+  int projectOffRange(int ns, int r);                 // its steps (friction_solver.cpp)
+  bool stepToBound(int ns, double step_tol);
+  void faceMultipliers(int r, int rf);
+  int releaseIndex(int ns, int r, double mult_tol, bool bland) const;
   // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
