@@ -247,7 +247,7 @@ double HdCore::smallestSingularValue() const {
       auto W = g.work_g.topLeftCorner(m, m);
       auto V = g.work_v.topLeftCorner(m, m);
       W = g.kg.topLeftCorner(m, m);
-      detail::jacobiEigen(W, V);
+      detail::jacobiEigen(W, V, 60, /*with_vectors=*/false);
       res.sigma_min = std::max(W.diagonal().minCoeff(), 0.0);
     } else {
       ws.fast.sigma_eig.compute(ws.fast.K, Eigen::EigenvaluesOnly);
