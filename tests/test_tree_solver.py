@@ -27,7 +27,14 @@ import pytest
 
 import vereshchagin as vs
 from chains import well_conditioned_task
-from friction_oracles import STICK, FrictionProblem, OracleInfeasible, enumeration_oracle, pinocchio_problem
+from friction_oracles import (
+    STICK,
+    FrictionProblem,
+    OracleInfeasible,
+    enumeration_oracle,
+    pinocchio_problem,
+    scipy_oracle,
+)
 from test_urdf_pinocchio import LWA, G, assert_rel
 from trees import pin_model, random_solvable_tree
 from vereshchagin.robots import example_robot_urdf, gen3_urdf
@@ -285,8 +292,8 @@ def test_response_columns_on_trees_are_the_derivative_of_solve(name):
 
 
 # ------------------------------------------------------------------------------------------------
-# Static friction on trees: the max-min against stick/slip enumeration of the same problem built
-# from Pinocchio's H, ABA and frame Jacobians (tests/friction_oracles.py)
+# Static friction on trees: the max-min against stick/slip enumeration and the scipy primal of the
+# same problem built from Pinocchio's H, ABA and frame Jacobians (tests/friction_oracles.py)
 # ------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", ["baxter", "talos", "random_3"])
 def test_friction_on_trees_matches_enumeration(name):
@@ -338,6 +345,8 @@ def test_friction_on_trees_matches_enumeration(name):
         if slipping.size and slipping.min() < 1e-6 * prob.accel_scale(oracle.qdd):
             continue  # near a stick/slip boundary: the status is a matter of round-off
         assert_rel(res.qdd, case.ours(oracle.qdd), f"{name}: qdd vs enumeration", 1e-8)
+        primal = scipy_oracle(prob)  # SLSQP on the primal, polished and certified
+        assert_rel(res.qdd, case.ours(primal.qdd), f"{name}: qdd vs scipy primal", 1e-8)
         np.testing.assert_array_equal(res.status, case.ours(oracle.status))
         assert_rel(res.gauss_value, oracle.objective, "Gauss value", 1e-8)
         # the motion is the frictionless solve with the friction torques as feed-forward
