@@ -12,7 +12,9 @@
    friction vs Pinocchio's JointFrictionConstraintModel + ADMM, about 10 s);
 5. runs benchmarks/bench_segments.py (constraints on 1, 2, 3 segments vs Pinocchio's KKT solve, from
    Python, about 15-20 s) and benchmarks/bench_python_face.py (the Python call's overhead over the C++
-   solve, out=, solve_batch per row and with threads=2, about 15 s);
+   solve, out=, solve_batch per row and with threads=2, about 15 s) and benchmarks/bench_tree.py
+   (trees: Baxter with one or two hands constrained and random trees of 15-60 joints vs Pinocchio's
+   pipeline, from Python, about 60 s);
 6. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
    the method, the target checks and all reports.
 """
@@ -214,6 +216,11 @@ def main():
     face_rc = run(
         [sys.executable, REPO / "benchmarks" / "bench_python_face.py", "--out", face_file], stdout=subprocess.DEVNULL
     ).returncode
+    tree_file = build / "bench_tree.md"
+    tree_file.unlink(missing_ok=True)
+    tree_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_tree.py", "--out", tree_file], stdout=subprocess.DEVNULL
+    ).returncode
     load_end = loadavg()
 
     cpp_md, py_md = cpp_file.read_text(), py_file.read_text()
@@ -275,10 +282,18 @@ def main():
         if face_file.exists()
         else f"**bench_python_face.py exited with code {face_rc} and wrote no report.**",
         "",
+        tree_file.read_text().rstrip()
+        if tree_file.exists()
+        else f"**bench_tree.py exited with code {tree_rc} and wrote no report.**",
+        "",
     ]
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
-    return 0 if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 and seg_rc == 0 and face_rc == 0 else 1
+    return (
+        0
+        if cpp_rc == 0 and py_rc == 0 and fr_rc == 0 and frpy_rc == 0 and seg_rc == 0 and face_rc == 0 and tree_rc == 0
+        else 1
+    )
 
 
 if __name__ == "__main__":
