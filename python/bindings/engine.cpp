@@ -25,17 +25,18 @@ KDL::Twist upward(const KDL::Vector& gravity) {
 
 }  // namespace
 
-SegmentKinematics::SegmentKinematics(const EngineModel& model) {
+SegmentKinematics::SegmentKinematics(const EngineModel& model, const vereshchagin::HdSolver& solver) {
   if (model.chain) {
     for (unsigned int i = 0; i < model.chain->getNrOfSegments(); ++i) {
       segments_.push_back(model.chain->getSegment(i));
       parent_.push_back(static_cast<int>(i) - 1);
     }
   } else {
-    const vereshchagin::TreeHdSolver probe(*model.tree, KDL::Twist::Zero(), vereshchagin::SolverOptions(), model.root);
-    for (const std::string& name : probe.segmentNames())
+    // The segment order and parents of the engine's own tree solver (solver is a TreeHdSolver).
+    const auto& tree_solver = dynamic_cast<const vereshchagin::TreeHdSolver&>(solver);
+    for (const std::string& name : tree_solver.segmentNames())
       segments_.push_back(model.tree->getSegments().at(name).segment);
-    parent_ = probe.parent();
+    parent_ = tree_solver.parent();
   }
   int joints = 0;  // joints are numbered in segment order, fixed joints skipped (hd_solver.hpp)
   for (const KDL::Segment& s : segments_)
@@ -54,7 +55,7 @@ KDL::Rotation SegmentKinematics::tipRotation(int segment, const double* q) const
 Engine::Engine(const EngineModel& model, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt)
     : hd_(makeSolver(model, upward(gravity), opt)),
       friction_(makeFriction(model, upward(gravity), opt)),
-      kinematics_(model) {
+      kinematics_(model, *hd_) {
   nj = hd_->nrOfJoints();
   ns = hd_->nrOfSegments();
   alfa_ = ChainHdSolver::Matrix6X::Zero(6, hd_->maxConstraints());

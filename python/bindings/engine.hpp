@@ -71,7 +71,8 @@ struct EngineModel {
 // moments from merged links to tips before a solve); no allocation per call.
 class SegmentKinematics {
  public:
-  explicit SegmentKinematics(const EngineModel& model);
+  // solver: the engine's solver of `model` (its segment order and parents).
+  SegmentKinematics(const EngineModel& model, const vereshchagin::HdSolver& solver);
   KDL::Rotation tipRotation(int segment, const double* q) const;
 
  private:
