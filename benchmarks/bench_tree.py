@@ -146,20 +146,10 @@ def random_robot(n, seed):
     with at least 3 joints of its own (not shared with the other's path), so that 3-D constraints on
     both are independent."""
     drawn = random_solvable_tree(seed, n_links=n, p_fixed=0.0)
-    parent = {j.child: j.parent for j in drawn.joints}
-
-    def path(link):
-        out = []
-        while link in parent:
-            out.append(link)
-            link = parent[link]
-        return out
-
-    leaves = [link for link in drawn.links if link not in set(parent.values())]
     best = None
-    for a in leaves:
-        for b in leaves:
-            own_a, own_b = set(path(a)) - set(path(b)), set(path(b)) - set(path(a))
+    for a in drawn.leaves:
+        for b in drawn.leaves:
+            own_a, own_b = set(drawn.path(a)) - set(drawn.path(b)), set(drawn.path(b)) - set(drawn.path(a))
             if a < b and min(len(own_a), len(own_b)) >= 3:
                 score = len(own_a) + len(own_b)
                 best = max(best or (0, a, b), (score, a, b))

@@ -36,7 +36,7 @@ from friction_oracles import (
     scipy_oracle,
 )
 from test_urdf_pinocchio import LWA, G, assert_rel
-from trees import pin_model, random_solvable_tree
+from trees import pin_model, pin_q, pin_v_index, random_solvable_tree
 from vereshchagin.robots import example_robot_urdf, gen3_urdf
 
 UP = np.r_[-G, 0.0, 0.0, 0.0]  # the base's upward acceleration that stands for gravity
@@ -53,23 +53,14 @@ class TreeCase:
         self.tasks = tasks  # named sets of frames to constrain together
         n = self.tree.n_joints
         assert self.model.nv == n, f"{name}: {self.model.nv} Pinocchio joints, {n} ours"
-        joints = [self.model.joints[self.model.getJointId(j)] for j in self.tree.joint_names]
-        self.idx_v = np.array([j.idx_v for j in joints])
-        self.idx_q = np.array([j.idx_q for j in joints])
-        self.nq2 = np.array([j.nq == 2 for j in joints])
+        self.idx_v = pin_v_index(self.model, list(self.tree.joint_names))
 
     @property
     def n(self):
         return self.tree.n_joints
 
     def pin_q(self, q):
-        pq = np.zeros(self.model.nq)
-        for k in range(self.n):
-            if self.nq2[k]:
-                pq[self.idx_q[k] : self.idx_q[k] + 2] = np.cos(q[k]), np.sin(q[k])
-            else:
-                pq[self.idx_q[k]] = q[k]
-        return pq
+        return pin_q(self.model, list(self.tree.joint_names), q)
 
     def pin_v(self, x):
         """Ours (n,) -> Pinocchio's velocity-space order."""
@@ -122,15 +113,10 @@ def _random(seed):
     """A random tree (tests/trees.py) with tasks on leaves and inner links of different branches."""
     drawn = random_solvable_tree(seed, n_links=16, p_fixed=0.2)
     tree = vs.Tree.from_urdf(drawn.urdf)
-    parents = {j.parent for j in drawn.joints}
-    leaves = [link for link in drawn.links if link not in parents and link not in drawn.base_links]
-    # an inner link that is not an ancestor of the first leaf
-    path, link = set(), leaves[0]
-    by_child = {j.child: j.parent for j in drawn.joints}
-    while link in by_child:
-        path.add(link)
-        link = by_child[link]
-    inner = [x for x in parents if x not in path and x not in drawn.base_links] or [leaves[-1]]
+    leaves = [link for link in drawn.leaves if link not in drawn.base_links]
+    # an inner link (in document order) that is not on the first leaf's path
+    parents, path = {j.parent for j in drawn.joints}, set(drawn.path(leaves[0]))
+    inner = [x for x in drawn.links if x in parents and x not in path and x not in drawn.base_links] or [leaves[-1]]
     assert len(leaves) >= 2 and tree.n_joints >= 8, "seed gives too small a tree"
     return TreeCase(
         f"random_{seed}",

@@ -71,6 +71,21 @@ class RandomTree:
         """Mass of every link that moves (not in :attr:`base_links`), kg."""
         return sum(m for name, m in self.masses.items() if name not in self.base_links)
 
+    @property
+    def leaves(self) -> list[str]:
+        """Links nothing hangs from, in document order."""
+        parents = {j.parent for j in self.joints}
+        return [link for link in self.links if link not in parents]
+
+    def path(self, link: str) -> list[str]:
+        """The links from ``link`` up to the root: ``link`` first, the root excluded."""
+        parent = {j.child: j.parent for j in self.joints}
+        out = []
+        while link in parent:
+            out.append(link)
+            link = parent[link]
+        return out
+
     def below(self, link: str) -> list[UrdfJoint]:
         """The joints of the sub-tree below ``link``, in document order."""
         inside, out = {link}, []
