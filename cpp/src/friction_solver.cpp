@@ -855,12 +855,9 @@ void FrictionSolver::leastActiveSet(int ns, int r, double yscale) {
 
 const ChainHdSolver::Matrix6X& FrictionSolver::linkAccelerations() {
   if (!link_acc_known_ && solved_) {
-    // One solve with the optimal friction torques as feed-forward (inputs kept from solve()).
-    tmp_ = tau0_;
-    for (int a = 0; a < k_; ++a) tmp_(rest_(a)) -= x_(a);
-    const Eigen::Ref<const Eigen::VectorXi> segs = seg_keep_.head(m_keep_);
-    hdSolve(q_keep_, qd_keep_, alfa_keep_.leftCols(m_keep_), beta_keep_.head(m_keep_), has_segments_ ? &segs : nullptr,
-            has_f_ ? f_keep_.leftCols(f_keep_.cols()) : f_keep_.leftCols(0), tmp_);
+    // The optimum's joint accelerations through the last solve's kinematics (same q, q_dot): one
+    // outward pass instead of a solve with the friction torques as feed-forward.
+    hd_.setJointAccelerations(qdd_);
     link_acc_known_ = true;
   }
   return hd_.linkAccelerations();

@@ -343,6 +343,19 @@ int HdCore::solveLast(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::R
 }
 
 // Link accelerations in base axes, computed from the tip-frame ones on first request.
+void HdCore::accelerationsOf(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
+  for (unsigned int i = 0; i < model.ns; ++i) {
+    const SegmentModel& sm = model.seg[i];
+    SegmentState& s = ws.seg[i];
+    const int p = model.parent(i);
+    Vector6 a = motionToChild(s.X, p >= 0 ? ws.seg[p].xdd : root_acc);
+    a += s.c;
+    if (sm.joint >= 0) a += sm.S * qdd(sm.joint);
+    s.xdd = a;
+  }
+  res.link_acc_known = false;
+}
+
 const Matrix6X& HdCore::linkAccelerations() const {
   if (!res.link_acc_known) {
     res.link_acc.col(0) = root_acc;

@@ -184,6 +184,9 @@ class HdCore {
   void clearPassThrough();
   int setOptions(const SolverOptions& options);
   const Matrix6X& linkAccelerations() const;
+  // Segment accelerations of given joint accelerations at the last solve's state (poses and
+  // velocity products kept): one outward pass; link accelerations follow on request.
+  void accelerationsOf(const Eigen::Ref<const Eigen::VectorXd>& qdd);
   double smallestSingularValue() const;
   Eigen::Map<const Eigen::VectorXd> nu() const {
     return Eigen::Map<const Eigen::VectorXd>(res.general ? res.nu_user.data() : res.nu.data(), res.m);

@@ -71,6 +71,15 @@ Eigen::Map<const Eigen::VectorXd> HdSolver::nu() const {
 const HdSolver::Matrix6X& HdSolver::linkAccelerations() const {
   return core_->linkAccelerations();
 }
+int HdSolver::setJointAccelerations(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
+  if (!core_->res.solved)
+    return record(core_->fail(E_NO_SOLUTION, "setJointAccelerations() needs a successful solve() first"));
+  if (qdd.size() != static_cast<Eigen::Index>(nrOfJoints()))
+    return record(
+        core_->fail(E_SIZE_MISMATCH, "qdd has %ld entries, expected %u (joints)", (long)qdd.size(), nrOfJoints()));
+  core_->accelerationsOf(qdd);
+  return E_NOERROR;
+}
 int HdSolver::constraintCount() const {
   return core_->res.m;
 }

@@ -177,6 +177,12 @@ class HdSolver : public KDL::SolverI {
   const Eigen::VectorXd& commandTorques() const;
   Eigen::Map<const Eigen::VectorXd> nu() const;
   const Matrix6X& linkAccelerations() const;  // computed on first request after a solve
+  // Replaces the segment accelerations of the last solve by those of the joint accelerations qdd
+  // (n_joints) at the same state (q, q_dot, root_acc): one outward pass, no new solve. What
+  // linkAccelerations() and linkLocalAcceleration() return afterwards (FrictionSolver: the
+  // accelerations at the friction optimum). E_SIZE_MISMATCH for a wrong size, E_NO_SOLUTION
+  // before a successful solve.
+  int setJointAccelerations(const Eigen::Ref<const Eigen::VectorXd>& qdd);
   int constraintCount() const;
   // Segment i's state at the last successful solve (i < nrOfSegments(), unchecked; unspecified before):
   // the pose of its tip frame in its parent's tip frame (the base for a segment without parent),
