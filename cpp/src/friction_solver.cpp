@@ -22,21 +22,17 @@ constexpr double kGradientTolerance = 1e-11;
 }  // namespace
 
 FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
-    : FrictionSolver(std::make_unique<ChainHdSolver>(chain, root_acc, options),
-                     std::make_unique<ChainHdSolver>(chain, root_acc, options)) {}
+    : FrictionSolver(std::make_unique<ChainHdSolver>(chain, root_acc, options)) {}
 
 FrictionSolver::FrictionSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options,
                                const std::string& root_segment)
-    : FrictionSolver(std::make_unique<TreeHdSolver>(tree, root_acc, options, root_segment),
-                     std::make_unique<TreeHdSolver>(tree, root_acc, options, root_segment)) {}
+    : FrictionSolver(std::make_unique<TreeHdSolver>(tree, root_acc, options, root_segment)) {}
 
-FrictionSolver::FrictionSolver(std::unique_ptr<HdSolver> hd, std::unique_ptr<HdSolver> free)
-    : hd_owner_(std::move(hd)), free_owner_(std::move(free)), hd_(*hd_owner_), free_(*free_owner_) {
+FrictionSolver::FrictionSolver(std::unique_ptr<HdSolver> hd) : hd_owner_(std::move(hd)), hd_(*hd_owner_) {
   nj_ = hd_.nrOfJoints();
   const int n = static_cast<int>(nj_);
   qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = ff_driver_ = Eigen::VectorXd::Zero(n);
-  q_keep_ = qd_keep_ = fstatic_ = Eigen::VectorXd::Zero(n);
-  f_keep_ = ChainHdSolver::Matrix6X::Zero(6, hd_.nrOfSegments());
+  fstatic_ = Eigen::VectorXd::Zero(n);
   status_.assign(n, Moving);
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
   Gc_ = Q_ = work_ = L_ = Eigen::MatrixXd::Zero(n, n);
@@ -46,15 +42,12 @@ FrictionSolver::FrictionSolver(std::unique_ptr<HdSolver> hd, std::unique_ptr<HdS
   c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = invdiag_ = dpiv_ = Eigen::VectorXd::Zero(n);
   const int mcap = hd_.maxConstraints();
   dnu_ = Eigen::MatrixXd::Zero(mcap, n);
-  nu0_ = nu_ = beta_keep_ = Eigen::VectorXd::Zero(mcap);
-  alfa_keep_ = ChainHdSolver::Matrix6X::Zero(6, mcap);
-  seg_keep_ = Eigen::VectorXi::Zero(mcap);
+  nu0_ = nu_ = Eigen::VectorXd::Zero(mcap);
 }
 
 int FrictionSolver::setOptions(const SolverOptions& options) {
   const int rc = hd_.setOptions(options);
   if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
-  free_.setOptions(options);
   return rc;
 }
 
@@ -253,10 +246,6 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
   const int k = restingJoints(q, q_dot, ff_torques, friction);
   rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
   if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
-  q_keep_ = q;
-  qd_keep_ = q_dot;
-  has_f_ = f_ext.cols() != 0;
-  if (has_f_) f_keep_ = f_ext;
   fstatic_ = friction.static_friction;
   iterations_ = 0;
   if (k > 0) {
@@ -268,10 +257,6 @@ int FrictionSolver::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q,
     nu_.head(hd_.constraintCount()) = hd_.nu();
   }
   m_keep_ = hd_.constraintCount();
-  alfa_keep_.leftCols(m_keep_) = alfa;
-  beta_keep_.head(m_keep_) = beta;
-  has_segments_ = segments != nullptr;
-  if (has_segments_) seg_keep_.head(m_keep_) = *segments;
   k_ = k;
   link_acc_known_ = k == 0;
   frictionOutputs(q_dot, friction, k);
@@ -865,23 +850,19 @@ const ChainHdSolver::Matrix6X& FrictionSolver::linkAccelerations() {
 
 double FrictionSolver::gaussValue() {
   if (!solved_) return std::numeric_limits<double>::quiet_NaN();
-  // qdd_free: unconstrained motion under ff torques and kinetic friction (tau0_).
-  const Eigen::Matrix<double, 6, 0> no_alfa;
-  const Eigen::Matrix<double, 0, 1> no_beta;
-  const int rc = has_f_ ? free_.solve(q_keep_, qd_keep_, no_alfa, no_beta, f_keep_, tau0_)
-                        : free_.solve(q_keep_, qd_keep_, no_alfa, no_beta, f_keep_.leftCols(0), tau0_);
-  if (rc != ChainHdSolver::E_NOERROR) return std::numeric_limits<double>::quiet_NaN();
-  // H (qdd* - qdd_free) = tau_cmd* + friction and limit torques of the resting joints.
-  double z0 = 0.0, dissipation = 0.0;
+  // H (qdd* - qdd_free) = dtau = tau_cmd* + the friction and limit torques of the resting joints,
+  // with qdd_free the unconstrained motion under ff torques and kinetic friction; so
+  // Z0 = 1/2 dtau^T H^-1 dtau, from the articulated inertias of hd_'s last solve (same q).
+  double dissipation = 0.0;
   for (unsigned int j = 0; j < nj_; ++j) {
     const bool resting = status_[j] != Moving;
-    const double torque = tau_cmd_(j) + (resting ? friction_(j) + limit_(j) : 0.0);
-    z0 += 0.5 * (qdd_(j) - free_.qdd()(j)) * torque;
+    tmp_(j) = tau_cmd_(j) + (resting ? friction_(j) + limit_(j) : 0.0);
     // A sticking joint has qdd = 0: its round-off residual times a huge f (up to 1e308) must not
     // overflow the sum.
     if (resting && status_[j] != Stick) dissipation += fstatic_(j) * std::abs(qdd_(j));
   }
-  return z0 + dissipation;
+  if (hd_.inverseInertiaTimes(tmp_, tmp2_) != ChainHdSolver::E_NOERROR) return std::numeric_limits<double>::quiet_NaN();
+  return 0.5 * tmp_.dot(tmp2_) + dissipation;
 }
 
 }  // namespace vereshchagin

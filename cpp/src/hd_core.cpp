@@ -342,7 +342,6 @@ int HdCore::solveLast(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::R
   return 0;
 }
 
-// Link accelerations in base axes, computed from the tip-frame ones on first request.
 void HdCore::accelerationsOf(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
   for (unsigned int i = 0; i < model.ns; ++i) {
     const SegmentModel& sm = model.seg[i];
@@ -356,6 +355,7 @@ void HdCore::accelerationsOf(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
   res.link_acc_known = false;
 }
 
+// Link accelerations in base axes, computed from the tip-frame ones on first request.
 const Matrix6X& HdCore::linkAccelerations() const {
   if (!res.link_acc_known) {
     res.link_acc.col(0) = root_acc;

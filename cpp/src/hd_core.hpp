@@ -149,6 +149,8 @@ struct HdWorkspace {
   Matrix6X zero_f_ext;        // 6 x n_segments zeros
   Eigen::VectorXd zero_joints;
   Matrix6 alfa_buf;
+  Matrix6X inertia_force, inertia_acc;  // inverseInertia(): per segment, bias force and acceleration
+  Eigen::VectorXd inertia_joint;        // inverseInertia(): (tau_j - S^T f) / D per joint
 };
 
 struct HdResults {
@@ -187,6 +189,9 @@ class HdCore {
   // Segment accelerations of given joint accelerations at the last solve's state (poses and
   // velocity products kept): one outward pass; link accelerations follow on request.
   void accelerationsOf(const Eigen::Ref<const Eigen::VectorXd>& qdd);
+  // out = H(q)^-1 tau at the last solve's q (its articulated inertias kept): one inward and one
+  // outward pass without velocity, gravity or constraints (inverse_inertia.cpp).
+  void inverseInertia(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> out);
   double smallestSingularValue() const;
   Eigen::Map<const Eigen::VectorXd> nu() const {
     return Eigen::Map<const Eigen::VectorXd>(res.general ? res.nu_user.data() : res.nu.data(), res.m);

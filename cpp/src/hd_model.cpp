@@ -106,6 +106,8 @@ void HdCore::allocateWorkspace() {
   res.link_acc_known = true;  // zeros until the first solve
   ws.zero_f_ext = Matrix6X::Zero(6, ns);
   ws.alfa_buf.setZero();
+  ws.inertia_force = ws.inertia_acc = Matrix6X::Zero(6, ns);
+  ws.inertia_joint = Eigen::VectorXd::Zero(nj);
   mcap = std::max<int>(kMaxConstraints, kMaxConstraints * static_cast<int>(ns));
   PassThroughState& pt = ws.pt;
   pt.f = pt.t = pt.energy = pt.tmp = Eigen::VectorXd::Zero(mcap);

@@ -80,6 +80,16 @@ int HdSolver::setJointAccelerations(const Eigen::Ref<const Eigen::VectorXd>& qdd
   core_->accelerationsOf(qdd);
   return E_NOERROR;
 }
+int HdSolver::inverseInertiaTimes(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> out) {
+  if (!core_->res.solved)
+    return record(core_->fail(E_NO_SOLUTION, "inverseInertiaTimes() needs a successful solve() first"));
+  const auto n = static_cast<Eigen::Index>(nrOfJoints());
+  if (tau.size() != n || out.size() != n)
+    return record(core_->fail(E_SIZE_MISMATCH, "tau has %ld and out %ld entries, expected %u (joints)",
+                              (long)tau.size(), (long)out.size(), nrOfJoints()));
+  core_->inverseInertia(tau, out);
+  return E_NOERROR;
+}
 int HdSolver::constraintCount() const {
   return core_->res.m;
 }

@@ -213,6 +213,37 @@ void testForwardDynamics(testutil::Checker& ck) {
   std::printf("  m = 0 forward dynamics vs TreeIdSolver_RNE: worst %.2e\n", worst);
 }
 
+// inverseInertiaTimes after a solve (with and without constraints) against H from RNE columns:
+// H out = tau; and its error codes.
+void testInverseInertia(testutil::Checker& ck) {
+  double worst = 0.0;
+  for (int seed = 0; seed < 30; ++seed) {
+    TreeCase c(900 + seed, 30);
+    auto& [g, tree, s, o, nj, ns] = c;
+    const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, tau = g.torques(nj).data;
+    Eigen::VectorXd out(nj);
+    if (seed == 0) {
+      ck.check(s.inverseInertiaTimes(tau, out) == vereshchagin::HdSolver::E_NO_SOLUTION,
+               "inverseInertiaTimes before a solve");
+      ck.check(std::string(s.errorMessage()).find("needs a successful solve") != std::string::npos,
+               std::string("its message: ") + s.errorMessage());
+    }
+    const Task t = randomTask(g, s, tree, seed % 4);
+    const Matrix6X none(6, 0);
+    const int rc = seed % 2 ? s.solve(q, qd, t.alfa, t.beta, t.segments, none, Eigen::VectorXd(0))
+                            : s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), none, Eigen::VectorXd(0));
+    if (!ck.check(rc == 0, "seed " + str(seed) + ": solve failed: " + s.errorMessage())) continue;
+    if (!ck.check(s.inverseInertiaTimes(tau, out) == 0, "inverseInertiaTimes failed")) continue;
+    const double e = relErr(o.massMatrix(q) * out, tau);
+    worst = std::max(worst, e);
+    ck.check(e < kTol, "seed " + str(seed) + ": H (H^-1 tau) misses tau by " + str(e));
+    Eigen::VectorXd short_out(std::max(nj - 1, 0));
+    ck.check(s.inverseInertiaTimes(tau, short_out) == vereshchagin::HdSolver::E_SIZE_MISMATCH,
+             "wrong out size is refused");
+  }
+  std::printf("  inverseInertiaTimes vs H from TreeIdSolver_RNE: worst %.2e\n", worst);
+}
+
 // Constrained solves at q_dot = 0 against the KKT solution; command torques replayed through
 // RNE and beta checked from the link accelerations (q_dot = 0 and q_dot != 0).
 void testConstraints(testutil::Checker& ck) {
@@ -555,6 +586,7 @@ int main() {
   testutil::Checker ck("test_tree");
   testChainAsTree(ck);
   testForwardDynamics(ck);
+  testInverseInertia(ck);
   testConstraints(ck);
   testLinkAccelerations(ck);
   testResponseColumns(ck);

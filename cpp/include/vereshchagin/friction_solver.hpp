@@ -33,10 +33,12 @@
 //  * status (n): Moving, Stick, SlipPositive (qdd > 0) or SlipNegative (qdd < 0).
 //  * nu, constraint rank: as HdSolver at the optimum.
 //  * gaussValue(): Z0(qdd*) + sum_rest f_j |qdd*_j|, with Z0(qdd) = 1/2 (qdd - qdd_free)^T H
-//    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction
-//    (computed on request: one extra O(n) solve). NaN before a successful solve, or when qdd_free
-//    itself overflows (that solve fails with E_NONFINITE_RESULT); Inf when the value is beyond the
-//    double range (friction or torques times accelerations near 1e300). The Python API raises then.
+//    (qdd - qdd_free) and qdd_free the unconstrained motion under ff_torques and kinetic friction.
+//    Computed on request as 1/2 dtau^T H^-1 dtau, dtau = H (qdd* - qdd_free) the command plus the
+//    resting joints' friction and limit torques, by one articulated pass on the last solve's
+//    inertias (HdSolver::inverseInertiaTimes; a fraction of a solve). NaN before a successful
+//    solve; Inf or NaN when the value is beyond the double range (friction or torques times
+//    accelerations near 1e300). The Python API raises then.
 //  * iterations(): active-set iterations of the last solve (at most 5 (k + 1) 3^k + 4, k the
 //    resting joints with friction or on a limit; the argument is in friction_solver.cpp's
 //    boxQp()). Bland's smallest-index rule takes over if a face-optimal value fails to decrease.
@@ -109,10 +111,7 @@ class FrictionSolver {
   HdSolver& hdSolver() { return hd_; }
   const char* errorMessage() const { return message_.data(); }
   int modelError() const { return hd_.modelError(); }
-  void setRootAcceleration(const KDL::Twist& root_acc) {
-    hd_.setRootAcceleration(root_acc);
-    free_.setRootAcceleration(root_acc);
-  }
+  void setRootAcceleration(const KDL::Twist& root_acc) { hd_.setRootAcceleration(root_acc); }
   // Driver pass-through weights as ChainHdSolver::setPassThrough: they weight f_ext and
   // ff_torques only; friction (kinetic and the max-min's static) is always compensated along the
   // constraints. Returns ChainHdSolver's codes (message in errorMessage()).
@@ -122,7 +121,7 @@ class FrictionSolver {
   int setOptions(const SolverOptions& options);
 
  private:
-  FrictionSolver(std::unique_ptr<HdSolver> hd, std::unique_ptr<HdSolver> free);
+  explicit FrictionSolver(std::unique_ptr<HdSolver> hd);
   int fail(int code, const char* fmt, ...);
   int solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                 const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
@@ -159,18 +158,13 @@ class FrictionSolver {
   void gradient(int k);
   void factorDelete(int q, int nf);
 
-  std::unique_ptr<HdSolver> hd_owner_, free_owner_;  // the solver of the problem; one for qdd_free
+  std::unique_ptr<HdSolver> hd_owner_;  // the solver of the problem
   HdSolver& hd_;
-  HdSolver& free_;
   unsigned int nj_ = 0;
   std::array<char, 512> message_{};
   Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;
   Eigen::VectorXd ff_driver_;  // ff_torques of the last solve (zero if empty): hd_'s pass-through driver
   Eigen::MatrixXd dnu_;
-  ChainHdSolver::Matrix6X alfa_keep_;  // 6 x maxConstraints() storage
-  Eigen::VectorXd beta_keep_;
-  Eigen::VectorXi seg_keep_;
-  bool has_segments_ = false;
   int m_keep_ = 0, k_ = 0;
   bool link_acc_known_ = false;
   std::vector<signed char> status_;
@@ -179,11 +173,7 @@ class FrictionSolver {
   double gscale_ = 0.0;          // scale of the QP gradient (see boxQp())
   bool free_full_rank_ = false;  // the last free-set factorisation had full rank
   bool solved_ = false;
-  // Inputs kept for gaussValue().
-  Eigen::VectorXd q_keep_, qd_keep_;
-  ChainHdSolver::Matrix6X f_keep_;
-  bool has_f_ = false;
-  Eigen::VectorXd fstatic_;  // static friction of the last solve
+  Eigen::VectorXd fstatic_;  // static friction of the last solve (gaussValue())
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;                    // joint index of each resting joint
   Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_;  // Tc_ stays empty (0 x 0): tau_cmd follows from nu

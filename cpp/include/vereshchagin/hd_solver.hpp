@@ -183,6 +183,11 @@ class HdSolver : public KDL::SolverI {
   // accelerations at the friction optimum). E_SIZE_MISMATCH for a wrong size, E_NO_SOLUTION
   // before a successful solve.
   int setJointAccelerations(const Eigen::Ref<const Eigen::VectorXd>& qdd);
+  // out = H(q)^-1 tau, H the joint-space inertia matrix (rotor inertias included) at the last
+  // successful solve's q: joint accelerations (rad/s^2 or m/s^2) the joint torques tau (N m or N,
+  // n_joints) would add, from the articulated inertias that solve left (one inward and one outward
+  // pass, no allocation). E_SIZE_MISMATCH for wrong sizes, E_NO_SOLUTION before a successful solve.
+  int inverseInertiaTimes(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> out);
   int constraintCount() const;
   // Segment i's state at the last successful solve (i < nrOfSegments(), unchecked; unspecified before):
   // the pose of its tip frame in its parent's tip frame (the base for a segment without parent),
