@@ -26,7 +26,8 @@ Variants (:data:`VARIANTS`):
 - ``unsupported``: the tree solver, no table, the motors hold the resting hand;
 - ``separate``: the shortcut. Two :class:`vereshchagin.Chain` s, torso + left arm and torso +
   right arm, each from :func:`~vereshchagin.robots.dual_gen3_urdf` with ``torso_share = 0.5``
-  (half the torso link's mass and inertia, half the torso joint's friction and damping) and
+  (half the mass and inertia of the torso segment: the torso link and both arm base links;
+  half the torso joint's friction and damping) and
   each solved with its own hand's constraint only (the left with the table share as in
   ``table``); the arm joints take their chain's torque, the torso joint the **sum** of the two
   chains' torso torques, and each chain gets half the torso's posture term. So the torso is

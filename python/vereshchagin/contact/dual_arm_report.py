@@ -134,7 +134,9 @@ def _checks(efforts: dict, outcomes: dict) -> dict:
     }
 
 
-def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None) -> dict:
+def run(
+    out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None, runs: Optional[dict] = None
+) -> dict:
     """Run the three dual-arm variants, write table, CSV and figure into ``out_dir/dual_arm``.
 
     Parameters
@@ -145,6 +147,9 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         Shorter phases (:func:`~.dual_arm.dual_arm`).
     progress : callable, optional
         ``progress(line)`` after each run.
+    runs : dict, optional
+        Runs already made, ``{variant: Run}`` for every variant of :data:`~.dual_arm.VARIANTS`
+        (with the same ``quick``); None: run them here.
 
     Returns
     -------
@@ -156,8 +161,10 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     out = Path(out_dir) / "dual_arm"
     out.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
-    runs = {}
+    runs = dict(runs or {})
     for k, v in enumerate(VARIANTS):
+        if v in runs:
+            continue
         t0 = time.perf_counter()
         runs[v] = dual_arm(v, quick)
         say(
@@ -187,8 +194,8 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         "(six directions constrained), cascaded P gains of the contact use cases, posture damping in the 3 "
         "redundant DOF, friction-aware solve. Variants: **table** (tree solver), **unsupported** (tree "
         "solver, no table: the motors hold the resting hand), **separate** (the shortcut: torso + left arm "
-        "and torso + right arm as two chains, each with half the torso's mass, inertia, friction and "
-        "damping and only its own hand's constraint; the torso joint gets the sum of both chains' torso "
+        "and torso + right arm as two chains, each with half the torso segment's mass and inertia (torso "
+        "link and both arm bases), half the torso joint's friction and damping and only its own hand's constraint; the torso joint gets the sum of both chains' torso "
         "torques, the arms their chain's; the coupling through the torso is ignored).",
         "",
         f"Mode: {'quick' if quick else 'full'}. Per joint over the slide:",
