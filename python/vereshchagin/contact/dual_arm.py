@@ -45,13 +45,12 @@ solver, the coupling error for the separate chains.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
-from typing import Optional
+from typing import Optional, Union
 
 import numpy as np
 
 from .. import robots
-from .._core import Tree
+from .._core import Chain, Tree
 from ..friction import Friction
 from ..solver import Solver
 from ..task import beta_for, pose_error
@@ -95,7 +94,6 @@ def start_pose() -> np.ndarray:
     return np.concatenate([[0.0], arm, arm])
 
 
-@lru_cache(maxsize=2)
 def dual_arm_model(torso_share: float = 1.0) -> tuple[str, Tree]:
     """URDF text and tree of the dual-arm robot with :data:`REST_FRAME` added (module doc).
 
@@ -112,6 +110,16 @@ def dual_arm_model(torso_share: float = 1.0) -> tuple[str, Tree]:
     tree : Tree
         15 joints, :data:`vereshchagin.robots.DUAL_GEN3_JOINT_NAMES`.
     """
+    key = float(torso_share)
+    if key not in _MODELS:
+        _MODELS[key] = _model(key)
+    return _MODELS[key]
+
+
+_MODELS: dict[float, tuple[str, Tree]] = {}  # torso_share -> (urdf, tree), built once
+
+
+def _model(torso_share: float) -> tuple[str, Tree]:
     urdf = robots.dual_gen3_urdf(JOINT_FRICTION, JOINT_DAMPING, torso_share=torso_share)
     tree = Tree.from_urdf(urdf)
     q0 = start_pose()
@@ -127,7 +135,7 @@ class _Part:
     """One solve of the command: a model (the tree, or one chain of the shortcut) and where its joints go."""
 
     solver: Solver
-    model: object
+    model: Union[Chain, Tree]
     idx: np.ndarray  # its joints' indices in the tree's q
     frames: tuple  # the hand frames it constrains
     torso_scale: np.ndarray  # factor on the posture term per joint (0.5 at a shared torso)
@@ -225,6 +233,8 @@ class DualArmController:
             ``table_force`` (the model's upward force at :data:`REST_FRAME`, N, 0 when none).
         """
         q, qd = np.asarray(q, float), np.asarray(qd, float)
+        if self.goal is None:
+            raise ValueError("set_goal() before command()")
         if self.rest_goal is None:
             self.rest_goal = np.asarray(self.tree.fk(q, REST_FRAME))
             self.q_ref = q.copy()
@@ -245,7 +255,7 @@ class DualArmController:
             )
             share = np.zeros(len(p.idx))
             if self.table_share and REST_FRAME in p.frames:
-                nu_up = float(res.segment_nu[REST_FRAME][UP])
+                nu_up = float((res.segment_nu or {})[REST_FRAME][UP])
                 if nu_up < 0.0:
                     share = -np.asarray(p.model.jacobian(qp, REST_FRAME))[UP] * nu_up
                     force = -nu_up

@@ -17,6 +17,8 @@ Torque is the motor torque the plant applied (after saturation), qd the measured
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 __all__ = ["dual_arm_outcome", "effort", "elbow_outcome", "grasp_outcome", "writing_accuracy"]
@@ -169,7 +171,7 @@ def dual_arm_outcome(run, phase: str = "slide", dx: float = 0.10) -> dict:
     tip = run.tip
     off = np.hypot(tip[after, 1] - tip[start, 1], tip[after, 2] - tip[start, 2])
     rest = np.asarray(run.info["rest"])
-    out = dict(
+    out: dict[str, Any] = dict(
         final_error_x=float(tip[-1, 0] - (tip[start, 0] + dx)),
         max_off_line=float(off.max()),
         rest_drift=float(np.linalg.norm(rest - rest[0], axis=1).max()),

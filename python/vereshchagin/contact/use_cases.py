@@ -20,7 +20,7 @@ along +x. The tables are placed from that pose:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -229,7 +229,7 @@ def _shifted(T, dx=0.0, dy=0.0, dz=0.0, R=None):
 
 def run_loop(
     robot,
-    controller: CascadedController,
+    controller: Any,
     phases,
     case: str,
     variant: str,

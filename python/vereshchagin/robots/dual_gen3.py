@@ -15,13 +15,13 @@ name): ``torso_joint``, ``left_joint_1`` .. ``left_joint_7``, ``right_joint_1`` 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import Optional
+from typing import Any, Optional
 
 from .gen3 import gen3_urdf
 
 __all__ = ["DUAL_GEN3_JOINT_NAMES", "TORSO", "dual_gen3_urdf"]
 
-TORSO = {
+TORSO: dict[str, Any] = {
     "mass": 10.0,
     "size": (0.20, 0.50, 0.25),
     "effort": 80.0,
@@ -50,19 +50,20 @@ def _prefixed(arm_urdf: str, prefix: str, base_scale: float) -> list[ET.Element]
             continue
         if el.tag == "link" and el.get("name") == "base_link":
             _scale_inertial(el, base_scale)
-        el.set("name", prefix + el.get("name"))
+        el.set("name", prefix + el.get("name", ""))
         for ref in el.iter():
             if ref.tag in ("parent", "child"):
-                ref.set("link", prefix + ref.get("link"))
+                ref.set("link", prefix + ref.get("link", ""))
         out.append(el)
     return out
 
 
 def _scale_inertial(link: ET.Element, factor: float) -> None:
     """Multiply the mass and every inertia entry of ``link`` by ``factor`` (same centre of mass)."""
-    mass = link.find("inertial/mass")
-    mass.set("value", repr(float(mass.get("value")) * factor))
-    inertia = link.find("inertial/inertia")
+    mass, inertia = link.find("inertial/mass"), link.find("inertial/inertia")
+    if mass is None or inertia is None:
+        raise ValueError(f"link {link.get('name')!r} has no inertial to scale")
+    mass.set("value", repr(float(mass.get("value", "0")) * factor))
     for key, value in inertia.attrib.items():
         inertia.set(key, repr(float(value) * factor))
 
