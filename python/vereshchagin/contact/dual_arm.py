@@ -260,7 +260,9 @@ class DualArmController:
                     share = -np.asarray(p.model.jacobian(qp, REST_FRAME))[UP] * nu_up
                     force = -nu_up
             tau[p.idx] += np.asarray(res.tau_command) + ff - share
-            total[p.idx] += tau_ff + np.asarray(res.tau_command) + np.asarray(res.friction_torque)
+            total[p.idx] += tau_ff + np.asarray(res.tau_command)
+            if res.friction_torque is not None:
+                total[p.idx] += np.asarray(res.friction_torque)
         inputs = dict(q=q, qd=qd, constraints=cons, model_torque=total, table_force=force)
         info = CycleInfo(pose=T, twist=tw, error=pose_error(T, self.goal), normal_force_estimate=force, contact=False)
         info.result, info.inputs = res, inputs
