@@ -34,8 +34,10 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     out_dir : str or Path
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
-    case : {"friction", "demo", "contact", "friction-energy", "all"}
+    case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "all"}
         ``contact``: the three use cases of W. K. Lau (2023) in MuJoCo (:mod:`vereshchagin.contact.report`);
+        ``dual-arm``: one hand of a dual-arm Gen3 resting on a table while the other slides, tree
+        solver against separate chains (:mod:`vereshchagin.contact.dual_arm_report`);
         ``friction-energy``: the motor effort exact static friction saves on the Gen3
         (:mod:`vereshchagin.experiments.friction_energy_report`).
 
@@ -105,6 +107,10 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
         from .contact.report import run as run_contact
 
         ok &= _section("Lau (2023) contact use cases (MuJoCo plant)", run_contact, out, quick, index)
+    if case in ("dual-arm", "all"):
+        from .contact.dual_arm_report import run as run_dual
+
+        ok &= _section("dual-arm case on a tree robot (MuJoCo plant)", run_dual, out, quick, index)
     if case in ("friction-energy", "all"):
         from .experiments.friction_energy_report import run as run_energy
 
@@ -134,13 +140,13 @@ def main(argv=None) -> int:
     rep = sub.add_parser(
         "reproduce",
         help="reproduce the friction figures of Vukcevic (2018), the demo, the contact "
-        "use cases of Lau (2023) and the friction-energy experiment into a folder",
+        "use cases of Lau (2023), the dual-arm case and the friction-energy experiment into a folder",
     )
     rep.add_argument("--out", default="results", help="output folder (default: ./results)")
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
     rep.add_argument(
         "--case",
-        choices=("friction", "demo", "contact", "friction-energy", "all"),
+        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "all"),
         default="all",
         help="which experiments to run (default: all)",
     )

@@ -19,6 +19,7 @@ CASE_NEEDS = {
     "friction": ("matplotlib",),
     "demo": (),
     "contact": ("mujoco", "matplotlib"),
+    "dual-arm": ("mujoco", "matplotlib"),
     "friction-energy": ("mujoco", "matplotlib"),
 }
 

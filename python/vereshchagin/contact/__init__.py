@@ -12,6 +12,9 @@ closed loop at 1 kHz, with this package's solver inside the controller:
 - :mod:`.use_cases`: the phases of the grasp and writing tasks and the loop that runs them;
 - :mod:`.elbow`: the resting-elbow task, with the support left to the plant or stated as a segment
   constraint;
+- :mod:`.dual_arm`: a dual-arm Gen3 on a torso (a kinematic tree), one hand resting on a table
+  while the other slides, the tree solver against the arms solved as separate chains
+  (:mod:`.dual_arm_report`: ``--case dual-arm``);
 - :mod:`.metrics`: effort and accuracy numbers of a run (the report's Tables 6.1-6.3);
 - :mod:`.report`: runs everything and writes tables and figures
   (``python -m vereshchagin reproduce --case contact``).

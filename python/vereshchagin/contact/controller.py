@@ -239,6 +239,10 @@ class CascadedController:
         self._alpha: dict[tuple, np.ndarray] = {}  # constraint directions (6, m) per tuple of names
 
     # -- task state ------------------------------------------------------------------------------
+    def pose(self, q) -> np.ndarray:
+        """End-effector pose (4, 4) at joint positions ``q`` (rad): the frame the goals refer to (base frame, m)."""
+        return np.asarray(self.chain.fk(q))
+
     def set_goal(self, T_goal) -> None:
         """Set the desired end-effector pose.
 

@@ -17,9 +17,11 @@ Torque is the motor torque the plant applied (after saturation), qd the measured
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-__all__ = ["effort", "elbow_outcome", "grasp_outcome", "writing_accuracy"]
+__all__ = ["dual_arm_outcome", "effort", "elbow_outcome", "grasp_outcome", "writing_accuracy"]
 
 
 def effort(run, mask=None) -> dict:
@@ -136,3 +138,49 @@ def elbow_outcome(run, phase: str = "slide", dx: float = -0.10) -> dict:
         support_force=float(run.support_force[m].mean()),
         model_support_force=float(model.mean()) if np.all(np.isfinite(model)) else float("nan"),
     )
+
+
+def dual_arm_outcome(run, phase: str = "slide", dx: float = 0.10) -> dict:
+    """Task, table and open-loop outcome of a dual-arm run (:mod:`.dual_arm`).
+
+    Parameters
+    ----------
+    run : Run
+        A :func:`~.dual_arm.dual_arm` run.
+    phase : str
+        The sliding phase's name.
+    dx : float
+        The sliding hand's travel along base x (m).
+
+    Returns
+    -------
+    dict
+        Closed loop (plant): ``final_error_x`` the sliding hand's x at the end minus its goal (x
+        at the start of ``phase`` + ``dx``, m); ``max_off_line`` its largest distance from the
+        line along x through its start (y and z, m) from ``phase`` on; ``rest_drift`` the largest
+        displacement of the resting hand's frame from its start (m); ``table_fraction`` the share
+        of ``phase`` samples with a table force; ``table_force`` / ``table_force_model`` the mean
+        table force over ``phase`` in the plant / the model's upward share (N). Open loop, over all
+        samples, per hand (``rest``, ``task``): ``open_loop_rms`` / ``open_loop_max`` of the
+        linear rows (m/s^2), ``open_loop_ang_rms`` / ``open_loop_ang_max`` of the angular rows
+        (rad/s^2).
+    """
+    m = run.window(phase)
+    start = np.argmax(m)
+    after = np.arange(len(run.t)) >= start
+    tip = run.tip
+    off = np.hypot(tip[after, 1] - tip[start, 1], tip[after, 2] - tip[start, 2])
+    rest = np.asarray(run.info["rest"])
+    out: dict[str, Any] = dict(
+        final_error_x=float(tip[-1, 0] - (tip[start, 0] + dx)),
+        max_off_line=float(off.max()),
+        rest_drift=float(np.linalg.norm(rest - rest[0], axis=1).max()),
+        table_fraction=float((run.table_force[m] > 0.0).mean()),
+        table_force=float(run.table_force[m].mean()),
+        table_force_model=float(np.asarray(run.info["table_force_model"])[m].mean()),
+    )
+    for key, rows in (("open_loop", run.info["open_loop"]), ("open_loop_ang", run.info["open_loop_ang"])):
+        rows = np.asarray(rows)
+        out[key + "_rms"] = dict(zip(("rest", "task"), np.sqrt(np.mean(rows**2, axis=0)).tolist()))
+        out[key + "_max"] = dict(zip(("rest", "task"), rows.max(axis=0).tolist()))
+    return out

@@ -1,4 +1,4 @@
-"""The plant: a MuJoCo model of the Kinova Gen3 built from our own URDF, at 1 kHz.
+"""The plant: a MuJoCo model of the Kinova Gen3 (or a tree of Gen3 arms) built from our own URDF, at 1 kHz.
 
 :func:`build_model` compiles the URDF of :func:`vereshchagin.robots.gen3_urdf` (rigid Robotiq
 2F-85) with MuJoCo's URDF reader, so the plant and the controller's :class:`vereshchagin.Chain`
@@ -12,7 +12,11 @@ links are fused into ``bracelet_link`` by both). Then it adds
   9 N m joints 5-7);
 - a table (box; top at ``Scene.table_top``), optionally an elbow support (box) and a pen held in
   the gripper (capsule, pointing down at the start pose);
-- a collision sphere around the elbow actuator (joint 4), radius 0.055 m.
+- a collision sphere around each elbow actuator (joint 4; every body named ``*forearm_link``),
+  radius 0.055 m.
+
+A tree robot (:func:`vereshchagin.robots.dual_gen3_urdf` with a :class:`vereshchagin.Tree`) is
+built the same way: one motor per joint in the tree's joint order, contact geoms on every arm.
 
 Collision filtering: the arm's rough primitives (URDF cylinders, the gripper box, pen, elbow
 sphere) have ``contype`` 1 / ``conaffinity`` 0 and the environment 0 / 1, so the arm touches the
@@ -30,6 +34,7 @@ from typing import Optional
 import mujoco
 import numpy as np
 
+from .._core import Chain
 from .robot_interface import JointState
 
 __all__ = ["MujocoGen3", "Scene", "build_model"]
@@ -87,16 +92,53 @@ def _quat(R: np.ndarray) -> np.ndarray:
     return q
 
 
+def _add_pen(spec, chain, direction, fr) -> None:
+    """A massless capsule held by the gripper along ``direction`` (end-effector frame)."""
+    # End-effector frame in the bracelet body (the URDF's fixed joints are fused into it).
+    probe = spec.compile()
+    pd = mujoco.MjData(probe)
+    mujoco.mj_kinematics(probe, pd)
+    T_b_ee = np.linalg.inv(_pose_of_body(probe, pd, "bracelet_link")) @ np.asarray(chain.fk(np.zeros(chain.n_joints)))
+
+    def in_bracelet(p_ee):
+        return (T_b_ee @ np.append(p_ee, 1.0))[:3]
+
+    grip = in_bracelet([0.0, 0.0, PEN_GRIP])
+    tip = in_bracelet(pen_tip(direction))
+    spec.body("bracelet_link").add_geom(
+        name="pen",
+        type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+        size=[PEN_RADIUS, 0, 0],
+        fromto=np.concatenate([grip, tip]),
+        contype=1,
+        conaffinity=0,
+        group=ARM,
+        friction=fr,
+        mass=0.0,
+        rgba=[0.1, 0.1, 0.8, 1],
+    )
+
+
 def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
     """Compile the plant (see module doc).
 
     Parameters
     ----------
     urdf : str
-        URDF text of the Gen3 (from :func:`vereshchagin.robots.gen3_urdf`, ``gripper=True``).
-    chain : Chain
-        The controller's chain from the same URDF (for the end-effector frame and rotor inertia).
+        URDF text of the robot: the Gen3 (from :func:`vereshchagin.robots.gen3_urdf`,
+        ``gripper=True``) or a tree of Gen3 arms such as
+        :func:`vereshchagin.robots.dual_gen3_urdf`.
+    chain : Chain or Tree
+        The controller's model from the same URDF: its joint order is the plant's (checked), its
+        effort limits the motors' ranges, its rotor inertia (chains) the armature; a chain also
+        gives the end-effector frame for the pen.
     scene : Scene
+        A pen (``pen_direction``) needs a :class:`~vereshchagin.Chain`.
+
+    Raises
+    ------
+    ValueError
+        If MuJoCo orders the joints differently from ``chain``, or a pen is asked for on a tree.
     """
     spec = mujoco.MjSpec.from_string(urdf)
     spec.option.timestep = 1e-3
@@ -105,8 +147,8 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
     fr = [scene.friction, 0.005, 1e-4]
     for g in spec.geoms:
         g.contype, g.conaffinity, g.group, g.friction = 1, 0, ARM, fr
-    rotor = np.asarray(chain.rotor_inertia, float)
     joints = list(chain.joint_names)
+    rotor = np.asarray(getattr(chain, "rotor_inertia", np.zeros(len(joints))), float)
     for k, name in enumerate(joints):
         joint = spec.joint(name)
         joint.armature = float(rotor[k])
@@ -121,43 +163,23 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
             ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
             ctrlrange=[-lim, lim],
         )
-
-    # End-effector frame in the bracelet body (the URDF's fixed joints are fused into it).
-    probe = spec.compile()
-    pd = mujoco.MjData(probe)
-    mujoco.mj_kinematics(probe, pd)
-    T_b_ee = np.linalg.inv(_pose_of_body(probe, pd, "bracelet_link")) @ np.asarray(chain.fk(np.zeros(len(joints))))
-
-    def in_bracelet(p_ee):
-        return (T_b_ee @ np.append(p_ee, 1.0))[:3]
-
-    bracelet = spec.body("bracelet_link")
     if scene.pen_direction is not None:
-        grip = in_bracelet([0.0, 0.0, PEN_GRIP])
-        tip = in_bracelet(pen_tip(scene.pen_direction))
-        bracelet.add_geom(
-            name="pen",
-            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-            size=[PEN_RADIUS, 0, 0],
-            fromto=np.concatenate([grip, tip]),
-            contype=1,
-            conaffinity=0,
-            group=ARM,
-            friction=fr,
-            mass=0.0,
-            rgba=[0.1, 0.1, 0.8, 1],
-        )
-    spec.body("forearm_link").add_geom(
-        name="elbow",
-        type=mujoco.mjtGeom.mjGEOM_SPHERE,
-        size=[ELBOW_RADIUS, 0, 0],
-        pos=[0, 0, 0],
-        contype=1,
-        conaffinity=0,
-        group=ARM,
-        friction=fr,
-        mass=0.0,
-    )
+        if not isinstance(chain, Chain):
+            raise ValueError("a pen (scene.pen_direction) needs a Chain: its end-effector frame holds the pen")
+        _add_pen(spec, chain, scene.pen_direction, fr)
+    for body in spec.bodies:
+        if body.name.endswith("forearm_link"):
+            body.add_geom(
+                name=body.name.removesuffix("forearm_link") + "elbow",
+                type=mujoco.mjtGeom.mjGEOM_SPHERE,
+                size=[ELBOW_RADIUS, 0, 0],
+                pos=[0, 0, 0],
+                contype=1,
+                conaffinity=0,
+                group=ARM,
+                friction=fr,
+                mass=0.0,
+            )
     world = spec.worldbody
     if scene.table_top is not None:
         (x0, x1), (y0, y1) = scene.table_x, scene.table_y
@@ -186,7 +208,9 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
             rgba=[0.3, 0.5, 0.3, 1],
         )
     model = spec.compile()
-    # The pen and the elbow sphere are massless (mass=0 would make MuJoCo infer one from density).
+    order = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt)]
+    if order != joints:
+        raise ValueError(f"MuJoCo orders the joints {order}, the controller's model {joints}")
     return model
 
 

@@ -20,7 +20,7 @@ along +x. The tables are placed from that pose:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -84,22 +84,26 @@ PAYLOAD_RADIUS = 0.04
 """m, the payload sphere of :func:`gen3_model` (inertia 2/5 m r^2 about its centre)."""
 
 
-def with_tool_link(urdf: str, name: str, xyz, mass: float = 0.0, radius: float = 0.0) -> str:
-    """The URDF with a link ``name`` fixed to the end-effector link at ``xyz`` (m).
+def with_tool_link(
+    urdf: str, name: str, xyz, mass: float = 0.0, radius: float = 0.0, parent: str = robots.GEN3_TIP_LINK
+) -> str:
+    """The URDF with a link ``name`` fixed to the link ``parent`` (the end-effector link) at ``xyz`` (m).
 
     Parameters
     ----------
     urdf : str
-        URDF text with a link named :data:`vereshchagin.robots.GEN3_TIP_LINK`.
+        URDF text with a link named ``parent``.
     name : str
         Name of the new link (its fixed joint is ``{name}_joint``).
     xyz : sequence of 3 float
-        Its origin in the end-effector frame (m), no rotation.
+        Its origin in the frame of ``parent`` (m), no rotation.
     mass : float
         kg; 0 (default): massless. Else the link is a solid sphere of that mass and ``radius``
         (m) centred at its origin (inertial only, no collision shape).
     radius : float
         m, used only with ``mass`` > 0.
+    parent : str
+        The link it is fixed to; default :data:`vereshchagin.robots.GEN3_TIP_LINK`.
 
     Returns
     -------
@@ -115,7 +119,7 @@ def with_tool_link(urdf: str, name: str, xyz, mass: float = 0.0, radius: float =
             "    </inertial>\n"
         )
     link = (
-        f'  <joint name="{name}_joint" type="fixed">\n    <parent link="{robots.GEN3_TIP_LINK}"/>\n'
+        f'  <joint name="{name}_joint" type="fixed">\n    <parent link="{parent}"/>\n'
         f'    <child link="{name}"/>\n    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="0 0 0"/>\n'
         f'  </joint>\n  <link name="{name}">\n{inertial}  </link>\n'
     )
@@ -225,7 +229,7 @@ def _shifted(T, dx=0.0, dy=0.0, dz=0.0, R=None):
 
 def run_loop(
     robot,
-    controller: CascadedController,
+    controller: Any,
     phases,
     case: str,
     variant: str,
@@ -240,7 +244,9 @@ def run_loop(
     robot : RobotInterface
         The backend; a ``contact_forces()`` method, if it has one, fills the force logs.
     controller : CascadedController
-        Gets each phase's goal, contact mode and detection, and computes every command.
+        Gets each phase's goal, contact mode and detection, and computes every command;
+        ``controller.pose(q)`` is the pose the goals refer to (any controller with the same
+        methods, e.g. :class:`~.dual_arm.DualArmController`).
     phases : sequence of Phase
         Run in order; a phase with ``detect`` ends early on contact.
     case, variant : str
@@ -272,7 +278,7 @@ def run_loop(
     k = 0
     for i, p in enumerate(phases):
         s = robot.read()
-        T_now = np.asarray(controller.chain.fk(s.q))
+        T_now = controller.pose(s.q)
         goal = p.goal(T_now) if callable(p.goal) else p.goal
         controller.set_goal(goal)
         if p.contact is not None:
@@ -355,14 +361,17 @@ def _lowest_arm_point(model, q) -> float:
     return float(low)
 
 
-def _gripper_low_point(model, chain, q) -> np.ndarray:
-    """The gripper box's lowest corner at ``q`` in the end-effector frame (m)."""
+def _gripper_low_point(model, q, T_frame, body: str = "bracelet_link") -> np.ndarray:
+    """The lowest edge's middle of the gripper box on ``body`` at ``q``, in the frame ``T_frame`` (m).
+
+    ``T_frame`` is that frame's pose (4, 4) in the base frame at ``q`` (e.g. the end-effector's).
+    """
     import mujoco
 
     d = mujoco.MjData(model)
     d.qpos[:] = q
     mujoco.mj_forward(model, d)
-    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "bracelet_link")
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body)
     boxes = [
         g for g in range(model.ngeom) if model.geom_bodyid[g] == bid and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
     ]
@@ -372,8 +381,7 @@ def _gripper_low_point(model, chain, q) -> np.ndarray:
     # The lowest edge runs along the box's longest axis: take its middle (sliding contact line).
     long_axis = int(np.argmax(model.geom_size[g]))
     corner = corner + R[:, long_axis] * np.sign(R[2, long_axis]) * model.geom_size[g][long_axis]
-    T = np.asarray(chain.fk(q))
-    return (np.linalg.inv(T) @ np.append(corner, 1.0))[:3]
+    return (np.linalg.inv(np.asarray(T_frame)) @ np.append(corner, 1.0))[:3]
 
 
 def _controller(chain, tool_point, **overrides):
@@ -408,7 +416,7 @@ def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[f
     R0 = np.asarray(chain.fk(q0))[:3, :3]
     descent = (0.05 if quick else DESCENT) if descent is None else descent
     probe = build_model(urdf, chain, Scene())
-    low = _gripper_low_point(probe, chain, q0)
+    low = _gripper_low_point(probe, q0, chain.fk(q0))
     z_low = (np.asarray(chain.fk(q0)) @ np.append(low, 1.0))[2]
     scene = Scene(table_top=float(z_low - descent))
     robot = MujocoGen3(build_model(urdf, chain, scene), q0)

@@ -2,13 +2,15 @@
 
 :func:`gen3_urdf` writes the Gen3 (optionally with a rigid Robotiq 2F-85) as URDF text from the
 numbers of Kinova's ``ros2_kortex`` description (see :mod:`vereshchagin.robots.gen3`);
-:func:`gen3` loads it as a :class:`vereshchagin.Chain`.
+:func:`gen3` loads it as a :class:`vereshchagin.Chain`; :func:`dual_gen3_urdf` writes two of them
+on a turning torso (a kinematic tree, :class:`vereshchagin.Tree`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from .dual_gen3 import DUAL_GEN3_JOINT_NAMES, TORSO, dual_gen3_urdf
 from .gen3 import (
     GEN3_JOINT_NAMES,
     GEN3_START_POSE,
@@ -20,10 +22,13 @@ from .gen3 import (
 )
 
 __all__ = [
+    "DUAL_GEN3_JOINT_NAMES",
     "GEN3_JOINT_NAMES",
     "GEN3_START_POSE",
     "GEN3_START_POSE_REPORTED",
     "GEN3_TIP_LINK",
+    "TORSO",
+    "dual_gen3_urdf",
     "example_robot_urdf",
     "gen3",
     "gen3_data",
