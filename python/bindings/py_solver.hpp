@@ -35,6 +35,26 @@ struct ParsedSolve {
 
 struct BatchRunner;  // solve_batch.cpp
 
+// The keys of a constraints= dict, for solve and solve_batch alike: each resolved by the model's
+// addressing rule, one entry per frame, at most 6 columns per segment (alpha counts on the last).
+class ConstraintKeys {
+ public:
+  ConstraintKeys(const Addressable& model, int n_segments, int alpha_columns);
+  // constraints[key]'s target; raises for a frame given twice.
+  FrameTarget resolve(PyObject* key, const std::string& label);
+  // Counts `cols` more columns on `segment`; raises past 6.
+  void count(int segment, int cols, const std::string& label);
+  // The pair (alpha, beta) of one entry; raises unless a tuple or list of two.
+  static std::pair<PyObject*, PyObject*> pair(PyObject* value, const std::string& label, const std::string& shapes);
+  const std::vector<py::object>& keys() const { return keys_; }
+
+ private:
+  const Addressable& model_;
+  std::vector<int> per_segment_;
+  std::vector<FrameTarget> targets_;
+  std::vector<py::object> keys_;
+};
+
 // Raised for alpha/beta (the end segment's constraint) on a tree solver.
 inline constexpr const char* kTreeAlpha =
     "alpha and beta constrain a chain's last segment; a Tree has no last segment: pass constraints={segment or "

@@ -150,33 +150,50 @@ void PySolver::parseFExt(PyObject* f_ext, ParsedSolve& p) const {
   }
 }
 
+ConstraintKeys::ConstraintKeys(const Addressable& model, int n_segments, int alpha_columns)
+    : model_(model), per_segment_(n_segments, 0) {
+  if (alpha_columns > 0) per_segment_[n_segments - 1] = alpha_columns;
+}
+
+FrameTarget ConstraintKeys::resolve(PyObject* key, const std::string& label) {
+  const FrameTarget t = model_.resolveMoving(key, label);
+  for (std::size_t k = 0; k < targets_.size(); ++k)
+    if (targets_[k].segment == t.segment && (targets_[k].link_in_tip.p - t.link_in_tip.p).Norm() == 0.0)
+      raise(label + ": the same frame as constraints[" + keyRepr(keys_[k].ptr()) +
+            "] (one entry per frame: put all its columns in one alpha)");
+  targets_.push_back(t);
+  keys_.push_back(py::reinterpret_borrow<py::object>(key));
+  return t;
+}
+
+void ConstraintKeys::count(int segment, int cols, const std::string& label) {
+  per_segment_[segment] += cols;
+  if (per_segment_[segment] > 6)
+    raise(label + ": more than 6 constraint columns on segment '" + model_.segmentName(segment) +
+          "' (alpha and every key on it count)");
+}
+
+std::pair<PyObject*, PyObject*> ConstraintKeys::pair(PyObject* value, const std::string& label,
+                                                     const std::string& shapes) {
+  if ((!PyTuple_Check(value) && !PyList_Check(value)) || PySequence_Fast_GET_SIZE(value) != 2)
+    raise(label + " must be a pair (alpha " + shapes + ")");
+  return {PySequence_Fast_GET_ITEM(value, 0), PySequence_Fast_GET_ITEM(value, 1)};
+}
+
 void PySolver::parseConstraints(PyObject* constraints, ParsedSolve& p) const {
   if (!PyDict_Check(constraints))
     raise("constraints must be a dict {segment name or index: (alpha (6, m_i), beta (m_i,))}");
-  const Py_ssize_t n_entries = PyDict_Size(constraints);
-  p.block_views.reserve(p.block_views.size() + 2 * n_entries);
-  std::vector<int> per_segment(ns, 0);
-  if (!p.blocks.empty()) per_segment[ns - 1] = p.blocks[0].cols;
+  p.block_views.reserve(p.block_views.size() + 2 * PyDict_Size(constraints));
+  ConstraintKeys keys(*model_, static_cast<int>(ns), p.blocks.empty() ? 0 : p.blocks[0].cols);
   PyObject *key, *value;
   Py_ssize_t pos = 0;
   while (PyDict_Next(constraints, &pos, &key, &value)) {
     const std::string label = "constraints[" + keyRepr(key) + "]";
-    const FrameTarget t = model_->resolveMoving(key, label);
-    for (std::size_t k = 0; k < p.block_keys.size(); ++k) {
-      const ConstraintBlock& other = p.blocks[p.blocks.size() - p.block_keys.size() + k];
-      if (other.segment == t.segment && (other.offset - t.link_in_tip.p).Norm() == 0.0)
-        raise(label + ": the same frame as constraints[" + keyRepr(p.block_keys[k].ptr()) +
-              "] (one entry per frame: put all its columns in one alpha)");
-    }
-    if (!PyTuple_Check(value) && !PyList_Check(value)) raise(label + " must be a pair (alpha (6, m_i), beta (m_i,))");
-    py::sequence pair = py::reinterpret_borrow<py::sequence>(value);
-    if (pair.size() != 2) raise(label + " must be a pair (alpha (6, m_i), beta (m_i,))");
-    F64View a = alphaView(pair[0].ptr(), label + " alpha");
-    F64View b = vectorView(pair[1].ptr(), (label + " beta").c_str(), a.shape[1], /*scalar_ok=*/true);
-    per_segment[t.segment] += static_cast<int>(a.shape[1]);
-    if (per_segment[t.segment] > 6)
-      raise(label + ": more than 6 constraint columns on segment '" + model_->segmentName(t.segment) +
-            "' (alpha and every key on it count)");
+    const FrameTarget t = keys.resolve(key, label);
+    const auto [alpha, beta] = ConstraintKeys::pair(value, label, "(6, m_i), beta (m_i,)");
+    F64View a = alphaView(alpha, label + " alpha");
+    F64View b = vectorView(beta, (label + " beta").c_str(), a.shape[1], /*scalar_ok=*/true);
+    keys.count(t.segment, static_cast<int>(a.shape[1]), label);
     ConstraintBlock blk;
     blk.segment = t.segment;
     blk.cols = static_cast<int>(a.shape[1]);
@@ -185,10 +202,10 @@ void PySolver::parseConstraints(PyObject* constraints, ParsedSolve& p) const {
     blk.offset = t.link_in_tip.p;
     blk.has_offset = t.merged;
     p.blocks.push_back(blk);
-    p.block_keys.push_back(py::reinterpret_borrow<py::object>(key));
     p.block_views.push_back(std::move(a));
     p.block_views.push_back(std::move(b));
   }
+  p.block_keys = keys.keys();
 }
 
 // friction: None/False (frictionless), True (the chain's values: static friction, limits), a

@@ -178,28 +178,19 @@ struct BatchRunner {
   void parseConstraints(PyObject* obj) {
     if (!PyDict_Check(obj)) raise("constraints must be a dict {segment name or index: (alpha (6, m_i), beta (m_i,))}");
     general = true;
-    std::vector<int> per_segment(s.ns, 0);
-    if (!block_template.empty()) per_segment[s.ns - 1] = block_template[0].cols;
+    ConstraintKeys keys(*s.model_, static_cast<int>(s.ns), block_template.empty() ? 0 : block_template[0].cols);
     PyObject *key, *value;
     Py_ssize_t pos = 0;
     while (PyDict_Next(obj, &pos, &key, &value)) {
       const std::string label = "constraints[" + py::repr(key).cast<std::string>() + "]";
-      const FrameTarget t = s.model_->resolveMoving(key, label);
-      for (std::size_t k = 0; k < key_block.size(); ++k) {
-        const ConstraintBlock& other = block_template[key_block[k]];
-        if (other.segment == t.segment && (other.offset - t.link_in_tip.p).Norm() == 0.0)
-          raise(label + ": the same frame as constraints[" + py::repr(block_keys[k]).cast<std::string>() + "]");
-      }
-      if ((!PyTuple_Check(value) && !PyList_Check(value)) || PySequence_Size(value) != 2)
-        raise(label + " must be a pair (alpha (6, m_i) or (B, 6, m_i), beta (m_i,) or (B, m_i))");
-      py::sequence pair = py::reinterpret_borrow<py::sequence>(value);
+      const FrameTarget t = keys.resolve(key, label);
+      const auto [alpha_obj, beta_obj] =
+          ConstraintKeys::pair(value, label, "(6, m_i) or (B, 6, m_i), beta (m_i,) or (B, m_i)");
       key_block.push_back(static_cast<int>(block_template.size()));
-      block_keys.push_back(py::reinterpret_borrow<py::object>(key));
-      addBlock(t.segment, pair[0].ptr(), pair[1].ptr(), label, &t);
-      per_segment[t.segment] += block_template.back().cols;
-      if (per_segment[t.segment] > 6)
-        raise(label + ": more than 6 constraint columns on segment '" + s.model_->segmentName(t.segment) + "'");
+      addBlock(t.segment, alpha_obj, beta_obj, label, &t);
+      keys.count(t.segment, block_template.back().cols, label);
     }
+    block_keys = keys.keys();
   }
 
   void parseFrictionArg(PyObject* obj) {
