@@ -127,6 +127,7 @@ struct SolverOptions {
 namespace detail {
 struct ModelSource;
 class HdCore;
+class FrictionCore;
 }  // namespace detail
 
 class FrictionSolver;
@@ -263,8 +264,8 @@ class HdSolver : public KDL::SolverI {
   const detail::HdCore& core() const { return *core_; }
 
  private:
-  friend class FrictionSolver;  // sets the pass-through driver (its ff_torques carry friction too)
-  int record(int rc);           // keeps rc in KDL::SolverI::error when it is an error
+  friend class detail::FrictionCore;  // sets the pass-through driver (its ff_torques carry friction too)
+  int record(int rc);                 // keeps rc in KDL::SolverI::error when it is an error
   std::unique_ptr<detail::HdCore> core_;
 };
 

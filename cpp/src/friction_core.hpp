@@ -1,0 +1,111 @@
+// The private side of FrictionSolver: its workspace, results and stages (math in
+// friction_solver.hpp; stage 1, the box QP, in friction_box_qp.cpp; stage 2, the least-command
+// tie-break, in friction_least_command.cpp).
+#pragma once
+
+#include <array>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "vereshchagin/friction_solver.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Curvatures (eigenvalues of Q, Cholesky pivots) below this fraction of Q's scale are zero.
+constexpr double kZeroCurvature = 1e-10;
+// Gradient entries (accelerations) below this fraction of the gradient's scale are zero.
+constexpr double kGradientTolerance = 1e-11;
+
+class FrictionCore {
+ public:
+  using JointStatus = FrictionSolver::JointStatus;
+  static constexpr JointStatus Moving = FrictionSolver::Moving, Stick = FrictionSolver::Stick,
+                               SlipPositive = FrictionSolver::SlipPositive, SlipNegative = FrictionSolver::SlipNegative;
+  static constexpr int E_INVALID_FRICTION = FrictionSolver::E_INVALID_FRICTION,
+                       E_NOT_CONVERGED = FrictionSolver::E_NOT_CONVERGED;
+
+  explicit FrictionCore(std::unique_ptr<HdSolver> hd);
+  int setOptions(const SolverOptions& options);
+  int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
+                     const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
+  const ChainHdSolver::Matrix6X& linkAccelerations();
+  double gaussValue();
+  int fail(int code, const char* fmt, ...);
+  int solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                const Eigen::Ref<const Eigen::VectorXi>* segments,
+                const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+  // The hybrid-dynamics solve of the current problem with joint torques tau (segments or not).
+  int hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+              const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+              const Eigen::Ref<const Eigen::VectorXi>* segments, const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+              const Eigen::Ref<const Eigen::VectorXd>& tau);
+  // The stages of solveImpl: the friction model's checks; the resting joints (rest_, their bounds
+  // lo_ / hi_, kinetic friction into tau0_), returning their number k; the max-min over them from
+  // hd_'s solve without static friction (boxQp, leastCommand, outputs updated affinely); the
+  // friction and limit torques and the status per joint.
+  int checkFriction(const FrictionModel& friction);
+  int restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+  int optimiseResting(int k);
+  void frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_dot, const FrictionModel& friction, int k);
+  int boxQp(int k);          // stage 1 on Q_, c_, lo_, hi_ -> x_
+  void leastCommand(int k);  // stage 2: tie-break on the optimal face
+  // Stage 2's solvers on the sticking set (ns joints, Q_StSt = V_ V_^T of rank r < ns), from
+  // ys_ = x*_St with target ts_ and bounds p_ / eig_ (see leastCommand).
+  void leastOnLine(int ns, int r);                    // ns - r = 1: closed form
+  void leastActiveSet(int ns, int r, double yscale);  // range-space primal active set
+  int projectOffRange(int ns, int r);                 // its steps (friction_least_command.cpp)
+  bool stepToBound(int ns, double step_tol);
+  void faceMultipliers(int r, int rf);
+  int releaseIndex(int ns, int r, double mult_tol, bool bland) const;
+  // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
+  // (returns true) when g_F has a component in null(Q_FF).
+  bool freeStep(int nf);
+  void gradient(int k);
+  void factorDelete(int q, int nf);
+
+  std::unique_ptr<HdSolver> hd_owner_;  // the solver of the problem
+  HdSolver& hd_;
+  unsigned int nj_ = 0;
+  std::array<char, 512> message_{};
+  Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;
+  Eigen::VectorXd ff_driver_;  // ff_torques of the last solve (zero if empty): hd_'s pass-through driver
+  Eigen::MatrixXd dnu_;
+  int m_keep_ = 0, k_ = 0;
+  bool link_acc_known_ = false;
+  std::vector<signed char> status_;
+  int iterations_ = 0;
+  double qscale_ = 0.0;          // scale of Q (see solve())
+  double gscale_ = 0.0;          // scale of the QP gradient (see boxQp())
+  bool free_full_rank_ = false;  // the last free-set factorisation had full rank
+  bool solved_ = false;
+  Eigen::VectorXd fstatic_;  // static friction of the last solve (gaussValue())
+  // Optimisation workspace (k <= n resting joints).
+  Eigen::VectorXi rest_;                    // joint index of each resting joint
+  Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_;  // Tc_ stays empty (0 x 0): tau_cmd follows from nu
+  Eigen::VectorXd c_, x_, lo_, hi_, grad_, p_, d_, tmp_, tmp2_, eig_, invdiag_, dpiv_;
+  // Free-set factor L D L^T kept across blocked steps (freeStep / factorDelete): valid for the
+  // free set of size factor_n_, rank factor_r_ (n or n - 1, then remainder_ is the last pivot).
+  bool factor_valid_ = false;
+  bool tau_cmd_known_ = false;  // leastCommand() left tau_cmd_ at the final x
+  int factor_n_ = 0, factor_r_ = 0;
+  double remainder_ = 0.0;
+  Eigen::VectorXi state_, free_idx_, rows_;
+  // Stage-2 workspace (leastCommand): Q_StSt = V V^T (V ns x r); the iterate y and target t on
+  // St; U R = V_F (column-pivoted QR of V with the held rows zeroed, U's columns kept at V's
+  // column index); lam_ the face multipliers of V^T y = const; side_ the working set; cols_ / piv_
+  // the QR's and the Cholesky's pivot orders.
+  Eigen::MatrixXd V_, U_, R_;
+  Eigen::VectorXd ys_, ts_, lam_;
+  Eigen::VectorXi side_, cols_, piv_;
+};
+
+}  // namespace detail
+}  // namespace vereshchagin
