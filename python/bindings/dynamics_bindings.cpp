@@ -16,23 +16,11 @@
 #include <kdl/jntspaceinertiamatrix.hpp>
 
 #include "chain_bindings.hpp"
+#include "dynamics_common.hpp"
 
 namespace vsbind {
 
 namespace {
-
-const std::vector<double> kEarthGravity{0.0, 0.0, -9.81};
-
-// Results of finite inputs can still overflow (e.g. |qd| = 1e160); never hand back Inf or NaN.
-void requireFiniteResult(const double* p, size_t n, const char* what) {
-  for (size_t k = 0; k < n; ++k)
-    if (!std::isfinite(p[k])) raise(std::string(what) + ": the result overflows the double range");
-}
-
-py::array_t<double> jointTorques(const KDL::JntArray& tau, const char* what) {
-  requireFiniteResult(tau.data.data(), tau.rows(), what);
-  return copyVector(tau.data.data(), tau.rows());
-}
 
 // Tip frame of every segment in the base frame (empty for a chain without segments).
 std::vector<KDL::Frame> tipFrames(const KDL::Chain& chain, const KDL::JntArray& q) {
@@ -86,12 +74,7 @@ py::array_t<double> massMatrix(const PyChain& c, const py::object& q_obj) {
   KDL::JntSpaceInertiaMatrix H(n);
   KDL::ChainDynParam dyn(chain, KDL::Vector::Zero());
   if (dyn.JntToMass(q, H) < 0) raise("mass matrix computation failed: " + std::string(dyn.strError(dyn.getError())));
-  requireFiniteResult(H.data.data(), static_cast<size_t>(H.data.size()), "mass_matrix");
-  py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(n)});
-  auto o = out.mutable_unchecked<2>();
-  for (unsigned int r = 0; r < n; ++r)
-    for (unsigned int k = 0; k < n; ++k) o(r, k) = H(r, k);
-  return out;
+  return jointMatrix(H.data, "mass_matrix");
 }
 
 py::array_t<double> gravityTorques(const PyChain& c, const py::object& q_obj, const py::object& gravity) {
