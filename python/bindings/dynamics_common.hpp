@@ -37,4 +37,12 @@ inline py::array_t<double> jointMatrix(const Eigen::MatrixXd& H, const char* wha
   return out;
 }
 
+// Frames as a new (n, 4, 4) array of homogeneous transforms.
+inline py::array_t<double> homogeneousStack(const std::vector<KDL::Frame>& frames) {
+  py::array_t<double> out(
+      {static_cast<py::ssize_t>(frames.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
+  for (size_t i = 0; i < frames.size(); ++i) writeHomogeneous(frames[i], out.mutable_data() + 16 * i);
+  return out;
+}
+
 }  // namespace vsbind

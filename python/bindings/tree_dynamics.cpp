@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dynamics_common.hpp"
+#include "dynamics_docs.hpp"
 #include "tree_bindings.hpp"
 #include "tree_sweeps.hpp"
 
@@ -98,126 +99,34 @@ py::array_t<double> jacobianDotTimesQd(const PyTree& t, const py::object& q_obj,
 
 py::array_t<double> fkAll(const PyTree& t, const py::object& q_obj) {
   const TreePlacement at = placeTree(t, jntArrayArg(q_obj, "q", jointCount(t)));
-  py::array_t<double> out(
-      {static_cast<py::ssize_t>(at.tip.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
-  for (std::size_t i = 0; i < at.tip.size(); ++i) writeHomogeneous(at.tip[i], out.mutable_data() + 16 * i);
-  return out;
+  return homogeneousStack(at.tip);
 }
-
-const char* kInverseDynamicsDoc = R"doc(Joint torques that realise ``qdd`` (recursive Newton-Euler over the tree).
-
-``tau = M(q) qdd + C(q, qd) qd + g(q) - sum_i J_i(q)^T f_ext[i]``, rotor inertia included
-(``rotor_inertia * qdd`` on each joint's diagonal).
-
-Parameters
-----------
-q, qd, qdd : array_like, shape (n_joints,)
-    Joint positions (rad or m), velocities (rad/s or m/s) and accelerations (rad/s^2 or m/s^2),
-    in q order (:attr:`joint_names`).
-f_ext : array_like, shape (n_segments, 6), optional
-    Wrench ``[force, moment]`` (N, N m) applied ON each segment BY the environment, rows in
-    segment order (:attr:`segment_names`), base-frame axes, moment about that segment's tip
-    origin (the solver's convention). ``J_i`` above is the base-axes Jacobian of segment i's tip.
-gravity : array_like, shape (3,)
-    Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
-
-Returns
--------
-ndarray, shape (n_joints,)
-    Joint torques / forces, N m or N, in q order.
-)doc";
-
-const char* kMassMatrixDoc = R"doc(Joint-space mass matrix ``M(q)`` (composite rigid bodies over the tree).
-
-Parameters
-----------
-q : array_like, shape (n_joints,)
-    Joint positions, rad or m.
-
-Returns
--------
-ndarray, shape (n_joints, n_joints)
-    Symmetric positive definite, kg m^2 / kg m / kg, rows and columns in q order;
-    ``rotor_inertia`` is included on the diagonal (Pinocchio's ``armature``). Entries of two
-    joints on different branches (neither on the other's path to the base) are zero.
-)doc";
-
-const char* kGravityTorquesDoc = R"doc(Generalised gravity ``g(q)``: the torques that hold the tree still.
-
-Parameters
-----------
-q : array_like, shape (n_joints,)
-    Joint positions, rad or m.
-gravity : array_like, shape (3,)
-    Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
-
-Returns
--------
-ndarray, shape (n_joints,)
-    ``inverse_dynamics(q, 0, 0, gravity=gravity)``, N m or N.
-)doc";
-
-const char* kCoriolisTorquesDoc = R"doc(Coriolis and centrifugal torques ``C(q, qd) qd``.
-
-Parameters
-----------
-q, qd : array_like, shape (n_joints,)
-    Joint positions (rad or m) and velocities (rad/s or m/s).
-
-Returns
--------
-ndarray, shape (n_joints,)
-    ``inverse_dynamics(q, qd, 0, gravity=[0, 0, 0])``, N m or N.
-)doc";
-
-const char* kJacobianDotDoc = R"doc(Time derivative of the Jacobian times the joint velocities, ``(d/dt J(q)) qd``.
-
-``J`` is :meth:`jacobian`: the (6, n) base-axes Jacobian ``[linear; angular]`` of the frame's
-origin. The result is the acceleration of that point at ``qdd = 0`` without gravity: rows 0-2 the
-*classical* linear acceleration of the point (not the spatial one: it includes ``omega x v``),
-rows 3-5 the angular acceleration, base-frame axes, so that
-``a = J qdd + jacobian_dot_times_qd(q, qd, segment)``. Pinocchio:
-``getFrameJacobianTimeVariation(..., LOCAL_WORLD_ALIGNED) @ v``. Only the joints on the frame's
-path to the base contribute.
-
-Parameters
-----------
-q, qd : array_like, shape (n_joints,)
-    Joint positions (rad or m) and velocities (rad/s or m/s).
-segment : str or int
-    As in :meth:`fk`: a segment name or index (negative from the end), a merged link's name, or
-    the base link's name (zeros). Required: a tree has no last segment.
-
-Returns
--------
-ndarray, shape (6,)
-    m/s^2 and rad/s^2.
-)doc";
-
-const char* kFkAllDoc = R"doc(Pose of every segment's tip frame in the base frame.
-
-Parameters
-----------
-q : array_like, shape (n_joints,)
-    Joint positions, rad or m.
-
-Returns
--------
-ndarray, shape (n_segments, 4, 4)
-    ``fk_all(q)[i] == fk(q, i)``: homogeneous transforms, metres, in segment order.
-)doc";
 
 }  // namespace
 
 void bindTreeDynamics(py::class_<PyTree>& cls) {
   cls.def("inverse_dynamics", &inverseDynamics, py::arg("q"), py::arg("qd"), py::arg("qdd"),
-          py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity, kInverseDynamicsDoc)
-      .def("mass_matrix", &massMatrix, py::arg("q"), kMassMatrixDoc)
-      .def("gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity, kGravityTorquesDoc)
-      .def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"), kCoriolisTorquesDoc)
+          py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity,
+          docs::inverseDynamicsDoc("recursive Newton-Euler over the tree", ",\n    in q order (:attr:`joint_names`)",
+                                   "; rows in\n    segment order, :attr:`segment_names`", ", in q order")
+              .c_str())
+      .def("mass_matrix", &massMatrix, py::arg("q"),
+           docs::massMatrixDoc("composite rigid bodies over the tree",
+                               "\n    Rows and columns in q order; the entries of two joints on different branches "
+                               "(neither on\n    the other's path to the base) are zero.")
+               .c_str())
+      .def("gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
+           docs::gravityTorquesDoc("tree", "").c_str())
+      .def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"), docs::coriolisTorquesDoc("").c_str())
       .def("jacobian_dot_times_qd", &jacobianDotTimesQd, py::arg("q"), py::arg("qd"), py::arg("segment"),
-           kJacobianDotDoc)
-      .def("fk_all", &fkAll, py::arg("q"), kFkAllDoc)
+           docs::jacobianDotDoc("jacobian_dot_times_qd(q, qd, segment)",
+                                "Only the joints on the frame's path to the base contribute.",
+                                "segment : str or int\n"
+                                "    As in :meth:`fk`: a segment name or index (negative from the end), a merged "
+                                "link's name, or\n    the base link's name (zeros). Required: a tree has no last "
+                                "segment.\n")
+               .c_str())
+      .def("fk_all", &fkAll, py::arg("q"), docs::fkAllDoc(", in segment order").c_str())
       .def_property("rotor_inertia", &PyTree::rotorInertia, &PyTree::setRotorInertia,
                     "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg, q order (settable; "
                     "added to the joint's articulated inertia; a Solver built afterwards uses it, one built before "
