@@ -104,24 +104,14 @@ py::array_t<double> PyChain::rotorInertia() const {
 }
 
 void PyChain::setRotorInertia(const py::object& values) {
-  Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(robot.joints.size()));
-  for (py::ssize_t k = 0; k < a.size(); ++k)
-    if (a.at(k) < 0.0)
-      raise("rotor_inertia must be >= 0, got " + std::to_string(a.at(k)) + " at joint " + std::to_string(k));
+  const Array a = rotorInertiaArg(values, robot.joints.size());
   KDL::Chain rebuilt;
   size_t jk = 0;
   for (unsigned int i = 0; i < robot.chain.getNrOfSegments(); ++i) {
     const KDL::Segment& seg = robot.chain.getSegment(i);
     const KDL::Joint& j = seg.getJoint();
-    KDL::Joint nj = j;
-    if (j.getType() != KDL::Joint::Fixed) {
-      const double rotor = a.at(static_cast<py::ssize_t>(jk++));
-      if (j.getType() == KDL::Joint::RotAxis || j.getType() == KDL::Joint::TransAxis) {
-        nj = KDL::Joint(j.getName(), j.JointOrigin(), j.JointAxis(), j.getType(), 1.0, 0.0, rotor);
-      } else {
-        nj = KDL::Joint(j.getName(), j.getType(), 1.0, 0.0, rotor);
-      }
-    }
+    const KDL::Joint nj =
+        j.getType() == KDL::Joint::Fixed ? j : withRotorInertia(j, a.at(static_cast<py::ssize_t>(jk++)));
     rebuilt.addSegment(KDL::Segment(seg.getName(), nj, seg.getFrameToTip(), seg.getInertia()));
   }
   robot.chain = rebuilt;

@@ -59,6 +59,23 @@ inline JointSpec jointFromString(const std::string& s) {
         "Joint.revolute(axis, origin) or Joint.prismatic(axis, origin)");
 }
 
+// A copy of `joint` (a moving joint) with rotor inertia `rotor` reflected to it, kg m^2 or kg.
+inline KDL::Joint withRotorInertia(const KDL::Joint& joint, double rotor) {
+  if (joint.getType() == KDL::Joint::RotAxis || joint.getType() == KDL::Joint::TransAxis)
+    return KDL::Joint(joint.getName(), joint.JointOrigin(), joint.JointAxis(), joint.getType(), 1.0, 0.0, rotor,
+                      joint.getDamping(), joint.getStiffness());
+  return KDL::Joint(joint.getName(), joint.getType(), 1.0, 0.0, rotor, joint.getDamping(), joint.getStiffness());
+}
+
+// The value of a `rotor_inertia` setter: shape (n_joints,), finite, every entry >= 0.
+inline Array rotorInertiaArg(const py::object& values, size_t n_joints) {
+  Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(n_joints));
+  for (py::ssize_t k = 0; k < a.size(); ++k)
+    if (a.at(k) < 0.0)
+      raise("rotor_inertia must be >= 0, got " + std::to_string(a.at(k)) + " at joint " + std::to_string(k));
+  return a;
+}
+
 // The Python Chain: a RobotChain (KDL::Chain plus joint and link metadata), built segment by
 // segment or from a URDF. Frames and joints are addressed by the rule of addressing.hpp.
 struct PyChain : Addressable {

@@ -16,23 +16,12 @@
 #include <kdl/jntspaceinertiamatrix.hpp>
 
 #include "chain_bindings.hpp"
+#include "dynamics_common.hpp"
+#include "dynamics_docs.hpp"
 
 namespace vsbind {
 
 namespace {
-
-const std::vector<double> kEarthGravity{0.0, 0.0, -9.81};
-
-// Results of finite inputs can still overflow (e.g. |qd| = 1e160); never hand back Inf or NaN.
-void requireFiniteResult(const double* p, size_t n, const char* what) {
-  for (size_t k = 0; k < n; ++k)
-    if (!std::isfinite(p[k])) raise(std::string(what) + ": the result overflows the double range");
-}
-
-py::array_t<double> jointTorques(const KDL::JntArray& tau, const char* what) {
-  requireFiniteResult(tau.data.data(), tau.rows(), what);
-  return copyVector(tau.data.data(), tau.rows());
-}
 
 // Tip frame of every segment in the base frame (empty for a chain without segments).
 std::vector<KDL::Frame> tipFrames(const KDL::Chain& chain, const KDL::JntArray& q) {
@@ -86,12 +75,7 @@ py::array_t<double> massMatrix(const PyChain& c, const py::object& q_obj) {
   KDL::JntSpaceInertiaMatrix H(n);
   KDL::ChainDynParam dyn(chain, KDL::Vector::Zero());
   if (dyn.JntToMass(q, H) < 0) raise("mass matrix computation failed: " + std::string(dyn.strError(dyn.getError())));
-  requireFiniteResult(H.data.data(), static_cast<size_t>(H.data.size()), "mass_matrix");
-  py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(n)});
-  auto o = out.mutable_unchecked<2>();
-  for (unsigned int r = 0; r < n; ++r)
-    for (unsigned int k = 0; k < n; ++k) o(r, k) = H(r, k);
-  return out;
+  return jointMatrix(H.data, "mass_matrix");
 }
 
 py::array_t<double> gravityTorques(const PyChain& c, const py::object& q_obj, const py::object& gravity) {
@@ -147,10 +131,7 @@ py::array_t<double> jacobianDotTimesQd(const PyChain& c, const py::object& q_obj
 py::array_t<double> fkAll(const PyChain& c, const py::object& q_obj) {
   const KDL::Chain& chain = c.robot.chain;
   const std::vector<KDL::Frame> tips = tipFrames(chain, jntArrayArg(q_obj, "q", chain.getNrOfJoints()));
-  py::array_t<double> out(
-      {static_cast<py::ssize_t>(tips.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
-  for (size_t i = 0; i < tips.size(); ++i) writeHomogeneous(tips[i], out.mutable_data() + 16 * i);
-  return out;
+  return homogeneousStack(tips);
 }
 
 }  // namespace
@@ -159,106 +140,25 @@ void bindDynamics(py::module_& mod) {
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
   chain.def("inverse_dynamics", &inverseDynamics, py::arg("q"), py::arg("qd"), py::arg("qdd"),
             py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity,
-            R"doc(Joint torques that realise ``qdd`` (recursive Newton-Euler, KDL's ChainIdSolver_RNE).
-
-``tau = M(q) qdd + C(q, qd) qd + g(q) - sum_i J_i(q)^T f_ext[i]``, rotor inertia included
-(``rotor_inertia * qdd`` on each joint's diagonal).
-
-Parameters
-----------
-q, qd, qdd : array_like, shape (n_joints,)
-    Joint positions (rad or m), velocities (rad/s or m/s) and accelerations (rad/s^2 or m/s^2).
-f_ext : array_like, shape (n_segments, 6), optional
-    Wrench ``[force, moment]`` (N, N m) applied ON each segment BY the environment, base-frame
-    axes, moment about that segment's tip origin (the solver's convention; converted to KDL's
-    tip-frame axes internally). ``J_i`` above is the base-axes Jacobian of segment i's tip.
-gravity : array_like, shape (3,)
-    Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
-
-Returns
--------
-ndarray, shape (n_joints,)
-    Joint torques / forces, N m or N.
-)doc");
+            docs::inverseDynamicsDoc("recursive Newton-Euler, KDL's ChainIdSolver_RNE", "",
+                                     "; converted to KDL's\n    tip-frame axes internally", "")
+                .c_str());
   chain.def("mass_matrix", &massMatrix, py::arg("q"),
-            R"doc(Joint-space mass matrix ``M(q)`` (KDL's ChainDynParam::JntToMass).
-
-Parameters
-----------
-q : array_like, shape (n_joints,)
-    Joint positions, rad or m.
-
-Returns
--------
-ndarray, shape (n_joints, n_joints)
-    Symmetric positive definite, kg m^2 / kg m / kg; ``rotor_inertia`` is included on the diagonal
-    (Pinocchio's ``armature``).
-)doc");
-  chain.def(
-      "gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
-      R"doc(Generalised gravity ``g(q)``: the torques that hold the chain still (KDL's ChainDynParam::JntToGravity).
-
-Parameters
-----------
-q : array_like, shape (n_joints,)
-    Joint positions, rad or m.
-gravity : array_like, shape (3,)
-    Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
-
-Returns
--------
-ndarray, shape (n_joints,)
-    ``inverse_dynamics(q, 0, 0, gravity=gravity)``, N m or N.
-)doc");
+            docs::massMatrixDoc("KDL's ChainDynParam::JntToMass", "").c_str());
+  chain.def("gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
+            docs::gravityTorquesDoc("chain", " (KDL's ChainDynParam::JntToGravity)").c_str());
   chain.def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"),
-            R"doc(Coriolis and centrifugal torques ``C(q, qd) qd`` (KDL's ChainDynParam::JntToCoriolis).
-
-Parameters
-----------
-q, qd : array_like, shape (n_joints,)
-    Joint positions (rad or m) and velocities (rad/s or m/s).
-
-Returns
--------
-ndarray, shape (n_joints,)
-    ``inverse_dynamics(q, qd, 0, gravity=[0, 0, 0])``, N m or N.
-)doc");
-  chain.def("jacobian_dot_times_qd", &jacobianDotTimesQd, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
-            R"doc(Time derivative of the Jacobian times the joint velocities, ``(d/dt J(q)) qd``.
-
-``J`` is :meth:`jacobian`: the (6, n) base-axes Jacobian ``[linear; angular]`` of the segment's
-tip origin (or of a merged link's origin). The result is the acceleration of that point at
-``qdd = 0`` without gravity: rows 0-2 the *classical* linear acceleration of the point (not the
-spatial one: it includes ``omega x v``), rows 3-5 the angular acceleration, base-frame axes, so
-that ``a = J qdd + jacobian_dot_times_qd(q, qd)``. Pinocchio: ``getFrameJacobianTimeVariation(...,
-LOCAL_WORLD_ALIGNED) @ v``. Computed by KDL's ChainJntToJacDotSolver (HYBRID representation), the
-reference point then moved to the link origin.
-
-Parameters
-----------
-q, qd : array_like, shape (n_joints,)
-    Joint positions (rad or m) and velocities (rad/s or m/s).
-segment : str or int, optional
-    As in :meth:`fk`: a segment name or index (negative from the end), or a merged link's name;
-    default the last segment. A base link gives zeros.
-
-Returns
--------
-ndarray, shape (6,)
-    m/s^2 and rad/s^2.
-)doc");
-  chain.def("fk_all", &fkAll, py::arg("q"), R"doc(Pose of every segment's tip frame in the base frame.
-
-Parameters
-----------
-q : array_like, shape (n_joints,)
-    Joint positions, rad or m.
-
-Returns
--------
-ndarray, shape (n_segments, 4, 4)
-    ``fk_all(q)[i] == fk(q, i)``: homogeneous transforms, metres.
-)doc");
+            docs::coriolisTorquesDoc(" (KDL's ChainDynParam::JntToCoriolis)").c_str());
+  chain.def(
+      "jacobian_dot_times_qd", &jacobianDotTimesQd, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
+      docs::jacobianDotDoc("jacobian_dot_times_qd(q, qd)",
+                           "Computed by KDL's ChainJntToJacDotSolver (HYBRID representation), the reference point "
+                           "then\nmoved to the link origin.",
+                           "segment : str or int, optional\n"
+                           "    As in :meth:`fk`: a segment name or index (negative from the end), or a merged "
+                           "link's name;\n    default the last segment. A base link gives zeros.\n")
+          .c_str());
+  chain.def("fk_all", &fkAll, py::arg("q"), docs::fkAllDoc("").c_str());
 }
 
 }  // namespace vsbind

@@ -161,9 +161,10 @@ void bindTree(py::module_& mod) {
   cls.def("fk", &PyTree::fk, py::arg("q"), py::arg("segment"), kFkDoc)
       .def("jacobian", &PyTree::jacobian, py::arg("q"), py::arg("segment"), kJacobianDoc)
       .def("twist", &PyTree::twist, py::arg("q"), py::arg("qd"), py::arg("segment"), kTwistDoc)
-      .def("chain", &PyTree::pathChain, py::arg("tip"), kChainDoc)
-      .def(py::pickle([](const PyTree& t) { return t.getState(); },
-                      [](const py::tuple& s) { return PyTree::fromState(s); }))
+      .def("chain", &PyTree::pathChain, py::arg("tip"), kChainDoc);
+  bindTreeDynamics(cls);
+  cls.def(py::pickle([](const PyTree& t) { return t.getState(); },
+                     [](const py::tuple& s) { return PyTree::fromState(s); }))
       .def("__copy__", [](const PyTree& t) { return t; })
       .def(
           "__deepcopy__", [](const PyTree& t, const py::dict&) { return t; }, py::arg("memo"))

@@ -18,6 +18,11 @@
 
 namespace vsbind {
 
+inline bool isPrismatic(KDL::Joint::JointType type) {
+  return type == KDL::Joint::TransAxis || type == KDL::Joint::TransX || type == KDL::Joint::TransY ||
+         type == KDL::Joint::TransZ;
+}
+
 struct PyTree : Addressable {
   vereshchagin::RobotTree robot;
 
@@ -43,10 +48,15 @@ struct PyTree : Addressable {
   py::array_t<double> fk(const py::object& q, const py::object& segment) const;
   py::array_t<double> jacobian(const py::object& q, const py::object& segment) const;
   py::array_t<double> twist(const py::object& q, const py::object& qd, const py::object& segment) const;
+  // Rotor inertia of each joint in q order; the setter rebuilds the KDL::Tree with it.
+  py::array_t<double> rotorInertia() const;
+  void setRotorInertia(const py::object& values);
   // The serial chain from the base to a segment: that path's segments, joints and links only.
   PyChain pathChain(const py::object& tip) const;
 };
 
 void bindTree(py::module_& mod);
+// Tree.inverse_dynamics, mass_matrix, ... (tree_dynamics.cpp).
+void bindTreeDynamics(py::class_<PyTree>& cls);
 
 }  // namespace vsbind

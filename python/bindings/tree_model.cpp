@@ -67,14 +67,33 @@ std::vector<int> PyTree::pathTo(int index) const {
   return path;
 }
 
-namespace {
-
-bool isPrismatic(KDL::Joint::JointType type) {
-  return type == KDL::Joint::TransAxis || type == KDL::Joint::TransX || type == KDL::Joint::TransY ||
-         type == KDL::Joint::TransZ;
+py::array_t<double> PyTree::rotorInertia() const {
+  py::array_t<double> a(static_cast<py::ssize_t>(robot.joints.size()));
+  for (std::size_t k = 0; k < robot.joints.size(); ++k)
+    a.mutable_data()[k] = segment(static_cast<int>(robot.joints[k].segment)).getJoint().getInertia();
+  return a;
 }
 
-}  // namespace
+void PyTree::setRotorInertia(const py::object& values) {
+  const Array a = rotorInertiaArg(values, robot.joints.size());
+  std::vector<double> rotor(static_cast<std::size_t>(segmentCount()), 0.0);  // per segment
+  for (std::size_t k = 0; k < robot.joints.size(); ++k)
+    rotor[robot.joints[k].segment] = a.at(static_cast<py::ssize_t>(k));
+  // Re-insert the segments in segment order, as fromState does: KDL numbers the joints (q_nr) in
+  // insertion order, so the joint order and the segment order stay what they were.
+  KDL::Tree rebuilt(robot.root_link);
+  for (int i = 0; i < segmentCount(); ++i) {
+    const KDL::Segment& seg = segment(i);
+    const KDL::Joint& j = seg.getJoint();
+    const KDL::Joint joint =
+        j.getType() == KDL::Joint::None ? j : withRotorInertia(j, rotor[static_cast<std::size_t>(i)]);
+    const int parent = robot.parent[static_cast<std::size_t>(i)];
+    const std::string& hook = parent < 0 ? robot.root_link : segmentName(parent);
+    if (!rebuilt.addSegment(KDL::Segment(seg.getName(), joint, seg.getFrameToTip(), seg.getInertia()), hook))
+      raise("rotor_inertia: segment '" + seg.getName() + "' cannot be re-added");
+  }
+  robot.tree = rebuilt;
+}
 
 py::array_t<double> PyTree::fk(const py::object& q_obj, const py::object& which) const {
   const KDL::JntArray q = jntArrayArg(q_obj, "q", robot.tree.getNrOfJoints());
