@@ -216,7 +216,8 @@ def _options_text(header, rows, options: dict) -> list:
         "follow these jumps, and the table takes the rest. The hold band (zero task acceleration while a hand "
         "is within 1 mm / 0.01 rad of its goal) lets friction hold the resting arm: chatter "
         f"{band['chatter']:.3f} N m per step, ∫τ² {100 * (band['tau2'] / plain['tau2'] - 1):+.1f} %; what is "
-        "left is the sliding arm's little-used joints during the slide, where the task keeps correcting.",
+        "left comes mostly at the slide's start and after the arrival, while the sliding arm's joints break "
+        "away or settle and the torso passes the change on to the resting arm (right column of the figure).",
         f"- Smooth compensation f tanh(qd/eps) does not chatter ({smooth['chatter']:.3f}) but gives up "
         "friction as a holding resource and lets the sliding hand leave its line by "
         f"{1e3 * smooth['outcome']['max_off_line']:.1f} mm. No compensation has the least ∫τ² "
