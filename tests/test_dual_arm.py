@@ -16,6 +16,7 @@ mujoco = pytest.importorskip("mujoco")
 import vereshchagin as vs  # noqa: E402
 from vereshchagin.contact import dual_arm as da  # noqa: E402
 from vereshchagin.contact import dual_arm_report, metrics  # noqa: E402
+from vereshchagin.contact.controller import ControllerConfig  # noqa: E402
 from vereshchagin.contact.mujoco_plant import MujocoGen3, Scene, build_model  # noqa: E402
 
 from trees import pin_model, pin_q, pin_v_index  # noqa: E402
@@ -33,6 +34,12 @@ def model():
 @pytest.fixture(scope="module")
 def runs():
     return {v: da.dual_arm(v, quick=True) for v in da.VARIANTS}
+
+
+@pytest.fixture(scope="module")
+def report(runs, tmp_path_factory):
+    out = tmp_path_factory.mktemp("results")
+    return dual_arm_report.run(out, quick=True, runs=runs), out / "dual_arm"
 
 
 def _random_state(tree, rng):
@@ -172,13 +179,13 @@ def test_shortcut_task_error_well_above_the_tree_solver(runs):
     assert max(o["separate"]["open_loop_ang_max"].values()) > 1e-1
 
 
-def test_report_section_table_csv_and_figure(runs, tmp_path, monkeypatch):
-    res = dual_arm_report.run(tmp_path, quick=True, runs=runs)
+def test_report_section_table_csv_and_figure(report, tmp_path, monkeypatch):
+    res, folder = report
     assert res["ok"], res["checks"]
     text = "\n".join(res["index"])
     assert "Dual-arm" in text and "Checks:" in text and "FAILED" not in text
-    for name in ("dual_arm_effort.csv", "dual_arm_errors.csv", "dual_arm.png"):
-        path = tmp_path / "dual_arm" / name
+    for name in ("dual_arm_effort.csv", "dual_arm_errors.csv", "dual_arm_friction.csv", "dual_arm.png"):
+        path = folder / name
         assert path.is_file() and path.stat().st_size > 0
         assert f"dual_arm/{name}" in text
     # the CLI wires the case into results/index.md (the runs reused)
@@ -189,6 +196,23 @@ def test_report_section_table_csv_and_figure(runs, tmp_path, monkeypatch):
     assert "Dual-arm Gen3 on a torso" in (tmp_path / "index.md").read_text(encoding="utf-8")
 
 
+def test_hold_band_keeps_the_command_from_chattering(report, runs):
+    """Chosen setting (max-min + hold band): chatter below the bound; without the band above it."""
+    opts = report[0]["options"]
+    chosen, plain, smooth, none = (opts[k] for k in dual_arm_report.OPTIONS)
+    ch = dual_arm_report.chatter(runs["table"], runs["table"].window("slide"))
+    assert ch.mean() == pytest.approx(chosen["chatter"], rel=1e-12)  # the module-scoped run is the chosen one
+    assert chosen["chatter"] < dual_arm_report.CHATTER_BOUND < plain["chatter"]
+    assert chosen["chatter"] < 0.7 * plain["chatter"]
+    assert chosen["tau2"] < plain["tau2"]  # the band also saves copper loss: friction holds the resting arm
+    assert smooth["chatter"] < 0.1 * plain["chatter"]  # the tanh compensation is about chatter-free ...
+    assert smooth["outcome"]["max_off_line"] > 2.0 * chosen["outcome"]["max_off_line"]  # ... and tracks worse
+    assert none["outcome"]["final_error_x"] < -0.02  # no compensation: the slide stalls
+    # the plant's table force follows the model more closely with the band than without
+    gap = {k: abs(o["outcome"]["table_force"] - o["outcome"]["table_force_model"]) for k, o in opts.items()}
+    assert gap[next(iter(opts))] < gap[list(opts)[1]]
+
+
 def test_bad_variant_and_contact_mode_raise(model):
     _, tree, _ = model
     with pytest.raises(ValueError):
@@ -197,3 +221,5 @@ def test_bad_variant_and_contact_mode_raise(model):
         da.DualArmController(tree, "floating")
     with pytest.raises(ValueError):
         da.DualArmController(tree, "table").set_contact(True)
+    with pytest.raises(ValueError):
+        da.DualArmController(tree, "table", ControllerConfig(friction_mode="sign"))

@@ -10,7 +10,8 @@ Task (base frame, m):
 
 - the **left hand rests**: a 6-D segment constraint on :data:`REST_FRAME`, a frame fixed to the
   left gripper at the middle of its box's lowest edge (where it touches the table), holds the
-  start pose (cascaded P of :mod:`.controller`, zero acceleration at rest). Its third column
+  start pose (cascaded P of :mod:`.controller`; zero acceleration inside the hold band of
+  :data:`CONFIG`, which lets joint friction hold the resting arm). Its third column
   (linear base z, the table normal) is the table's: when the solver's ``nu_z < 0`` (the
   constraint pushes the hand up), the share ``-J_r^T e_z nu_z`` of the command is left to the
   table, as the ``constraint`` variant of :mod:`.elbow` does for the elbow;
@@ -71,6 +72,8 @@ __all__ = [
     "REST_FRAME",
     "TASK_FRAME",
     "VARIANTS",
+    "CONFIG",
+    "FRICTION_MODES",
     "DualArmController",
     "dual_arm",
     "dual_arm_model",
@@ -78,6 +81,16 @@ __all__ = [
 ]
 
 VARIANTS = ("table", "unsupported", "separate")
+FRICTION_MODES = ("maxmin", "none", "smooth")
+"""``ControllerConfig.friction_mode`` s the dual-arm controller takes (see :data:`CONFIG`)."""
+CONFIG = ControllerConfig(hold_band=(1e-3, 1e-2))
+"""The controller settings of the case: the exact max-min (``friction_mode="maxmin"``, joints with
+|qd| <= 0.01 rad/s at rest) and a hold band of 1 mm / 0.01 rad on each hand's pose error, inside
+which that hand's task asks for zero acceleration ("stay"), as ``hold_band`` does in
+:class:`~.controller.CascadedController`. Without the band the P loop's tiny
+corrections give resting joints small commanded accelerations whose sign changes almost every
+cycle; the max-min charges the full breakaway friction against each (its ``f_j |qdd_j|`` term), so
+the command jumps by up to ``2 f_j`` per cycle (docs/trees.md has the measured comparison)."""
 REST_FRAME = "left_rest_point"
 """Frame of the resting hand: fixed to ``left_end_effector_link`` at the gripper box's lowest edge."""
 TASK_FRAME = "right_end_effector_link"
@@ -142,12 +155,14 @@ class _Part:
     friction: Optional[Friction]
 
 
-def _part(model, tree: Tree, frames: tuple, velocity_tolerance: float, shared_torso: bool) -> _Part:
+def _part(model, tree: Tree, frames: tuple, config: ControllerConfig, shared_torso: bool) -> _Part:
     idx = np.array([tree.joint_index(j) for j in model.joint_names])
     scale = np.ones(len(idx))
     if shared_torso:
         scale[0] = 0.5
-    friction = Friction(static=np.asarray(model.friction), velocity_tolerance=velocity_tolerance)
+    friction = None
+    if config.friction_mode == "maxmin":
+        friction = Friction(static=np.asarray(model.friction), velocity_tolerance=config.friction_velocity_tolerance)
     return _Part(Solver(model, gravity=GRAVITY), model, idx, frames, scale, friction)
 
 
@@ -162,8 +177,16 @@ class DualArmController:
         See the module doc; ``table`` and ``separate`` leave the resting hand's upward share to
         the table.
     config : ControllerConfig, optional
-        Free-space gains, twist saturation, posture gains, friction rest tolerance (the rest is
-        unused); default ``ControllerConfig()``.
+        Free-space gains, twist saturation, posture gains, ``friction_mode`` (one of
+        :data:`FRICTION_MODES`: ``"maxmin"`` the friction-aware solve, ``"none"`` a plain solve,
+        ``"smooth"`` a plain solve plus ``f_j tanh(qd_j / eps)``), ``friction_velocity_tolerance``
+        (``eps``, rad/s) and ``hold_band`` (applied to each hand's pose error); the contact
+        settings are unused. Default :data:`CONFIG`.
+
+    Raises
+    ------
+    ValueError
+        Unknown ``variant`` or ``config.friction_mode``.
 
     Attributes
     ----------
@@ -176,17 +199,18 @@ class DualArmController:
     """
 
     def __init__(self, tree: Tree, variant: str, config: Optional[ControllerConfig] = None):
-        config = ControllerConfig() if config is None else config
+        config = CONFIG if config is None else config
         if variant not in VARIANTS:
             raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")
+        if config.friction_mode not in FRICTION_MODES:
+            raise ValueError(f"friction_mode must be one of {FRICTION_MODES}, got {config.friction_mode!r}")
         self.tree, self.variant, self.config = tree, variant, config
         self.n = tree.n_joints
-        tol = config.friction_velocity_tolerance
         if variant == "separate":
             _, half = dual_arm_model(0.5)
-            self.parts = [_part(half.chain(f), tree, (f,), tol, True) for f in (REST_FRAME, TASK_FRAME)]
+            self.parts = [_part(half.chain(f), tree, (f,), config, True) for f in (REST_FRAME, TASK_FRAME)]
         else:
-            self.parts = [_part(tree, tree, (REST_FRAME, TASK_FRAME), tol, False)]
+            self.parts = [_part(tree, tree, (REST_FRAME, TASK_FRAME), config, False)]
         self.table_share = variant != "unsupported"
         self.goal: Optional[np.ndarray] = None
         self.rest_goal: Optional[np.ndarray] = None
@@ -210,13 +234,16 @@ class DualArmController:
         """No contact detection in this task (accepted for :func:`~.use_cases.run_loop`)."""
 
     def _hand_beta(self, frame: str, goal: np.ndarray, q, qd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``beta`` (6,) of the cascaded P towards ``goal`` at ``frame``, with its pose and twist."""
+        """``beta`` (6,) of the cascaded P towards ``goal`` at ``frame`` (zero acceleration inside the hold band), with its pose and twist."""
         cfg, g = self.config, self.config.free_gains
         T = np.asarray(self.tree.fk(q, frame))
         tw = np.asarray(self.tree.twist(q, qd, frame))
         e = pose_error(T, goal)
         v = np.concatenate([_saturate(g.k_pos[0] * e[:3], cfg.v_max), _saturate(g.k_pos[1] * e[3:], cfg.w_max)])
         a = np.concatenate([g.k_vel[0] * (v[:3] - tw[:3]), g.k_vel[1] * (v[3:] - tw[3:])])
+        band = cfg.hold_band
+        if band is not None and np.linalg.norm(e[:3]) < band[0] and np.linalg.norm(e[3:]) < band[1]:
+            a[:] = 0.0  # "stay": zero acceleration, so joints the task does not move may stick
         return beta_for(ALPHA, a, tw, GRAVITY), T, tw
 
     def command(self, q, qd) -> tuple[np.ndarray, CycleInfo]:
@@ -260,6 +287,8 @@ class DualArmController:
                     share = -np.asarray(p.model.jacobian(qp, REST_FRAME))[UP] * nu_up
                     force = -nu_up
             tau[p.idx] += np.asarray(res.tau_command) + ff - share
+            if self.config.friction_mode == "smooth":  # f tanh(qd / eps), the plain solve's compensation
+                tau[p.idx] += np.asarray(p.model.friction) * np.tanh(qdp / self.config.friction_velocity_tolerance)
             total[p.idx] += tau_ff + np.asarray(res.tau_command)
             if res.friction_torque is not None:
                 total[p.idx] += np.asarray(res.friction_torque)
@@ -309,7 +338,7 @@ def _scene(tree: Tree, q0) -> Scene:
     return Scene(table_top=float(p[2]), table_x=(p[0] - 0.25, p[0] + 0.20), table_y=(p[1] - 0.12, p[1] + 0.15))
 
 
-def dual_arm(variant: str, quick: bool = False, progress=None):
+def dual_arm(variant: str, quick: bool = False, progress=None, config: Optional[ControllerConfig] = None):
     """Run the dual-arm case in one of :data:`VARIANTS` (module doc).
 
     Parameters
@@ -320,6 +349,8 @@ def dual_arm(variant: str, quick: bool = False, progress=None):
         Shorter settle and hold phases (0.5 s instead of 1 s) and a shorter tail on the slide.
     progress : callable, optional
         ``progress(fraction)``, see :func:`~.use_cases.run_loop`.
+    config : ControllerConfig, optional
+        The controller's settings (:class:`DualArmController`); default :data:`CONFIG`.
 
     Returns
     -------
@@ -333,7 +364,7 @@ def dual_arm(variant: str, quick: bool = False, progress=None):
     Raises
     ------
     ValueError
-        If ``variant`` is not one of :data:`VARIANTS`.
+        If ``variant`` is not one of :data:`VARIANTS` (or ``config.friction_mode`` unknown).
     """
     if variant not in VARIANTS:
         raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")
@@ -341,7 +372,7 @@ def dual_arm(variant: str, quick: bool = False, progress=None):
     q0 = start_pose()
     scene = _scene(tree, q0) if variant != "unsupported" else Scene()
     robot = MujocoGen3(build_model(urdf, tree, scene), q0)
-    ctl = DualArmController(tree, variant)
+    ctl = DualArmController(tree, variant, config)
     truth = Solver(tree, gravity=GRAVITY)
     R0 = ctl.pose(q0)[:3, :3]
     duration = 0.5 if quick else 1.0
