@@ -203,7 +203,8 @@ bool tridiagonalEigenvalues(VD& d, VD& e, int k) {
     double x = d(l) - mu, z = e(l);
     for (int i = l; i < h; ++i) {  // rotation R = [c s; -s c] on rows and columns i, i + 1
       const double r = std::abs(x) < 1e150 && std::abs(z) < 1e150 ? std::sqrt(x * x + z * z) : std::hypot(x, z);
-      const double c = r > 0.0 ? x / r : 1.0, s = r > 0.0 ? z / r : 0.0;
+      const double inv = r > 0.0 ? 1.0 / r : 0.0;
+      const double c = r > 0.0 ? x * inv : 1.0, s = z * inv;
       if (i > l) e(i - 1) = r;  // R [x; z] = [r; 0]: the bulge at (i + 1, i - 1) is gone
       const double di = d(i), dj = d(i + 1), ei = e(i);
       d(i) = c * c * di + 2.0 * c * s * ei + s * s * dj;
