@@ -105,7 +105,7 @@ struct CouplingGeneral {
   mutable Eigen::VectorXd tmp;
   Eigen::MatrixXd kg, cholg, vg;             // coupling matrix, its Cholesky factor or eigenvectors
   Eigen::VectorXd invg;                      // policy multiplier per eigenvalue
-  mutable Eigen::MatrixXd work_g, work_v;    // Jacobi workspace for the smallest singular value
+  mutable Eigen::MatrixXd work_g, work_v;    // workspace of the smallest eigenvalue (matrix, scratch)
   mutable Matrix6X seg_force;                // per-segment wrench accumulators
   int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
   {
