@@ -240,6 +240,8 @@ def test_constraints_on_branches_match_forward_dynamics(name, task):
         assert_rel(res.qdd, case.ours(ddq), f"{name} {task}: qdd vs pin.forwardDynamics", 1e-9)
         assert_rel(res.nu, -lam, f"{name} {task}: nu vs -lambda", 1e-8)
         assert res.constraint_rank == A_pin.shape[0]
+        ev = np.linalg.eigvalsh(A_pin @ Minv @ A_pin.T)  # K = A H^-1 A^T
+        assert res.smallest_singular_value == pytest.approx(ev.min(), rel=1e-9, abs=1e-12 * ev.max())
         # command torques: -sum_i J_i^T alpha_i nu_i, and replayed through ABA
         assert_rel(case.pin_v(res.tau_command), -A_pin.T @ res.nu, "tau_command = -A^T nu", 1e-9)
         replay = pin.aba(case.model, data, pq, pv, case.pin_v(tau + res.tau_command))

@@ -1,7 +1,7 @@
 // Small dense symmetric linear algebra on preallocated storage (no heap allocation): Cholesky
 // with a pivot threshold and its multi-column solve, rank-revealing L D L^T and pivoted Cholesky
 // for the positive semi-definite matrices of the friction optimisation (dimension <= joints),
-// and a Jacobi eigen-decomposition.
+// a Jacobi eigen-decomposition, and the smallest eigenvalue of a symmetric matrix.
 #pragma once
 
 #include <algorithm>
@@ -178,6 +178,85 @@ int pivotedCholeskyLeft(const MA& A, const VI& idx, int k, MV& V, VD& diag, VP& 
     diag(p) = kDone;
   }
   return k;
+}
+
+// Eigenvalues (into d, unsorted) of the symmetric tridiagonal matrix with diagonal d and
+// off-diagonal e (e(i) couples i and i + 1; overwritten): implicit QR steps with the Wilkinson
+// shift, each chasing its bulge down the unreduced block by Givens rotations, until every
+// off-diagonal entry is negligible against its neighbours on the diagonal. Returns false if
+// 30 k steps did not suffice (the diagonal is then still a backward-stable approximation).
+template <typename VD>
+bool tridiagonalEigenvalues(VD& d, VD& e, int k) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  int h = k - 1, steps = 0;
+  while (h > 0) {
+    if (std::abs(e(h - 1)) <= eps * (std::abs(d(h - 1)) + std::abs(d(h)))) {  // d(h) has converged
+      e(h - 1) = 0.0;
+      --h;
+      continue;
+    }
+    if (++steps > 30 * k) return false;
+    int l = h - 1;  // the unreduced block [l, h]
+    while (l > 0 && std::abs(e(l - 1)) > eps * (std::abs(d(l - 1)) + std::abs(d(l)))) --l;
+    const double delta = 0.5 * (d(h - 1) - d(h)), b = e(h - 1);
+    const double mu = d(h) - b * b / (delta + std::copysign(std::hypot(delta, b), delta));
+    double x = d(l) - mu, z = e(l);
+    for (int i = l; i < h; ++i) {  // rotation R = [c s; -s c] on rows and columns i, i + 1
+      const double r = std::abs(x) < 1e150 && std::abs(z) < 1e150 ? std::sqrt(x * x + z * z) : std::hypot(x, z);
+      const double inv = r > 0.0 ? 1.0 / r : 0.0;
+      const double c = r > 0.0 ? x * inv : 1.0, s = z * inv;
+      if (i > l) e(i - 1) = r;  // R [x; z] = [r; 0]: the bulge at (i + 1, i - 1) is gone
+      const double di = d(i), dj = d(i + 1), ei = e(i);
+      d(i) = c * c * di + 2.0 * c * s * ei + s * s * dj;
+      d(i + 1) = s * s * di - 2.0 * c * s * ei + c * c * dj;
+      e(i) = c * s * (dj - di) + (c * c - s * s) * ei;
+      if (i + 1 < h) {  // the new bulge at (i + 2, i)
+        x = e(i);
+        z = s * e(i + 1);
+        e(i + 1) *= c;
+      }
+    }
+  }
+  return true;
+}
+
+// Smallest eigenvalue of a symmetric k x k matrix A (overwritten): Householder reduction to
+// tridiagonal form (eigenvalues only), then tridiagonalEigenvalues(). work: scratch of k x 4
+// (diagonal, off-diagonal, Householder vector, product). Backward stable: the result is within a
+// few eps ||A|| of the exact one.
+template <typename MA, typename MW>
+double smallestEigenvalue(MA& A, MW& work) {
+  const int k = static_cast<int>(A.rows());
+  auto d = work.col(0), e = work.col(1), v = work.col(2), p = work.col(3);
+  for (int j = 0; j + 2 < k; ++j) {  // zero A(j+2:, j) by H = I - beta v v^T on rows/columns j+1:
+    const int n = k - j - 1;
+    double xnorm2 = 0.0;
+    for (int i = 0; i < n; ++i) xnorm2 += A(j + 1 + i, j) * A(j + 1 + i, j);
+    const double x0 = A(j + 1, j), tail2 = xnorm2 - x0 * x0;
+    if (!(tail2 > 0.0)) continue;  // already tridiagonal in this column
+    const double alpha = x0 > 0.0 ? -std::sqrt(xnorm2) : std::sqrt(xnorm2);
+    for (int i = 0; i < n; ++i) v(i) = A(j + 1 + i, j);
+    v(0) -= alpha;
+    const double beta = 1.0 / (xnorm2 - alpha * x0);  // 2 / (v^T v)
+    double vp = 0.0;
+    for (int i = 0; i < n; ++i) {  // p = beta A22 v
+      double s = 0.0;
+      for (int c = 0; c < n; ++c) s += A(j + 1 + i, j + 1 + c) * v(c);
+      p(i) = beta * s;
+      vp += v(i) * p(i);
+    }
+    const double half = 0.5 * beta * vp;
+    for (int i = 0; i < n; ++i) p(i) -= half * v(i);  // w = p - (beta v^T p / 2) v
+    for (int c = 0; c < n; ++c)                       // A22 -= v w^T + w v^T
+      for (int i = 0; i < n; ++i) A(j + 1 + i, j + 1 + c) -= v(i) * p(c) + p(i) * v(c);
+    A(j + 1, j) = alpha;
+  }
+  for (int i = 0; i < k; ++i) {
+    d(i) = A(i, i);
+    e(i) = i + 1 < k ? A(i + 1, i) : 0.0;
+  }
+  tridiagonalEigenvalues(d, e, k);
+  return d.head(k).minCoeff();
 }
 
 // Cyclic Jacobi eigen-decomposition of a symmetric k x k matrix A: rotations J_pq zero one

@@ -243,12 +243,7 @@ double HdCore::smallestSingularValue() const {
     if (m == 0) {
       res.sigma_min = 0.0;
     } else if (res.general) {
-      const CouplingGeneral& g = ws.general;
-      auto W = g.work_g.topLeftCorner(m, m);
-      auto V = g.work_v.topLeftCorner(m, m);
-      W = g.kg.topLeftCorner(m, m);
-      detail::jacobiEigen(W, V, 60, /*with_vectors=*/false);
-      res.sigma_min = std::max(W.diagonal().minCoeff(), 0.0);
+      res.sigma_min = smallestEigenvalueGeneral();
     } else {
       ws.fast.sigma_eig.compute(ws.fast.K, Eigen::EigenvaluesOnly);
       res.sigma_min = std::max(ws.fast.sigma_eig.eigenvalues()(0), 0.0);

@@ -99,13 +99,13 @@ struct CouplingGeneral {
   Eigen::VectorXi seg_count;  // per segment: its number of columns, then the next free position
   std::vector<int> active;    // active[i]: columns on segments >= i (n_segments + 1)
   Matrix6X anew;              // each column's wrench in its own segment's tip axes (sorted)
-  Matrix6X acur, aproj;       // wrenches felt by the current segment / passed to the parent
+  Matrix6X acur;              // wrenches felt by the current segment, then passed to the parent
   Eigen::MatrixXd eg;         // mcap x n_segments: column i = (S_i^T A_i)^T, zero outside i's range
   Eigen::VectorXd ug, nug, rhs;
   mutable Eigen::VectorXd tmp;
   Eigen::MatrixXd kg, cholg, vg;             // coupling matrix, its Cholesky factor or eigenvectors
   Eigen::VectorXd invg;                      // policy multiplier per eigenvalue
-  mutable Eigen::MatrixXd work_g, work_v;    // Jacobi workspace for the smallest singular value
+  mutable Eigen::MatrixXd work_g, work_v;    // workspace of the smallest eigenvalue (matrix, scratch)
   mutable Matrix6X seg_force;                // per-segment wrench accumulators
   int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
   {
@@ -255,7 +255,13 @@ class HdCore {
   int sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments);
   int inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   void addOwnColumns(int i, const Eigen::Ref<const Matrix6X>& alfa);
+  void projectColumns(int i, int lo, int w, double free);
+  void moveColumnsToParent(int i, int lo, int w);
   void factorizeCouplingGeneral();
+  template <typename F>
+  void forEachCouplingBlock(const F& f) const;  // f(lo, w) per diagonal block of K
+  bool choleskyBlocks();
+  double smallestEigenvalueGeneral() const;
   void finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   void commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_sorted,
                             Eigen::Ref<Eigen::VectorXd> tau_cmd) const;

@@ -119,7 +119,7 @@ void HdCore::allocateWorkspace() {
   g.order = Eigen::VectorXi::Zero(mcap);
   g.seg_count = Eigen::VectorXi::Zero(ns);
   g.active.assign(ns + 1, 0);
-  g.anew = g.acur = g.aproj = Matrix6X::Zero(6, mcap);
+  g.anew = g.acur = Matrix6X::Zero(6, mcap);
   g.eg = Eigen::MatrixXd::Zero(mcap, std::max<unsigned int>(ns, 1));
   g.ug = g.nug = g.rhs = g.tmp = g.invg = Eigen::VectorXd::Zero(mcap);
   res.nu_user = Eigen::VectorXd::Zero(mcap);

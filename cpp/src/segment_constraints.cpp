@@ -10,6 +10,7 @@
 // with e_i = A_i^T S_i couples every pair felt by a common segment, block-wise.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "articulated_step.hpp"
 #include "dense_small.hpp"
@@ -108,52 +109,74 @@ int HdCore::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
   const int M = res.m;
   g.ug.head(M).setZero();
   g.kg.topLeftCorner(M, M).setZero();
-  double kappa = 0.0;
+  ws.kappa = 0.0;
   const bool has_tau = ff_torques.size() != 0;
   for (int i = static_cast<int>(model.ns) - 1; i >= 0; --i) {
     const SegmentModel& sm = model.seg[i];
     SegmentState& s = ws.seg[i];
     addOwnColumns(i, alfa);
     const int lo = g.lo(model, i), w = g.active[i] - lo;  // the columns felt here: [lo, lo + w)
-    auto A = g.acur.middleCols(lo, w);
-    auto Ap = g.aproj.middleCols(lo, w);
     Vector6 pa;
     g.eg.col(i).head(M).setZero();
     if (sm.joint >= 0) {
       double free = 0.0;
       if (!articulate(i, has_tau ? ff_torques(sm.joint) : 0.0, pa, free)) return degenerate(i);
-      if (w > 0) {
-        auto e = g.eg.col(i).segment(lo, w);  // A^T S
-        e.noalias() = A.transpose().lazyProduct(sm.S);
-        const Vector6 bias = s.c + sm.S * free;
-        g.ug.segment(lo, w).noalias() += A.transpose().lazyProduct(bias);
-        g.kg.block(lo, lo, w, w).noalias() += s.Dinv * e.lazyProduct(e.transpose());
-        // The fast path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
-        kappa += 2.0 * s.Dinv * (sm.v2 * A.topRows<3>().squaredNorm() + sm.w2 * A.bottomRows<3>().squaredNorm());
-        Ap = A;
-        Ap.noalias() -= (s.Dinv * s.u).lazyProduct(e.transpose());
-      }
+      if (w > 0) projectColumns(i, lo, w, free);
     } else {
       pa = s.pA;
-      if (w > 0) Ap = A;
-    }
-    if (w > 0) {  // to the parent's frame (the base frame at the root): f = R f', n = R n' + p x f
-      A.topRows<3>().noalias() = s.X.R.lazyProduct(Ap.topRows<3>());
-      A.bottomRows<3>().noalias() = s.X.R.lazyProduct(Ap.bottomRows<3>());
-      A.bottomRows<3>().noalias() += skew(s.X.p).lazyProduct(A.topRows<3>());
+      if (w > 0) moveColumnsToParent(i, lo, w);
     }
     if (model.parent(i) >= 0) {
       passToParent(i, pa);
     } else if (w > 0) {
-      g.ug.segment(lo, w).noalias() += A.transpose().lazyProduct(root_acc);
+      g.ug.segment(lo, w).noalias() += g.acur.middleCols(lo, w).transpose().lazyProduct(root_acc);
     }
   }
-  ws.kappa = kappa;
   return 0;
 }
 
+// The felt columns [lo, lo + w) at moving segment i, one 6-vector at a time: e_c = S^T a_c into
+// eg, U_c += a_c^T (c_i + S free), the bound kappa, then a_c <- a_c - u e_c / D (what the parent
+// feels through the joint) carried to the parent's frame; K += e e^T / D on the block.
+void HdCore::projectColumns(int i, int lo, int w, double free) {
+  const SegmentModel& sm = model.seg[i];
+  const SegmentState& s = ws.seg[i];
+  CouplingGeneral& g = ws.general;
+  const Vector6 bias = s.c + sm.S * free;
+  const Vector6 ud = s.Dinv * s.u;
+  double* e = g.eg.col(i).data() + lo;
+  double* u = g.ug.data() + lo;
+  double kappa = 0.0;
+  for (int k = 0; k < w; ++k) {
+    Eigen::Map<Vector6> a(g.acur.col(lo + k).data());
+    const double ek = sm.S.dot(a);
+    e[k] = ek;
+    u[k] += a.dot(bias);
+    // The fast path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
+    kappa += sm.v2 * a.head<3>().squaredNorm() + sm.w2 * a.tail<3>().squaredNorm();
+    a -= ek * ud;
+    a = forceToParent(s.X, a);
+  }
+  ws.kappa += 2.0 * s.Dinv * kappa;
+  for (int c = 0; c < w; ++c) {
+    double* kc = g.kg.col(lo + c).data() + lo;
+    for (int r = 0; r < w; ++r) kc[r] += s.Dinv * (e[r] * e[c]);
+  }
+}
+
+// The felt columns at a segment on a fixed joint: carried rigidly to the parent's frame.
+void HdCore::moveColumnsToParent(int i, int lo, int w) {
+  const Pose& X = ws.seg[i].X;
+  for (int k = lo; k < lo + w; ++k) {
+    Eigen::Map<Vector6> a(ws.general.acur.col(k).data());
+    a = forceToParent(X, a);
+  }
+}
+
 // K = kg (M x M): certified Cholesky (truncation policy, every eigenvalue provably above the
-// threshold) else a Jacobi eigen-decomposition with the policy's multipliers.
+// threshold) else a Jacobi eigen-decomposition with the policy's multipliers. The Cholesky factor
+// is built block by block (couplingBlocks()): its entries off the blocks are exact zeros anyway,
+// and L^-1 is block-diagonal too, so ||L^-1||_F^2 is the sum over the blocks.
 void HdCore::factorizeCouplingGeneral() {
   CouplingGeneral& g = ws.general;
   const int m = res.m;
@@ -162,18 +185,10 @@ void HdCore::factorizeCouplingGeneral() {
   ws.use_cholesky = false;
   if (m == 0) return;
   const auto K = g.kg.topLeftCorner(m, m);
-  if (options.policy == SingularityPolicy::TruncatedPseudoInverse) {
-    auto L = g.cholg.topLeftCorner(m, m);
-    L.setZero();
-    if (detail::choleskyCertified(K, L, 0.0)) {
-      auto x = g.tmp.head(m);
-      const double lower = 1.0 / detail::inverseFrobeniusSquared(L, x);  // <= lambda_min(K)
-      if (std::isfinite(lower) && lower > options.rcond * ws.kappa) {
-        ws.use_cholesky = true;
-        res.rank = m;
-        return;
-      }
-    }
+  if (options.policy == SingularityPolicy::TruncatedPseudoInverse && choleskyBlocks()) {
+    ws.use_cholesky = true;
+    res.rank = m;
+    return;
   }
   auto W = g.work_g.topLeftCorner(m, m);
   auto V = g.vg.topLeftCorner(m, m);
@@ -188,6 +203,51 @@ void HdCore::factorizeCouplingGeneral() {
                                        options.damping);
 }
 
+// Calls f(lo, w) for each diagonal block [lo, lo + w) of K: the columns under one segment
+// attached to the base (columns of different such subtrees share no segment, so K couples them
+// by exact zeros). A chain has one block.
+template <typename F>
+void HdCore::forEachCouplingBlock(const F& f) const {
+  const CouplingGeneral& g = ws.general;
+  for (int r = 0; r < static_cast<int>(model.ns); r = model.subtree_end[r]) {
+    const int lo = g.lo(model, r), w = g.active[r] - lo;
+    if (w > 0) f(lo, w);
+  }
+}
+
+// Cholesky factor of K into cholg (zero off the blocks) and the certificate that every
+// eigenvalue is above the truncation threshold: lambda_min(K) >= 1 / ||L^-1||_F^2 > rcond kappa
+// (kappa >= lambda_max(K)). False if a block is not positive definite or the proof fails.
+bool HdCore::choleskyBlocks() {
+  CouplingGeneral& g = ws.general;
+  const int m = res.m;
+  g.cholg.topLeftCorner(m, m).setZero();
+  bool ok = true;
+  double frob2 = 0.0;  // ||L^-1||_F^2
+  forEachCouplingBlock([&](int lo, int w) {
+    if (!ok) return;
+    auto L = g.cholg.block(lo, lo, w, w);
+    ok = detail::choleskyCertified(g.kg.block(lo, lo, w, w), L, 0.0);
+    auto x = g.tmp.head(w);
+    if (ok) frob2 += detail::inverseFrobeniusSquared(L, x);
+  });
+  const double lower = 1.0 / frob2;
+  return ok && std::isfinite(lower) && lower > options.rcond * ws.kappa;
+}
+
+// Smallest eigenvalue of K: the smallest over its diagonal blocks.
+double HdCore::smallestEigenvalueGeneral() const {
+  const CouplingGeneral& g = ws.general;
+  double lam = std::numeric_limits<double>::infinity();
+  forEachCouplingBlock([&](int lo, int w) {
+    auto W = g.work_g.topLeftCorner(w, w);
+    auto scratch = g.work_v.topLeftCorner(w, 4);
+    W = g.kg.block(lo, lo, w, w);
+    lam = std::min(lam, detail::smallestEigenvalue(W, scratch));
+  });
+  return std::max(lam, 0.0);
+}
+
 void HdCore::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const {
   const int m = res.m;
   if (!res.general) {
@@ -200,8 +260,10 @@ void HdCore::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::
   const CouplingGeneral& g = ws.general;
   if (ws.use_cholesky) {
     out.head(m) = rhs.head(m);
-    auto x = out.head(m);
-    detail::choleskySolve(g.cholg.topLeftCorner(m, m), x);
+    forEachCouplingBlock([&](int lo, int w) {
+      auto x = out.segment(lo, w);
+      detail::choleskySolve(g.cholg.block(lo, lo, w, w), x);
+    });
     return;
   }
   const auto V = g.vg.topLeftCorner(m, m);

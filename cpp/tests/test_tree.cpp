@@ -247,7 +247,7 @@ void testInverseInertia(testutil::Checker& ck) {
 // Constrained solves at q_dot = 0 against the KKT solution; command torques replayed through
 // RNE and beta checked from the link accelerations (q_dot = 0 and q_dot != 0).
 void testConstraints(testutil::Checker& ck) {
-  double worst_kkt = 0.0, worst_tau = 0.0, worst_beta = 0.0;
+  double worst_kkt = 0.0, worst_tau = 0.0, worst_beta = 0.0, worst_sigma = 0.0;
   int tested = 0;
   for (int seed = 0; seed < 120; ++seed) {
     TreeCase c(2000 + seed, 40);
@@ -268,6 +268,12 @@ void testConstraints(testutil::Checker& ck) {
     const double e_kkt = relErr(s.qdd(), qdd_kkt);
     ck.check(e_kkt < kTol, tag + ": qdd differs from the KKT solution by " + str(e_kkt));
     worst_kkt = std::max(worst_kkt, e_kkt);
+    // K = A H^-1 A^T: its smallest eigenvalue against Eigen's dense eigen-solver.
+    const Eigen::MatrixXd K = A * o.massMatrix(q).ldlt().solve(A.transpose());
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K, Eigen::EigenvaluesOnly).eigenvalues();
+    const double e_sigma = std::abs(s.smallestSingularValue() - ev(0)) / ev(ev.size() - 1);
+    ck.check(e_sigma < kTol, tag + ": smallestSingularValue " + str(s.smallestSingularValue()) + " vs " + str(ev(0)));
+    worst_sigma = std::max(worst_sigma, e_sigma);
     for (int pass = 0; pass < 2; ++pass) {  // q_dot = 0, then q_dot != 0
       const Eigen::VectorXd qd = pass ? g.qdot(nj).data : zero;
       rc = s.solve(q, qd, t.alfa, t.beta, t.segments, f_ext, ff);
@@ -284,8 +290,8 @@ void testConstraints(testutil::Checker& ck) {
     }
   }
   ck.check(tested >= 50, "only " + str(tested) + " constraint layouts of full rank");
-  std::printf("  constraints on branches (%d layouts): KKT %.2e, tau replay %.2e, beta %.2e\n", tested, worst_kkt,
-              worst_tau, worst_beta);
+  std::printf("  constraints on branches (%d layouts): KKT %.2e, tau replay %.2e, beta %.2e, sigma_min %.2e\n", tested,
+              worst_kkt, worst_tau, worst_beta, worst_sigma);
 }
 
 // Link accelerations against d/dt of the segment twists J(q) q_dot: the spatial acceleration
