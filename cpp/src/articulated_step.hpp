@@ -36,6 +36,15 @@ inline void HdCore::passToParent(int i, const Vector6& pa) {
   p.pA += forceToParent(s.X, pa);
 }
 
+// Segment i's acceleration before its own joint's: the parent's (root_acc at the base) in i's
+// tip frame plus the velocity-product term c_i.
+inline Vector6 HdCore::incomingAcceleration(int i) const {
+  const int p = model.parent(i);
+  Vector6 a = motionToChild(ws.seg[i].X, p >= 0 ? ws.seg[p].xdd : root_acc);
+  a += ws.seg[i].c;
+  return a;
+}
+
 // Final outward sweep: joint and link accelerations given the constraint magnitudes.
 // constraint_force(i) is segment i's joint-axis share of the constraint forces, S^T A nu (the
 // only part in which the two paths differ).
@@ -47,9 +56,7 @@ inline void HdCore::finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torqu
   for (unsigned int i = 0; i < model.ns; ++i) {
     const SegmentModel& sm = model.seg[i];
     SegmentState& s = ws.seg[i];
-    const int p = model.parent(i);
-    Vector6 a = motionToChild(s.X, p >= 0 ? ws.seg[p].xdd : root_acc);
-    a += s.c;
+    Vector6 a = incomingAcceleration(i);
     if (sm.joint >= 0) {
       const double tau = has_tau ? ff_torques(sm.joint) : 0.0;
       const double f = sm.S.dot(s.pA) + s.u.dot(a) + constraint_force(i);  // S^T IA a = u^T a

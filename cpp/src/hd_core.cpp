@@ -340,12 +340,9 @@ int HdCore::solveLast(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::R
 void HdCore::accelerationsOf(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
   for (unsigned int i = 0; i < model.ns; ++i) {
     const SegmentModel& sm = model.seg[i];
-    SegmentState& s = ws.seg[i];
-    const int p = model.parent(i);
-    Vector6 a = motionToChild(s.X, p >= 0 ? ws.seg[p].xdd : root_acc);
-    a += s.c;
+    Vector6 a = incomingAcceleration(i);
     if (sm.joint >= 0) a += sm.S * qdd(sm.joint);
-    s.xdd = a;
+    ws.seg[i].xdd = a;
   }
   res.link_acc_known = false;
 }

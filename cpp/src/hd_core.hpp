@@ -231,6 +231,7 @@ class HdCore {
   inline bool articulate(int i, double tau, Vector6& pa, double& free);
   // Apparent inertia and bias force of segment i added to its parent (which must exist).
   inline void passToParent(int i, const Vector6& pa);
+  inline Vector6 incomingAcceleration(int i) const;
   // Final outward sweep; constraint_force(i) gives segment i's S^T A nu.
   template <typename ConstraintForce>
   inline void finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const ConstraintForce& constraint_force);
