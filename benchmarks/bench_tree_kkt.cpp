@@ -272,6 +272,14 @@ std::string report(const std::vector<Row>& rows, int n) {
         << " | " << bench::fmt("%.2f", r.ratio) << " | " << (r.m == 0 ? bench::fmt("%.2f", r.aba) : "-") << " | "
         << (r.m == 0 ? bench::fmt("%.2f", r.ratio_aba) : "-") << " | " << bench::fmt("%.1e", r.err) << " |\n";
   }
+  out << "\nTarget: with constraints, ours / KKT <= 0.5:";
+  bool met = true;
+  for (const Row& r : rows) {
+    if (r.m == 0) continue;
+    out << " " << bench::fmt("%.2f", r.ratio) << " (m = " << r.m << ")";
+    met = met && r.ratio <= 0.5;
+  }
+  out << (met ? ": met.\n" : ": not met.\n");
   return out.str();
 }
 
