@@ -240,42 +240,8 @@ def _option_runs(table_run, quick: bool, say) -> dict:
     return out
 
 
-def run(
-    out_dir,
-    quick: bool = False,
-    progress: Optional[Callable[[str], None]] = None,
-    runs: Optional[dict] = None,
-    option_runs: Optional[dict] = None,
-) -> dict:
-    """Run the three dual-arm variants, write table, CSV and figure into ``out_dir/dual_arm``.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        Output folder (``dual_arm/`` is created in it).
-    quick : bool
-        Shorter phases (:func:`~.dual_arm.dual_arm`).
-    progress : callable, optional
-        ``progress(line)`` after each run.
-    runs : dict, optional
-        Runs already made, ``{variant: Run}`` for every variant of :data:`~.dual_arm.VARIANTS`
-        (with the same ``quick``); None: run them here.
-    option_runs : dict, optional
-        Runs of the ``table`` variant for each label of :data:`OPTIONS`; None: run them here.
-
-    Returns
-    -------
-    dict
-        ``index``: Markdown lines for results/index.md; ``runs``: the runs by variant;
-        ``option_runs``: by label of :data:`OPTIONS`; ``options``: per label ``tau2`` (N² m² s),
-        ``chatter`` (N m per step) and ``outcome`` (:func:`~.metrics.dual_arm_outcome`) over the
-        slide; ``ok``: all checks passed; ``checks``: the named checks; ``seconds``: wall time.
-    """
-    say = progress or (lambda s: None)
-    out = Path(out_dir) / "dual_arm"
-    out.mkdir(parents=True, exist_ok=True)
-    t_start = time.perf_counter()
-    runs = dict(runs or {})
+def _variant_runs(runs: dict, quick: bool, say) -> dict:
+    """The runs of every variant of :data:`~.dual_arm.VARIANTS` not in ``runs`` yet, made here."""
     for k, v in enumerate(VARIANTS):
         if v in runs:
             continue
@@ -284,24 +250,17 @@ def run(
         say(
             f"[dual-arm] {_bar((k + 1) / len(VARIANTS))} {v} ({runs[v].t[-1]:.1f} s simulated in {time.perf_counter() - t0:.1f} s)"
         )
-    option_runs = dict(option_runs or _option_runs(runs["table"], quick, say))
-    names = dual_arm_model()[1].joint_names
-    efforts = {v: metrics.effort(r, r.window("slide")) for v, r in runs.items()}
-    outcomes = {v: metrics.dual_arm_outcome(r) for v, r in runs.items()}
-    header, rows = _effort_table(names, efforts)
-    write_csv(out / "dual_arm_effort.csv", header, rows)
-    eheader, erows = _error_table(outcomes)
-    write_csv(out / "dual_arm_errors.csv", eheader, erows)
-    oheader, orows, options = _options_table(option_runs)
-    write_csv(out / "dual_arm_friction.csv", oheader, orows)
-    fig = out / "dual_arm.png"
-    _plot(fig, runs, names, option_runs)
-    chosen = options[next(iter(OPTIONS))]
-    checks = _checks(efforts, outcomes, chosen["chatter"])
-    ok = all(checks.values())
+    return runs
+
+
+def _index_lines(quick: bool, efforts: dict, outcomes: dict, tables: dict, checks: dict) -> list:
+    """The case's Markdown section for results/index.md (without the wall-time line)."""
+    header, rows = tables["effort"]
+    eheader, erows = tables["errors"]
+    oheader, orows, options = tables["options"]
     tau2 = {v: e["energy_tau2"].sum() for v, e in efforts.items()}
     ot, os_ = outcomes["table"], outcomes["separate"]
-    idx = [
+    return [
         "## Dual-arm Gen3 on a torso: one hand rests on a table, the other slides (issue 17)",
         "",
         "Robot: two Kinova Gen3 arms (rigid Robotiq 2F-85) mounted upright at y = ±0.25 m on a torso turning "
@@ -349,6 +308,61 @@ def run(
         "[dual_arm/dual_arm_friction.csv](dual_arm/dual_arm_friction.csv); figure: [dual_arm/dual_arm.png](dual_arm/dual_arm.png)",
         "",
     ]
+
+
+def run(
+    out_dir,
+    quick: bool = False,
+    progress: Optional[Callable[[str], None]] = None,
+    runs: Optional[dict] = None,
+    option_runs: Optional[dict] = None,
+) -> dict:
+    """Run the three dual-arm variants, write table, CSV and figure into ``out_dir/dual_arm``.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        Output folder (``dual_arm/`` is created in it).
+    quick : bool
+        Shorter phases (:func:`~.dual_arm.dual_arm`).
+    progress : callable, optional
+        ``progress(line)`` after each run.
+    runs : dict, optional
+        Runs already made, ``{variant: Run}`` for every variant of :data:`~.dual_arm.VARIANTS`
+        (with the same ``quick``); None: run them here.
+    option_runs : dict, optional
+        Runs of the ``table`` variant for each label of :data:`OPTIONS`; None: run them here.
+
+    Returns
+    -------
+    dict
+        ``index``: Markdown lines for results/index.md; ``runs``: the runs by variant;
+        ``option_runs``: by label of :data:`OPTIONS`; ``options``: per label ``tau2`` (N² m² s),
+        ``chatter`` (N m per step) and ``outcome`` (:func:`~.metrics.dual_arm_outcome`) over the
+        slide; ``ok``: all checks passed; ``checks``: the named checks; ``seconds``: wall time.
+    """
+    say = progress or (lambda s: None)
+    out = Path(out_dir) / "dual_arm"
+    out.mkdir(parents=True, exist_ok=True)
+    t_start = time.perf_counter()
+    runs = _variant_runs(dict(runs or {}), quick, say)
+    option_runs = dict(option_runs or _option_runs(runs["table"], quick, say))
+    names = dual_arm_model()[1].joint_names
+    efforts = {v: metrics.effort(r, r.window("slide")) for v, r in runs.items()}
+    outcomes = {v: metrics.dual_arm_outcome(r) for v, r in runs.items()}
+    header, rows = _effort_table(names, efforts)
+    write_csv(out / "dual_arm_effort.csv", header, rows)
+    eheader, erows = _error_table(outcomes)
+    write_csv(out / "dual_arm_errors.csv", eheader, erows)
+    oheader, orows, options = _options_table(option_runs)
+    write_csv(out / "dual_arm_friction.csv", oheader, orows)
+    fig = out / "dual_arm.png"
+    _plot(fig, runs, names, option_runs)
+    chosen = options[next(iter(OPTIONS))]
+    checks = _checks(efforts, outcomes, chosen["chatter"])
+    ok = all(checks.values())
+    tables = dict(effort=(header, rows), errors=(eheader, erows), options=(oheader, orows, options))
+    idx = _index_lines(quick, efforts, outcomes, tables, checks)
     secs = time.perf_counter() - t_start
     idx += [f"Dual-arm case: {len(runs)} runs in {secs:.1f} s wall time.", ""]
     return dict(index=idx, runs=runs, option_runs=option_runs, options=options, ok=ok, checks=checks, seconds=secs)
