@@ -264,11 +264,10 @@ double smallestEigenvalue(MA& A, MW& work) {
 // eigenvalues (unsorted) and the columns of V the orthonormal eigenvectors. Stops when the
 // off-diagonal mass is below eps^2 of A's Frobenius norm squared, after at most max_sweeps sweeps
 // (convergence is quadratic; 6-10 sweeps are typical). Returns the number of sweeps.
-// with_vectors = false leaves V untouched (eigenvalues only, half the work).
 template <typename MA, typename MV>
-int jacobiEigen(MA& A, MV& V, int max_sweeps = 60, bool with_vectors = true) {
+int jacobiEigen(MA& A, MV& V, int max_sweeps = 60) {
   const int k = static_cast<int>(A.rows());
-  if (with_vectors) V.setIdentity();
+  V.setIdentity();
   const double total = A.squaredNorm();
   const double eps = std::numeric_limits<double>::epsilon();
   int sweep = 0;
@@ -295,7 +294,6 @@ int jacobiEigen(MA& A, MV& V, int max_sweeps = 60, bool with_vectors = true) {
             A(r, p) = A(p, r) = c * arp - s * arq;
             A(r, q) = A(q, r) = s * arp + c * arq;
           }
-          if (!with_vectors) continue;
           const double vrp = V(r, p), vrq = V(r, q);
           V(r, p) = c * vrp - s * vrq;
           V(r, q) = s * vrp + c * vrq;

@@ -78,7 +78,7 @@ class FrictionCore {
   Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;
   Eigen::VectorXd ff_driver_;  // ff_torques of the last solve (zero if empty): hd_'s pass-through driver
   Eigen::MatrixXd dnu_;
-  int m_keep_ = 0, k_ = 0;
+  int m_keep_ = 0;
   bool link_acc_known_ = false;
   std::vector<signed char> status_;
   int iterations_ = 0;

@@ -7,7 +7,6 @@
 #include <limits>
 #include <utility>
 
-#include "dense_small.hpp"
 #include "friction_core.hpp"
 #include "hd_core.hpp"
 #include "model_validation.hpp"
@@ -310,7 +309,6 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
     nu_.head(hd_.constraintCount()) = hd_.nu();
   }
   m_keep_ = hd_.constraintCount();
-  k_ = k;
   link_acc_known_ = k == 0;
   frictionOutputs(q_dot, friction, k);
   // The optimum is affine in finite friction bounds, but huge values can still overflow.

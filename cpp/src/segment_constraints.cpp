@@ -175,7 +175,7 @@ void HdCore::moveColumnsToParent(int i, int lo, int w) {
 
 // K = kg (M x M): certified Cholesky (truncation policy, every eigenvalue provably above the
 // threshold) else a Jacobi eigen-decomposition with the policy's multipliers. The Cholesky factor
-// is built block by block (couplingBlocks()): its entries off the blocks are exact zeros anyway,
+// is built block by block (choleskyBlocks()): its entries off the blocks are exact zeros anyway,
 // and L^-1 is block-diagonal too, so ||L^-1||_F^2 is the sum over the blocks.
 void HdCore::factorizeCouplingGeneral() {
   CouplingGeneral& g = ws.general;
