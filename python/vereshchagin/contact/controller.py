@@ -42,7 +42,15 @@ import numpy as np
 from ..friction import Friction
 from ..task import beta_for, directions, pose_error
 
-__all__ = ["CONTACT_GAINS", "FREE_GAINS", "FRICTION_MODES", "CascadedController", "ControllerConfig", "Gains"]
+__all__ = [
+    "CONTACT_GAINS",
+    "FREE_GAINS",
+    "FRICTION_MODES",
+    "CascadedController",
+    "ControllerConfig",
+    "Gains",
+    "cascaded_acceleration",
+]
 
 G = 9.81
 
@@ -315,19 +323,12 @@ class CascadedController:
         tw = np.asarray(self.chain.twist(q, qd))
         if self.detect:
             self._contact_update(tw[2])
-        gains = self.gains
         e = pose_error(T, self.goal)
-        v_lin = _saturate(gains.k_pos[0] * e[:3], cfg.v_max)
-        v_ang = _saturate(gains.k_pos[1] * e[3:], cfg.w_max)
-        a_des = np.concatenate([gains.k_vel[0] * (v_lin - tw[:3]), gains.k_vel[1] * (v_ang - tw[3:])])
         names = CONTACT_DIRECTIONS if self.in_contact else cfg.free_directions
         if names not in self._alpha:
             self._alpha[names] = directions(names)
         alpha = self._alpha[names]
-        if cfg.hold_band is not None:
-            e_task = alpha @ (alpha.T @ e)  # the error along the constrained directions
-            if np.linalg.norm(e_task[:3]) < cfg.hold_band[0] and np.linalg.norm(e_task[3:]) < cfg.hold_band[1]:
-                a_des[:] = 0.0
+        a_des, v_des = cascaded_acceleration(e, tw, self.gains, cfg, alpha)
         beta = beta_for(alpha, a_des, tw, self.solver.gravity)
 
         tau_motor_ff = np.zeros(self.n)
@@ -356,7 +357,7 @@ class CascadedController:
             Jw = np.asarray(self.chain.jacobian(q)).T @ w
             lam = float(Jw @ Gc @ Jw)
             N = max(0.0, (G - float(w @ res0.link_acc[-1])) / lam) if lam > 1e-12 else 0.0
-            u = np.array([v_lin[0], v_lin[1], 0.0])
+            u = np.array([v_des[0], v_des[1], 0.0])
             speed = np.linalg.norm(u)
             u = u / speed * min(1.0, speed / 0.01) if speed > 1e-9 else np.zeros(3)
             F = N * np.array([0.0, 0.0, 1.0]) - cfg.mu_estimate * N * u
@@ -391,6 +392,46 @@ class CascadedController:
             return tau_ff
         push = float(Jw @ Gc @ tau_motor_ff) / lam
         return tau_ff - Jw * push
+
+
+def cascaded_acceleration(e, tw, gains: Gains, config: ControllerConfig, alpha=None) -> tuple[np.ndarray, np.ndarray]:
+    """Desired spatial acceleration (6,) and twist (6,) of the cascaded P at one frame, base axes.
+
+    ``a = k_vel (sat(k_pos e) - tw)`` per linear / angular half, the desired velocity saturated at
+    ``config.v_max`` / ``config.w_max``; zero ("stay", so joints the task does not move may
+    stick) while the error along the constrained directions is inside ``config.hold_band``.
+
+    Parameters
+    ----------
+    e : ndarray, shape (6,)
+        Pose error towards the goal (:func:`vereshchagin.task.pose_error`: m, rad).
+    tw : ndarray, shape (6,)
+        The frame's twist (m/s, rad/s).
+    gains : Gains
+        ``k_pos``, ``k_vel`` (linear, angular).
+    config : ControllerConfig
+        ``v_max``, ``w_max``, ``hold_band``.
+    alpha : ndarray, shape (6, m), optional
+        The constrained directions (orthonormal columns) the hold band measures the error
+        along; None: all six.
+
+    Returns
+    -------
+    a : ndarray, shape (6,)
+        Desired acceleration [linear (m/s^2); angular (rad/s^2)].
+    v : ndarray, shape (6,)
+        Desired twist [linear (m/s); angular (rad/s)], saturated.
+    """
+    v = np.concatenate(
+        [_saturate(gains.k_pos[0] * e[:3], config.v_max), _saturate(gains.k_pos[1] * e[3:], config.w_max)]
+    )
+    a = np.concatenate([gains.k_vel[0] * (v[:3] - tw[:3]), gains.k_vel[1] * (v[3:] - tw[3:])])
+    band = config.hold_band
+    if band is not None:
+        e_task = e if alpha is None else alpha @ (alpha.T @ e)  # the error along the constrained directions
+        if np.linalg.norm(e_task[:3]) < band[0] and np.linalg.norm(e_task[3:]) < band[1]:
+            a[:] = 0.0
+    return a, v
 
 
 def _saturate(v: np.ndarray, limit: float) -> np.ndarray:

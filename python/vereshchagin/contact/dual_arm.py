@@ -55,7 +55,7 @@ from .._core import Chain, Tree
 from ..friction import Friction
 from ..solver import Solver
 from ..task import beta_for, pose_error
-from .controller import ControllerConfig, CycleInfo, _saturate
+from .controller import ControllerConfig, CycleInfo, cascaded_acceleration
 from .mujoco_plant import MujocoGen3, Scene, build_model
 from .use_cases import (
     JOINT_DAMPING,
@@ -235,15 +235,10 @@ class DualArmController:
 
     def _hand_beta(self, frame: str, goal: np.ndarray, q, qd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``beta`` (6,) of the cascaded P towards ``goal`` at ``frame`` (zero acceleration inside the hold band), with its pose and twist."""
-        cfg, g = self.config, self.config.free_gains
         T = np.asarray(self.tree.fk(q, frame))
         tw = np.asarray(self.tree.twist(q, qd, frame))
-        e = pose_error(T, goal)
-        v = np.concatenate([_saturate(g.k_pos[0] * e[:3], cfg.v_max), _saturate(g.k_pos[1] * e[3:], cfg.w_max)])
-        a = np.concatenate([g.k_vel[0] * (v[:3] - tw[:3]), g.k_vel[1] * (v[3:] - tw[3:])])
-        band = cfg.hold_band
-        if band is not None and np.linalg.norm(e[:3]) < band[0] and np.linalg.norm(e[3:]) < band[1]:
-            a[:] = 0.0  # "stay": zero acceleration, so joints the task does not move may stick
+        # all six directions constrained: the hold band sees the whole error
+        a, _ = cascaded_acceleration(pose_error(T, goal), tw, self.config.free_gains, self.config)
         return beta_for(ALPHA, a, tw, GRAVITY), T, tw
 
     def command(self, q, qd) -> tuple[np.ndarray, CycleInfo]:

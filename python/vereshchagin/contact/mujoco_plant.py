@@ -130,7 +130,7 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
         :func:`vereshchagin.robots.dual_gen3_urdf`.
     chain : Chain or Tree
         The controller's model from the same URDF: its joint order is the plant's (checked), its
-        effort limits the motors' ranges, its rotor inertia (chains) the armature; a chain also
+        effort limits the motors' ranges, its rotor inertia the armature; a chain also
         gives the end-effector frame for the pen.
     scene : Scene
         A pen (``pen_direction``) needs a :class:`~vereshchagin.Chain`.
@@ -148,7 +148,7 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
     for g in spec.geoms:
         g.contype, g.conaffinity, g.group, g.friction = 1, 0, ARM, fr
     joints = list(chain.joint_names)
-    rotor = np.asarray(getattr(chain, "rotor_inertia", np.zeros(len(joints))), float)
+    rotor = np.asarray(chain.rotor_inertia, float)
     for k, name in enumerate(joints):
         joint = spec.joint(name)
         joint.armature = float(rotor[k])
