@@ -23,17 +23,14 @@ inline bool HdCore::articulate(int i, double tau, Vector6& pa, double& free) {
 }
 
 // Apparent inertia IA - u u^T / D (IA for a fixed joint) and bias force pa moved to the parent.
+// IA is downdated in place: nothing reads a segment's articulated inertia after this step (u and
+// D keep what the later passes need), and a copy of it cost more than the downdate.
 inline void HdCore::passToParent(int i, const Vector6& pa) {
   SegmentState& s = ws.seg[i];
   SegmentState& p = ws.seg[model.parent(i)];
-  if (model.seg[i].joint >= 0) {
-    Matrix6 Ia = s.IA;
-    Ia.noalias() -= s.Dinv * s.u * s.u.transpose();
-    addInertiaToParent(s.X, Ia, p.IA);
-  } else {
-    addInertiaToParent(s.X, s.IA, p.IA);
-  }
-  p.pA += forceToParent(s.X, pa);
+  if (model.seg[i].joint >= 0) s.IA.noalias() -= s.Dinv * s.u * s.u.transpose();
+  addInertiaToParent(s.X, s.IA, p.IA);
+  addForceToParent(s.X, pa, p.pA);
 }
 
 // Segment i's acceleration before its own joint's: the parent's (root_acc at the base) in i's

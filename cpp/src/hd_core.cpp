@@ -281,7 +281,7 @@ void HdCore::commandFromNu(const VectorC& nu, Eigen::Ref<Eigen::VectorXd> tau_cm
   for (int i = ns - 1; i >= 0; --i) {
     const SegmentState& s = ws.seg[i];
     if (model.seg[i].joint >= 0) tau_cmd(model.seg[i].joint) = model.seg[i].S.dot(f);
-    if (i > 0) f = forceToParent(s.X, f);
+    if (i > 0) forceToParentInPlace(s.X, f);
   }
 }
 

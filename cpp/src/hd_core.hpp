@@ -74,7 +74,7 @@ struct HdModel {
 struct SegmentState {
   Pose X;                                       // pose of this tip frame in the parent tip frame at q
   Matrix3 R_base;                               // orientation of this tip frame in the base frame
-  Matrix6 IA;                                   // articulated inertia
+  Matrix6 IA;                                   // articulated inertia, then (after passToParent) apparent
   Vector6 v, c, pA;                             // velocity, velocity-product acceleration, articulated bias force
   Vector6 u;                                    // IA * S
   Vector6 xdd;                                  // spatial acceleration (tip frame)

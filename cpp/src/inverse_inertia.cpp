@@ -28,7 +28,10 @@ void HdCore::inverseInertia(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen:
       pa += s.u * z(sm.joint);
     }
     const int p = model.parent(i);
-    if (p >= 0) force.col(p) += forceToParent(s.X, pa);
+    if (p >= 0) {
+      auto fp = force.col(p);
+      addForceToParent(s.X, pa, fp);
+    }
   }
   for (unsigned int i = 0; i < model.ns; ++i) {
     const SegmentModel& sm = model.seg[i];

@@ -108,7 +108,10 @@ void HdCore::driverFree(const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Re
       ws.pt.free(sm.joint) = free;
       p += s.u * free;
     }
-    if (model.parent(i) >= 0) p_all.col(model.parent(i)) += forceToParent(s.X, p);
+    if (model.parent(i) >= 0) {
+      auto fp = p_all.col(model.parent(i));
+      addForceToParent(s.X, p, fp);
+    }
   }
 }
 

@@ -155,7 +155,7 @@ void HdCore::projectColumns(int i, int lo, int w, double free) {
     // The fast path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
     kappa += sm.v2 * a.head<3>().squaredNorm() + sm.w2 * a.tail<3>().squaredNorm();
     a -= ek * ud;
-    a = forceToParent(s.X, a);
+    forceToParentInPlace(s.X, a);
   }
   ws.kappa += 2.0 * s.Dinv * kappa;
   for (int c = 0; c < w; ++c) {
@@ -169,7 +169,7 @@ void HdCore::moveColumnsToParent(int i, int lo, int w) {
   const Pose& X = ws.seg[i].X;
   for (int k = lo; k < lo + w; ++k) {
     Eigen::Map<Vector6> a(ws.general.acur.col(k).data());
-    a = forceToParent(X, a);
+    forceToParentInPlace(X, a);
   }
 }
 
@@ -226,6 +226,13 @@ bool HdCore::choleskyBlocks() {
   double frob2 = 0.0;  // ||L^-1||_F^2
   forEachCouplingBlock([&](int lo, int w) {
     if (!ok) return;
+    if (w == kMaxConstraints) {  // one 6-D constraint: the same loops, unrolled at a fixed size
+      auto L = g.cholg.block<kMaxConstraints, kMaxConstraints>(lo, lo);
+      ok = detail::choleskyCertified(g.kg.block<kMaxConstraints, kMaxConstraints>(lo, lo), L, 0.0);
+      auto x = g.tmp.head<kMaxConstraints>();
+      if (ok) frob2 += detail::inverseFrobeniusSquared(L, x);
+      return;
+    }
     auto L = g.cholg.block(lo, lo, w, w);
     ok = detail::choleskyCertified(g.kg.block(lo, lo, w, w), L, 0.0);
     auto x = g.tmp.head(w);
@@ -261,6 +268,11 @@ void HdCore::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::
   if (ws.use_cholesky) {
     out.head(m) = rhs.head(m);
     forEachCouplingBlock([&](int lo, int w) {
+      if (w == kMaxConstraints) {
+        auto x = out.segment<kMaxConstraints>(lo);
+        detail::choleskySolve(g.cholg.block<kMaxConstraints, kMaxConstraints>(lo, lo), x);
+        return;
+      }
       auto x = out.segment(lo, w);
       detail::choleskySolve(g.cholg.block(lo, lo, w, w), x);
     });
@@ -294,7 +306,10 @@ void HdCore::commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_so
     const int c0 = g.active[i + 1], c = g.active[i];
     if (c > c0) f.col(i).noalias() -= g.anew.middleCols(c0, c - c0).lazyProduct(nu_sorted.segment(c0, c - c0));
     if (sm.joint >= 0) tau_cmd(sm.joint) = sm.S.dot(f.col(i));
-    if (model.parent(i) >= 0) f.col(model.parent(i)) += forceToParent(ws.seg[i].X, f.col(i));
+    if (model.parent(i) >= 0) {
+      auto fp = f.col(model.parent(i));
+      addForceToParent(ws.seg[i].X, f.col(i), fp);
+    }
   }
 }
 
