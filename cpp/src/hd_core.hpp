@@ -17,6 +17,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -100,10 +101,10 @@ struct CouplingGeneral {
   std::vector<int> active;    // active[i]: columns on segments >= i (n_segments + 1)
   Matrix6X anew;              // each column's wrench in its own segment's tip axes (sorted)
   Matrix6X acur;              // wrenches felt by the current segment, then passed to the parent
-  Eigen::MatrixXd eg;         // mcap x n_segments: column i = (S_i^T A_i)^T, zero outside i's range
+  Eigen::MatrixXd eg;         // mcap x n_segments: column i = (S_i^T A_i)^T on i's felt range (only)
   Eigen::VectorXd ug, nug, rhs;
   mutable Eigen::VectorXd tmp;
-  Eigen::MatrixXd kg, cholg, vg;             // coupling matrix, its Cholesky factor or eigenvectors
+  Eigen::MatrixXd kg, cholg, vg;             // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
   Eigen::VectorXd invg;                      // policy multiplier per eigenvalue
   mutable Eigen::MatrixXd work_g, work_v;    // workspace of the smallest eigenvalue (matrix, scratch)
   mutable Matrix6X seg_force;                // per-segment wrench accumulators
@@ -193,6 +194,12 @@ class HdCore {
   // outward pass without velocity, gravity or constraints (inverse_inertia.cpp).
   void inverseInertia(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> out);
   double smallestSingularValue() const;
+  // The constraint columns segment i feels, [first, second) in the last solve's column order (the
+  // sorted order on the several-segment path): where eg.col(i) and e_i are defined.
+  std::pair<int, int> feltColumns(int i) const {
+    if (!res.general) return {0, res.m};
+    return {ws.general.lo(model, i), ws.general.active[i]};
+  }
   Eigen::Map<const Eigen::VectorXd> nu() const {
     return Eigen::Map<const Eigen::VectorXd>(res.general ? res.nu_user.data() : res.nu.data(), res.m);
   }
@@ -268,6 +275,8 @@ class HdCore {
                             Eigen::Ref<Eigen::VectorXd> tau_cmd) const;
   // out = K^+ rhs for either path (vectors of length m, sorted order on the general path).
   void couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::Ref<Eigen::VectorXd> out) const;
+  // B <- K^-1 B column by column through the certified Cholesky factor of either path (m rows).
+  void couplingSolveColumns(Eigen::Ref<Eigen::MatrixXd> B) const;
 
   // Pass-through (pass_through.cpp).
   int passThroughEnergy(const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);

@@ -124,7 +124,8 @@ void HdCore::driverEnergy(Eigen::Ref<Eigen::VectorXd> out) const {
     const int joint = model.seg[i].joint;
     if (joint < 0) continue;
     if (res.general) {
-      out.noalias() += ws.general.eg.col(i).head(m) * ws.pt.free(joint);  // zero outside the columns i feels
+      const auto [lo, hi] = feltColumns(static_cast<int>(i));
+      out.segment(lo, hi - lo).noalias() += ws.general.eg.col(i).segment(lo, hi - lo) * ws.pt.free(joint);
     } else {
       out.noalias() += ws.seg[i].e.leftCols(m).transpose() * ws.pt.free(joint);
     }

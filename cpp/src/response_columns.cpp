@@ -142,7 +142,8 @@ void HdCore::responseInward(const Eigen::Ref<const Eigen::VectorXi>& joints, lon
     if (ascending)
       while (lo > 0 && joint_seg(lo - 1) >= i) --lo;
     const int end = model.subtree_end[i];
-    const double* eg = ws.general.eg.col(i).data();
+    const double* eg = ws.general.eg.col(i).data();  // defined on the felt columns
+    const std::pair<int, int> felt = feltColumns(i);
     const Eigen::Map<const Vector6> S0(r.axis.col(i).data()), u0(r.axis_inertia.col(i).data());
     for (long c = lo; c < kc; ++c) {
       const int js = joint_seg(c);
@@ -172,7 +173,7 @@ void HdCore::responseInward(const Eigen::Ref<const Eigen::VectorXi>& joints, lon
       for (int t = 0; t < 3; ++t) dp[t] = f(t), dp[3 + t] = n(t);
       if (sm.joint < 0) continue;
       double* du = DU.col(c).data();
-      for (int t = 0; t < m; ++t) du[t] += eg[t] * acc;
+      for (int t = felt.first; t < felt.second; ++t) du[t] += eg[t] * acc;
     }
     for (long c = 0; c < lo; ++c) SDP(i, c) = 0.0;  // not alive yet
   }
@@ -186,11 +187,7 @@ void HdCore::responseCoupling(long c0, long kc, Eigen::Ref<Eigen::MatrixXd>* dnu
   auto DNU = r.dnu.topLeftCorner(m, kc);
   if (ws.use_cholesky && m > 0) {  // all columns through one factor
     DNU = DU;
-    if (res.general) {
-      detail::choleskySolveColumns(ws.general.cholg.topLeftCorner(m, m), DNU);
-    } else {
-      detail::choleskySolveColumns(ws.fast.chol, DNU);
-    }
+    couplingSolveColumns(DNU);
   }
   for (long c = 0; c < kc; ++c) {
     if (!ws.use_cholesky) couplingSolve(DU.col(c), DNU.col(c));
@@ -227,7 +224,8 @@ void HdCore::responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, lo
       }
     }
     const Vector3 offset = r.offset.col(i);
-    const double* eg = ws.general.eg.col(i).data();
+    const double* eg = ws.general.eg.col(i).data();  // defined on the felt columns
+    const std::pair<int, int> felt = feltColumns(i);
     const double Dinv = ws.seg[i].Dinv;
     const Eigen::Map<const Vector6> S0(r.axis.col(i).data()), u0(r.axis_inertia.col(i).data());
     for (long c = first; c < kc; ++c) {
@@ -240,7 +238,7 @@ void HdCore::responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, lo
       }
       double v = (joints(c0 + c) == sm.joint ? 1.0 : 0.0) - SDP(i, c) - u0.head<3>().dot(a) - u0.tail<3>().dot(w);
       const double* dnu = DNU.col(c).data();
-      for (int t = 0; t < m; ++t) v -= eg[t] * dnu[t];
+      for (int t = felt.first; t < felt.second; ++t) v -= eg[t] * dnu[t];
       v *= Dinv;
       dqdd(sm.joint, c0 + c) = v;
       for (int t = 0; t < 3; ++t) acc[t] = a(t) + S0(t) * v, acc[3 + t] = w(t) + S0(3 + t) * v;

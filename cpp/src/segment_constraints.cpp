@@ -91,6 +91,18 @@ int HdCore::sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments) {
   return 0;
 }
 
+// Calls f(lo, w) for each diagonal block [lo, lo + w) of K: the columns under one segment
+// attached to the base (columns of different such subtrees share no segment, so K couples them
+// by exact zeros). A chain has one block.
+template <typename F>
+void HdCore::forEachCouplingBlock(const F& f) const {
+  const CouplingGeneral& g = ws.general;
+  for (int r = 0; r < static_cast<int>(model.ns); r = model.subtree_end[r]) {
+    const int lo = g.lo(model, r), w = g.active[r] - lo;
+    if (w > 0) f(lo, w);
+  }
+}
+
 // Segment i's own columns: alfa in its tip axes (the moment is already about its origin).
 void HdCore::addOwnColumns(int i, const Eigen::Ref<const Matrix6X>& alfa) {
   CouplingGeneral& g = ws.general;
@@ -108,7 +120,13 @@ int HdCore::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
   CouplingGeneral& g = ws.general;
   const int M = res.m;
   g.ug.head(M).setZero();
-  g.kg.topLeftCorner(M, M).setZero();
+  forEachCouplingBlock([&g](int lo, int w) {  // K is only ever read block by block
+    if (w == kMaxConstraints) {
+      g.kg.block<kMaxConstraints, kMaxConstraints>(lo, lo).setZero();
+    } else {
+      g.kg.block(lo, lo, w, w).setZero();
+    }
+  });
   ws.kappa = 0.0;
   const bool has_tau = ff_torques.size() != 0;
   for (int i = static_cast<int>(model.ns) - 1; i >= 0; --i) {
@@ -117,7 +135,6 @@ int HdCore::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
     addOwnColumns(i, alfa);
     const int lo = g.lo(model, i), w = g.active[i] - lo;  // the columns felt here: [lo, lo + w)
     Vector6 pa;
-    g.eg.col(i).head(M).setZero();
     if (sm.joint >= 0) {
       double free = 0.0;
       if (!articulate(i, has_tau ? ff_torques(sm.joint) : 0.0, pa, free)) return degenerate(i);
@@ -184,7 +201,6 @@ void HdCore::factorizeCouplingGeneral() {
   res.sigma_known = false;
   ws.use_cholesky = false;
   if (m == 0) return;
-  const auto K = g.kg.topLeftCorner(m, m);
   if (options.policy == SingularityPolicy::TruncatedPseudoInverse && choleskyBlocks()) {
     ws.use_cholesky = true;
     res.rank = m;
@@ -192,7 +208,8 @@ void HdCore::factorizeCouplingGeneral() {
   }
   auto W = g.work_g.topLeftCorner(m, m);
   auto V = g.vg.topLeftCorner(m, m);
-  W = K;
+  W.setZero();  // the exact zeros between the blocks, which kg does not hold
+  forEachCouplingBlock([&](int lo, int w) { W.block(lo, lo, w, w) = g.kg.block(lo, lo, w, w); });
   detail::jacobiEigen(W, V);
   const auto lam = W.diagonal();
   const double cut = options.rcond * std::max(std::max(lam.maxCoeff(), 0.0), ws.kappa);
@@ -203,25 +220,12 @@ void HdCore::factorizeCouplingGeneral() {
                                        options.damping);
 }
 
-// Calls f(lo, w) for each diagonal block [lo, lo + w) of K: the columns under one segment
-// attached to the base (columns of different such subtrees share no segment, so K couples them
-// by exact zeros). A chain has one block.
-template <typename F>
-void HdCore::forEachCouplingBlock(const F& f) const {
-  const CouplingGeneral& g = ws.general;
-  for (int r = 0; r < static_cast<int>(model.ns); r = model.subtree_end[r]) {
-    const int lo = g.lo(model, r), w = g.active[r] - lo;
-    if (w > 0) f(lo, w);
-  }
-}
-
-// Cholesky factor of K into cholg (zero off the blocks) and the certificate that every
-// eigenvalue is above the truncation threshold: lambda_min(K) >= 1 / ||L^-1||_F^2 > rcond kappa
-// (kappa >= lambda_max(K)). False if a block is not positive definite or the proof fails.
+// Cholesky factor of K into cholg's diagonal blocks (their lower triangles; nothing reads the
+// rest) and the certificate that every eigenvalue is above the truncation threshold:
+// lambda_min(K) >= 1 / ||L^-1||_F^2 > rcond kappa (kappa >= lambda_max(K)). False if a block is
+// not positive definite or the proof fails.
 bool HdCore::choleskyBlocks() {
   CouplingGeneral& g = ws.general;
-  const int m = res.m;
-  g.cholg.topLeftCorner(m, m).setZero();
   bool ok = true;
   double frob2 = 0.0;  // ||L^-1||_F^2
   forEachCouplingBlock([&](int lo, int w) {
@@ -284,6 +288,17 @@ void HdCore::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::
   out.head(m).noalias() = V.lazyProduct(g.tmp.head(m));
 }
 
+void HdCore::couplingSolveColumns(Eigen::Ref<Eigen::MatrixXd> B) const {
+  if (!res.general) {
+    detail::choleskySolveColumns(ws.fast.chol, B);
+    return;
+  }
+  forEachCouplingBlock([&](int lo, int w) {
+    auto rows = B.middleRows(lo, w);
+    detail::choleskySolveColumns(ws.general.cholg.block(lo, lo, w, w), rows);
+  });
+}
+
 // Final outward sweep of the several-segment path: the columns felt by segment i.
 void HdCore::finalSweepGeneral(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   const CouplingGeneral& g = ws.general;
@@ -300,6 +315,7 @@ void HdCore::commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_so
   const CouplingGeneral& g = ws.general;
   Matrix6X& f = g.seg_force;  // the wrench felt by each segment
   tau_cmd.setZero();
+  if (res.m == 0) return;
   f.setZero();
   for (int i = static_cast<int>(model.ns) - 1; i >= 0; --i) {
     const SegmentModel& sm = model.seg[i];

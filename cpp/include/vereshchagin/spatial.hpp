@@ -90,6 +90,40 @@ inline Vector6 crossForce(const Vector6& a, const Vector6& f) {
   return out;
 }
 
+// Products with P = [p]x written as cross products: column j of P A is p x (column j of A), row
+// i of A P is (row i of A) x p. Each entry is then the same two products and one difference as
+// in the dense 3x3 product with P, whose third term is an exact zero (x + 0 = x), so the results
+// are bit for bit those of the dense product at a third fewer operations.
+inline Matrix3 skewTimes(const Vector3& p, const Matrix3& A) {  // [p]x A
+  Matrix3 out;
+  for (int j = 0; j < 3; ++j) {
+    out(0, j) = p.y() * A(2, j) - p.z() * A(1, j);
+    out(1, j) = p.z() * A(0, j) - p.x() * A(2, j);
+    out(2, j) = p.x() * A(1, j) - p.y() * A(0, j);
+  }
+  return out;
+}
+
+inline Matrix3 timesSkew(const Matrix3& A, const Vector3& p) {  // A [p]x
+  Matrix3 out;
+  for (int i = 0; i < 3; ++i) {
+    out(i, 0) = A(i, 1) * p.z() - A(i, 2) * p.y();
+    out(i, 1) = A(i, 2) * p.x() - A(i, 0) * p.z();
+    out(i, 2) = A(i, 0) * p.y() - A(i, 1) * p.x();
+  }
+  return out;
+}
+
+inline Matrix3 transposeTimesSkew(const Matrix3& A, const Vector3& p) {  // A^T [p]x
+  Matrix3 out;
+  for (int i = 0; i < 3; ++i) {
+    out(i, 0) = A(1, i) * p.z() - A(2, i) * p.y();
+    out(i, 1) = A(2, i) * p.x() - A(0, i) * p.z();
+    out(i, 2) = A(0, i) * p.y() - A(1, i) * p.x();
+  }
+  return out;
+}
+
 // A symmetric 6x6 inertia (rigid or articulated) given in the child frame, expressed in the
 // parent frame: X^* I X with X the parent-to-child motion transform. Block form with
 // I = [M H; H^T J]: rotate every block by R, then shift the reference point by p (P = [p]x):
@@ -99,11 +133,10 @@ inline void addInertiaToParent(const Pose& X, const Matrix6& Ic, Matrix6& Ip) {
   const Matrix3 M = R * Ic.topLeftCorner<3, 3>() * R.transpose();
   const Matrix3 H = R * Ic.topRightCorner<3, 3>() * R.transpose();
   const Matrix3 J = R * Ic.bottomRightCorner<3, 3>() * R.transpose();
-  const Matrix3 P = skew(X.p);
-  const Matrix3 MP = M * P;
+  const Matrix3 MP = timesSkew(M, X.p);
   const Matrix3 H2 = H - MP;
-  const Matrix3 PH = P * H;
-  const Matrix3 J2 = J - H.transpose() * P + PH - P * MP;
+  const Matrix3 PH = skewTimes(X.p, H);
+  const Matrix3 J2 = J - transposeTimesSkew(H, X.p) + PH - skewTimes(X.p, MP);
   Ip.topLeftCorner<3, 3>() += M;
   Ip.topRightCorner<3, 3>() += H2;
   Ip.bottomLeftCorner<3, 3>() += H2.transpose();
