@@ -31,7 +31,13 @@ void HdCore::screwPose(const SegmentModel& sm, SegmentState& s, double q) const 
   const double theta = sm.w_norm * q;
   const double sn = std::sin(theta), c1 = 1.0 - std::cos(theta);
   const Matrix3 K = skew(k);
-  const Matrix3 KK = K * K;
+  // K K entry by entry: the nonzero products of the dense product (the others are exact zeros),
+  // so the same values at a third of the multiplications: k_i k_j off the diagonal and minus the
+  // other two squares on it.
+  Matrix3 KK;
+  KK << -(k.z() * k.z()) - k.y() * k.y(), k.y() * k.x(), k.z() * k.x(),  //
+      k.x() * k.y(), -(k.z() * k.z()) - k.x() * k.x(), k.z() * k.y(),    //
+      k.x() * k.z(), k.y() * k.z(), -(k.y() * k.y()) - k.x() * k.x();
   Matrix3 R = Matrix3::Identity();
   R.noalias() += sn * K + c1 * KK;
   // (I - R) = -(sn K + c1 KK), applied to k x v / |w|.
