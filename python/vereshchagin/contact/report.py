@@ -197,19 +197,12 @@ def _grasp_comparison(e_c, e_n) -> list[str]:
     return lines
 
 
-def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None) -> dict:
-    """Run the three use cases (both/all variants), write tables and figures into ``out_dir/contact``.
+def _rel(p: Path) -> str:
+    return f"contact/{p.name}"
 
-    Returns
-    -------
-    dict
-        ``index``: Markdown lines for results/index.md; ``runs``: the runs; ``ok``: all physical
-        checks passed; ``seconds``: wall time.
-    """
-    say = progress or (lambda s: None)
-    out = Path(out_dir) / "contact"
-    out.mkdir(parents=True, exist_ok=True)
-    t_start = time.perf_counter()
+
+def _run_jobs(quick: bool, say: Callable[[str], None]) -> dict:
+    """Simulate every use case and variant; keys (case, variant)."""
     jobs: list[tuple[str, str, Callable[[], Run]]] = [
         ("grasp", "contact", partial(grasp, True, quick)),
         ("grasp", "contactless", partial(grasp, False, quick)),
@@ -225,11 +218,12 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
             f"[contact] {_bar((k + 1) / len(jobs))} {case} {variant} "
             f"({runs[(case, variant)].t[-1]:.1f} s simulated in {time.perf_counter() - t0:.1f} s)"
         )
+    return runs
 
-    def rel(p: Path) -> str:
-        return f"contact/{p.name}"
 
-    idx = [
+def _intro_lines(quick: bool) -> list[str]:
+    """The section's heading and the plant and controller description."""
+    return [
         "## Exploiting contact surfaces: the use cases of W. K. Lau (2023) in simulation",
         "",
         "Plant: MuJoCo (1 kHz, implicitfast) model of the Kinova Gen3 + rigid Robotiq 2F-85 compiled from our "
@@ -249,9 +243,10 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         "Joint j in the tables is the report's 0-based joint j = our joint_(j+1).",
         "",
     ]
-    ok = True
 
-    # -- use case 1 --------------------------------------------------------------------------------
+
+def _grasp_section(runs: dict, out: Path) -> tuple[list[str], bool]:
+    """Use case 1: tables, figures and index lines; whether its physical checks pass."""
     gc, gn = runs[("grasp", "contact")], runs[("grasp", "contactless")]
     oc, on = metrics.grasp_outcome(gc), metrics.grasp_outcome(gn)
     e_c, e_n = metrics.effort(gc, gc.window("slide")), metrics.effort(gn, gn.window("slide"))
@@ -267,9 +262,8 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         and not gn.table_touch
         and not metrics.grasp_outcome(gn)["contact_detected"]
     )
-    ok &= grasp_ok
     (out / "grasp_effort.md").write_text("\n".join(md_table(header, rows)) + "\n", encoding="utf-8")
-    idx += [
+    lines = [
         "### Use case 1: grasp by sliding (cf. report Tables 6.1, 6.2)",
         "",
         f"Contact: detected at t = {oc['contact_time']:.3f} s; slid {1e3 * oc['distance_x']:.1f} mm along x "
@@ -284,8 +278,8 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         "",
         *md_table(header, rows),
         "",
-        f"CSV: [{rel(out / 'grasp_effort.csv')}]({rel(out / 'grasp_effort.csv')}); figures: "
-        f"[{rel(p1)}]({rel(p1)}), [{rel(p2)}]({rel(p2)})",
+        f"CSV: [{_rel(out / 'grasp_effort.csv')}]({_rel(out / 'grasp_effort.csv')}); figures: "
+        f"[{_rel(p1)}]({_rel(p1)}), [{_rel(p2)}]({_rel(p2)})",
         "",
         "How contact changes torque and energy, next to the report's measurements (section 6.2):",
         "",
@@ -297,8 +291,11 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         "lever), whose own joint controllers are not modelled here.",
         "",
     ]
+    return lines, grasp_ok
 
-    # -- use case 2 --------------------------------------------------------------------------------
+
+def _writing_section(runs: dict, out: Path) -> tuple[list[str], bool]:
+    """Use case 2: tables, figures and index lines; whether its physical checks pass."""
     wc, wn = runs[("writing", "contact")], runs[("writing", "contactless")]
     ac, an = metrics.writing_accuracy(wc), metrics.writing_accuracy(wn)
     w_ok = (
@@ -308,7 +305,6 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         and abs(ac["length"] - 0.10) < 0.005
         and abs(an["length"] - 0.10) < 0.005
     )
-    ok &= w_ok
     wh = [
         "case",
         "maximum displacement (m)",
@@ -345,7 +341,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     _plot_trajectories(p3, {"contact": wc, "contactless": wn}, "Use case 2: pen tip", y_mm=True)
     _plot_effort(p4, {"contact": wc, "contactless": wn}, "write", "Use case 2, writing: torque and power")
     less_accurate = ac["max_displacement"] > an["max_displacement"]
-    idx += [
+    lines = [
         "### Use case 2: writing a 10 cm line (cf. report Table 6.3)",
         "",
         *md_table(wh, wrows),
@@ -361,13 +357,16 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         f"{ew_n['energy_tau2'].sum():.1f} N² m² s; ∫|τ q̇| contact {ew_c['energy_abs'].sum():.3f} J, contactless "
         f"{ew_n['energy_abs'].sum():.3f} J.",
         "",
-        f"Tables: [{rel(out / 'writing_accuracy.csv')}]({rel(out / 'writing_accuracy.csv')}), "
-        f"[{rel(out / 'writing_effort.csv')}]({rel(out / 'writing_effort.csv')}); figures: "
-        f"[{rel(p3)}]({rel(p3)}), [{rel(p4)}]({rel(p4)})",
+        f"Tables: [{_rel(out / 'writing_accuracy.csv')}]({_rel(out / 'writing_accuracy.csv')}), "
+        f"[{_rel(out / 'writing_effort.csv')}]({_rel(out / 'writing_effort.csv')}); figures: "
+        f"[{_rel(p3)}]({_rel(p3)}), [{_rel(p4)}]({_rel(p4)})",
         "",
     ]
+    return lines, w_ok
 
-    # -- use case 3 --------------------------------------------------------------------------------
+
+def _elbow_section(runs: dict, out: Path) -> tuple[list[str], bool]:
+    """Use case 3: tables, figures and index lines; whether its physical checks pass."""
     er = {v: runs[("elbow", v)] for v in ELBOW_VARIANTS}
     ee = {v: metrics.effort(r, r.window("slide")) for v, r in er.items()}
     eo = {v: metrics.elbow_outcome(r) for v, r in er.items()}
@@ -418,8 +417,7 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         and not er["unsupported"].support_force.any()
         and abs(ou["final_error_x"]) < 0.005
     )
-    ok &= elbow_ok
-    idx += [
+    lines = [
         "### Use case 3: resting elbow (report section 6.4)",
         "",
         "End-effector moves 0.10 m towards the base in the air (all six directions constrained); the elbow "
@@ -434,9 +432,32 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         "",
         f"Checks: {'ok' if elbow_ok else 'FAILED'}.",
         "",
-        f"CSV: [{rel(out / 'elbow_effort.csv')}]({rel(out / 'elbow_effort.csv')}); figure: [{rel(p5)}]({rel(p5)})",
+        f"CSV: [{_rel(out / 'elbow_effort.csv')}]({_rel(out / 'elbow_effort.csv')}); figure: [{_rel(p5)}]({_rel(p5)})",
         "",
     ]
+    return lines, elbow_ok
+
+
+def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None) -> dict:
+    """Run the three use cases (both/all variants), write tables and figures into ``out_dir/contact``.
+
+    Returns
+    -------
+    dict
+        ``index``: Markdown lines for results/index.md; ``runs``: the runs; ``ok``: all physical
+        checks passed; ``seconds``: wall time.
+    """
+    say = progress or (lambda s: None)
+    out = Path(out_dir) / "contact"
+    out.mkdir(parents=True, exist_ok=True)
+    t_start = time.perf_counter()
+    runs = _run_jobs(quick, say)
+    idx = _intro_lines(quick)
+    ok = True
+    for section in (_grasp_section, _writing_section, _elbow_section):
+        lines, passed = section(runs, out)
+        idx += lines
+        ok &= passed
     secs = time.perf_counter() - t_start
     idx += [
         f"Contact experiments: {len(runs)} runs, {sum(r.t[-1] for r in runs.values()):.1f} s simulated in "
