@@ -9,6 +9,18 @@
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
+namespace {
+
+// Appends s to `tree` under segment `parent` of `robot`'s segment order (-1: the root link).
+// fromState and setRotorInertia rebuild a KDL::Tree this way in segment order: KDL numbers the
+// joints (q_nr) in insertion order, so the joint order stays the segment order's.
+void appendSegment(KDL::Tree& tree, const vereshchagin::RobotTree& robot, const KDL::Segment& s, int parent,
+                   const char* context) {
+  const std::string& hook = parent < 0 ? robot.root_link : robot.segment_names[static_cast<std::size_t>(parent)];
+  if (!tree.addSegment(s, hook)) raise(std::string(context) + ": segment '" + s.getName() + "' cannot be added");
+}
+
+}  // namespace
 
 PyTree PyTree::fromUrdf(const py::object& source, const std::string& root, vereshchagin::InertiaCheck inertia_check) {
   const UrdfSource src = urdfSourceArg(source);
@@ -40,8 +52,7 @@ PyTree PyTree::fromState(const py::tuple& state) {
     const KDL::Segment s = segmentFromState(entry[0].cast<py::tuple>());
     const int parent = entry[1].cast<int>();
     if (parent < -1 || parent >= t.segmentCount()) raise("Tree state: parent index out of range");
-    const std::string& hook = parent < 0 ? t.robot.root_link : t.robot.segment_names[static_cast<std::size_t>(parent)];
-    if (!t.robot.tree.addSegment(s, hook)) raise("Tree state: segment '" + s.getName() + "' cannot be added");
+    appendSegment(t.robot.tree, t.robot, s, parent, "Tree state");
     t.robot.segment_names.push_back(s.getName());
     t.robot.parent.push_back(parent);
   }
@@ -79,18 +90,14 @@ void PyTree::setRotorInertia(const py::object& values) {
   std::vector<double> rotor(static_cast<std::size_t>(segmentCount()), 0.0);  // per segment
   for (std::size_t k = 0; k < robot.joints.size(); ++k)
     rotor[robot.joints[k].segment] = a.at(static_cast<py::ssize_t>(k));
-  // Re-insert the segments in segment order, as fromState does: KDL numbers the joints (q_nr) in
-  // insertion order, so the joint order and the segment order stay what they were.
   KDL::Tree rebuilt(robot.root_link);
   for (int i = 0; i < segmentCount(); ++i) {
     const KDL::Segment& seg = segment(i);
     const KDL::Joint& j = seg.getJoint();
     const KDL::Joint joint =
         j.getType() == KDL::Joint::None ? j : withRotorInertia(j, rotor[static_cast<std::size_t>(i)]);
-    const int parent = robot.parent[static_cast<std::size_t>(i)];
-    const std::string& hook = parent < 0 ? robot.root_link : segmentName(parent);
-    if (!rebuilt.addSegment(KDL::Segment(seg.getName(), joint, seg.getFrameToTip(), seg.getInertia()), hook))
-      raise("rotor_inertia: segment '" + seg.getName() + "' cannot be re-added");
+    appendSegment(rebuilt, robot, KDL::Segment(seg.getName(), joint, seg.getFrameToTip(), seg.getInertia()),
+                  robot.parent[static_cast<std::size_t>(i)], "rotor_inertia");
   }
   robot.tree = rebuilt;
 }
