@@ -150,11 +150,24 @@ void FrictionCore::gradient(int k) {
 }
 
 // Stage 1: minimise 1/2 x^T Q x - c^T x over lo <= x <= hi by a primal active-set method.
+namespace {
+
+constexpr int kPrimalDualRounds = 4;
+
+// boxQp's iteration bound (derivation there): (P + 1) (k + 1) 3^k + P, capped at 1e8.
+long boxQpIterationBound(int k) {
+  long bound = k + 1;
+  for (int i = 0; i < k && bound < 100000000L; ++i) bound *= 3;
+  bound = (kPrimalDualRounds + 1) * bound + kPrimalDualRounds;
+  return std::min(bound, 100000000L);
+}
+
+}  // namespace
+
 int FrictionCore::boxQp(int k) {
   auto x = x_.head(k);
-  x.setZero();  // feasible: every box contains 0
-  auto state = state_.head(k);
-  state.setZero();  // 0 free, -1 at lower bound, +1 at upper bound
+  x.setZero();               // feasible: every box contains 0
+  state_.head(k).setZero();  // 0 free, -1 at lower bound, +1 at upper bound
   // Scale of the gradient (accelerations), at Q's physical scale (not Q's entries, which a task
   // can make vanish): the frictionless accelerations, what the current friction iterate causes,
   // and the torques acting (feed-forward, kinetic friction, the frictionless motor command). Not
@@ -164,7 +177,6 @@ int FrictionCore::boxQp(int k) {
   // then round-off.
   const double cmax = std::max(c_.head(k).cwiseAbs().maxCoeff(), qdd0_.cwiseAbs().maxCoeff());
   const double torque_scale = std::max(tau0_.cwiseAbs().maxCoeff(), tau_cmd0_.cwiseAbs().maxCoeff());
-  double tol_g = 0.0;
   // Iteration bound. Between two face-optimal points each iteration binds one more variable (a
   // blocked step) or ends on the face optimum (a full step): at most k + 1 iterations. The
   // objective never increases, and it strictly decreases from one face-optimal point to the next
@@ -184,11 +196,7 @@ int FrictionCore::boxQp(int k) {
   // rounds when the whole Q is singular (a task fixes accelerations): its nearly singular faces
   // have minimisers far outside the box, and the rounds then cost more than the primal steps.
   // (The free-set factor updates of factorDelete() change how a step is computed, not which.)
-  constexpr int kPrimalDualRounds = 4;
-  long bound = k + 1;
-  for (int i = 0; i < k && bound < 100000000L; ++i) bound *= 3;
-  bound = (kPrimalDualRounds + 1) * bound + kPrimalDualRounds;
-  const long max_iterations = std::min(bound, 100000000L);
+  const long max_iterations = boxQpIterationBound(k);
   int rounds_left = kPrimalDualRounds;
   bool face_optimal = false, bland = false;
   double last_face_value = kInf;
@@ -197,11 +205,11 @@ int FrictionCore::boxQp(int k) {
   for (long it = 0; it < max_iterations; ++it) {
     iterations_ = static_cast<int>(std::min<long>(it + 1, 2147483647L));
     gscale_ = std::max({cmax, qscale_ * x.cwiseAbs().maxCoeff(), qscale_ * torque_scale, 1e-300});
-    tol_g = kGradientTolerance * gscale_;
+    const double tol_g = kGradientTolerance * gscale_;
     gradient(k);
     int nf = 0;
     for (int i = 0; i < k; ++i)
-      if (state(i) == 0) free_idx_(nf++) = i;
+      if (state_(i) == 0) free_idx_(nf++) = i;
     if (nf > 0 && !face_optimal) {
       const bool zero_curvature = freeStep(nf);
       // A singular full problem (a task fixes some accelerations) leaves nearly singular faces
@@ -209,73 +217,99 @@ int FrictionCore::boxQp(int k) {
       if (it == 0 && !free_full_rank_) rounds_left = 0;
       if (!zero_curvature && free_full_rank_ && rounds_left > 0) {
         --rounds_left;
-        for (int a = 0; a < nf; ++a) x(free_idx_(a)) += p_(a);  // the face minimiser (maybe outside)
-        gradient(k);
-        bool changed = false;
-        for (int i = 0; i < k; ++i) {
-          if (state(i) == 0) {
-            if (x(i) > hi_(i))
-              state(i) = 1, changed = true;
-            else if (x(i) < lo_(i))
-              state(i) = -1, changed = true;
-          } else if ((state(i) < 0 ? -grad_(i) : grad_(i)) > tol_g) {
-            state(i) = 0, changed = true;  // wrong-sign multiplier: release
-          }
-        }
-        if (!changed) return ChainHdSolver::E_NOERROR;  // KKT point
-        factor_valid_ = false;
-        for (int i = 0; i < k; ++i)
-          x(i) = state(i) > 0 ? hi_(i) : (state(i) < 0 ? lo_(i) : std::min(hi_(i), std::max(lo_(i), x(i))));
+        if (primalDualRound(k, nf, tol_g)) return ChainHdSolver::E_NOERROR;  // KKT point
         last_face_value = kInf;
         continue;
       }
-      const auto dir = zero_curvature ? d_.head(nf) : p_.head(nf);
-      double alpha = zero_curvature ? kInf : 1.0;
-      int block = -1, side = 0, block_pos = -1;
-      for (int a = 0; a < nf; ++a) {
-        const int i = free_idx_(a);
-        const double s = dir(a);
-        if (s > 0.0 && hi_(i) < kInf) {
-          const double t = (hi_(i) - x(i)) / s;
-          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = 1, block_pos = a;
-        } else if (s < 0.0 && lo_(i) > -kInf) {
-          const double t = (lo_(i) - x(i)) / s;
-          if (t < alpha) alpha = std::max(t, 0.0), block = i, side = -1, block_pos = a;
-        }
-      }
-      if (!std::isfinite(alpha))
-        return fail(E_NOT_CONVERGED,
-                    "the task drives a joint into its position limit: the limit reaction would be unbounded");
-      for (int a = 0; a < nf; ++a) x(free_idx_(a)) += alpha * dir(a);
-      if (block >= 0) {
-        state(block) = side;
-        x(block) = side > 0 ? hi_(block) : lo_(block);
-        factorDelete(block_pos, nf);
-        face_optimal = false;
-        continue;
-      }
-      face_optimal = true;  // full Newton step: optimal on this face
+      const int rc = primalStep(nf, zero_curvature, face_optimal);
+      if (rc != 0) return rc;
       continue;
     }
     // Optimal on the current face: the bound multipliers must have the right sign.
     const double value = 0.5 * x.dot(grad_.head(k)) - 0.5 * c_.head(k).dot(x);  // 1/2 x'Qx - c'x
     if (!(value < last_face_value)) bland = true;
     last_face_value = value;
-    int release = -1;
-    double worst = tol_g;
-    for (int i = 0; i < k; ++i) {
-      const double violation = state(i) < 0 ? -grad_(i) : (state(i) > 0 ? grad_(i) : 0.0);
-      if (violation > worst) {
-        worst = violation, release = i;
-        if (bland) break;  // smallest index
-      }
-    }
+    const int release = wrongSignMultiplier(k, tol_g, bland);
     if (release < 0) return ChainHdSolver::E_NOERROR;
-    state(release) = 0;
+    state_(release) = 0;
     factor_valid_ = false;
     face_optimal = false;
   }
   return fail(E_NOT_CONVERGED, "friction optimisation did not converge in %ld active-set iterations", max_iterations);
+}
+
+// A primal-dual round from the free set's minimiser p_ (boxQp): take the full step, re-guess the
+// working set from every bound violation and wrong-sign multiplier, clamp x back into the box.
+// True when nothing changed: x is a KKT point.
+bool FrictionCore::primalDualRound(int k, int nf, double tol_g) {
+  auto x = x_.head(k);
+  auto state = state_.head(k);
+  for (int a = 0; a < nf; ++a) x(free_idx_(a)) += p_(a);  // the face minimiser (maybe outside)
+  gradient(k);
+  bool changed = false;
+  for (int i = 0; i < k; ++i) {
+    if (state(i) == 0) {
+      if (x(i) > hi_(i))
+        state(i) = 1, changed = true;
+      else if (x(i) < lo_(i))
+        state(i) = -1, changed = true;
+    } else if ((state(i) < 0 ? -grad_(i) : grad_(i)) > tol_g) {
+      state(i) = 0, changed = true;  // wrong-sign multiplier: release
+    }
+  }
+  if (!changed) return true;
+  factor_valid_ = false;
+  for (int i = 0; i < k; ++i)
+    x(i) = state(i) > 0 ? hi_(i) : (state(i) < 0 ? lo_(i) : std::min(hi_(i), std::max(lo_(i), x(i))));
+  return false;
+}
+
+// A primal step along the free set's direction (the minimiser p_, or d_ of zero curvature) up to
+// the first bound in the way, which joins the working set; face_optimal when no bound blocks (a
+// full Newton step). E_NOT_CONVERGED when a zero-curvature direction meets no bound.
+int FrictionCore::primalStep(int nf, bool zero_curvature, bool& face_optimal) {
+  const auto dir = zero_curvature ? d_.head(nf) : p_.head(nf);
+  double alpha = zero_curvature ? kInf : 1.0;
+  int block = -1, side = 0, block_pos = -1;
+  for (int a = 0; a < nf; ++a) {
+    const int i = free_idx_(a);
+    const double s = dir(a);
+    if (s > 0.0 && hi_(i) < kInf) {
+      const double t = (hi_(i) - x_(i)) / s;
+      if (t < alpha) alpha = std::max(t, 0.0), block = i, side = 1, block_pos = a;
+    } else if (s < 0.0 && lo_(i) > -kInf) {
+      const double t = (lo_(i) - x_(i)) / s;
+      if (t < alpha) alpha = std::max(t, 0.0), block = i, side = -1, block_pos = a;
+    }
+  }
+  if (!std::isfinite(alpha))
+    return fail(E_NOT_CONVERGED,
+                "the task drives a joint into its position limit: the limit reaction would be unbounded");
+  for (int a = 0; a < nf; ++a) x_(free_idx_(a)) += alpha * dir(a);
+  if (block >= 0) {
+    state_(block) = side;
+    x_(block) = side > 0 ? hi_(block) : lo_(block);
+    factorDelete(block_pos, nf);
+    face_optimal = false;
+    return 0;
+  }
+  face_optimal = true;  // full Newton step: optimal on this face
+  return 0;
+}
+
+// At a face optimum: the bound whose multiplier has the wrong sign by the most (beyond tol_g), or
+// with Bland's rule the first such; -1 if none (optimal).
+int FrictionCore::wrongSignMultiplier(int k, double tol_g, bool bland) const {
+  int release = -1;
+  double worst = tol_g;
+  for (int i = 0; i < k; ++i) {
+    const double violation = state_(i) < 0 ? -grad_(i) : (state_(i) > 0 ? grad_(i) : 0.0);
+    if (violation > worst) {
+      worst = violation, release = i;
+      if (bland) break;  // smallest index
+    }
+  }
+  return release;
 }
 
 }  // namespace detail

@@ -68,6 +68,9 @@ class FrictionCore {
   // Subproblem on the free set: p = -Q_FF^+ g_F, and a zero-curvature descent direction d
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
+  bool primalDualRound(int k, int nf, double tol_g);
+  int primalStep(int nf, bool zero_curvature, bool& face_optimal);
+  int wrongSignMultiplier(int k, double tol_g, bool bland) const;
   void gradient(int k);
   void factorDelete(int q, int nf);
 
