@@ -189,7 +189,10 @@ PyChain PyChain::fromState(const py::tuple& state) {
   return c;
 }
 
-void bindChain(py::module_& mod) {
+namespace {
+
+// Joint: the joint types of Chain.add_segment.
+void bindJointSpec(py::module_& mod) {
   py::class_<JointSpec>(mod, "Joint", R"doc(A joint type for :meth:`Chain.add_segment`, made by the static methods.
 
 ``Joint.revolute(axis, origin)`` and ``Joint.prismatic(axis, origin)`` give a rotation about, or
@@ -215,6 +218,61 @@ name the axis-aligned cases.
       .def_static(
           "fixed", []() { return JointSpec(); }, "A rigid connection (no joint variable).")
       .def("__repr__", &JointSpec::repr);
+}
+
+// fk, jacobian and twist of any segment (or link) of a Chain.
+void bindChainKinematics(py::class_<PyChain>& cls) {
+  cls.def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(), R"doc(Pose of a frame in the base frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+    Joint positions, rad or m.
+segment : str or int, optional
+    Segment name or index (negative from the end; default: the last segment's tip), a link
+    merged into a segment (its own frame), or the base link's name (identity).
+
+Returns
+-------
+ndarray, shape (4, 4)
+    Homogeneous transform of the frame in the base frame (m).
+)doc")
+      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(),
+           R"doc(Geometric Jacobian of a frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+segment : str or int, optional
+    As in :meth:`fk` (default: the last segment's tip).
+
+Returns
+-------
+ndarray, shape (6, n)
+    Rows ``[linear; angular]``: the velocity of the frame's origin and the angular velocity,
+    base-frame axes, per unit joint velocity (zero for the base).
+)doc")
+      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
+           R"doc(Velocity of a frame.
+
+Parameters
+----------
+q, qd : array_like, shape (n,)
+segment : str or int, optional
+    As in :meth:`fk` (default: the last segment's tip).
+
+Returns
+-------
+ndarray, shape (6,)
+    ``[v; omega]``: linear velocity of the frame's origin (m/s) and angular velocity (rad/s),
+    base-frame axes; ``jacobian(q, segment) @ qd``.
+)doc");
+}
+
+}  // namespace
+
+void bindChain(py::module_& mod) {
+  bindJointSpec(mod);
 
   py::class_<PyChain> cls(mod, "Chain",
                           R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
@@ -297,54 +355,10 @@ use ``Solver(..., inertia_check='joint_space')`` with them).
               m.mutable_data()[i] = c.robot.chain.getSegment(i).getInertia().getMass();
             return m;
           },
-          "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.")
-      .def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(), R"doc(Pose of a frame in the base frame.
-
-Parameters
-----------
-q : array_like, shape (n,)
-    Joint positions, rad or m.
-segment : str or int, optional
-    Segment name or index (negative from the end; default: the last segment's tip), a link
-    merged into a segment (its own frame), or the base link's name (identity).
-
-Returns
--------
-ndarray, shape (4, 4)
-    Homogeneous transform of the frame in the base frame (m).
-)doc")
-      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(),
-           R"doc(Geometric Jacobian of a frame.
-
-Parameters
-----------
-q : array_like, shape (n,)
-segment : str or int, optional
-    As in :meth:`fk` (default: the last segment's tip).
-
-Returns
--------
-ndarray, shape (6, n)
-    Rows ``[linear; angular]``: the velocity of the frame's origin and the angular velocity,
-    base-frame axes, per unit joint velocity (zero for the base).
-)doc")
-      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
-           R"doc(Velocity of a frame.
-
-Parameters
-----------
-q, qd : array_like, shape (n,)
-segment : str or int, optional
-    As in :meth:`fk` (default: the last segment's tip).
-
-Returns
--------
-ndarray, shape (6,)
-    ``[v; omega]``: linear velocity of the frame's origin (m/s) and angular velocity (rad/s),
-    base-frame axes; ``jacobian(q, segment) @ qd``.
-)doc")
-      .def(py::pickle([](const PyChain& c) { return c.getState(); },
-                      [](const py::tuple& t) { return PyChain::fromState(t); }))
+          "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.");
+  bindChainKinematics(cls);
+  cls.def(py::pickle([](const PyChain& c) { return c.getState(); },
+                     [](const py::tuple& t) { return PyChain::fromState(t); }))
       .def("__copy__", [](const PyChain& c) { return c; })
       .def(
           "__deepcopy__", [](const PyChain& c, const py::dict&) { return c; }, py::arg("memo"))
