@@ -106,7 +106,7 @@ struct CouplingGeneral {
   mutable Eigen::VectorXd tmp;
   Eigen::MatrixXd kg, cholg, vg;             // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
   Eigen::VectorXd invg;                      // policy multiplier per eigenvalue
-  mutable Eigen::MatrixXd work_g, work_v;    // workspace of the smallest eigenvalue (matrix, scratch)
+  mutable Eigen::MatrixXd work_g, work_v;    // smallest eigenvalue: matrix (mcap x mcap), scratch (mcap x 4)
   mutable Matrix6X seg_force;                // per-segment wrench accumulators
   int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
   {

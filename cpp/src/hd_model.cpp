@@ -123,7 +123,8 @@ void HdCore::allocateWorkspace() {
   g.eg = Eigen::MatrixXd::Zero(mcap, std::max<unsigned int>(ns, 1));
   g.ug = g.nug = g.rhs = g.tmp = g.invg = Eigen::VectorXd::Zero(mcap);
   res.nu_user = Eigen::VectorXd::Zero(mcap);
-  g.kg = g.cholg = g.vg = g.work_g = g.work_v = Eigen::MatrixXd::Zero(mcap, mcap);
+  g.kg = g.cholg = g.vg = g.work_g = Eigen::MatrixXd::Zero(mcap, mcap);
+  g.work_v = Eigen::MatrixXd::Zero(mcap, 4);  // smallestEigenvalue's scratch: 4 columns
   g.seg_force = Matrix6X::Zero(6, ns);
   r.cmd_per_nu = Eigen::MatrixXd::Zero(nj, mcap);
   r.energy = Eigen::MatrixXd::Zero(mcap, nj);
