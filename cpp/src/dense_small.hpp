@@ -199,7 +199,9 @@ bool tridiagonalEigenvalues(VD& d, VD& e, int k) {
     int l = h - 1;  // the unreduced block [l, h]
     while (l > 0 && std::abs(e(l - 1)) > eps * (std::abs(d(l - 1)) + std::abs(d(l)))) --l;
     const double delta = 0.5 * (d(h - 1) - d(h)), b = e(h - 1);
-    const double mu = d(h) - b * b / (delta + std::copysign(std::hypot(delta, b), delta));
+    const double root =
+        std::abs(delta) < 1e150 && std::abs(b) < 1e150 ? std::sqrt(delta * delta + b * b) : std::hypot(delta, b);
+    const double mu = d(h) - b * b / (delta + std::copysign(root, delta));
     double x = d(l) - mu, z = e(l);
     for (int i = l; i < h; ++i) {  // rotation R = [c s; -s c] on rows and columns i, i + 1
       const double r = std::abs(x) < 1e150 && std::abs(z) < 1e150 ? std::sqrt(x * x + z * z) : std::hypot(x, z);
@@ -220,10 +222,74 @@ bool tridiagonalEigenvalues(VD& d, VD& e, int k) {
   return true;
 }
 
+// Smallest eigenvalue of the symmetric tridiagonal matrix T (diagonal d, off-diagonal e, k
+// entries) by Laguerre's iteration on its characteristic polynomial p(x) = det(T - x I), from
+// Gershgorin's lower bound. p has only real roots, so from the left of the smallest one the
+// iterates increase monotonically to it, cubically near a simple root: x <- x + k / (f +
+// sqrt((k - 1)(k g - f^2))) with f = sum_j 1 / (lambda_j - x) = -p'/p and g = sum_j
+// 1 / (lambda_j - x)^2 = f^2 - p''/p, and p, p', p'' from the three-term recurrence of the
+// leading minors (rescaled against overflow). About five iterations of O(k) each, against the
+// two QR sweeps per eigenvalue of tridiagonalEigenvalues(). False (lambda unset) if it has not
+// converged in 16 iterations: a multiple smallest eigenvalue converges only linearly.
+template <typename VD>
+bool smallestTridiagonalEigenvalue(const VD& d, const VD& e, int k, double& lambda) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  double x = std::numeric_limits<double>::infinity(), scale = 0.0;
+  for (int i = 0; i < k; ++i) {
+    const double r = (i > 0 ? std::abs(e(i - 1)) : 0.0) + (i + 1 < k ? std::abs(e(i)) : 0.0);
+    x = std::min(x, d(i) - r);
+    scale = std::max(scale, std::abs(d(i)) + r);
+  }
+  if (!(scale > 0.0) || !std::isfinite(scale)) return false;
+  // Work on T / 2^s with 2^s ~ scale (exact: a power of two), so that e^2 neither overflows nor
+  // underflows where it matters.
+  int s = 0;
+  std::frexp(scale, &s);
+  const double tol = 4.0 * eps;
+  x = std::ldexp(x, -s) - tol;  // strictly below every eigenvalue
+  bool converged = false;
+  for (int it = 0; it < 16; ++it) {
+    double p0 = 1.0, p0d = 0.0, p0dd = 0.0;                        // P_{i-1} and its derivatives
+    double p1 = std::ldexp(d(0), -s) - x, p1d = -1.0, p1dd = 0.0;  // P_i
+    for (int i = 1; i < k; ++i) {
+      const double ei = std::ldexp(e(i - 1), -s);
+      const double t = std::ldexp(d(i), -s) - x, e2 = ei * ei;
+      const double p2 = t * p1 - e2 * p0;
+      const double p2d = t * p1d - p1 - e2 * p0d;
+      const double p2dd = t * p1dd - 2.0 * p1d - e2 * p0dd;
+      p0 = p1, p0d = p1d, p0dd = p1dd, p1 = p2, p1d = p2d, p1dd = p2dd;
+      const double a = std::abs(p1);
+      if (a > 1e100 || (a < 1e-100 && a > 0.0)) {  // rescale both minors alike (f, g are ratios)
+        const double s = 1.0 / a;
+        p0 *= s, p0d *= s, p0dd *= s, p1 *= s, p1d *= s, p1dd *= s;
+      }
+    }
+    // p > 0 and f > 0 below the smallest eigenvalue; otherwise x has reached it (to rounding).
+    const double f = -p1d / p1, g = f * f - p1dd / p1;
+    if (!(p1 > 0.0) || !(f > 0.0)) {
+      converged = true;
+      break;
+    }
+    const double disc = std::max((k - 1.0) * (k * g - f * f), 0.0);
+    const double denom = f + std::sqrt(disc);
+    if (!(denom > 0.0) || !std::isfinite(denom)) return false;
+    const double step = k / denom;
+    x += step;
+    if (step <= tol) {
+      converged = true;
+      break;
+    }
+  }
+  if (!converged || !std::isfinite(x)) return false;
+  lambda = std::ldexp(x, s);
+  return true;
+}
+
 // Smallest eigenvalue of a symmetric k x k matrix A (overwritten): Householder reduction to
-// tridiagonal form (eigenvalues only), then tridiagonalEigenvalues(). work: scratch of k x 4
-// (diagonal, off-diagonal, Householder vector, product). Backward stable: the result is within a
-// few eps ||A|| of the exact one.
+// tridiagonal form (eigenvalues only), then smallestTridiagonalEigenvalue() (if it does not
+// converge, tridiagonalEigenvalues()). work: scratch of k x 4 (diagonal, off-diagonal,
+// Householder vector, product). Backward stable: the result is within a few eps ||A|| of the
+// exact one.
 template <typename MA, typename MW>
 double smallestEigenvalue(MA& A, MW& work) {
   const int k = static_cast<int>(A.rows());
@@ -255,6 +321,8 @@ double smallestEigenvalue(MA& A, MW& work) {
     d(i) = A(i, i);
     e(i) = i + 1 < k ? A(i + 1, i) : 0.0;
   }
+  double lambda = 0.0;
+  if (smallestTridiagonalEigenvalue(d, e, k, lambda)) return lambda;
   tridiagonalEigenvalues(d, e, k);
   return d.head(k).minCoeff();
 }

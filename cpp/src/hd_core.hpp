@@ -91,7 +91,8 @@ struct CouplingFast {
   MatrixC chol;   // lower Cholesky factor of K on the certified path
   Eigen::SelfAdjointEigenSolver<MatrixC> eig;
   VectorC inv_eigen;  // per-eigenvalue multiplier of the policy
-  mutable Eigen::SelfAdjointEigenSolver<MatrixC> sigma_eig;
+  mutable Eigen::Matrix<double, kMaxConstraints, kMaxConstraints> sigma_work;  // smallestSingularValue(): K
+  mutable Eigen::Matrix<double, kMaxConstraints, 4> sigma_scratch;             // and its scratch
 };
 
 // The several-segment path (storage sized at construction, mcap columns).
