@@ -308,6 +308,35 @@ def fext_to_pinocchio(rc, data, q, f_ext):
     return fext
 
 
+def moving_frames(model):
+    """The frames an ``f_ext`` dict may name on a Chain or Tree: the links merged into segments
+    (first), then the segments; links merged into the base are not moving."""
+    segments = list(model.segment_names)
+    merged = []
+    for link in model.link_names:
+        if link in segments:
+            continue
+        try:
+            model.segment_index(link)
+        except vs.SolverError:
+            continue  # merged into the base
+        merged.append(link)
+    return merged + segments
+
+
+def fext_at_frames(model, data, q, wrenches):
+    """An ``f_ext`` dict {frame name: (6,) wrench} (base axes, moment about that frame's origin,
+    applied TO the body) -> Pinocchio's per-joint external forces, frames by Pinocchio's names."""
+    pin.framesForwardKinematics(model, data, q)
+    fext = [pin.Force.Zero() for _ in range(model.njoints)]
+    for name, w in wrenches.items():
+        fid = model.getFrameId(name)
+        joint = model.frames[fid].parentJoint
+        at_frame = pin.SE3(np.eye(3), data.oMf[fid].translation)  # base axes, the frame's origin
+        fext[joint] += data.oMi[joint].actInv(at_frame.act(pin.Force(np.asarray(w[:3]), np.asarray(w[3:]))))
+    return fext
+
+
 def well_conditioned_task(A, Minv, ratio=1e-4):
     """True if the task rows A (m x n) couple through the inverse inertia Minv with every
     eigenvalue of A Minv A^T above ratio x the largest: a near-singular task would make a

@@ -25,7 +25,7 @@ import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
-from chains import assert_close, fext_to_pinocchio, random_chain, random_state
+from chains import assert_close, fext_at_frames, fext_to_pinocchio, moving_frames, random_chain, random_state
 from test_urdf_pinocchio import BUILDERS, _with_rotors
 
 RTOL = 1e-9
@@ -86,6 +86,26 @@ def test_inverse_dynamics_matches_rnea(name):
             pin.rnea(r.model, data, pq, qd, qdd),
             RTOL,
             "inverse_dynamics vs pin.rnea",
+        )
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_inverse_dynamics_reads_an_f_ext_dict_as_pinocchio(name):
+    """f_ext as {frame: wrench}, the moment about that frame's origin (links merged into a segment
+    included, e.g. the Gen3's gripper links), as Pinocchio's fext on the frame's parent joint."""
+    r, _, rng = _robot(name, [4, len(name)])
+    data = r.model.createData()
+    frames = moving_frames(r.chain)
+    for k in range(4):
+        q, qd = r.random_state(rng)
+        qdd = rng.normal(size=r.chain.n_joints) * 3.0
+        wrenches = {f: rng.uniform(-20.0, 20.0, 6) for f in frames[k::4][:5]}
+        pq = r.pin_q(q)
+        assert_close(
+            r.chain.inverse_dynamics(q, qd, qdd, wrenches),
+            pin.rnea(r.model, data, pq, qd, qdd, fext_at_frames(r.model, data, pq, wrenches)),
+            RTOL,
+            f"inverse_dynamics with f_ext {sorted(wrenches)} vs pin.rnea",
         )
 
 

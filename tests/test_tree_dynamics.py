@@ -18,6 +18,7 @@ import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
+from chains import fext_at_frames, moving_frames
 from test_tree_solver import ROBOTS, robot
 from test_urdf_pinocchio import LWA, assert_rel
 from vereshchagin.robots import gen3_urdf
@@ -74,6 +75,25 @@ def test_inverse_dynamics_matches_rnea(name):
         expected = case.ours(pin.rnea(*args))
         got = case.tree.inverse_dynamics(q, qd, qdd, f_ext=f_ext, gravity=GRAVITY)
         assert_rel(got, expected, f"{name}: inverse_dynamics vs pin.rnea (f_ext {f_ext is not None})", RTOL)
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_inverse_dynamics_reads_an_f_ext_dict_as_pinocchio(name):
+    """f_ext as {frame: wrench}, the moment about that frame's origin (merged links included), as
+    Pinocchio's fext on the frame's parent joint."""
+    case = robot(name)
+    model = _pin_with(case)
+    data = model.createData()
+    rng = np.random.default_rng([52, len(name)])
+    frames = moving_frames(case.tree)
+    for k in range(3):
+        q, qd, qdd = _state(case, rng)
+        pq = case.pin_q(q)
+        wrenches = {f: rng.normal(size=6) * 5.0 for f in frames[k::3][:6]}
+        fext = fext_at_frames(model, data, pq, wrenches)
+        expected = case.ours(pin.rnea(model, data, pq, case.pin_v(qd), case.pin_v(qdd), fext))
+        got = case.tree.inverse_dynamics(q, qd, qdd, f_ext=wrenches, gravity=GRAVITY)
+        assert_rel(got, expected, f"{name}: inverse_dynamics with f_ext {sorted(wrenches)} vs pin.rnea", RTOL)
 
 
 @pytest.mark.parametrize("name", sorted(ROBOTS))
@@ -227,8 +247,14 @@ def test_bad_input_raises_the_chains_messages():
             with pytest.raises(vs.SolverError) as err:
                 call(model, zeros, k)
             assert text in str(err.value), (type(model).__name__, str(err.value))
-    with pytest.raises(vs.SolverError, match=rf"f_ext must have shape \({ns}, 6\), got \(6,\)"):
+    with pytest.raises(vs.SolverError, match=rf"f_ext must have shape \({ns}, 6\) or be a dict .*, got \(6,\)"):
         tree.inverse_dynamics(z, z, z, f_ext=np.zeros(6))
+    with pytest.raises(vs.SolverError, match=r"f_ext\['head'\] must have shape \(6,\), got \(3,\)"):
+        tree.inverse_dynamics(z, z, z, f_ext={"head": np.zeros(3)})
+    with pytest.raises(vs.SolverError, match=r"f_ext\['nowhere'\]: no segment or link named 'nowhere'"):
+        tree.inverse_dynamics(z, z, z, f_ext={"nowhere": np.zeros(6)})
+    with pytest.raises(vs.SolverError, match=r"f_ext\['head'\] contains NaN or Inf"):
+        tree.inverse_dynamics(z, z, z, f_ext={"head": np.r_[np.nan, np.zeros(5)]})
     with pytest.raises(vs.SolverError, match=r"f_ext contains NaN or Inf \(flat index 7\)"):
         tree.inverse_dynamics(z, z, z, f_ext=np.r_[np.zeros(7), np.inf, np.zeros(6 * ns - 8)].reshape(ns, 6))
     with pytest.raises(vs.SolverError, match="segment: no segment or link named 'hand'"):

@@ -35,19 +35,16 @@ std::vector<KDL::Frame> tipFrames(const KDL::Chain& chain, const KDL::JntArray& 
 // Our f_ext (n_segments, 6): rows [force, moment], base-frame axes, moment about the segment's tip
 // origin, applied ON the segment. KDL's RNE wants the same wrench (same sign: it subtracts f_ext
 // from the wrench the segment needs) in the segment's tip-frame axes: rotate both halves.
-KDL::Wrenches externalWrenches(const py::object& f_ext, const KDL::Chain& chain, const KDL::JntArray& q) {
+KDL::Wrenches externalWrenches(const py::object& f_ext, const PyChain& c, const KDL::JntArray& q) {
+  const KDL::Chain& chain = c.robot.chain;
   const unsigned int ns = chain.getNrOfSegments();
   KDL::Wrenches out(ns, KDL::Wrench::Zero());
   if (f_ext.is_none()) return out;
-  const Array f = toArray(f_ext, "f_ext");
-  if (f.ndim() != 2 || f.shape(0) != static_cast<py::ssize_t>(ns) || f.shape(1) != 6)
-    raise("f_ext must have shape (" + std::to_string(ns) + ", 6), got " + shapeStr(f));
-  requireFinite(f, "f_ext");
   const std::vector<KDL::Frame> tips = tipFrames(chain, q);
+  const auto rows = externalWrenchRows(f_ext, c, [&tips](int s) { return tips[static_cast<std::size_t>(s)].M; });
   for (unsigned int i = 0; i < ns; ++i) {
-    const KDL::Wrench base_axes(KDL::Vector(f.at(i, 0), f.at(i, 1), f.at(i, 2)),
-                                KDL::Vector(f.at(i, 3), f.at(i, 4), f.at(i, 5)));
-    out[i] = tips[i].M.Inverse(base_axes);
+    const Eigen::Matrix<double, 6, 1>& r = rows[i];
+    out[i] = tips[i].M.Inverse(KDL::Wrench(KDL::Vector(r(0), r(1), r(2)), KDL::Vector(r(3), r(4), r(5))));
   }
   return out;
 }
@@ -60,7 +57,7 @@ py::array_t<double> inverseDynamics(const PyChain& c, const py::object& q_obj, c
   const KDL::JntArray qd = jntArrayArg(qd_obj, "qd", n);
   const KDL::JntArray qdd = jntArrayArg(qdd_obj, "qdd", n);
   const KDL::Vector g = vec3(gravity, "gravity");
-  const KDL::Wrenches wrenches = externalWrenches(f_ext, chain, q);
+  const KDL::Wrenches wrenches = externalWrenches(f_ext, c, q);
   KDL::JntArray tau(n);
   KDL::ChainIdSolver_RNE rne(chain, g);  // KDL takes physical gravity here (base accelerates by -g)
   if (rne.CartToJnt(q, qd, qdd, wrenches, tau) < 0)

@@ -33,10 +33,12 @@ Parameters
 q, qd, qdd : array_like, shape (n_joints,)
     Joint positions (rad or m), velocities (rad/s or m/s) and accelerations (rad/s^2 or m/s^2))doc" +
          q_order + R"doc(.
-f_ext : array_like, shape (n_segments, 6), optional
+f_ext : array_like, shape (n_segments, 6), or dict, optional
     Wrench ``[force, moment]`` (N, N m) applied ON each segment BY the environment, base-frame
     axes, moment about that segment's tip origin (the solver's convention)doc" +
          f_ext_note + R"doc(). ``J_i`` above is the base-axes Jacobian of segment i's tip.
+    Dict: ``{segment: wrench (6,)}`` keyed by segment name, merged link name or index, the
+    moment about the named frame's origin, as :meth:`Solver.solve` reads it.
 )doc" + kGravityParam +
          R"doc(
 Returns

@@ -24,15 +24,12 @@ unsigned int jointCount(const PyTree& t) {
 std::vector<KDL::Wrench> externalWrenches(const py::object& f_ext, const PyTree& t, const TreePlacement& at) {
   const int ns = t.segmentCount();
   std::vector<KDL::Wrench> out(static_cast<std::size_t>(ns), KDL::Wrench::Zero());
-  if (f_ext.is_none()) return out;
-  const Array f = toArray(f_ext, "f_ext");
-  if (f.ndim() != 2 || f.shape(0) != static_cast<py::ssize_t>(ns) || f.shape(1) != 6)
-    raise("f_ext must have shape (" + std::to_string(ns) + ", 6), got " + shapeStr(f));
-  requireFinite(f, "f_ext");
-  for (int i = 0; i < ns; ++i) {
-    const KDL::Vector force(f.at(i, 0), f.at(i, 1), f.at(i, 2));
-    const KDL::Vector moment(f.at(i, 3), f.at(i, 4), f.at(i, 5));
-    out[static_cast<std::size_t>(i)] = KDL::Wrench(force, moment + at.tip[static_cast<std::size_t>(i)].p * force);
+  const auto rows = externalWrenchRows(f_ext, t, [&at](int s) { return at.tip[static_cast<std::size_t>(s)].M; });
+  if (rows.empty()) return out;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const KDL::Vector force(rows[i](0), rows[i](1), rows[i](2));
+    const KDL::Vector moment(rows[i](3), rows[i](4), rows[i](5));
+    out[i] = KDL::Wrench(force, moment + at.tip[i].p * force);
   }
   return out;
 }

@@ -79,7 +79,7 @@ class Chain:
         q: ArrayLike,
         qd: ArrayLike,
         qdd: ArrayLike,
-        f_ext: Optional[ArrayLike] = None,
+        f_ext: Optional[Union[ArrayLike, Mapping[Union[str, int], ArrayLike]]] = None,
         gravity: ArrayLike = ...,
     ) -> NDArray[np.float64]: ...
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
@@ -145,7 +145,7 @@ class Tree:
         q: ArrayLike,
         qd: ArrayLike,
         qdd: ArrayLike,
-        f_ext: Optional[ArrayLike] = None,
+        f_ext: Optional[Union[ArrayLike, Mapping[Union[str, int], ArrayLike]]] = None,
         gravity: ArrayLike = ...,
     ) -> NDArray[np.float64]: ...
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
