@@ -37,14 +37,21 @@ inline Vector6 motionToChild(const Pose& X, const Eigen::MatrixBase<In>& m) {
   return out;
 }
 
-// Force vector given in the child frame -> the same force in the parent frame.
-// f = R f', n = R n' + p x (R f').
+// Force vector given in the child frame -> the same force in the parent frame, as its two
+// halves: f = R f', n = R n' + p x (R f').
 template <typename In>
-inline Vector6 forceToParent(const Pose& X, const Eigen::MatrixBase<In>& f) {
+inline void forceHalvesToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child, Vector3& f, Vector3& n) {
+  f.noalias() = X.R * f_child.template head<3>();
+  n.noalias() = X.R * f_child.template tail<3>();
+  n += X.p.cross(f);
+}
+
+template <typename In>
+inline Vector6 forceToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child) {
+  Vector3 f, n;
+  forceHalvesToParent(X, f_child, f, n);
   Vector6 out;
-  out.template head<3>().noalias() = X.R * f.template head<3>();
-  out.template tail<3>().noalias() = X.R * f.template tail<3>();
-  out.template tail<3>() += X.p.cross(out.template head<3>());
+  out << f, n;
   return out;
 }
 
@@ -55,9 +62,7 @@ inline Vector6 forceToParent(const Pose& X, const Eigen::MatrixBase<In>& f) {
 template <typename Io>
 inline void forceToParentInPlace(const Pose& X, Eigen::MatrixBase<Io>& f_io) {
   Vector3 f, n;
-  f.noalias() = X.R * f_io.template head<3>();
-  n.noalias() = X.R * f_io.template tail<3>();
-  n += X.p.cross(f);
+  forceHalvesToParent(X, f_io, f, n);
   f_io.template head<3>() = f;
   f_io.template tail<3>() = n;
 }
@@ -65,9 +70,7 @@ inline void forceToParentInPlace(const Pose& X, Eigen::MatrixBase<Io>& f_io) {
 template <typename In, typename Out>
 inline void addForceToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child, Eigen::MatrixBase<Out>& out) {
   Vector3 f, n;
-  f.noalias() = X.R * f_child.template head<3>();
-  n.noalias() = X.R * f_child.template tail<3>();
-  n += X.p.cross(f);
+  forceHalvesToParent(X, f_child, f, n);
   out.template head<3>() += f;
   out.template tail<3>() += n;
 }
@@ -104,22 +107,13 @@ inline Matrix3 skewTimes(const Vector3& p, const Matrix3& A) {  // [p]x A
   return out;
 }
 
-inline Matrix3 timesSkew(const Matrix3& A, const Vector3& p) {  // A [p]x
+template <typename M>  // any 3x3 expression, e.g. a transpose, read in place
+inline Matrix3 timesSkew(const Eigen::MatrixBase<M>& A, const Vector3& p) {  // A [p]x
   Matrix3 out;
   for (int i = 0; i < 3; ++i) {
     out(i, 0) = A(i, 1) * p.z() - A(i, 2) * p.y();
     out(i, 1) = A(i, 2) * p.x() - A(i, 0) * p.z();
     out(i, 2) = A(i, 0) * p.y() - A(i, 1) * p.x();
-  }
-  return out;
-}
-
-inline Matrix3 transposeTimesSkew(const Matrix3& A, const Vector3& p) {  // A^T [p]x
-  Matrix3 out;
-  for (int i = 0; i < 3; ++i) {
-    out(i, 0) = A(1, i) * p.z() - A(2, i) * p.y();
-    out(i, 1) = A(2, i) * p.x() - A(0, i) * p.z();
-    out(i, 2) = A(0, i) * p.y() - A(1, i) * p.x();
   }
   return out;
 }
@@ -136,7 +130,7 @@ inline void addInertiaToParent(const Pose& X, const Matrix6& Ic, Matrix6& Ip) {
   const Matrix3 MP = timesSkew(M, X.p);
   const Matrix3 H2 = H - MP;
   const Matrix3 PH = skewTimes(X.p, H);
-  const Matrix3 J2 = J - transposeTimesSkew(H, X.p) + PH - skewTimes(X.p, MP);
+  const Matrix3 J2 = J - timesSkew(H.transpose(), X.p) + PH - skewTimes(X.p, MP);
   Ip.topLeftCorner<3, 3>() += M;
   Ip.topRightCorner<3, 3>() += H2;
   Ip.bottomLeftCorner<3, 3>() += H2.transpose();
