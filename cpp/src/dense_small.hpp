@@ -228,11 +228,13 @@ bool tridiagonalEigenvalues(VD& d, VD& e, int k) {
 // iterates increase monotonically to it, cubically near a simple root: x <- x + k / (f +
 // sqrt((k - 1)(k g - f^2))) with f = sum_j 1 / (lambda_j - x) = -p'/p and g = sum_j
 // 1 / (lambda_j - x)^2 = f^2 - p''/p, and p, p', p'' from the three-term recurrence of the
-// leading minors (rescaled against overflow). About five iterations of O(k) each, against the
-// two QR sweeps per eigenvalue of tridiagonalEigenvalues(). False (lambda unset) if it has not
-// converged in 16 iterations: a multiple smallest eigenvalue converges only linearly.
-template <typename VD>
-bool smallestTridiagonalEigenvalue(const VD& d, const VD& e, int k, double& lambda) {
+// leading minors (rescaled against overflow). d_scaled, e2_scaled: scratch of k entries each, for
+// the diagonal and the squared off-diagonal of T / 2^s (2^s ~ T's scale), computed once. About
+// five iterations of O(k) each, against the two QR sweeps per eigenvalue of
+// tridiagonalEigenvalues(). False (lambda unset) if it has not converged in 16 iterations: a
+// multiple smallest eigenvalue converges only linearly.
+template <typename VD, typename VS>
+bool smallestTridiagonalEigenvalue(const VD& d, const VD& e, int k, VS& d_scaled, VS& e2_scaled, double& lambda) {
   const double eps = std::numeric_limits<double>::epsilon();
   double x = std::numeric_limits<double>::infinity(), scale = 0.0;
   for (int i = 0; i < k; ++i) {
@@ -245,23 +247,27 @@ bool smallestTridiagonalEigenvalue(const VD& d, const VD& e, int k, double& lamb
   // underflows where it matters.
   int s = 0;
   std::frexp(scale, &s);
+  for (int i = 0; i < k; ++i) {
+    d_scaled(i) = std::ldexp(d(i), -s);
+    const double ei = i + 1 < k ? std::ldexp(e(i), -s) : 0.0;
+    e2_scaled(i) = ei * ei;
+  }
   const double tol = 4.0 * eps;
   x = std::ldexp(x, -s) - tol;  // strictly below every eigenvalue
   bool converged = false;
   for (int it = 0; it < 16; ++it) {
-    double p0 = 1.0, p0d = 0.0, p0dd = 0.0;                        // P_{i-1} and its derivatives
-    double p1 = std::ldexp(d(0), -s) - x, p1d = -1.0, p1dd = 0.0;  // P_i
+    double p0 = 1.0, p0d = 0.0, p0dd = 0.0;               // P_{i-1} and its derivatives
+    double p1 = d_scaled(0) - x, p1d = -1.0, p1dd = 0.0;  // P_i
     for (int i = 1; i < k; ++i) {
-      const double ei = std::ldexp(e(i - 1), -s);
-      const double t = std::ldexp(d(i), -s) - x, e2 = ei * ei;
+      const double t = d_scaled(i) - x, e2 = e2_scaled(i - 1);
       const double p2 = t * p1 - e2 * p0;
       const double p2d = t * p1d - p1 - e2 * p0d;
       const double p2dd = t * p1dd - 2.0 * p1d - e2 * p0dd;
       p0 = p1, p0d = p1d, p0dd = p1dd, p1 = p2, p1d = p2d, p1dd = p2dd;
       const double a = std::abs(p1);
       if (a > 1e100 || (a < 1e-100 && a > 0.0)) {  // rescale both minors alike (f, g are ratios)
-        const double s = 1.0 / a;
-        p0 *= s, p0d *= s, p0dd *= s, p1 *= s, p1d *= s, p1dd *= s;
+        const double inv = 1.0 / a;
+        p0 *= inv, p0d *= inv, p0dd *= inv, p1 *= inv, p1d *= inv, p1dd *= inv;
       }
     }
     // p > 0 and f > 0 below the smallest eigenvalue; otherwise x has reached it (to rounding).
@@ -322,7 +328,7 @@ double smallestEigenvalue(MA& A, MW& work) {
     e(i) = i + 1 < k ? A(i + 1, i) : 0.0;
   }
   double lambda = 0.0;
-  if (smallestTridiagonalEigenvalue(d, e, k, lambda)) return lambda;
+  if (smallestTridiagonalEigenvalue(d, e, k, v, p, lambda)) return lambda;  // v, p: free scratch now
   tridiagonalEigenvalues(d, e, k);
   return d.head(k).minCoeff();
 }

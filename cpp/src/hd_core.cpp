@@ -253,8 +253,8 @@ double HdCore::smallestSingularValue() const {
     } else {
       // The general path's routine (Householder tridiagonalisation, shifted QR on the diagonals):
       // the same accuracy as Eigen's eigenvalues-only solver at two thirds of its time.
-      auto W = ws.fast.sigma_work.topLeftCorner(m, m);
-      auto scratch = ws.fast.sigma_scratch.topRows(m);
+      auto W = ws.general.work_g.topLeftCorner(m, m);
+      auto scratch = ws.general.work_v.topRows(m);
       W = ws.fast.K;
       res.sigma_min = std::max(detail::smallestEigenvalue(W, scratch), 0.0);
     }

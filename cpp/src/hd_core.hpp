@@ -91,8 +91,6 @@ struct CouplingFast {
   MatrixC chol;   // lower Cholesky factor of K on the certified path
   Eigen::SelfAdjointEigenSolver<MatrixC> eig;
   VectorC inv_eigen;  // per-eigenvalue multiplier of the policy
-  mutable Eigen::Matrix<double, kMaxConstraints, kMaxConstraints> sigma_work;  // smallestSingularValue(): K
-  mutable Eigen::Matrix<double, kMaxConstraints, 4> sigma_scratch;             // and its scratch
 };
 
 // The several-segment path (storage sized at construction, mcap columns).
@@ -105,10 +103,10 @@ struct CouplingGeneral {
   Eigen::MatrixXd eg;         // mcap x n_segments: column i = (S_i^T A_i)^T on i's felt range (only)
   Eigen::VectorXd ug, nug, rhs;
   mutable Eigen::VectorXd tmp;
-  Eigen::MatrixXd kg, cholg, vg;             // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
-  Eigen::VectorXd invg;                      // policy multiplier per eigenvalue
-  mutable Eigen::MatrixXd work_g, work_v;    // smallest eigenvalue: matrix (mcap x mcap), scratch (mcap x 4)
-  mutable Matrix6X seg_force;                // per-segment wrench accumulators
+  Eigen::MatrixXd kg, cholg, vg;           // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
+  Eigen::VectorXd invg;                    // policy multiplier per eigenvalue
+  mutable Eigen::MatrixXd work_g, work_v;  // smallest eigenvalue (both paths): matrix (mcap x mcap), scratch (mcap x 4)
+  mutable Matrix6X seg_force;              // per-segment wrench accumulators
   int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
   {
     return active[model.subtree_end[i]];
