@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "articulated_step.hpp"
 #include "dense_small.hpp"
@@ -103,6 +104,19 @@ void HdCore::forEachCouplingBlock(const F& f) const {
   }
 }
 
+// Calls g(size) with size = std::integral_constant<int, S>: S = 6 for a block of one 6-D
+// constraint (the same loops then run unrolled at a fixed size), Eigen::Dynamic otherwise.
+namespace {
+template <typename G>
+void withBlockSize(int w, const G& g) {
+  if (w == kMaxConstraints) {
+    g(std::integral_constant<int, kMaxConstraints>());
+  } else {
+    g(std::integral_constant<int, Eigen::Dynamic>());
+  }
+}
+}  // namespace
+
 // Segment i's own columns: alfa in its tip axes (the moment is already about its origin).
 void HdCore::addOwnColumns(int i, const Eigen::Ref<const Matrix6X>& alfa) {
   CouplingGeneral& g = ws.general;
@@ -121,11 +135,10 @@ int HdCore::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
   const int M = res.m;
   g.ug.head(M).setZero();
   forEachCouplingBlock([&g](int lo, int w) {  // K is only ever read block by block
-    if (w == kMaxConstraints) {
-      g.kg.block<kMaxConstraints, kMaxConstraints>(lo, lo).setZero();
-    } else {
-      g.kg.block(lo, lo, w, w).setZero();
-    }
+    withBlockSize(w, [&](auto size) {
+      constexpr int S = decltype(size)::value;
+      g.kg.block<S, S>(lo, lo, w, w).setZero();
+    });
   });
   ws.kappa = 0.0;
   const bool has_tau = ff_torques.size() != 0;
@@ -230,17 +243,13 @@ bool HdCore::choleskyBlocks() {
   double frob2 = 0.0;  // ||L^-1||_F^2
   forEachCouplingBlock([&](int lo, int w) {
     if (!ok) return;
-    if (w == kMaxConstraints) {  // one 6-D constraint: the same loops, unrolled at a fixed size
-      auto L = g.cholg.block<kMaxConstraints, kMaxConstraints>(lo, lo);
-      ok = detail::choleskyCertified(g.kg.block<kMaxConstraints, kMaxConstraints>(lo, lo), L, 0.0);
-      auto x = g.tmp.head<kMaxConstraints>();
+    withBlockSize(w, [&](auto size) {
+      constexpr int S = decltype(size)::value;
+      auto L = g.cholg.block<S, S>(lo, lo, w, w);
+      ok = detail::choleskyCertified(g.kg.block<S, S>(lo, lo, w, w), L, 0.0);
+      auto x = g.tmp.head<S>(w);
       if (ok) frob2 += detail::inverseFrobeniusSquared(L, x);
-      return;
-    }
-    auto L = g.cholg.block(lo, lo, w, w);
-    ok = detail::choleskyCertified(g.kg.block(lo, lo, w, w), L, 0.0);
-    auto x = g.tmp.head(w);
-    if (ok) frob2 += detail::inverseFrobeniusSquared(L, x);
+    });
   });
   const double lower = 1.0 / frob2;
   return ok && std::isfinite(lower) && lower > options.rcond * ws.kappa;
@@ -272,13 +281,11 @@ void HdCore::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::
   if (ws.use_cholesky) {
     out.head(m) = rhs.head(m);
     forEachCouplingBlock([&](int lo, int w) {
-      if (w == kMaxConstraints) {
-        auto x = out.segment<kMaxConstraints>(lo);
-        detail::choleskySolve(g.cholg.block<kMaxConstraints, kMaxConstraints>(lo, lo), x);
-        return;
-      }
-      auto x = out.segment(lo, w);
-      detail::choleskySolve(g.cholg.block(lo, lo, w, w), x);
+      withBlockSize(w, [&](auto size) {
+        constexpr int S = decltype(size)::value;
+        auto x = out.template segment<S>(lo, w);
+        detail::choleskySolve(g.cholg.block<S, S>(lo, lo, w, w), x);
+      });
     });
     return;
   }
