@@ -330,7 +330,7 @@ def fext_at_frames(model, data, q, wrenches):
     pin.framesForwardKinematics(model, data, q)
     fext = [pin.Force.Zero() for _ in range(model.njoints)]
     for name, w in wrenches.items():
-        fid = model.getFrameId(name)
+        fid = model.getFrameId(name, pin.BODY)  # our segments and merged links are URDF links
         joint = model.frames[fid].parentJoint
         at_frame = pin.SE3(np.eye(3), data.oMf[fid].translation)  # base axes, the frame's origin
         fext[joint] += data.oMi[joint].actInv(at_frame.act(pin.Force(np.asarray(w[:3]), np.asarray(w[3:]))))

@@ -40,19 +40,6 @@ def _state(case, rng):
     return q, qd, rng.normal(size=case.n) * 2.0
 
 
-def _pin_fext(case, model, data, pq, f_ext):
-    """Our f_ext (rows per segment: base axes, moment about the tip origin) as Pinocchio's fext
-    (per joint: its local frame, moment about the joint origin)."""
-    pin.framesForwardKinematics(model, data, pq)
-    fext = [pin.Force.Zero() for _ in range(model.njoints)]
-    for i, name in enumerate(case.tree.segment_names):
-        fid = model.getFrameId(name, pin.BODY)
-        at_tip = pin.SE3(np.eye(3), data.oMf[fid].translation)  # base axes, tip origin
-        joint = model.frames[fid].parentJoint
-        fext[joint] += data.oMi[joint].actInv(at_tip.act(pin.Force(f_ext[i, :3], f_ext[i, 3:])))
-    return fext
-
-
 def _symmetric(M):
     return np.triu(M) + np.triu(M, 1).T
 
@@ -70,7 +57,8 @@ def test_inverse_dynamics_matches_rnea(name):
         q, qd, qdd = _state(case, rng)
         f_ext = rng.normal(size=(case.tree.n_segments, 6)) * 5.0 if k % 2 else None
         pq = case.pin_q(q)
-        fext = _pin_fext(case, model, data, pq, f_ext) if f_ext is not None else None
+        rows = None if f_ext is None else dict(zip(case.tree.segment_names, f_ext))  # per segment's tip frame
+        fext = None if rows is None else fext_at_frames(model, data, pq, rows)
         args = (model, data, pq, case.pin_v(qd), case.pin_v(qdd)) + ((fext,) if fext is not None else ())
         expected = case.ours(pin.rnea(*args))
         got = case.tree.inverse_dynamics(q, qd, qdd, f_ext=f_ext, gravity=GRAVITY)
