@@ -22,6 +22,24 @@ std::vector<std::string> Addressable::jointNames() const {
   return out;
 }
 
+namespace {
+
+// The int value of an index argument, or raises naming the valid range (an int beyond the C range
+// is out of range like any other).
+int indexInRange(PyObject* which, int n, const std::string& label, const char* what) {
+  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(which));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0 || v < -n || v >= n)
+    raise(label + ": " + what + " index " + py::str(index).cast<std::string>() + " out of range for " +
+          std::to_string(n) + " " + what + "s (valid " + std::to_string(-n) + " .. " + std::to_string(n - 1) +
+          (std::string(what) == "segment" ? "; the base is addressed by its name only)" : ")"));
+  return static_cast<int>(v < 0 ? v + n : v);
+}
+
+}  // namespace
+
 Addressable::Target Addressable::resolveTarget(PyObject* which, const std::string& label) const {
   const int ns = segmentCount();
   const std::string& root_link = rootLink();
@@ -49,12 +67,7 @@ Addressable::Target Addressable::resolveTarget(PyObject* which, const std::strin
   if (PyBool_Check(which) || !PyIndex_Check(which))
     raise(label + ": a segment is named by a str (segment or link name) or an int index, got " +
           std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  const long long v = py::handle(which).cast<long long>();
-  if (v < -ns || v >= ns)
-    raise(label + ": segment index " + std::to_string(v) + " out of range for " + std::to_string(ns) +
-          " segments (valid " + std::to_string(-ns) + " .. " + std::to_string(ns - 1) +
-          "; the base is addressed by its name only)");
-  t.segment = static_cast<int>(v < 0 ? v + ns : v);
+  t.segment = indexInRange(which, ns, label, "segment");
   return t;
 }
 
@@ -84,11 +97,7 @@ int Addressable::resolveJoint(PyObject* which, const std::string& label) const {
   if (PyBool_Check(which) || !PyIndex_Check(which))
     raise(label + ": a joint is named by a str or an int index, got " +
           std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  const long long v = py::handle(which).cast<long long>();
-  if (v < -nj || v >= nj)
-    raise(label + ": joint index " + std::to_string(v) + " out of range for " + std::to_string(nj) + " joints (valid " +
-          std::to_string(-nj) + " .. " + std::to_string(nj - 1) + ")");
-  return static_cast<int>(v < 0 ? v + nj : v);
+  return indexInRange(which, nj, label, "joint");
 }
 
 }  // namespace vsbind

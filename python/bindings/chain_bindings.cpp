@@ -6,6 +6,7 @@
 #include <kdl/chainfksolvervel_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include "dynamics_common.hpp"
 #include "model_properties.hpp"
 #include "model_state.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg
@@ -156,16 +157,7 @@ py::array_t<double> PyChain::jacobian(const py::object& q_obj, const py::object&
 
 py::array_t<double> PyChain::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& segment) const {
   py::array_t<double> J = jacobian(q_obj, segment);
-  const unsigned int n = robot.chain.getNrOfJoints();
-  Array qd = vectorArg(qd_obj, "qd", n);
-  py::array_t<double> out(6);
-  auto j = J.unchecked<2>();
-  for (int r = 0; r < 6; ++r) {
-    double v = 0.0;
-    for (unsigned int c = 0; c < n; ++c) v += j(r, c) * qd.at(c);
-    out.mutable_data()[r] = v;
-  }
-  return out;
+  return twistOf(J, vectorArg(qd_obj, "qd", robot.chain.getNrOfJoints()));
 }
 
 py::tuple PyChain::getState() const {
@@ -178,12 +170,22 @@ py::tuple PyChain::getState() const {
 }
 
 PyChain PyChain::fromState(const py::tuple& state) {
-  if (state.size() != 6 || state[0].cast<int>() != 1) raise("Chain state: unknown format");
+  if (state.size() != 6 || !py::isinstance<py::int_>(state[0]) || state[0].cast<long long>() != 1)
+    raise("Chain state: unknown format");
   PyChain c;
-  for (const auto& item : state[1].cast<py::list>()) c.robot.chain.addSegment(segmentFromState(item.cast<py::tuple>()));
-  for (const auto& item : state[2].cast<py::list>())
-    c.robot.joints.push_back(jointInfoFromState(item.cast<py::tuple>()));
-  for (const auto& item : state[3].cast<py::list>()) c.robot.links.push_back(linkFromState(item.cast<py::tuple>()));
+  std::vector<int> moving;
+  int i = 0;
+  for (const auto& item : stateList(state[1], "Chain state: segments")) {
+    const KDL::Segment s = segmentFromState(item, "Chain state: segment " + std::to_string(i));
+    if (s.getJoint().getType() != KDL::Joint::Fixed) moving.push_back(i);
+    c.robot.chain.addSegment(s);
+    ++i;
+  }
+  for (const auto& item : stateList(state[2], "Chain state: joints"))
+    c.robot.joints.push_back(jointInfoFromState(item, "Chain state: joint record"));
+  for (const auto& item : stateList(state[3], "Chain state: links"))
+    c.robot.links.push_back(linkFromState(item, "Chain state: link record"));
+  checkStateIndices(c.robot.joints, c.robot.links, moving, c.segmentCount(), "Chain state");
   c.robot.root_link = state[4].cast<std::string>();
   c.robot.notes = state[5].cast<std::vector<std::string>>();
   return c;

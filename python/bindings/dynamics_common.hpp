@@ -21,6 +21,19 @@ inline void requireFiniteResult(const double* p, size_t n, const char* what) {
     if (!std::isfinite(p[k])) raise(std::string(what) + ": the result overflows the double range");
 }
 
+// The twist J qd (6,) of a frame from its Jacobian (6, n), checked finite.
+inline py::array_t<double> twistOf(const py::array_t<double>& J, const Array& qd) {
+  const auto j = J.unchecked<2>();
+  py::array_t<double> out(6);
+  for (py::ssize_t r = 0; r < 6; ++r) {
+    double v = 0.0;
+    for (py::ssize_t c = 0; c < j.shape(1); ++c) v += j(r, c) * qd.at(c);
+    out.mutable_data()[r] = v;
+  }
+  requireFiniteResult(out.data(), 6, "twist");
+  return out;
+}
+
 // Joint torques (n,) as a new numpy array, checked finite.
 inline py::array_t<double> jointTorques(const KDL::JntArray& tau, const char* what) {
   requireFiniteResult(tau.data.data(), tau.rows(), what);

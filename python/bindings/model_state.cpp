@@ -1,8 +1,11 @@
 // Pickle states of model parts and the URDF source argument (model_state.hpp).
 #include "model_state.hpp"
 
+#include <sys/stat.h>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 
 namespace vsbind {
 
@@ -21,9 +24,21 @@ py::tuple inertiaState(const KDL::RigidBodyInertia& I) {
   return t;
 }
 
-KDL::RigidBodyInertia inertiaFromState(const py::tuple& t) {
+// The entries of a state tuple as doubles: exactly `n` finite reals, or raises naming `what`.
+void finiteEntries(const py::handle& obj, std::size_t n, const std::string& what, double* out) {
+  if (!py::isinstance<py::tuple>(obj) || py::len(obj) != n)
+    raise(what + " must be a tuple of " + std::to_string(n) + " reals");
+  const py::tuple t = py::reinterpret_borrow<py::tuple>(obj);
+  for (std::size_t k = 0; k < n; ++k) {
+    out[k] = t[k].cast<double>();
+    if (!std::isfinite(out[k])) raise(what + " holds a non-finite value");
+  }
+}
+
+KDL::RigidBodyInertia inertiaFromState(const py::handle& obj, const std::string& what) {
   double raw[13];
-  for (int k = 0; k < 13; ++k) raw[k] = t[k].cast<double>();
+  finiteEntries(obj, 13, what + " inertia", raw);
+  if (raw[0] < 0.0) raise(what + " inertia has a negative mass");
   KDL::RigidBodyInertia I;
   std::memcpy(static_cast<void*>(&I), raw, sizeof(raw));
   return I;
@@ -34,20 +49,39 @@ py::tuple frameState(const KDL::Frame& f) {
                         f.M(2, 2), f.p.x(), f.p.y(), f.p.z());
 }
 
-KDL::Frame frameFromState(const py::tuple& t) {
-  auto d = [&](int k) { return t[k].cast<double>(); };
-  return KDL::Frame(KDL::Rotation(d(0), d(1), d(2), d(3), d(4), d(5), d(6), d(7), d(8)),
-                    KDL::Vector(d(9), d(10), d(11)));
+KDL::Frame frameFromState(const py::handle& obj, const std::string& what) {
+  double d[12];
+  finiteEntries(obj, 12, what, d);
+  return KDL::Frame(KDL::Rotation(d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7], d[8]),
+                    KDL::Vector(d[9], d[10], d[11]));
 }
 
 py::tuple vectorState(const KDL::Vector& v) {
   return py::make_tuple(v.x(), v.y(), v.z());
 }
-KDL::Vector vectorFromState(const py::tuple& t) {
-  return KDL::Vector(t[0].cast<double>(), t[1].cast<double>(), t[2].cast<double>());
+KDL::Vector vectorFromState(const py::handle& obj, const std::string& what) {
+  double d[3];
+  finiteEntries(obj, 3, what, d);
+  return KDL::Vector(d[0], d[1], d[2]);
+}
+
+// A state record: a tuple of exactly n entries.
+py::tuple record(const py::handle& obj, std::size_t n, const std::string& what) {
+  if (!py::isinstance<py::tuple>(obj) || py::len(obj) != n)
+    raise(what + " must be a tuple of " + std::to_string(n) + " entries");
+  return py::reinterpret_borrow<py::tuple>(obj);
 }
 
 }  // namespace
+
+long long stateInt(const py::handle& obj, long long lo, long long hi, const std::string& what) {
+  if (PyBool_Check(obj.ptr()) || !PyLong_Check(obj.ptr())) raise(what + " must be an int");
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(obj.ptr(), &overflow);
+  if (overflow != 0 || v < lo || v > hi)
+    raise(what + " is out of range (" + std::to_string(lo) + " .. " + std::to_string(hi) + ")");
+  return v;
+}
 
 py::tuple segmentState(const KDL::Segment& s) {
   const KDL::Joint& j = s.getJoint();
@@ -56,17 +90,25 @@ py::tuple segmentState(const KDL::Segment& s) {
                         frameState(s.getFrameToTip()), inertiaState(s.getInertia()));
 }
 
-KDL::Segment segmentFromState(const py::tuple& t) {
-  const auto type = static_cast<KDL::Joint::JointType>(t[2].cast<int>());
+KDL::Segment segmentFromState(const py::handle& obj, const std::string& what) {
+  const py::tuple t = record(obj, 10, what);
+  const auto type =
+      static_cast<KDL::Joint::JointType>(stateInt(t[2], KDL::Joint::RotAxis, KDL::Joint::Fixed, what + " joint type"));
   const std::string jname = t[1].cast<std::string>();
-  const double rotor = t[5].cast<double>(), damping = t[6].cast<double>(), stiffness = t[7].cast<double>();
-  const KDL::Joint j =
-      (type == KDL::Joint::RotAxis || type == KDL::Joint::TransAxis)
-          ? KDL::Joint(jname, vectorFromState(t[3].cast<py::tuple>()), vectorFromState(t[4].cast<py::tuple>()), type,
-                       1.0, 0.0, rotor, damping, stiffness)
-          : KDL::Joint(jname, type, 1.0, 0.0, rotor, damping, stiffness);
-  return KDL::Segment(t[0].cast<std::string>(), j, frameFromState(t[8].cast<py::tuple>()),
-                      inertiaFromState(t[9].cast<py::tuple>()));
+  double params[3];  // rotor inertia, damping, stiffness
+  for (int k = 0; k < 3; ++k) {
+    params[k] = t[5 + k].cast<double>();
+    if (!std::isfinite(params[k])) raise(what + " joint parameters must be finite");
+  }
+  if (params[0] < 0.0) raise(what + " rotor inertia must be >= 0");
+  const KDL::Vector origin = vectorFromState(t[3], what + " joint origin"),
+                    axis = vectorFromState(t[4], what + " joint axis");
+  const bool has_axis = type == KDL::Joint::RotAxis || type == KDL::Joint::TransAxis;
+  if (has_axis && !(axis.Norm() > 0.0)) raise(what + " joint axis must be non-zero");
+  const KDL::Joint j = has_axis ? KDL::Joint(jname, origin, axis, type, 1.0, 0.0, params[0], params[1], params[2])
+                                : KDL::Joint(jname, type, 1.0, 0.0, params[0], params[1], params[2]);
+  return KDL::Segment(t[0].cast<std::string>(), j, frameFromState(t[8], what + " tip frame"),
+                      inertiaFromState(t[9], what));
 }
 
 py::tuple jointInfoState(const vereshchagin::JointInfo& j) {
@@ -74,7 +116,8 @@ py::tuple jointInfoState(const vereshchagin::JointInfo& j) {
                         j.segment);
 }
 
-vereshchagin::JointInfo jointInfoFromState(const py::tuple& t) {
+vereshchagin::JointInfo jointInfoFromState(const py::handle& obj, const std::string& what) {
+  const py::tuple t = record(obj, 9, what);
   vereshchagin::JointInfo j;
   j.name = t[0].cast<std::string>();
   j.type = t[1].cast<std::string>();
@@ -84,7 +127,10 @@ vereshchagin::JointInfo jointInfoFromState(const py::tuple& t) {
   j.effort_limit = t[5].cast<double>();
   j.friction = t[6].cast<double>();
   j.damping = t[7].cast<double>();
-  j.segment = t[8].cast<unsigned int>();
+  if (std::isnan(j.lower) || std::isnan(j.upper) || !(j.lower <= j.upper))
+    raise(what + " limits must satisfy lower <= upper");
+  if (!std::isfinite(j.friction) || j.friction < 0.0) raise(what + " friction must be finite and >= 0");
+  j.segment = static_cast<unsigned int>(stateInt(t[8], 0, std::numeric_limits<int>::max(), what + " segment"));
   return j;
 }
 
@@ -92,8 +138,27 @@ py::tuple linkState(const vereshchagin::LinkPlacement& l) {
   return py::make_tuple(l.link, l.segment, frameState(l.in_segment_tip));
 }
 
-vereshchagin::LinkPlacement linkFromState(const py::tuple& t) {
-  return {t[0].cast<std::string>(), t[1].cast<int>(), frameFromState(t[2].cast<py::tuple>())};
+vereshchagin::LinkPlacement linkFromState(const py::handle& obj, const std::string& what) {
+  const py::tuple t = record(obj, 3, what);
+  return {t[0].cast<std::string>(),
+          static_cast<int>(stateInt(t[1], -1, std::numeric_limits<int>::max(), what + " segment")),
+          frameFromState(t[2], what + " frame")};
+}
+
+void checkStateIndices(const std::vector<vereshchagin::JointInfo>& joints,
+                       const std::vector<vereshchagin::LinkPlacement>& links, const std::vector<int>& moving_segments,
+                       int n_segments, const std::string& what) {
+  if (joints.size() != moving_segments.size())
+    raise(what + ": " + std::to_string(joints.size()) + " joint records for " + std::to_string(moving_segments.size()) +
+          " moving joints");
+  for (std::size_t k = 0; k < joints.size(); ++k)
+    if (static_cast<int>(joints[k].segment) != moving_segments[k])
+      raise(what + ": joint record " + std::to_string(k) + " names segment " + std::to_string(joints[k].segment) +
+            ", but that joint moves segment " + std::to_string(moving_segments[k]));
+  for (const vereshchagin::LinkPlacement& l : links)
+    if (l.segment >= n_segments)
+      raise(what + ": link '" + l.link + "' names segment " + std::to_string(l.segment) + " of " +
+            std::to_string(n_segments));
 }
 
 UrdfSource urdfSourceArg(const py::object& source) {
@@ -103,6 +168,9 @@ UrdfSource urdfSourceArg(const py::object& source) {
   out.text_or_path = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
   out.is_text = out.text_or_path.find('<') != std::string::npos;
   if (!out.is_text) {
+    struct stat info {};
+    if (::stat(out.text_or_path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
+      raise("URDF source '" + out.text_or_path + "' is a directory, not a URDF file");
     std::ifstream probe(out.text_or_path);
     if (!probe) raise("URDF source is neither XML text nor a readable file: '" + out.text_or_path + "'");
   }

@@ -12,6 +12,15 @@
 
 namespace vsbind {
 
+// Clears the pending Python error and returns " (its conversion raised Type: message)", so that a
+// message about a failed conversion keeps the reason (e.g. an __array__ that raised).
+inline std::string pendingErrorNote() {
+  if (!PyErr_Occurred()) return "";
+  py::error_already_set e;  // fetches and clears it
+  const std::string type = py::str(e.type().attr("__name__"));
+  return " (its conversion raised " + type + ": " + std::string(py::str(e.value())) + ")";
+}
+
 // A read-only view of a real array argument. `data` points into numpy memory owned by the
 // caller's object or by `keep` (a converted copy); valid while both live.
 struct F64View {
@@ -64,12 +73,12 @@ inline F64View asF64(PyObject* obj, const char* name) {
   }
   if (obj == Py_None) raise(std::string(name) + " must be a real array, got None");
   if (PyBool_Check(obj)) raise(std::string(name) + " must be a real number or array, got bool");
-  py::array any = py::array::ensure(py::handle(obj));
-  if (!any) {
-    PyErr_Clear();
+  // PyArray_FromAny keeps the error of a failed conversion (py::array::ensure clears it).
+  py::array any =
+      py::reinterpret_steal<py::array>(py::detail::npy_api::get().PyArray_FromAny_(obj, nullptr, 0, 0, 0, nullptr));
+  if (!any)
     raise(std::string(name) + " must be a real array (numbers of equal-length rows), got " +
-          std::string(py::str(py::type::of(py::handle(obj)).attr("__name__"))));
-  }
+          std::string(py::str(py::type::of(py::handle(obj)).attr("__name__"))) + pendingErrorNote());
   const char kind = any.dtype().kind();
   if (kind != 'f' && kind != 'i' && kind != 'u')
     raise(std::string(name) + " must hold real numbers (int or float), got dtype " + std::string(py::str(any.dtype())));

@@ -3,9 +3,11 @@
 // rows on one engine per thread with the GIL released (solve_batch.cpp).
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "chain_bindings.hpp"
@@ -55,6 +57,10 @@ class ConstraintKeys {
   std::vector<py::object> keys_;
 };
 
+// The most threads solve_batch starts (threads= beyond it is refused): each costs an OS thread and
+// an engine (a solver's workspace), and no machine gains from more.
+inline constexpr long kMaxBatchThreads = 256;
+
 // Raised for alpha/beta (the end segment's constraint) on a tree solver.
 inline constexpr const char* kTreeAlpha =
     "alpha and beta constrain a chain's last segment; a Tree has no last segment: pass constraints={segment or "
@@ -86,8 +92,22 @@ class PySolver {
   py::array gravity() const;
   py::tuple getState() const;
 
-  // Locks the solver; waits with the GIL released if another thread holds it.
-  std::unique_lock<std::mutex> lock();
+  // Holds the solver for one call. Waits with the GIL released while another thread holds it;
+  // raises SolverError if this thread already holds it (a call re-entered from inside its own
+  // argument conversion, e.g. a q whose __array__ calls the same solver).
+  class Lock {
+   public:
+    explicit Lock(PySolver& s);
+    ~Lock();
+    Lock(const Lock&) = delete;
+    Lock& operator=(const Lock&) = delete;
+
+   private:
+    PySolver& s_;
+  };
+  Lock lock() { return Lock(*this); }
+  // Starts a call that replaces the solver's state: response_columns() raises until it succeeds.
+  void beginStateCall() { last_state_ = false; }
 
   // The solver's model: a copy of its Chain or Tree.
   py::object model() const;
@@ -101,6 +121,8 @@ class PySolver {
   void parseFExt(PyObject* f_ext, ParsedSolve& p) const;
   void parseConstraints(PyObject* constraints, ParsedSolve& p) const;
   bool parseFriction(PyObject* friction, ParsedSolve& p);
+  bool frictionUnchanged(PyObject* friction) const;
+  void rememberFriction(PyObject* friction);
   Engine& engine(std::size_t k);
   void keepLastRow(BatchRunner& br, long threads);
 
@@ -113,9 +135,13 @@ class PySolver {
   py::object damping_arg_;
   std::vector<std::unique_ptr<Engine>> engines_;
   vereshchagin::FrictionModel chain_friction_;  // friction=True
-  py::object friction_cache_key_;               // the last vereshchagin.Friction parsed
+  // The last vereshchagin.Friction parsed and its six attribute objects: reused only while every
+  // attribute is the same object (the arrays cannot be written: friction.py).
+  py::object friction_cache_key_;
+  py::object friction_cache_attrs_[6];
   vereshchagin::FrictionModel friction_cache_;
   std::mutex mutex_;
+  std::atomic<std::thread::id> holder_{};  // the thread inside a call, or none
   // Engine 0 holds the state of the last successful solve() or of the last row of the last
   // successful solve_batch(): response_columns() linearises around it.
   bool last_state_ = false;

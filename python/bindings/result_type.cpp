@@ -33,9 +33,23 @@ struct ResultObject {
 PyTypeObject* g_type = nullptr;
 
 Py_ssize_t bufferDoubles(const ResultLayout& l) {
-  Py_ssize_t n = 2 * l.nj + l.m + 6 * (l.ns + 1);
-  if (l.friction) n += 2 * l.nj + (l.nj + 1) / 2;  // friction, limit torques; int32 status
+  const Py_ssize_t nj = l.nj, ns = l.ns, m = l.m;  // no int arithmetic: sizes from a state are checked first
+  Py_ssize_t n = 2 * nj + m + 6 * (ns + 1);
+  if (l.friction) n += 2 * nj + (nj + 1) / 2;  // friction, limit torques; int32 status
   return n;
+}
+
+// Sizes a result can have: up to kMaxSize joints or segments, m <= 6 per segment.
+constexpr long long kMaxSize = 1 << 24;
+
+int stateSize(const py::handle& obj, long long hi, const char* what) {
+  if (PyBool_Check(obj.ptr()) || !PyLong_Check(obj.ptr()))
+    throw SolverError(std::string("SolveResult state: ") + what + " must be an int");
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(obj.ptr(), &overflow);
+  if (overflow != 0 || v < 0 || v > hi)
+    throw SolverError(std::string("SolveResult state: ") + what + " out of range (0 .. " + std::to_string(hi) + ")");
+  return static_cast<int>(v);
 }
 
 ResultObject* self(PyObject* o) {
@@ -182,18 +196,34 @@ PyObject* stateTuple(PyObject* o) {
                        orNone(r->segment_starts), orNone(r->segment_counts));
 }
 
+// A segment_nu layout: keys, starts and counts of equal length, each part inside nu (m entries).
+void checkSegmentLayout(const py::handle& keys, const py::handle& starts, const py::handle& counts, int m) {
+  if (starts.is_none() || counts.is_none() || py::len(keys) != py::len(starts) || py::len(keys) != py::len(counts))
+    throw SolverError("SolveResult state: segment layout of inconsistent lengths");
+  const py::tuple s = py::reinterpret_borrow<py::tuple>(starts), c = py::reinterpret_borrow<py::tuple>(counts);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const int a = stateSize(s[k], m, "segment layout start"), n = stateSize(c[k], m, "segment layout count");
+    if (a + n > m) throw SolverError("SolveResult state: segment layout beyond nu");
+  }
+}
+
 PyObject* fromState(PyObject*, PyObject* args) {
   try {
     const py::tuple t = py::reinterpret_borrow<py::tuple>(args);
     if (t.size() != 12) throw SolverError("SolveResult state must have 12 entries");
     ResultLayout l;
-    l.nj = t[0].cast<int>();
-    l.ns = t[1].cast<int>();
-    l.m = t[2].cast<int>();
-    l.friction = t[3].cast<int>() != 0;
+    l.nj = stateSize(t[0], kMaxSize, "n_joints");
+    l.ns = stateSize(t[1], kMaxSize, "n_segments");
+    l.m = stateSize(t[2], 6LL * l.ns, "m");
+    l.friction = stateSize(t[3], 1, "the friction flag") != 0;
+    if (!PyBytes_Check(t[8].ptr())) throw SolverError("SolveResult state: data must be bytes");
     const std::string buf = t[8].cast<std::string>();
-    if (l.nj < 0 || l.ns < 0 || l.m < 0 || buf.size() != sizeof(double) * static_cast<std::size_t>(bufferDoubles(l)))
+    if (buf.size() != sizeof(double) * static_cast<std::size_t>(bufferDoubles(l)))
       throw SolverError("SolveResult state: data of the wrong size");
+    for (int k = 9; k < 12; ++k)
+      if (!t[k].is_none() && !py::isinstance<py::tuple>(t[k]))
+        throw SolverError("SolveResult state: segment layout entries must be tuples or None");
+    if (!t[9].is_none()) checkSegmentLayout(t[9], t[10], t[11], l.m);
     PyObject* o = allocate(l);
     ResultObject* r = self(o);
     std::memcpy(r->data, buf.data(), buf.size());
@@ -279,6 +309,15 @@ void bindResultType(py::module_& mod) {
   mod.add_object("_result_from_state", py::reinterpret_borrow<py::object>(g_from_state));
 }
 
+namespace {
+
+std::string layoutString(const ResultLayout& l) {
+  return "n_joints = " + std::to_string(l.nj) + ", n_segments = " + std::to_string(l.ns) +
+         ", m = " + std::to_string(l.m) + (l.friction ? " with" : " without") + " friction";
+}
+
+}  // namespace
+
 py::object newResult(const ResultLayout& layout, PyObject* out) {
   if (out == nullptr) return py::reinterpret_steal<py::object>(allocate(layout));
   if (Py_TYPE(out) != g_type)
@@ -287,9 +326,8 @@ py::object newResult(const ResultLayout& layout, PyObject* out) {
   ResultObject* r = self(out);
   const ResultLayout& l = r->layout;
   if (l.nj != layout.nj || l.ns != layout.ns || l.m != layout.m || l.friction != layout.friction)
-    throw SolverError("out does not fit this solve: it holds m = " + std::to_string(l.m) +
-                      (l.friction ? " with" : " without") + " friction, this solve has m = " +
-                      std::to_string(layout.m) + (layout.friction ? " with" : " without") + " friction");
+    throw SolverError("out does not fit this solve: it holds " + layoutString(l) + ", this solve has " +
+                      layoutString(layout));
   Py_CLEAR(r->segment_keys);
   Py_CLEAR(r->segment_starts);
   Py_CLEAR(r->segment_counts);

@@ -13,6 +13,7 @@ void ParsedSolve::clear() {
   block_views.clear();
   blocks.clear();
   block_keys.clear();
+  f_ext_dense.clear();  // keeps its capacity: no allocation in a control loop
   link_wrenches.clear();
   friction_owner = py::object();
   friction = nullptr;
@@ -208,9 +209,49 @@ void PySolver::parseConstraints(PyObject* constraints, ParsedSolve& p) const {
   p.block_keys = keys.keys();
 }
 
+namespace {
+
+// The attributes of a vereshchagin.Friction, in the order of PySolver::friction_cache_attrs_.
+PyObject* frictionAttrName(int k) {
+  static PyObject* names[6] = {PyUnicode_InternFromString("static"),
+                               PyUnicode_InternFromString("kinetic"),
+                               PyUnicode_InternFromString("velocity_tolerance"),
+                               PyUnicode_InternFromString("lower"),
+                               PyUnicode_InternFromString("upper"),
+                               PyUnicode_InternFromString("limit_tolerance")};
+  return names[k];
+}
+
+// The instance dict of a vereshchagin.Friction (a dataclass: its fields live there).
+PyObject* instanceDict(PyObject* obj) {
+  PyObject** dict = _PyObject_GetDictPtr(obj);
+  return dict == nullptr ? nullptr : *dict;
+}
+
+}  // namespace
+
+// True while the cached Friction still holds the very attribute objects it was parsed from. Its
+// arrays are read-only views of immutable bytes (friction.py), so the same objects mean the same
+// values; an attribute replaced (object.__setattr__) makes the next solve parse it again.
+bool PySolver::frictionUnchanged(PyObject* friction) const {
+  PyObject* dict = instanceDict(friction);
+  if (dict == nullptr) return false;
+  for (int k = 0; k < 6; ++k)
+    if (PyDict_GetItem(dict, frictionAttrName(k)) != friction_cache_attrs_[k].ptr()) return false;
+  return true;
+}
+
+void PySolver::rememberFriction(PyObject* friction) {
+  PyObject* dict = instanceDict(friction);
+  if (dict == nullptr) return;  // not cached
+  for (int k = 0; k < 6; ++k)
+    friction_cache_attrs_[k] = py::reinterpret_borrow<py::object>(PyDict_GetItem(dict, frictionAttrName(k)));
+  friction_cache_key_ = py::reinterpret_borrow<py::object>(friction);
+}
+
 // friction: None/False (frictionless), True (the chain's values: static friction, limits), a
-// vereshchagin.Friction (immutable: parsed once and cached by identity) or any object with the
-// same attributes (parsed every call).
+// vereshchagin.Friction (immutable: parsed once and reused while its attributes are the same
+// objects) or any object with the same attributes (parsed every call).
 bool PySolver::parseFriction(PyObject* friction, ParsedSolve& p) {
   if (!given(friction) || friction == Py_False) return false;
   if (friction == Py_True) {
@@ -220,15 +261,19 @@ bool PySolver::parseFriction(PyObject* friction, ParsedSolve& p) {
   if (PyBool_Check(friction)) return false;
   static py::object friction_type = py::module_::import("vereshchagin.friction").attr("Friction");
   const bool cacheable = Py_TYPE(friction) == reinterpret_cast<PyTypeObject*>(friction_type.ptr());
-  if (cacheable && friction_cache_key_.ptr() == friction) {
+  if (cacheable && friction_cache_key_.ptr() == friction && frictionUnchanged(friction)) {
     p.friction = &friction_cache_;
     return true;
   }
   py::handle fr(friction);
-  if (!py::hasattr(fr, "static"))
+  const py::object static_obj = py::reinterpret_steal<py::object>(PyObject_GetAttrString(friction, "static"));
+  if (!static_obj) {
+    if (!PyErr_ExceptionMatches(PyExc_AttributeError)) throw py::error_already_set();  // e.g. a property raised
+    PyErr_Clear();
     raise("friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)");
+  }
   vereshchagin::FrictionModel& fm = cacheable ? friction_cache_ : p.friction_model;
-  F64View fs = vectorView(fr.attr("static").ptr(), "friction.static", nj);
+  F64View fs = vectorView(static_obj.ptr(), "friction.static", nj);
   fm.static_friction = Eigen::Map<const Eigen::VectorXd>(fs.data, nj);
   const py::object kin = py::getattr(fr, "kinetic", py::none());
   if (kin.is_none()) {
@@ -264,7 +309,7 @@ bool PySolver::parseFriction(PyObject* friction, ParsedSolve& p) {
   }
   if (cacheable) friction_cache_key_ = py::object();  // invalid until checked
   checkFriction(fm);
-  if (cacheable) friction_cache_key_ = py::reinterpret_borrow<py::object>(friction);
+  if (cacheable) rememberFriction(friction);
   p.friction = &fm;
   return true;
 }

@@ -2,6 +2,7 @@
 // axis; rows run on one engine per thread with the GIL released, through the same Engine::run as
 // Solver.solve (so every row equals the single solve bit for bit).
 #include <algorithm>
+#include <system_error>
 #include <thread>
 
 #include "py_solver.hpp"
@@ -254,6 +255,27 @@ struct BatchRunner {
   }
 };
 
+namespace {
+
+// solve_batch's threads: an int >= 0 (0: one per core), at most kMaxBatchThreads.
+long threadsArg(const py::object& obj) {
+  if (obj.is_none()) return 1;
+  if (PyBool_Check(obj.ptr()) || !PyIndex_Check(obj.ptr()))
+    raise("threads must be an int (0: one per core), got " + std::string(Py_TYPE(obj.ptr())->tp_name) + " " +
+          py::repr(obj).cast<std::string>());
+  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(obj.ptr()));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0 || v < 0 || v > kMaxBatchThreads)
+    raise("threads must be in 0 .. " + std::to_string(kMaxBatchThreads) + " (0: one per core), got " +
+          py::str(index).cast<std::string>());
+  if (v == 0) return std::max(1u, std::thread::hardware_concurrency());
+  return static_cast<long>(v);
+}
+
+}  // namespace
+
 // response_columns() after a batch linearises around its last row: engine 0 solved it unless the
 // rows were spread over threads; then it solves it once more (bit-identical rows).
 void PySolver::keepLastRow(BatchRunner& br, long threads) {
@@ -274,6 +296,7 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
                               const py::object& f_ext_pass_through_obj, const py::object& tau_ff_pass_through_obj,
                               const py::object& threads_obj) {
   auto lk = lock();
+  beginStateCall();
   BatchRunner br(*this);
   const py::ssize_t n = nj;
   br.q = batchedArg(q_obj.ptr(), "q", 1, {n}, br.bs);
@@ -304,11 +327,8 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
   }
   br.B = br.bs.B < 0 ? 1 : br.bs.B;
   br.finishFExt();
-  long threads = threads_obj.is_none() ? 1 : static_cast<long>(scalarArg(threads_obj, "threads"));
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  if (threads < 0) raise("threads must be >= 0 (0: one per core), got " + std::to_string(threads));
   const py::ssize_t B = br.B, M = br.M;
-  threads = std::min<long>(threads, std::max<py::ssize_t>(B, 1));
+  long threads = std::min<long>(threadsArg(threads_obj), std::max<py::ssize_t>(B, 1));
   for (long t = 0; t < threads; ++t) engine(static_cast<std::size_t>(t));
 
   py::array qdd = newDoubles({B, n}), tau = newDoubles({B, n}), nu = newDoubles({B, M});
@@ -357,19 +377,30 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
     }
   };
   last_state_ = false;  // until engine 0 holds the last row's state
+  std::string start_failure;
   {
     py::gil_scoped_release release;
     if (threads <= 1) {
       work(0, 0, B);
     } else {
       std::vector<std::thread> pool;
+      pool.reserve(static_cast<std::size_t>(threads));
       const py::ssize_t chunk = (B + threads - 1) / threads;
-      for (long t = 1; t < threads; ++t)
-        pool.emplace_back(work, t, std::min(B, t * chunk), std::min(B, (t + 1) * chunk));
-      work(0, 0, std::min(B, chunk));
-      for (auto& th : pool) th.join();
+      try {
+        for (long t = 1; t < threads; ++t)
+          pool.emplace_back(work, t, std::min(B, t * chunk), std::min(B, (t + 1) * chunk));
+      } catch (const std::system_error& e) {  // the OS refused a thread: join the started ones
+        for (auto& th : pool) th.join();
+        start_failure = "solve_batch could not start thread " + std::to_string(pool.size() + 1) + " of " +
+                        std::to_string(threads) + " (" + e.what() + "): pass fewer threads";
+      }
+      if (start_failure.empty()) {
+        work(0, 0, std::min(B, chunk));
+        for (auto& th : pool) th.join();
+      }
     }
   }
+  if (!start_failure.empty()) raise(start_failure);
   for (const Failure& f : failures)  // rows are in thread order: the first failure is the lowest row
     if (f.row >= 0) raise("batch row " + std::to_string(f.row) + ": " + f.message);
   keepLastRow(br, threads);

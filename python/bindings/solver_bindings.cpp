@@ -54,13 +54,21 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
   }
 }
 
-std::unique_lock<std::mutex> PySolver::lock() {
-  std::unique_lock<std::mutex> lk(mutex_, std::try_to_lock);
-  if (!lk.owns_lock()) {
+PySolver::Lock::Lock(PySolver& s) : s_(s) {
+  if (s.holder_.load() == std::this_thread::get_id())
+    raise(
+        "a Solver call re-entered the same Solver while it converts its arguments (an argument's __array__, "
+        "property or __index__ calls this solver): convert the arguments first, or use another Solver");
+  if (!s.mutex_.try_lock()) {
     py::gil_scoped_release release;  // another thread solves: wait without blocking it
-    lk.lock();
+    s.mutex_.lock();
   }
-  return lk;
+  s.holder_.store(std::this_thread::get_id());
+}
+
+PySolver::Lock::~Lock() {
+  s_.holder_.store(std::thread::id());
+  s_.mutex_.unlock();
 }
 
 Engine& PySolver::engine(std::size_t k) {
@@ -315,6 +323,7 @@ PyObject* solveEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, Py
     bindArguments("solve", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
     PySolver& s = solverOf(self);
     auto lk = s.lock();
+    s.beginStateCall();
     s.parse(a, s.parsed);
     s.runParsed(s.parsed);
     PyObject* out = (a[kOut] == nullptr || a[kOut] == Py_None) ? nullptr : a[kOut];

@@ -4,6 +4,7 @@
 
 #include <pybind11/stl.h>
 
+#include "dynamics_common.hpp"
 #include "model_state.hpp"
 #include "tree_bindings.hpp"
 #include "vereshchagin/urdf_loader.hpp"
@@ -43,22 +44,28 @@ py::tuple PyTree::getState() const {
 }
 
 PyTree PyTree::fromState(const py::tuple& state) {
-  if (state.size() != 6 || state[0].cast<int>() != 1) raise("Tree state: unknown format");
+  if (state.size() != 6 || !py::isinstance<py::int_>(state[0]) || state[0].cast<long long>() != 1)
+    raise("Tree state: unknown format");
   PyTree t;
   t.robot.root_link = state[1].cast<std::string>();
   t.robot.tree = KDL::Tree(t.robot.root_link);
-  for (const auto& item : state[2].cast<py::list>()) {
-    const py::tuple entry = item.cast<py::tuple>();
-    const KDL::Segment s = segmentFromState(entry[0].cast<py::tuple>());
-    const int parent = entry[1].cast<int>();
-    if (parent < -1 || parent >= t.segmentCount()) raise("Tree state: parent index out of range");
-    appendSegment(t.robot.tree, t.robot, s, parent, "Tree state");
+  std::vector<int> moving;
+  for (const auto& item : stateList(state[2], "Tree state: segments")) {
+    const std::string what = "Tree state: segment " + std::to_string(t.segmentCount());
+    if (!py::isinstance<py::tuple>(item) || py::len(item) != 2) raise(what + " must be a pair (segment, parent)");
+    const py::tuple entry = py::reinterpret_borrow<py::tuple>(item);
+    const KDL::Segment s = segmentFromState(entry[0], what);
+    const long long parent = stateInt(entry[1], -1, t.segmentCount() - 1, what + ": parent index");
+    if (s.getJoint().getType() != KDL::Joint::Fixed) moving.push_back(t.segmentCount());
+    appendSegment(t.robot.tree, t.robot, s, static_cast<int>(parent), "Tree state");
     t.robot.segment_names.push_back(s.getName());
-    t.robot.parent.push_back(parent);
+    t.robot.parent.push_back(static_cast<int>(parent));
   }
-  for (const auto& item : state[3].cast<py::list>())
-    t.robot.joints.push_back(jointInfoFromState(item.cast<py::tuple>()));
-  for (const auto& item : state[4].cast<py::list>()) t.robot.links.push_back(linkFromState(item.cast<py::tuple>()));
+  for (const auto& item : stateList(state[3], "Tree state: joints"))
+    t.robot.joints.push_back(jointInfoFromState(item, "Tree state: joint record"));
+  for (const auto& item : stateList(state[4], "Tree state: links"))
+    t.robot.links.push_back(linkFromState(item, "Tree state: link record"));
+  checkStateIndices(t.robot.joints, t.robot.links, moving, t.segmentCount(), "Tree state");
   t.robot.notes = state[5].cast<std::vector<std::string>>();
   return t;
 }
@@ -144,17 +151,8 @@ py::array_t<double> PyTree::jacobian(const py::object& q_obj, const py::object& 
 }
 
 py::array_t<double> PyTree::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& which) const {
-  const unsigned int n = robot.tree.getNrOfJoints();
-  Array qd = vectorArg(qd_obj, "qd", n);
-  py::array_t<double> J = jacobian(q_obj, which);
-  auto j = J.unchecked<2>();
-  py::array_t<double> out(6);
-  for (int r = 0; r < 6; ++r) {
-    double v = 0.0;
-    for (unsigned int c = 0; c < n; ++c) v += j(r, c) * qd.at(c);
-    out.mutable_data()[r] = v;
-  }
-  return out;
+  const Array qd = vectorArg(qd_obj, "qd", robot.tree.getNrOfJoints());
+  return twistOf(jacobian(q_obj, which), qd);
 }
 
 PyChain PyTree::pathChain(const py::object& tip) const {

@@ -25,16 +25,19 @@ def _frozen_vector(value, name: str, allow_inf: bool = False) -> Optional[np.nda
     a = np.array(a, dtype=np.float64)
     if np.isnan(a).any() or (not allow_inf and not np.isfinite(a).all()):
         raise SolverError(f"friction.{name} contains {'NaN' if allow_inf else 'NaN or Inf'}")
-    a.setflags(write=False)
-    return a
+    # A view of immutable bytes: its WRITEABLE flag cannot be switched back on, so the values of a
+    # Friction never change after construction (solvers may reuse a parsed Friction).
+    return np.frombuffer(a.tobytes(), dtype=np.float64)
 
 
 @dataclass(frozen=True)
 class Friction:
     """Per-joint friction for ``Solver.solve(..., friction=Friction(...))``.
 
-    Immutable: the arrays are stored as read-only float64 copies, so a solver may reuse a parsed
-    ``Friction`` across calls (pass the same object in a control loop).
+    Immutable: the arrays are stored as float64 copies that cannot be written (views of immutable
+    bytes: ``flags.writeable`` cannot be switched back on), so a solver may reuse a parsed
+    ``Friction`` across calls (pass the same object in a control loop). A solver reparses it if
+    an attribute was replaced.
 
     Parameters
     ----------

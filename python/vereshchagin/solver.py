@@ -134,7 +134,9 @@ class Solver(_core.Solver):
             Driver pass-through weights in [0, 1] per constraint column (see :meth:`solve`).
         threads : int
             Rows are split into ``threads`` contiguous chunks solved in parallel with the GIL
-            released (0: one per core). Results do not depend on it.
+            released (0: one per core; at most 256, and never more than B). Results do not
+            depend on it. If the operating system refuses to start a thread, the started ones
+            are joined and :class:`SolverError` says so.
 
         Returns
         -------
@@ -143,8 +145,9 @@ class Solver(_core.Solver):
         Raises
         ------
         SolverError
-            Shapes that do not fit (the message names the argument and its batch axis), or the
-            first failing row (``"batch row 3: ..."``).
+            Shapes that do not fit (the message names the argument and its batch axis), a
+            ``threads`` that is not an int in 0 .. 256, or the first failing row
+            (``"batch row 3: ..."``).
         """
         return BatchResult(
             **super().solve_batch(

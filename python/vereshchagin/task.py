@@ -20,26 +20,42 @@ from typing import Sequence, Union
 
 import numpy as np
 
+from ._core import SolverError
+
 __all__ = ["Task", "beta_for", "directions", "pose_error", "twist_error"]
 
 _NAMES = {"x": 0, "y": 1, "z": 2, "rx": 3, "ry": 4, "rz": 5}
 _G_EARTH = (0.0, 0.0, -9.81)
 
 
+def _real_array(value, what: str) -> np.ndarray:
+    """A float64 array of real numbers, finite (SolverError naming ``what`` otherwise)."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise SolverError(f"{what} must be an array of real numbers: {e}") from None
+    if not np.all(np.isfinite(a)):
+        raise SolverError(f"{what} must be finite (no NaN or Inf)")
+    return a
+
+
+def _proper_rotation(R: np.ndarray, what: str) -> np.ndarray:
+    """R itself if it is a rotation matrix (orthonormal to 1e-6, det +1), else SolverError."""
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0.0:
+        raise SolverError(f"{what}'s rotation part is not a rotation matrix (orthonormal, det +1)")
+    return R
+
+
 def _rotation_of(frame) -> np.ndarray:
     """The 3x3 rotation of a 3x3 rotation or 4x4 pose, validated."""
-    F = np.asarray(frame, dtype=float)
+    F = _real_array(frame, "frame")
     if F.shape == (4, 4):
         R = F[:3, :3]
     elif F.shape == (3, 3):
         R = F
     else:
-        raise ValueError(f"frame must be a 3x3 rotation or a 4x4 pose, got shape {F.shape}")
-    if not np.all(np.isfinite(R)):
-        raise ValueError("frame must be finite")
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0.0:
-        raise ValueError("frame's rotation part is not a rotation matrix (orthonormal, det +1)")
-    return R
+        raise SolverError(f"frame must be a 3x3 rotation or a 4x4 pose, got shape {F.shape}")
+    return _proper_rotation(R, "frame")
 
 
 def directions(names: Union[str, Sequence], frame=None) -> np.ndarray:
@@ -63,7 +79,7 @@ def directions(names: Union[str, Sequence], frame=None) -> np.ndarray:
 
     Raises
     ------
-    ValueError
+    SolverError
         Unknown name, a 6-vector of the wrong size, zero or non-finite, or an invalid frame.
     """
     if isinstance(names, str):
@@ -74,16 +90,16 @@ def directions(names: Union[str, Sequence], frame=None) -> np.ndarray:
         if isinstance(entry, str):
             key = entry.strip().lower()
             if key not in _NAMES:
-                raise ValueError(f"unknown direction {entry!r}; use one of {sorted(_NAMES)} or a 6-vector")
+                raise SolverError(f"unknown direction {entry!r}; use one of {sorted(_NAMES)} or a 6-vector")
             v = np.zeros(6)
             v[_NAMES[key]] = 1.0
         else:
             v = np.asarray(entry, dtype=float).reshape(-1)
             if v.shape != (6,):
-                raise ValueError(f"a direction vector must have 6 entries [force; moment], got {v.shape}")
+                raise SolverError(f"a direction vector must have 6 entries [force; moment], got {v.shape}")
             norm = np.linalg.norm(v)
             if not np.isfinite(norm) or norm == 0.0:
-                raise ValueError(f"a direction vector must be finite and nonzero, got {v}")
+                raise SolverError(f"a direction vector must be finite and nonzero, got {v}")
             v = v / norm
         cols.append(np.concatenate([R @ v[:3], R @ v[3:]]))
     return np.array(cols, dtype=float).reshape(-1, 6).T
@@ -111,6 +127,11 @@ def beta_for(alpha, a_desired, twist, gravity=_G_EARTH) -> np.ndarray:
     ndarray, shape (m,)
         ``alpha.T @ [a_lin - omega x v - gravity; a_ang]``.
 
+    Raises
+    ------
+    SolverError
+        Wrong shapes, NaN or Inf in any input, or a result that overflows.
+
     Notes
     -----
     The solver's ``a_N`` is a spatial acceleration: its linear part is the acceleration of the
@@ -120,18 +141,22 @@ def beta_for(alpha, a_desired, twist, gravity=_G_EARTH) -> np.ndarray:
     every linear acceleration it reports or constrains. Holding the tip still (``a_desired = 0``)
     therefore needs ``beta = alpha.T @ [-omega x v - gravity; 0]``, not 0.
     """
-    A = np.asarray(alpha, dtype=float)
+    A = _real_array(alpha, "alpha")
     if A.ndim == 1:
-        A = A.reshape(6, 1)
+        A = A.reshape(6, 1) if A.shape == (6,) else A
     if A.ndim != 2 or A.shape[0] != 6:
-        raise ValueError(f"alpha must have shape (6, m), got {A.shape}")
-    a = np.asarray(a_desired, dtype=float).reshape(-1)
-    t = np.asarray(twist, dtype=float).reshape(-1)
-    g = np.asarray(gravity, dtype=float).reshape(-1)
+        raise SolverError(f"alpha must have shape (6, m), got {A.shape}")
+    a = _real_array(a_desired, "a_desired").reshape(-1)
+    t = _real_array(twist, "twist").reshape(-1)
+    g = _real_array(gravity, "gravity").reshape(-1)
     if a.shape != (6,) or t.shape != (6,) or g.shape != (3,):
-        raise ValueError(f"a_desired and twist must have 6 entries and gravity 3, got {a.shape}, {t.shape}, {g.shape}")
-    spatial = np.concatenate([a[:3] - np.cross(t[3:], t[:3]) - g, a[3:]])
-    return A.T @ spatial
+        raise SolverError(f"a_desired and twist must have 6 entries and gravity 3, got {a.shape}, {t.shape}, {g.shape}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        spatial = np.concatenate([a[:3] - np.cross(t[3:], t[:3]) - g, a[3:]])
+        beta = A.T @ spatial
+    if not np.all(np.isfinite(beta)):
+        raise SolverError("beta_for: the result overflows the double range (inputs too large)")
+    return beta
 
 
 def _quaternion(R: np.ndarray) -> np.ndarray:
@@ -168,9 +193,13 @@ def _rotvec(R: np.ndarray) -> np.ndarray:
 
 
 def _pose(T, what: str) -> np.ndarray:
-    T = np.asarray(T, dtype=float)
-    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-        raise ValueError(f"{what} must be a finite 4x4 pose, got shape {T.shape}")
+    """A finite 4x4 homogeneous pose with a proper rotation (SolverError otherwise)."""
+    T = _real_array(T, what)
+    if T.shape != (4, 4):
+        raise SolverError(f"{what} must be a finite 4x4 pose, got shape {T.shape}")
+    if np.any(T[3] != (0.0, 0.0, 0.0, 1.0)):
+        raise SolverError(f"{what} must be a homogeneous pose: its last row must be [0, 0, 0, 1], got {T[3]}")
+    _proper_rotation(T[:3, :3], what)
     return T
 
 
@@ -180,7 +209,8 @@ def pose_error(T_current, T_desired) -> np.ndarray:
     Parameters
     ----------
     T_current, T_desired : array_like, shape (4, 4)
-        Poses in the base frame.
+        Poses in the base frame: finite, last row ``[0, 0, 0, 1]``, rotation part orthonormal
+        (to 1e-6) with determinant +1; anything else raises :class:`SolverError`.
 
     Returns
     -------
@@ -196,11 +226,15 @@ def pose_error(T_current, T_desired) -> np.ndarray:
 
 def twist_error(t_current, t_desired) -> np.ndarray:
     """Twist error ``t_desired - t_current``, (6,), both ``[v; omega]`` in base axes."""
-    c = np.asarray(t_current, dtype=float).reshape(-1)
-    d = np.asarray(t_desired, dtype=float).reshape(-1)
+    c = _real_array(t_current, "t_current").reshape(-1)
+    d = _real_array(t_desired, "t_desired").reshape(-1)
     if c.shape != (6,) or d.shape != (6,):
-        raise ValueError(f"twists must have 6 entries, got {c.shape} and {d.shape}")
-    return d - c
+        raise SolverError(f"twists must have 6 entries, got {c.shape} and {d.shape}")
+    with np.errstate(over="ignore"):
+        e = d - c
+    if not np.all(np.isfinite(e)):
+        raise SolverError("twist_error: the result overflows the double range")
+    return e
 
 
 class Task:
