@@ -497,8 +497,11 @@ def test_response_columns_after_a_batch_refers_to_its_last_row_whatever_the_thre
             solver.solve_batch(Q[:2], QD[:2], tau_ff=np.full((2, n), 1e308), threads=threads)
         with pytest.raises(vs.SolverError, match="last successful solve"):
             solver.response_columns([0])
-        # a batch that fails its argument checks runs no row: the state stands
+        # a batch that fails its argument checks is a failed call too (issue 23): no state stands
         solver.solve(Q[-1], QD[-1], friction=fr)
         with pytest.raises(vs.SolverError):
             solver.solve_batch(Q[:, :2], QD)
+        with pytest.raises(vs.SolverError, match="last successful solve"):
+            solver.response_columns([0])
+        solver.solve(Q[-1], QD[-1], friction=fr)
         np.testing.assert_array_equal(solver.response_columns([0, n - 1])[0], expected[0])

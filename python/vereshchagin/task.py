@@ -31,9 +31,12 @@ _G_EARTH = (0.0, 0.0, -9.81)
 def _real_array(value, what: str) -> np.ndarray:
     """A float64 array of real numbers, finite (SolverError naming ``what`` otherwise)."""
     try:
-        a = np.asarray(value, dtype=float)
+        a = np.asarray(value)
     except (TypeError, ValueError) as e:
         raise SolverError(f"{what} must be an array of real numbers: {e}") from None
+    if a.dtype.kind not in "iuf":
+        raise SolverError(f"{what} must hold real numbers (int or float), got dtype {a.dtype}")
+    a = a.astype(np.float64)
     if not np.all(np.isfinite(a)):
         raise SolverError(f"{what} must be finite (no NaN or Inf)")
     return a
