@@ -42,6 +42,10 @@ SETTINGS = settings(
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
 )
 
+# The replays are exact algebra (ABA of the total torque); measured worst relative error over the
+# derandomised examples: 2.8e-14 (command torques), 1.8e-12 (friction and limit torques).
+REPLAY_RTOL = 1e-9
+
 chain_params = st.fixed_dictionaries(
     {
         "seed": st.integers(0, 2**32 - 1),
@@ -147,7 +151,7 @@ def test_command_torques_reproduce_qdd(params, m, dependent, damped, with_fext):
     if dependent and m >= 2:
         assert res.constraint_rank < m
     free = vs.Solver(rc.chain).solve(q, qd, f_ext=f_ext, tau_ff=tau + res.tau_command)
-    assert close(free.qdd, res.qdd, 1e-7), (free.qdd, res.qdd)
+    assert close(free.qdd, res.qdd, REPLAY_RTOL), (free.qdd, res.qdd)
     if m:  # the replay holds for any nu: the task decides which one
         assert_task_policy(rc, q, qd, tau, f_ext, alpha, beta, res, damping=1e-8 if damped else None)
 
@@ -201,7 +205,7 @@ def test_friction_complementarity(params, m, rest_mask, friction_scale, kinetic_
             assert f == pytest.approx(-fs[j] * np.sign(qdd_j), rel=1e-9, abs=1e-12)
     total = tau + res.tau_command + res.friction_torque + res.limit_torque
     free = vs.Solver(rc.chain).solve(q, qd, tau_ff=total)
-    assert close(free.qdd, res.qdd, 1e-7), (free.qdd, res.qdd)
+    assert close(free.qdd, res.qdd, REPLAY_RTOL), (free.qdd, res.qdd)
 
 
 def _kinetic_energy(solver, n, q, qd):
