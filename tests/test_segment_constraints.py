@@ -17,6 +17,7 @@ import pytest
 
 import vereshchagin as vs
 from chains import well_conditioned_task
+from dense_oracle import dense_task
 from friction_oracles import FrictionProblem, enumeration_oracle, scipy_oracle
 from test_friction_oracles import check_against_oracles
 from test_urdf_pinocchio import BUILDERS, G, LWA, _minv, _with_rotors, assert_rel
@@ -168,19 +169,33 @@ def test_conflicting_segment_constraints_are_finite_with_rank():
     for damping in (None, 1e-6):
         solver = vs.Solver(r.chain, damping=damping)
         q, qd = r.random_state(rng)
-        res = solver.solve(
-            q,
-            qd,
-            constraints={
-                "forearm_link": (np.eye(6), rng.normal(size=6)),
-                "end_effector_link": (np.eye(6), rng.normal(size=6)),
-            },
-        )
+        cons = {
+            "forearm_link": (np.eye(6), rng.normal(size=6)),
+            "end_effector_link": (np.eye(6), rng.normal(size=6)),
+        }
+        res = solver.solve(q, qd, constraints=cons)
         for field in ("qdd", "tau_command", "nu", "link_acc"):
             assert np.all(np.isfinite(getattr(res, field))), field
         assert res.nu.shape == (12,)
         if damping is None:
             assert res.constraint_rank == 7
+        # by value (issue 23), against the dense oracle of tests/dense_oracle.py
+        r.model.armature = np.zeros(r.model.nv)
+        tasks = [(r.model.getFrameId(n), a, b) for n, (a, b) in cons.items()]
+        dense = dense_task(r.model, [], r.pin_q(q), qd, G, np.zeros(r.model.nv), tasks)
+        lam = np.linalg.eigvalsh(dense.K)
+        assert lam[4] < 1e-13 * lam[-1] < 1e-6 * lam[5], lam  # rank 7 with a clean gap
+        if damping is None:
+            nu = dense.truncated(1e-9 * lam[-1])[0]
+            assert_rel(res.nu, nu, "conflicting: nu = K^+ r (minimum norm)", RTOL_EXACT)
+        else:
+            nu = dense.damped(damping)  # its null-space part is round-off / damping^2: not compared
+        qdd, tau_cmd = dense.outputs(nu)
+        assert_rel(res.qdd, qdd, "conflicting: qdd", RTOL_EXACT)
+        assert_rel(res.tau_command, tau_cmd, "conflicting: tau_command", RTOL_EXACT)
+        # least squares: the residual of the 12 rows is orthogonal to range(K)
+        e = dense.task_acc(res.qdd) - dense.beta  # Pinocchio's frame accelerations at the solver's qdd
+        assert np.linalg.norm(dense.K @ e) <= 1e-9 * lam[-1] * max(np.linalg.norm(dense.r), 1.0)
 
 
 def test_bad_constraints_raise():
