@@ -677,6 +677,21 @@ def test_duplicated_alpha_columns(damping):
         # the duplicated constraint shares the force: the sum equals the single constraint's
         assert res.nu.sum() == pytest.approx(single.nu[0], rel=1e-9)
         assert a[:, 0] @ res.link_acc[-1] == pytest.approx(0.7, abs=1e-9)
+    # by value against the dense oracle (tests/dense_oracle.py): K = k [[1, 1], [1, 1]]
+    dense = dense_task(
+        rc.model,
+        rc.tip_frames,
+        q,
+        qd,
+        G_EARTH,
+        np.zeros(rc.n_joints),
+        [(rc.tip_frames[-1], np.hstack([a, a]), [0.7, 0.7])],
+    )
+    nu = dense.truncated(1e-9 * np.abs(dense.K).max())[0] if damping is None else dense.damped(damping)
+    qdd, tau_cmd = dense.outputs(nu)
+    assert_close(res.nu, nu, 1e-9, "nu")
+    assert_close(res.qdd, qdd, 1e-9, "qdd")
+    assert_close(res.tau_command, tau_cmd, 1e-9, "tau_command")
 
 
 def test_more_constraints_than_joints():
