@@ -327,6 +327,13 @@ def test_beta_for_never_returns_nan_or_inf(args):
     assert np.all(np.isfinite(beta))
 
 
+def test_task_helpers_refuse_non_real_dtypes():
+    with pytest.raises(vs.SolverError, match="real numbers"):
+        vs.task.beta_for(np.eye(6)[:, :1], np.zeros(6), np.zeros(6, dtype=complex))
+    with pytest.raises(vs.SolverError, match="real numbers"):
+        vs.task.pose_error(np.eye(4, dtype=complex), np.eye(4))
+
+
 def test_beta_for_refuses_nan_and_overflow():
     with pytest.raises(vs.SolverError, match="finite"):
         vs.task.beta_for(np.eye(6)[:, :1], np.full(6, np.nan), np.zeros(6))
