@@ -1,4 +1,4 @@
-"""The contact use cases of Lau (2023) in MuJoCo (vereshchagin.contact), quick mode: physical outcomes.
+"""The contact use cases of Lau (2023) in MuJoCo (vereshchagin_experiments.contact), quick mode: physical outcomes.
 
 The plant is MuJoCo (independent physics); the checks are on what it reports -- contact forces
 on the table, which arm geoms touched it, where the tool went -- not on controller internals.
@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 import vereshchagin as vs
-from vereshchagin.contact import metrics
-from vereshchagin.contact.elbow import elbow
-from vereshchagin.contact.mujoco_plant import ELBOW_RADIUS, MujocoGen3, Scene, build_model
-from vereshchagin.contact.robot_interface import RobotInterface
-from vereshchagin.contact.use_cases import gen3_model, grasp, writing
+from vereshchagin_experiments.contact import metrics
+from vereshchagin_experiments.contact.elbow import elbow
+from vereshchagin_experiments.contact.mujoco_plant import ELBOW_RADIUS, MujocoGen3, Scene, build_model
+from vereshchagin_experiments.contact.robot_interface import RobotInterface
+from vereshchagin_experiments.contact.use_cases import gen3_model, grasp, writing
 
 
 @pytest.fixture(scope="module")
@@ -156,7 +156,7 @@ def test_elbow_segment_constraint_rests_on_the_support_and_keeps_the_task(elbow_
 
 
 def test_reproduce_contact_writes_index_tables_and_figures(tmp_path):
-    from vereshchagin.__main__ import main
+    from vereshchagin_experiments.__main__ import main
 
     assert main(["reproduce", "--out", str(tmp_path), "--quick", "--case", "contact"]) == 0
     index = (tmp_path / "index.md").read_text(encoding="utf-8")

@@ -1,4 +1,4 @@
-"""The dual-arm case of issue 17 (vereshchagin.contact.dual_arm): robot, plant, runs and report.
+"""The dual-arm case of issue 17 (vereshchagin_experiments.contact.dual_arm): robot, plant, runs and report.
 
 Oracles: Pinocchio (``pin.aba``, ``pin.crba``, ``pin.rnea`` and frame accelerations) for the
 dual-arm tree, the open-loop task error and the torso split; MuJoCo (an independent physics
@@ -13,10 +13,10 @@ import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
-from vereshchagin.contact import dual_arm as da
-from vereshchagin.contact import dual_arm_report, metrics
-from vereshchagin.contact.controller import ControllerConfig
-from vereshchagin.contact.mujoco_plant import MujocoGen3, Scene, build_model
+from vereshchagin_experiments.contact import dual_arm as da
+from vereshchagin_experiments.contact import dual_arm_report, metrics
+from vereshchagin_experiments.contact.controller import ControllerConfig
+from vereshchagin_experiments.contact.mujoco_plant import MujocoGen3, Scene, build_model
 
 from trees import pin_model, pin_q, pin_v_index
 
@@ -188,7 +188,7 @@ def test_report_section_table_csv_and_figure(report, tmp_path, monkeypatch):
         assert path.is_file() and path.stat().st_size > 0
         assert f"dual_arm/{name}" in text
     # the CLI wires the case into results/index.md (the runs reused)
-    from vereshchagin.__main__ import main
+    from vereshchagin_experiments.__main__ import main
 
     monkeypatch.setattr(dual_arm_report, "run", lambda out, quick, progress: res)
     assert main(["reproduce", "--out", str(tmp_path), "--quick", "--case", "dual-arm"]) == 0

@@ -1,4 +1,4 @@
-"""The friction-energy experiment (vereshchagin.experiments.friction_energy), quick mode.
+"""The friction-energy experiment (vereshchagin_experiments.friction_energy), quick mode.
 
 What is checked: every controller runs every task to its end with a bounded error; each
 controller's command is exactly what its definition says, recomputed from the logged solver inputs
@@ -17,11 +17,11 @@ import pytest
 
 import vereshchagin as vs
 from vereshchagin import robots
-from vereshchagin.contact.controller import CascadedController, ControllerConfig
-from vereshchagin.contact.mujoco_plant import MujocoGen3, Scene, build_model
-from vereshchagin.contact.use_cases import gen3_model
-from vereshchagin.experiments import friction_energy as fe
-from vereshchagin.experiments import friction_energy_report as report
+from vereshchagin_experiments.contact.controller import CascadedController, ControllerConfig
+from vereshchagin_experiments.contact.mujoco_plant import MujocoGen3, Scene, build_model
+from vereshchagin_experiments.contact.use_cases import gen3_model
+from vereshchagin_experiments import friction_energy as fe
+from vereshchagin_experiments import friction_energy_report as report
 
 FINAL_ERROR_BOUND = 0.02
 """m: final translational task error (constrained directions) every run stays below; a run that

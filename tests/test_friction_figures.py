@@ -1,5 +1,5 @@
-"""The friction figures and table of Vukcevic (2018) (vereshchagin.experiments), and the slow references in
-vereshchagin.experiments.gauss (the Gauss function g(mu) by frictionless solves, grid sampling,
+"""The friction figures and table of Vukcevic (2018) (vereshchagin_experiments), and the slow references in
+vereshchagin_experiments.gauss (the Gauss function g(mu) by frictionless solves, grid sampling,
 vertex enumeration) against the exact friction-aware solve.
 
 Numbers (friction-maxmin.md sec. 5): 1-DOF arm, f = 10 N m; scenario 1 (-5 N m): friction +5 N m,
@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 import vereshchagin as vs
-from vereshchagin.experiments import friction_figures as ff
-from vereshchagin.experiments.gauss import (
+from vereshchagin_experiments import friction_figures as ff
+from vereshchagin_experiments.gauss import (
     brute_force_grid,
     evaluate,
     free_accelerations,
@@ -218,7 +218,7 @@ def test_input_validation():
 def test_reproduce_command(tmp_path):
     out = tmp_path / "results"
     proc = subprocess.run(
-        [sys.executable, "-m", "vereshchagin", "reproduce", "--quick", "--out", str(out)],
+        [sys.executable, "-m", "vereshchagin_experiments", "reproduce", "--quick", "--out", str(out)],
         cwd=tmp_path,
         capture_output=True,
         text=True,
@@ -236,6 +236,8 @@ def test_reproduce_command(tmp_path):
 
 
 def test_demo_command_still_works():
-    proc = subprocess.run([sys.executable, "-m", "vereshchagin", "demo"], capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, "-m", "vereshchagin_experiments", "demo"], capture_output=True, text=True, timeout=300
+    )
     assert proc.returncode == 0, proc.stderr
     assert "hold pose (m=6)" in proc.stdout

@@ -31,7 +31,7 @@ def test_version_is_written_once():
 def test_ruff_lint_clean():
     """The lint rules of pyproject.toml's [tool.ruff.lint] hold on every Python file of the repository."""
     proc = subprocess.run(
-        [sys.executable, "-m", "ruff", "check", "python", "tests", "benchmarks", "examples", "docs"],
+        [sys.executable, "-m", "ruff", "check", "python", "experiments", "tests", "benchmarks", "examples", "docs"],
         cwd=ROOT,
         capture_output=True,
         text=True,

@@ -99,7 +99,7 @@ def dual_gen3_urdf(
         Factor in (0, 1] on the mass and inertia of the torso segment's rigid body (the torso
         link and the two arms' ``base_link``, fixed to it) and on the torso joint's friction and
         damping. 0.5 gives the half torso of the separate-chains shortcut
-        (:mod:`vereshchagin.contact.dual_arm`): two chains each with half of it count it once.
+        (:mod:`vereshchagin_experiments.contact.dual_arm`): two chains each with half of it count it once.
     torso_friction, torso_damping : float, optional
         Torso joint static friction (N m) and damping (N m s/rad) before ``torso_share``;
         default :data:`TORSO`'s.

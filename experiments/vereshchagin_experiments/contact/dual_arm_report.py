@@ -1,6 +1,6 @@
 """The dual-arm case of issue 17 in ``results/``: runs, table, CSV, figure and verdict.
 
-:func:`run` is what ``python -m vereshchagin reproduce --case dual-arm`` calls: the three variants
+:func:`run` is what ``python -m vereshchagin_experiments reproduce --case dual-arm`` calls: the three variants
 of :mod:`.dual_arm` (tree solver with the table, tree solver unsupported, separate chains with
 the table), per-joint effort, the copper-loss proxy, the open-loop task error of the
 separate-chains shortcut and the closed-loop outcome in the MuJoCo plant.

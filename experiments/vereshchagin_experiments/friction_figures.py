@@ -23,9 +23,9 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from ..friction import Friction
-from ..solver import Solver
-from .._core import Chain
+from vereshchagin.friction import Friction
+from vereshchagin import Solver
+from vereshchagin import Chain
 from .gauss import brute_force_grid, evaluate, free_accelerations, gauss_function, vertex_enumeration
 
 __all__ = ["CASES", "Case", "F_BREAKAWAY", "arm_1dof", "run"]
@@ -443,7 +443,7 @@ def _write_tables(rows: list, out: Path) -> tuple:
         f"breakaway friction f = {F_BREAKAWAY:g} N m. Optimum from `Solver.solve(..., friction=...)`; "
         '"report" columns are the report\'s published values (— not published). Friction torque is the '
         "physical one, −μ (μ: Vereshchagin's multiplier). Net torque = external load + friction + motor "
-        "command (= H qdd here). g(μ*) reference: `experiments.gauss.gauss_function` (one frictionless "
+        "command (= H qdd here). g(μ*) reference: `vereshchagin_experiments.gauss.gauss_function` (one frictionless "
         "solve); grid: the report's sampling; vertex: the best of the box vertices ±f.",
         "",
         "| case | report fig. | friction torque [N m] | report | qdd [rad/s²] | report | motor command [N m] "

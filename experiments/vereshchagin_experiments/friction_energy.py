@@ -3,9 +3,9 @@
 Vukcevic (TR 03-2018, Hochschule Bonn-Rhein-Sieg, 2018) motivates the static-friction extension of
 the Popov-Vereshchagin solver by energy: motors should not fight what friction can hold. This
 module measures it in closed loop on the MuJoCo Gen3 of the contact experiments
-(:mod:`vereshchagin.contact`): same plant, same cascaded P controller, same task gains; the
+(:mod:`vereshchagin_experiments.contact`): same plant, same cascaded P controller, same task gains; the
 controllers differ only in how joint friction enters the command
-(:attr:`~vereshchagin.contact.controller.ControllerConfig.friction_mode`):
+(:attr:`~vereshchagin_experiments.contact.controller.ControllerConfig.friction_mode`):
 
 - ``none``: friction-unaware, the plain solve; feedback alone deals with friction;
 - ``sign``: naive compensation, plain solve + ``f_j sign(qd_j)``, at rest ``f_j`` times the sign of
@@ -22,8 +22,8 @@ controllers differ only in how joint friction enters the command
   correction, like the naive scheme. This variant differs from the others also in the task
   feedback (inside the band), which is why it is listed separately.
 
-Plant: :func:`vereshchagin.contact.use_cases.gen3_model` (joint friction
-:data:`~vereshchagin.contact.use_cases.JOINT_FRICTION`, scaled by 0.5, 1, 2), 1 kHz. The
+Plant: :func:`vereshchagin_experiments.contact.use_cases.gen3_model` (joint friction
+:data:`~vereshchagin_experiments.contact.use_cases.JOINT_FRICTION`, scaled by 0.5, 1, 2), 1 kHz. The
 controllers' chain carries the same friction values (a correct friction model).
 
 Tasks (:func:`tasks`), each a few seconds from the contact experiments' start pose:
@@ -45,11 +45,11 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from .. import robots
-from ..contact.controller import FREE_GAINS, CascadedController, ControllerConfig
-from ..contact.mujoco_plant import MujocoGen3, Scene, build_model
-from ..contact.use_cases import Phase, Run, gen3_model, run_loop
-from ..solver import Solver
+from vereshchagin import robots
+from .contact.controller import FREE_GAINS, CascadedController, ControllerConfig
+from .contact.mujoco_plant import MujocoGen3, Scene, build_model
+from .contact.use_cases import Phase, Run, gen3_model, run_loop
+from vereshchagin import Solver
 
 __all__ = [
     "CONTROLLERS",
@@ -267,7 +267,7 @@ def simulate(task: TaskSpec, controller: str, friction_scale: float = 1.0, keep_
     Returns
     -------
     Run
-        The contact experiments' log (:class:`~vereshchagin.contact.use_cases.Run`; ``tau`` is the
+        The contact experiments' log (:class:`~vereshchagin_experiments.contact.use_cases.Run`; ``tau`` is the
         torque the plant applied); ``info`` holds ``log`` (:class:`Log`), ``chain``, ``config``,
         ``friction_scale`` and ``task``.
     """
@@ -326,7 +326,7 @@ def outcome(run: Run) -> dict:
     sum |plant friction torque| / sum |motor + friction torque|: the share of the holding torque that
     friction supplied), ``saturated`` (fraction of samples with a command beyond the effort limits).
     """
-    from ..contact import metrics
+    from .contact import metrics
 
     log: Log = run.info["log"]
     task: TaskSpec = run.info["task"]

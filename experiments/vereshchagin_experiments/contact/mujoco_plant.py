@@ -34,7 +34,7 @@ from typing import Optional
 import mujoco
 import numpy as np
 
-from .._core import Chain
+from vereshchagin import Chain
 from .robot_interface import JointState
 
 __all__ = ["MujocoGen3", "Scene", "build_model"]

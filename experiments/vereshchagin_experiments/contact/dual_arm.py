@@ -50,11 +50,11 @@ from typing import Optional, Union
 
 import numpy as np
 
-from .. import robots
-from .._core import Chain, Tree
-from ..friction import Friction
-from ..solver import Solver
-from ..task import beta_for, pose_error
+from vereshchagin import robots
+from vereshchagin import Chain, Tree
+from vereshchagin.friction import Friction
+from vereshchagin import Solver
+from vereshchagin.task import beta_for, pose_error
 from .controller import ControllerConfig, CycleInfo, cascaded_acceleration
 from .mujoco_plant import MujocoGen3, Scene, build_model
 from .use_cases import (

@@ -1,10 +1,10 @@
 """Tables, figures and the ``results/index.md`` section of the friction-energy experiment.
 
-:func:`run` is what ``python -m vereshchagin reproduce --case friction-energy`` calls: it runs
-:func:`vereshchagin.experiments.friction_energy.run_all` and writes into ``out_dir/friction_energy``
+:func:`run` is what ``python -m vereshchagin_experiments reproduce --case friction-energy`` calls: it runs
+:func:`vereshchagin_experiments.friction_energy.run_all` and writes into ``out_dir/friction_energy``
 
 - ``summary.csv``: one row per task, controller and friction scale (every metric of
-  :func:`~vereshchagin.experiments.friction_energy.outcome`);
+  :func:`~vereshchagin_experiments.friction_energy.outcome`);
 - ``context.csv``: per joint at the held poses, the plant's gravity torque ``g_j`` and friction
   ``f_j``, and what friction could hold in principle;
 - ``<task>.png``: per task (nominal friction) the controllers' joint torques, the number of joints
@@ -22,8 +22,8 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from ..contact.report import md_table, write_csv
-from ..contact.use_cases import JOINT_DAMPING, JOINT_FRICTION
+from .contact.report import md_table, write_csv
+from .contact.use_cases import JOINT_DAMPING, JOINT_FRICTION
 from . import friction_energy as fe
 
 __all__ = ["run"]

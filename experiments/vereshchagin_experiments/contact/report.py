@@ -1,6 +1,6 @@
 """Run the use cases of W. K. Lau (2023) in simulation and write tables, figures and the comparison text.
 
-:func:`run` is what ``python -m vereshchagin reproduce --case contact`` calls. Tables follow the
+:func:`run` is what ``python -m vereshchagin_experiments reproduce --case contact`` calls. Tables follow the
 report's layout (Tables 6.1-6.3: per joint, contact next to contactless), as Markdown and CSV;
 figures are PNG. Joint numbers: the report's tables count joints from 0; ``joint_1`` .. ``joint_7``
 here are its joints 0 .. 6, so its "joint 1 (shoulder)", "joint 3 (elbow)", "joint 5 (wrist)" are

@@ -24,9 +24,9 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from .. import robots
-from .._core import Chain
-from ..solver import Solver
+from vereshchagin import robots
+from vereshchagin import Chain
+from vereshchagin import Solver
 from .controller import CascadedController, ControllerConfig
 from .mujoco_plant import MujocoGen3, Scene, build_model, pen_tip
 
@@ -169,7 +169,7 @@ class Run:
     case : str
         ``"grasp"``, ``"writing"`` or ``"elbow"``.
     variant : str
-        ``"contact"`` / ``"contactless"``, or one of :data:`vereshchagin.contact.elbow.VARIANTS`.
+        ``"contact"`` / ``"contactless"``, or one of :data:`vereshchagin_experiments.contact.elbow.VARIANTS`.
     t : ndarray, shape (k,)
         Plant clock after each step (s).
     q, qd, tau : ndarray, shape (k, n)

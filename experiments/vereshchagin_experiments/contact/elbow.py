@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..solver import Solver
-from ..task import beta_for
+from vereshchagin import Solver
+from vereshchagin.task import beta_for
 from .controller import CascadedController, ControllerConfig
 from .mujoco_plant import ELBOW_RADIUS, MujocoGen3, Scene, build_model
 from .use_cases import SLIDE, Phase, _shifted, gen3_model, run_loop

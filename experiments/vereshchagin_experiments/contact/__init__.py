@@ -17,7 +17,7 @@ closed loop at 1 kHz, with this package's solver inside the controller:
   (:mod:`.dual_arm_report`: ``--case dual-arm``);
 - :mod:`.metrics`: effort and accuracy numbers of a run (the report's Tables 6.1-6.3);
 - :mod:`.report`: runs everything and writes tables and figures
-  (``python -m vereshchagin reproduce --case contact``).
+  (``python -m vereshchagin_experiments reproduce --case contact``).
 
 Units are SI (m, rad, s, N, N m); poses and twists are in the robot's base frame, z up, gravity
 ``[0, 0, -9.81]`` m/s^2.

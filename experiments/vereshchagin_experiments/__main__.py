@@ -1,4 +1,4 @@
-"""Command line: ``python -m vereshchagin demo`` and ``python -m vereshchagin reproduce``."""
+"""Command line: ``python -m vereshchagin_experiments demo`` and ``python -m vereshchagin_experiments reproduce``."""
 
 from __future__ import annotations
 
@@ -35,11 +35,11 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
     case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "all"}
-        ``contact``: the three use cases of W. K. Lau (2023) in MuJoCo (:mod:`vereshchagin.contact.report`);
+        ``contact``: the three use cases of W. K. Lau (2023) in MuJoCo (:mod:`vereshchagin_experiments.contact.report`);
         ``dual-arm``: one hand of a dual-arm Gen3 resting on a table while the other slides, tree
-        solver against separate chains (:mod:`vereshchagin.contact.dual_arm_report`);
+        solver against separate chains (:mod:`vereshchagin_experiments.contact.dual_arm_report`);
         ``friction-energy``: the motor effort exact static friction saves on the Gen3
-        (:mod:`vereshchagin.experiments.friction_energy_report`).
+        (:mod:`vereshchagin_experiments.friction_energy_report`).
 
     Returns
     -------
@@ -51,12 +51,12 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     index = [
         "# vereshchagin: reproduced results",
         "",
-        f"Command: `python -m vereshchagin reproduce --out {out_dir}{' --quick' if quick else ''} --case {case}`",
+        f"Command: `python -m vereshchagin_experiments reproduce --out {out_dir}{' --quick' if quick else ''} --case {case}`",
         "",
     ]
     ok = True
     if case in ("friction", "all"):
-        from .experiments.friction_figures import run as run_friction
+        from .friction_figures import run as run_friction
 
         _say(f"[reproduce] Vukcevic (2018) friction figures -> {out}{' (quick)' if quick else ''}")
         res = run_friction(out, quick=quick, progress=_say)
@@ -112,7 +112,7 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
 
         ok &= _section("dual-arm case on a tree robot (MuJoCo plant)", run_dual, out, quick, index)
     if case in ("friction-energy", "all"):
-        from .experiments.friction_energy_report import run as run_energy
+        from .friction_energy_report import run as run_energy
 
         ok &= _section("friction-energy experiment (MuJoCo Gen3)", run_energy, out, quick, index)
     index_path = out / "index.md"
@@ -122,7 +122,7 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
 
 
 def main(argv=None) -> int:
-    """The command line (``python -m vereshchagin demo | reproduce [--out DIR] [--quick] [--case CASE]``).
+    """The command line (``python -m vereshchagin_experiments demo | reproduce [--out DIR] [--quick] [--case CASE]``).
 
     Parameters
     ----------
@@ -134,7 +134,7 @@ def main(argv=None) -> int:
     int
         Exit status: 0 on success, 1 if a reproduced result failed its checks.
     """
-    parser = argparse.ArgumentParser(prog="vereshchagin", description=__doc__)
+    parser = argparse.ArgumentParser(prog="vereshchagin-experiments", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("demo", help="solve three tasks on a 7-joint arm and print the results")
     rep = sub.add_parser(
@@ -162,7 +162,7 @@ def main(argv=None) -> int:
         cases = CASE_NEEDS if args.case == "all" else {args.case: CASE_NEEDS[args.case]}
         message = missing_message(sorted({m for needs in cases.values() for m in needs}))
         if message:
-            print(f"vereshchagin reproduce --case {args.case}: {message}", file=sys.stderr)
+            print(f"vereshchagin-experiments reproduce --case {args.case}: {message}", file=sys.stderr)
             return 2
         return reproduce(args.out, quick=args.quick, case=args.case)
     return 2  # pragma: no cover

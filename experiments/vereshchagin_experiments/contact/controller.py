@@ -39,8 +39,8 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ..friction import Friction
-from ..task import beta_for, directions, pose_error
+from vereshchagin.friction import Friction
+from vereshchagin.task import beta_for, directions, pose_error
 
 __all__ = [
     "CONTACT_GAINS",

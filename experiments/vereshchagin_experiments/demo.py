@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .models import seven_joint_arm
-from .solver import Solver
+from vereshchagin.models import seven_joint_arm
+from vereshchagin import Solver
 
 
 def run(out=print) -> dict:
