@@ -1,5 +1,6 @@
-// Building blocks shared by the URDF chain and tree loaders: parsing (urdfdom, no ROS), validated
-// frames, inertias and joints, and the folding of links into one segment's rigid body.
+// Building blocks shared by the URDF chain and tree loaders: parsing (a size pre-scan, then
+// urdfdom, no ROS), validated frames, inertias and joints, the folding of links into one
+// segment's rigid body, a walk over a subtree without recursion, and the note on the base's mass.
 #pragma once
 
 #include <stdexcept>
