@@ -1,6 +1,8 @@
 // URDF -> RobotChain. See urdf_loader.hpp for the frame conventions.
 #include "vereshchagin/urdf_loader.hpp"
 
+#include <algorithm>
+
 #include <urdf_model/model.h>
 
 #include "urdf_parts.hpp"
@@ -15,10 +17,17 @@ using urdfparts::jointOrigin;
 using urdfparts::LoadError;
 using urdfparts::RigidBody;
 
-// All leaves of the subtree below `link`.
-void collectLeaves(const urdf::Link& link, std::vector<std::string>& leaves) {
-  if (link.child_links.empty()) leaves.push_back(link.name);
-  for (const auto& c : link.child_links) collectLeaves(*c, leaves);
+// All leaves of the subtree below `top`, depth-first preorder, without recursion.
+std::vector<std::string> collectLeaves(const urdf::Link& top) {
+  std::vector<std::string> leaves;
+  std::vector<const urdf::Link*> stack{&top};
+  while (!stack.empty()) {
+    const urdf::Link* link = stack.back();
+    stack.pop_back();
+    if (link->child_links.empty()) leaves.push_back(link->name);
+    for (auto c = link->child_links.rbegin(); c != link->child_links.rend(); ++c) stack.push_back(c->get());
+  }
+  return leaves;
 }
 
 class Builder {
@@ -29,6 +38,8 @@ class Builder {
   void build(const std::string& root_name, const std::string& tip_name) {
     const std::vector<urdf::LinkConstSharedPtr> path = pathTo(root_name, tip_name);
     out_.root_link = root_name;
+    const std::string base_note = urdfparts::baseMassNote(*path.front());
+    if (!base_note.empty()) out_.notes.push_back(base_note);
     for (size_t k = 1; k < path.size(); ++k)
       urdfparts::requireSupported(*path[k]->parent_joint, "on the path", "", false);
 
@@ -61,8 +72,7 @@ class Builder {
     if (!root) throw LoadError("root link '" + root_name + "' not found in the URDF");
     std::string tip_name = tip_name_in;
     if (tip_name.empty()) {
-      std::vector<std::string> leaves;
-      collectLeaves(*root, leaves);
+      const std::vector<std::string> leaves = collectLeaves(*root);
       if (leaves.size() != 1) {
         std::string list;
         for (const auto& l : leaves) list += (list.empty() ? "" : ", ") + l;
@@ -74,9 +84,10 @@ class Builder {
     if (!tip) throw LoadError("tip link '" + tip_name + "' not found in the URDF");
     std::vector<urdf::LinkConstSharedPtr> path;
     for (urdf::LinkConstSharedPtr l = tip; l; l = l->getParent()) {
-      path.insert(path.begin(), l);
+      path.push_back(l);
       if (l->name == root_name) break;
     }
+    std::reverse(path.begin(), path.end());
     if (path.front()->name != root_name)
       throw LoadError("tip link '" + tip_name + "' is not below root link '" + root_name + "'");
     return path;
@@ -92,7 +103,7 @@ class Builder {
       // Side branches of the base: fixed to the world, recorded for their frames only.
       for (const auto& child : path[i]->child_links) {
         if (i + 1 < path.size() && child->name == path[i + 1]->name) continue;
-        placeBaseSubtree(*child, link_in_root * jointOrigin(*child->parent_joint));
+        placeBaseSubtree(*child, link_in_root);
       }
     }
     return link_in_root;
@@ -122,7 +133,7 @@ class Builder {
       for (const auto& child : path[i]->child_links) {
         if (i + 1 < end && child->name == path[i + 1]->name) continue;
         if (i + 1 == end && end < path.size() && child->name == path[end]->name) continue;
-        lumpSubtree(*child, link_in_tip * jointOrigin(*child->parent_joint), body);
+        lumpSubtree(*child, link_in_tip, body);
       }
     }
     // Joint in the previous tip frame.
@@ -132,24 +143,27 @@ class Builder {
     out_.joints.push_back(urdfparts::jointInfo(j, static_cast<unsigned int>(seg_index)));
   }
 
-  // Fold a side branch (rooted at `link`, whose frame is `pose` in the segment tip frame) into
-  // the segment's rigid body, rigidly at joint positions 0.
-  void lumpSubtree(const urdf::Link& link, const KDL::Frame& pose, RigidBody& body) {
-    const urdf::Joint& j = *link.parent_joint;
-    if (j.type == urdf::Joint::FLOATING || j.type == urdf::Joint::PLANAR)
-      throw LoadError(std::string("joint '") + j.name + "' (" + urdfparts::typeName(j.type) +
-                      ") attaches a side branch to the chain; floating and planar joints are not supported");
-    if (isMoving(j))
-      out_.notes.push_back("side branch through moving joint '" + j.name +
-                           "' lumped rigidly at position 0 into segment " + std::to_string(body.segment));
-    foldLink(link, pose, check_, body, out_.links);
-    for (const auto& child : link.child_links) lumpSubtree(*child, pose * jointOrigin(*child->parent_joint), body);
+  // Fold a side branch (rooted at `top`, whose parent link's frame is `above` in the segment tip
+  // frame) into the segment's rigid body, rigidly at joint positions 0.
+  void lumpSubtree(const urdf::Link& top, const KDL::Frame& above, RigidBody& body) {
+    urdfparts::walkSubtree(top, above, [&](const urdf::Link& link, const KDL::Frame& pose) {
+      const urdf::Joint& j = *link.parent_joint;
+      if (j.type == urdf::Joint::FLOATING || j.type == urdf::Joint::PLANAR)
+        throw LoadError(std::string("joint '") + j.name + "' (" + urdfparts::typeName(j.type) +
+                        ") attaches a side branch to the chain; floating and planar joints are not supported");
+      if (isMoving(j))
+        out_.notes.push_back("side branch through moving joint '" + j.name +
+                             "' lumped rigidly at position 0 into segment " + std::to_string(body.segment));
+      foldLink(link, pose, check_, body, out_.links);
+    });
   }
 
-  // Links hanging off the base (at joint positions 0): frames only, their inertia is irrelevant.
-  void placeBaseSubtree(const urdf::Link& link, const KDL::Frame& pose) {
-    out_.links.push_back({link.name, -1, pose});
-    for (const auto& child : link.child_links) placeBaseSubtree(*child, pose * jointOrigin(*child->parent_joint));
+  // Links hanging off the base (at joint positions 0; `above`: the pose of top's parent link in
+  // the root frame): frames only, their inertia is irrelevant.
+  void placeBaseSubtree(const urdf::Link& top, const KDL::Frame& above) {
+    urdfparts::walkSubtree(top, above, [&](const urdf::Link& link, const KDL::Frame& pose) {
+      out_.links.push_back({link.name, -1, pose});
+    });
   }
 
   const urdf::ModelInterface& model_;

@@ -1,10 +1,16 @@
 // Shared URDF building blocks (urdf_parts.hpp).
 #include "urdf_parts.hpp"
 
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <unordered_map>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -54,21 +60,87 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& xml, std::string& message
 }
 
 // urdfdom accepts some documents whose joints make a link its own ancestor (e.g. a joint whose
-// parent and child are the same link): every recursive walk would then never end.
+// parent and child are the same link): every walk down the tree would then never end. Linear:
+// each link's way up is walked once, stopping at a link already known to reach the root.
 void checkAcyclic(const urdf::ModelInterface& model) {
   for (const auto& entry : model.joints_) {
     const urdf::Joint& j = *entry.second;
     if (j.parent_link_name == j.child_link_name)
       throw LoadError("joint '" + j.name + "' connects link '" + j.child_link_name + "' to itself");
   }
-  const std::size_t n = model.links_.size();
+  enum class State { Open, OnWay, Done };
+  std::unordered_map<const urdf::Link*, State> state;
+  for (const auto& entry : model.links_) state[entry.second.get()] = State::Open;
+  std::vector<const urdf::Link*> way;
   for (const auto& entry : model.links_) {
-    std::size_t steps = 0;
-    for (urdf::LinkConstSharedPtr l = entry.second; l; l = l->getParent())
-      if (++steps > n + 1) throw LoadError("the links form a cycle through link '" + entry.first + "'");
+    way.clear();
+    for (urdf::LinkConstSharedPtr l = entry.second; l && state[l.get()] != State::Done; l = l->getParent()) {
+      if (state[l.get()] == State::OnWay) throw LoadError("the links form a cycle through link '" + l->name + "'");
+      state[l.get()] = State::OnWay;
+      way.push_back(l.get());
+    }
+    for (const urdf::Link* l : way) state[l] = State::Done;
     for (const auto& child : entry.second->child_links)
       if (!child || !child->parent_joint) throw LoadError("link '" + entry.first + "' has a child without a joint");
   }
+}
+
+// Every link holds its children: releasing the root would release its whole path below it one
+// nested destructor call per link. Emptying the child lists first releases the links one by one.
+void unlinkTree(urdf::ModelInterface& model) {
+  for (auto& entry : model.links_) {
+    entry.second->child_links.clear();
+    entry.second->child_joints.clear();
+  }
+  model.root_link_.reset();
+}
+
+// The same model, whose release unlinks the tree first (urdf::ModelInterfaceSharedPtr either way).
+urdf::ModelInterfaceSharedPtr guarded(urdf::ModelInterfaceSharedPtr model) {
+  if (!model) return model;
+  urdf::ModelInterface* raw = model.get();
+  return urdf::ModelInterfaceSharedPtr(raw, [owner = std::move(model)](urdf::ModelInterface* m) mutable {
+    unlinkTree(*m);
+    owner.reset();
+  });
+}
+
+// The name of the element whose tag starts at xml[i] ('<'), up to whitespace, '/' or '>'.
+std::string tagName(const std::string& xml, std::size_t i) {
+  std::size_t e = i + 1;
+  while (e < xml.size() && !std::isspace(static_cast<unsigned char>(xml[e])) && xml[e] != '/' && xml[e] != '>') ++e;
+  return xml.substr(i + 1, e - i - 1);
+}
+
+// The index just past the '>' that ends the tag starting at xml[i], quoted attribute values
+// skipped (they may hold '>'); xml.size() when it does not end. `self_closing`: "/>".
+std::size_t tagEnd(const std::string& xml, std::size_t i, bool& self_closing) {
+  char quote = 0;
+  for (std::size_t k = i + 1; k < xml.size(); ++k) {
+    const char c = xml[k];
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      self_closing = xml[k - 1] == '/';
+      return k + 1;
+    }
+  }
+  return xml.size();
+}
+
+// Where the markup starting at xml[i] ends when it is a comment, CDATA, processing instruction
+// or declaration (no element); 0 otherwise.
+std::size_t skipNonElement(const std::string& xml, std::size_t i) {
+  static const std::pair<const char*, const char*> kinds[] = {
+      {"<!--", "-->"}, {"<![CDATA[", "]]>"}, {"<?", "?>"}, {"<!", ">"}};
+  for (const auto& kind : kinds) {
+    if (xml.compare(i, std::strlen(kind.first), kind.first) != 0) continue;
+    const std::size_t end = xml.find(kind.second, i + std::strlen(kind.first));
+    return end == std::string::npos ? xml.size() : end + std::strlen(kind.second);
+  }
+  return 0;
 }
 
 KDL::Frame toFrame(const urdf::Pose& p) {
@@ -85,9 +157,39 @@ bool finitePose(const urdf::Pose& p) {
 
 }  // namespace
 
+bool prescan(const std::string& xml, std::string& message) {
+  int depth = 0, links = 0;
+  std::size_t i = xml.find('<');
+  while (i != std::string::npos && i < xml.size()) {
+    std::size_t next = skipNonElement(xml, i);
+    if (next == 0) {
+      bool self_closing = false;
+      next = tagEnd(xml, i, self_closing);
+      if (i + 1 < xml.size() && xml[i + 1] == '/') {
+        --depth;
+      } else {
+        if (depth == 1 && tagName(xml, i) == "link" && ++links > kMaxLinks) {
+          message = "the URDF has more than " + std::to_string(kMaxLinks) +
+                    " links; documents this large are refused (urdfdom releases a model recursively along its "
+                    "links, which overflows the stack on very long paths)";
+          return false;
+        }
+        if (!self_closing && ++depth > kMaxXmlDepth) {
+          message = "the URDF's XML elements are nested more than " + std::to_string(kMaxXmlDepth) +
+                    " levels deep; documents this deep are refused (urdfdom's XML reader recurses per level)";
+          return false;
+        }
+      }
+    }
+    i = xml.find('<', next);
+  }
+  return true;
+}
+
 urdf::ModelInterfaceSharedPtr parseModel(const std::string& xml, std::string& message) {
+  if (!prescan(xml, message)) return nullptr;
   std::string messages;
-  urdf::ModelInterfaceSharedPtr model = parse(xml, messages);
+  urdf::ModelInterfaceSharedPtr model = guarded(parse(xml, messages));
   // urdfdom returns a model even when it could not read some values (they silently become 0):
   // any error it reported fails the load.
   if (!model || !messages.empty()) {
@@ -104,9 +206,21 @@ urdf::ModelInterfaceSharedPtr parseModel(const std::string& xml, std::string& me
 }
 
 bool readFile(const std::string& path, std::string& text, std::string& message) {
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (status.type() == std::filesystem::file_type::not_found) {
+    message = "URDF file '" + path + "' does not exist";
+    return false;
+  }
+  if (status.type() == std::filesystem::file_type::directory) {
+    message = "URDF path '" + path + "' is a directory, not a file";
+    return false;
+  }
+  errno = 0;
   std::ifstream in(path);
   if (!in) {
-    message = "cannot read URDF file '" + path + "'";
+    const int err = errno;
+    message = "cannot read URDF file '" + path + "'" + (err ? std::string(": ") + std::strerror(err) : std::string());
     return false;
   }
   std::stringstream ss;
@@ -212,6 +326,31 @@ void foldLink(const urdf::Link& link, const KDL::Frame& in_tip, InertiaCheck che
               std::vector<LinkPlacement>& links) {
   links.push_back({link.name, body.segment, in_tip});
   if (body.segment >= 0) body.inertia = body.inertia + in_tip * linkInertia(link, check);
+}
+
+std::string baseMassNote(const urdf::Link& root) {
+  double mass = 0.0;
+  std::size_t massive = 0;  // links with mass in the base group
+  std::vector<const urdf::Link*> stack{&root};
+  while (!stack.empty()) {
+    const urdf::Link* link = stack.back();
+    stack.pop_back();
+    if (link->inertial && link->inertial->mass > 0.0) {
+      mass += link->inertial->mass;
+      ++massive;
+    }
+    for (const auto& child : link->child_links)
+      if (child->parent_joint->type == urdf::Joint::FIXED) stack.push_back(child.get());
+  }
+  if (!(mass > 0.0)) return std::string();
+  char kg[32];
+  std::snprintf(kg, sizeof kg, "%.6g kg", mass);
+  const bool only_root = massive == 1 && root.inertial && root.inertial->mass > 0.0;
+  return "root link '" + root.name + "' carries " + kg + (only_root ? "" : " (with the links fixed to it)") +
+         ": the root link is welded to the world, so its mass and inertia do not enter the dynamics. That is right "
+         "for a robot bolted down at this link (an arm on a table); for a free-moving robot (a quadruped or "
+         "humanoid base) the results are those of the robot with its base held still, as a floating base "
+         "(base=\"free\") is not supported yet.";
 }
 
 }  // namespace urdfparts

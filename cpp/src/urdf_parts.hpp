@@ -1,9 +1,11 @@
-// Building blocks shared by the URDF chain and tree loaders: parsing (urdfdom, no ROS), validated
-// frames, inertias and joints, and the folding of links into one segment's rigid body.
+// Building blocks shared by the URDF chain and tree loaders: parsing (a size pre-scan, then
+// urdfdom, no ROS), validated frames, inertias and joints, the folding of links into one
+// segment's rigid body, a walk over a subtree without recursion, and the note on the base's mass.
 #pragma once
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <urdf_model/model.h>
@@ -23,10 +25,18 @@ struct LoadError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Parses and checks a URDF document (urdfdom's error messages included, cycles rejected).
-// Returns the model, or null with `message` set.
+// Documents refused before urdfdom sees them (urdf_loader.hpp): urdfdom's XML reader recurses
+// once per element nesting level, and releasing a parsed model once per link of its deepest path.
+constexpr int kMaxXmlDepth = 1000;  // element nesting levels
+constexpr int kMaxLinks = 50000;    // <link> elements of the <robot>
+// Checks the document's nesting depth and link count in one linear scan; false with `message`.
+bool prescan(const std::string& xml, std::string& message);
+
+// Parses and checks a URDF document (prescan, urdfdom's error messages included, cycles
+// rejected). Returns the model, or null with `message` set. Releasing the returned pointer takes
+// the link tree apart without recursion.
 urdf::ModelInterfaceSharedPtr parseModel(const std::string& xml, std::string& message);
-// The file's text; false (message set) when it cannot be read.
+// The file's text; false (message set: missing, a directory, unreadable) when it cannot be read.
 bool readFile(const std::string& path, std::string& text, std::string& message);
 
 // The joint's <origin> (child link frame in the parent link frame at q = 0), validated finite.
@@ -57,6 +67,25 @@ struct RigidBody {
 };
 void foldLink(const urdf::Link& link, const KDL::Frame& in_tip, InertiaCheck check, RigidBody& body,
               std::vector<LinkPlacement>& links);
+
+// Calls visit(link, pose) for `top` and every link below it, depth-first preorder with the
+// children in the order urdfdom stores them, without recursion (any depth). pose: the link's
+// frame in the frame that `above` (the pose of top's parent link) is expressed in, at q = 0.
+template <class Visit>
+void walkSubtree(const urdf::Link& top, const KDL::Frame& above, Visit visit) {
+  std::vector<std::pair<const urdf::Link*, KDL::Frame>> stack{{&top, above}};
+  while (!stack.empty()) {
+    const urdf::Link* link = stack.back().first;
+    const KDL::Frame pose = stack.back().second * jointOrigin(*link->parent_joint);
+    stack.pop_back();
+    visit(*link, pose);
+    for (auto c = link->child_links.rbegin(); c != link->child_links.rend(); ++c) stack.emplace_back(c->get(), pose);
+  }
+}
+
+// The note a loader adds when the root link (with the links fixed to it) carries mass that the
+// fixed base leaves out of the dynamics; empty when it carries none.
+std::string baseMassNote(const urdf::Link& root);
 
 }  // namespace urdfparts
 }  // namespace vereshchagin

@@ -47,15 +47,16 @@ int RigidGroup::tipIndex() const {
     for (std::size_t i = 0; i < links.size(); ++i)
       if (!has_child[i]) ends.push_back(static_cast<int>(i));
   }
+  // The lowest common ancestor of the ends: the deepest link whose subtree holds all of them.
+  // Links are in preorder (parent[i] < i), so one backward pass sums the ends per subtree.
+  std::vector<std::size_t> below(links.size(), 0);
+  for (int e : ends) ++below[static_cast<std::size_t>(e)];
+  for (std::size_t i = links.size() - 1; i > 0; --i) below[static_cast<std::size_t>(parent[i])] += below[i];
   std::vector<int> depth(links.size(), 0);
-  for (std::size_t i = 1; i < links.size(); ++i) depth[i] = depth[static_cast<std::size_t>(parent[i])] + 1;
-  int common = ends.front();
-  for (int e : ends) {  // lowest common ancestor, pairwise
-    int a = common, b = e;
-    while (depth[a] > depth[b]) a = parent[a];
-    while (depth[b] > depth[a]) b = parent[b];
-    while (a != b) a = parent[a], b = parent[b];
-    common = a;
+  int common = 0;
+  for (std::size_t i = 1; i < links.size(); ++i) {
+    depth[i] = depth[static_cast<std::size_t>(parent[i])] + 1;
+    if (below[i] == ends.size() && depth[i] > depth[static_cast<std::size_t>(common)]) common = static_cast<int>(i);
   }
   return common;
 }
@@ -70,12 +71,16 @@ class TreeBuilder {
     if (!root) throw LoadError("root link '" + root_name + "' not found in the URDF");
     out_.root_link = root_name;
     out_.tree = KDL::Tree(root_name);
+    const std::string base_note = urdfparts::baseMassNote(*root);
+    if (!base_note.empty()) out_.notes.push_back(base_note);
     const RigidGroup base = collectGroup(*root);
     urdfparts::RigidBody body;  // the base: placements in the root frame, inertia irrelevant
     for (std::size_t i = 0; i < base.links.size(); ++i)
       urdfparts::foldLink(*base.links[i], base.in_first[i], check_, body, out_.links);
+    std::vector<Pending> first;
     for (const RigidGroup::Exit& e : base.exits)
-      addSegment(*e.joint, base.in_first[static_cast<std::size_t>(e.from)] * jointOrigin(*e.joint), -1);
+      first.push_back({e.joint, base.in_first[static_cast<std::size_t>(e.from)], -1});
+    addSegments(std::move(first));
     if (out_.joints.empty()) throw LoadError("no moving joint below root link '" + root_name + "'");
   }
 
@@ -89,8 +94,18 @@ class TreeBuilder {
     return g;
   }
 
-  void visitChildren(int at, RigidGroup& g) {
-    for (const urdf::Link* child : childrenByJointName(*g.links[static_cast<std::size_t>(at)])) {
+  // Depth-first preorder over the links below g.links[0] reached through fixed joints (children
+  // by joint name), without recursion; moving joints leaving them become exits, in that order.
+  void visitChildren(int first, RigidGroup& g) {
+    std::vector<std::pair<const urdf::Link*, int>> stack;  // link, index of its parent in g.links
+    const auto push = [&](int at) {
+      const std::vector<const urdf::Link*> children = childrenByJointName(*g.links[static_cast<std::size_t>(at)]);
+      for (auto c = children.rbegin(); c != children.rend(); ++c) stack.emplace_back(*c, at);
+    };
+    push(first);
+    while (!stack.empty()) {
+      const auto [child, at] = stack.back();
+      stack.pop_back();
       const urdf::Joint& j = *child->parent_joint;
       urdfparts::requireSupported(j, "in the tree below '" + out_.root_link + "'",
                                   "; pick a sub-tree root below it (root='" + child->name + "')", true);
@@ -104,13 +119,34 @@ class TreeBuilder {
       g.links.push_back(child);
       g.parent.push_back(at);
       g.in_first.push_back(g.in_first[static_cast<std::size_t>(at)] * jointOrigin(j));
-      visitChildren(static_cast<int>(g.links.size()) - 1, g);
+      push(static_cast<int>(g.links.size()) - 1);
     }
   }
 
-  // The segment moved by joint `j` (its frame `origin` in the parent segment's tip frame), then
-  // the segments below it: depth-first preorder, so the KDL q_nr equals the segment index.
-  void addSegment(const urdf::Joint& j, const KDL::Frame& origin, int parent_index) {
+  // A segment still to add: the moving joint, the pose of its parent link in the parent
+  // segment's tip frame (identity: the tip link itself), and the parent segment's index (-1: the base).
+  struct Pending {
+    const urdf::Joint* joint;
+    KDL::Frame above;
+    int parent;
+  };
+
+  // The segments below the base, depth-first preorder (so the KDL q_nr equals the segment
+  // index), without recursion: a stack of the segments still to add.
+  void addSegments(std::vector<Pending> stack) {
+    std::reverse(stack.begin(), stack.end());
+    while (!stack.empty()) {
+      const Pending p = stack.back();
+      stack.pop_back();
+      const std::size_t before = stack.size();
+      addSegment(*p.joint, p.above * jointOrigin(*p.joint), p.parent, stack);
+      std::reverse(stack.begin() + static_cast<std::ptrdiff_t>(before), stack.end());
+    }
+  }
+
+  // The segment moved by joint `j` (its frame `origin` in the parent segment's tip frame); the
+  // moving joints leaving its rigid body are appended to `next` in order.
+  void addSegment(const urdf::Joint& j, const KDL::Frame& origin, int parent_index, std::vector<Pending>& next) {
     const RigidGroup g = collectGroup(*model_.getLink(j.child_link_name));
     const std::size_t tip = static_cast<std::size_t>(g.tipIndex());
     const KDL::Frame tip_inv = g.in_first[tip].Inverse();
@@ -129,9 +165,7 @@ class TreeBuilder {
     for (const RigidGroup::Exit& e : g.exits) {
       const std::size_t from = static_cast<std::size_t>(e.from);
       // A joint on the tip link itself starts exactly at the tip frame (as in the chain loader).
-      const KDL::Frame in_tip =
-          from == tip ? jointOrigin(*e.joint) : tip_inv * g.in_first[from] * jointOrigin(*e.joint);
-      addSegment(*e.joint, in_tip, index);
+      next.push_back({e.joint, from == tip ? KDL::Frame::Identity() : tip_inv * g.in_first[from], index});
     }
   }
 

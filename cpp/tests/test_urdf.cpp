@@ -141,7 +141,101 @@ void testErrors() {
   expectError(replaced(kArm, "<mass value=\"1\"/>", "<mass value=\"abc\"/>"), "", "", "malformed URDF",
               "unparsable number (urdfdom would silently use 0)");
   const vereshchagin::UrdfResult missing = vereshchagin::chainFromUrdfFile("/nonexistent/robot.urdf");
-  check(!missing.ok && missing.message.find("cannot read") != std::string::npos, "missing file");
+  check(!missing.ok && missing.message.find("'/nonexistent/robot.urdf' does not exist") != std::string::npos,
+        "missing file: " + missing.message);
+  const vereshchagin::UrdfResult dir = vereshchagin::chainFromUrdfFile("/");
+  check(!dir.ok && dir.message.find("'/' is a directory") != std::string::npos, "a directory: " + dir.message);
+}
+
+// base -j1- l1 -j2- ... -jn- ln: revolute joints about z, 0.1 m apart along z, 1 kg per link.
+std::string serialXml(int n) {
+  std::string xml = "<robot name='serial'><link name='base'/>";
+  const std::string inertial =
+      "<inertial><mass value='1'/><inertia ixx='0.01' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.01'/></inertial>";
+  for (int k = 1; k <= n; ++k) {
+    const std::string name = "l" + std::to_string(k), parent = k == 1 ? "base" : "l" + std::to_string(k - 1);
+    xml += "<link name='" + name + "'>" + inertial + "</link><joint name='j" + std::to_string(k) +
+           "' type='continuous'><parent link='" + parent + "'/><child link='" + name +
+           "'/><origin xyz='0 0 0.1'/><axis xyz='0 0 1'/></joint>";
+  }
+  return xml + "</robot>";
+}
+
+// base -j1- a -j2- b, and n links of 0.01 kg in a line below `a` through fixed joints.
+std::string sideBranchXml(int n) {
+  std::string xml =
+      "<robot name='branch'><link name='base'/><link name='a'><inertial><mass value='1'/><inertia ixx='0.01' "
+      "ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.01'/></inertial></link><link name='b'/>"
+      "<joint name='j1' type='continuous'><parent link='base'/><child link='a'/><axis xyz='0 0 1'/></joint>"
+      "<joint name='j2' type='continuous'><parent link='a'/><child link='b'/><axis xyz='1 0 0'/></joint>";
+  for (int k = 1; k <= n; ++k) {
+    const std::string name = "s" + std::to_string(k), parent = k == 1 ? "a" : "s" + std::to_string(k - 1);
+    xml += "<link name='" + name +
+           "'><inertial><mass value='0.01'/><inertia ixx='1e-6' ixy='0' ixz='0' iyy='1e-6' iyz='0' "
+           "izz='1e-6'/></inertial></link><joint name='f" +
+           std::to_string(k) + "' type='fixed'><parent link='" + parent + "'/><child link='" + name +
+           "'/><origin xyz='0.001 0 0'/></joint>";
+  }
+  return xml + "</robot>";
+}
+
+// Deep documents used to overflow the stack in the recursive walks (leaves, side branches).
+void testDeep() {
+  const int n = 30000;
+  const vereshchagin::UrdfResult serial = vereshchagin::chainFromUrdfString(serialXml(n));
+  check(serial.ok && serial.robot.chain.getNrOfJoints() == static_cast<unsigned>(n), "deep chain: " + serial.message);
+  if (serial.ok) {
+    KDL::ChainFkSolverPos_recursive fk(serial.robot.chain);
+    KDL::JntArray q(static_cast<unsigned>(n));
+    KDL::Frame tip;
+    fk.JntToCart(q, tip);
+    check(near(tip.p.z(), 0.1 * n) && near(tip.p.x(), 0.0), "deep chain: the tip is n * 0.1 m up");
+  }
+  const vereshchagin::UrdfResult branch = vereshchagin::chainFromUrdfString(sideBranchXml(n), "", "b");
+  check(branch.ok && branch.robot.chain.getNrOfSegments() == 2, "deep fixed side branch: " + branch.message);
+  if (branch.ok) {
+    const KDL::RigidBodyInertia& body = branch.robot.chain.getSegment(0).getInertia();
+    check(near(body.getMass(), 1.0 + 0.01 * n), "the side branch's mass is lumped into segment 0");
+    // Centre of mass: s_k sits k mm along x, so sum(0.01 * k mm) / total mass.
+    const double cx = 0.01 * 0.001 * 0.5 * n * (n + 1.0) / (1.0 + 0.01 * n);
+    check(std::abs(body.getCOG().x() - cx) <= 1e-9 * cx, "the side branch's centre of mass");
+    check(branch.robot.links.size() == static_cast<std::size_t>(n) + 3, "every branch link is placed");
+  }
+}
+
+// Documents refused before urdfdom reads them (its reader recurses per nesting level).
+void testLimits() {
+  const std::string body =
+      "<link name='a'/><link name='b'/><joint name='j' type='continuous'><parent "
+      "link='a'/><child link='b'/><axis xyz='0 0 1'/></joint>";
+  const auto nested = [&](int levels) {  // <robot> plus `levels` nested elements
+    std::string xml = "<robot name='r'>" + body;
+    for (int k = 0; k < levels; ++k) xml += "<x a='>'>";
+    for (int k = 0; k < levels; ++k) xml += "</x>";
+    return xml + "<!-- <y><y> --><![CDATA[<z>]]></robot>";
+  };
+  check(vereshchagin::chainFromUrdfString(nested(999)).ok, "1000 nesting levels load");
+  expectError(nested(1000), "", "", "nested more than 1000 levels", "1001 nesting levels are refused");
+  expectError(nested(200000), "", "", "nested more than 1000 levels", "200000 nesting levels are refused");
+  std::string many = "<robot name='r'>";
+  for (int k = 0; k <= 50000; ++k) many += "<link name='l" + std::to_string(k) + "'/>";
+  expectError(many + "</robot>", "", "", "more than 50000 links", "more links than the limit");
+}
+
+// The fixed base leaves the root link's mass out: a note says so, with the mass and the link.
+void testBaseMassNote() {
+  const vereshchagin::UrdfResult bare = vereshchagin::chainFromUrdfString(kArm);
+  check(bare.ok && bare.robot.notes.empty(), "a massless root link gives no note");
+  const std::string heavy =
+      replaced(kArm, "<link name=\"base\"/>",
+               "<link name=\"base\"><inertial><mass value=\"7.5\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" "
+               "iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>");
+  const vereshchagin::UrdfResult r = vereshchagin::chainFromUrdfString(heavy);
+  check(r.ok && r.robot.notes.size() == 1 &&
+            r.robot.notes[0].find("root link 'base' carries 7.5 kg: ") != std::string::npos &&
+            r.robot.notes[0].find("welded to the world") != std::string::npos &&
+            r.robot.notes[0].find("a floating base (base=\"free\") is not supported yet") != std::string::npos,
+        "the root link's mass is noted: " + (r.robot.notes.empty() ? std::string() : r.robot.notes[0]));
 }
 
 }  // namespace
@@ -149,5 +243,8 @@ void testErrors() {
 int main() {
   testStructure();
   testErrors();
+  testDeep();
+  testLimits();
+  testBaseMassNote();
   return checker.finish("");
 }

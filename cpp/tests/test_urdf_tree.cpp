@@ -248,14 +248,97 @@ void testErrors() {
   std::string mimic = treeXml();
   mimic.insert(mimic.find("</joint>", mimic.find("name='d_head'")), "<mimic joint='a_torso'/>");
   const auto mimicked = vereshchagin::treeFromUrdfString(mimic);
-  check(mimicked.ok && mimicked.robot.joints.size() == 5 && mimicked.robot.notes.size() == 1 &&
-            mimicked.robot.notes[0].find("'d_head' mimics joint 'a_torso'") != std::string::npos,
+  check(mimicked.ok && mimicked.robot.joints.size() == 5 && mimicked.robot.notes.size() == 2 &&
+            mimicked.robot.notes[1].find("'d_head' mimics joint 'a_torso'") != std::string::npos,
         "a mimic joint becomes an independent joint, with a note");
   expectTreeError(treeXml(), "nowhere", {"root link 'nowhere' not found"}, "unknown root");
   expectTreeError(treeXml(), "finger_a", {"no moving joint below root link 'finger_a'"}, "a leaf as root");
   expectTreeError("<robot name='x'><link name='a'>", "", {"malformed URDF"}, "malformed XML");
   const auto missing = vereshchagin::treeFromUrdfFile("/nonexistent/robot.urdf");
-  check(!missing.ok && missing.message.find("cannot read") != std::string::npos, "missing file");
+  check(!missing.ok && missing.message.find("'/nonexistent/robot.urdf' does not exist") != std::string::npos,
+        "missing file: " + missing.message);
+  const auto dir = vereshchagin::treeFromUrdfFile("/");
+  check(!dir.ok && dir.message.find("'/' is a directory") != std::string::npos, "a directory: " + dir.message);
+}
+
+// The base (base 3 kg, pedestal 5 kg fixed to it) is welded to the world: a note gives its mass.
+void testBaseMassNote(const vereshchagin::RobotTree& t) {
+  check(!t.notes.empty() && t.notes[0].find("root link 'base' carries 8 kg (with the links fixed to it): ") == 0 &&
+            t.notes[0].find("a floating base (base=\"free\") is not supported yet") != std::string::npos,
+        "the base's mass is noted: " + (t.notes.empty() ? std::string() : t.notes[0]));
+  const auto sub = vereshchagin::treeFromUrdfString(treeXml(), "left1");  // left1 carries 1.1 kg
+  check(sub.ok && sub.robot.notes.size() == 1 && sub.robot.notes[0].find("root link 'left1' carries 1.1 kg: ") == 0,
+        "a sub-tree root's mass is noted");
+}
+
+// base -j1- l1 -j2- ... -jn- ln: revolute joints about z, 0.1 m apart along z, 1 kg per link;
+// `branch`: n links of 0.01 kg fixed in a line below l1 instead (l1 -j2- l2 the only other joint).
+std::string deepXml(int n, bool branch) {
+  std::string xml = "<robot name='deep'><link name='base'/>";
+  const auto add = [&xml](const std::string& name, const std::string& parent, const std::string& type, double mass) {
+    xml += "<link name='" + name + "'><inertial><mass value='" + std::to_string(mass) +
+           "'/><inertia ixx='1e-4' ixy='0' ixz='0' iyy='1e-4' iyz='0' izz='1e-4'/></inertial></link><joint name='j_" +
+           name + "' type='" + type + "'><parent link='" + parent + "'/><child link='" + name +
+           "'/><origin xyz='0 0 0.1'/><axis xyz='0 0 1'/></joint>";
+  };
+  for (int k = 1; k <= (branch ? 2 : n); ++k)
+    add("l" + std::to_string(k), k == 1 ? "base" : "l" + std::to_string(k - 1), "continuous", 1.0);
+  for (int k = 1; branch && k <= n; ++k)
+    add("s" + std::to_string(k), k == 1 ? "l1" : "s" + std::to_string(k - 1), "fixed", 0.01);
+  return xml + "</robot>";
+}
+
+// Deep trees used to overflow the stack: the loader's walks, treeSegmentOrder, and copies of a
+// RobotTree (KDL::Tree's own copy recurses per level).
+void testDeep() {
+  const int n = 30000;
+  const auto serial = vereshchagin::treeFromUrdfString(deepXml(n, false));
+  check(serial.ok && serial.robot.segment_names.size() == static_cast<std::size_t>(n), "deep tree: " + serial.message);
+  if (!serial.ok) return;
+  bool chain = true;
+  for (int i = 0; i < n; ++i) chain = chain && serial.robot.parent[static_cast<std::size_t>(i)] == i - 1;
+  check(chain, "deep tree: parent[i] = i - 1");
+  std::vector<KDL::SegmentMap::const_iterator> order;
+  std::vector<int> parent;
+  vereshchagin::treeSegmentOrder(serial.robot.tree, order, parent);
+  check(parent == serial.robot.parent && order.back()->first == "l30000", "deep tree: treeSegmentOrder");
+  const vereshchagin::RobotTree copy = serial.robot;
+  vereshchagin::RobotTree assigned;
+  assigned = copy;
+  for (const vereshchagin::RobotTree* t : {&copy, static_cast<const vereshchagin::RobotTree*>(&assigned)}) {
+    const auto last = t->tree.getSegments().find("l30000");
+    check(t->tree.getNrOfJoints() == static_cast<unsigned>(n) && last != t->tree.getSegments().end() &&
+              GetTreeElementQNr(last->second) == static_cast<unsigned>(n - 1) &&
+              t->segment_names == serial.robot.segment_names,
+          "deep tree: copies keep every segment and q_nr");
+  }
+  const auto branch = vereshchagin::treeFromUrdfString(deepXml(n, true));
+  check(branch.ok && branch.robot.segment_names == std::vector<std::string>({"l1", "l2"}),
+        "deep fixed side branch: " + branch.message);
+  if (branch.ok) {
+    const KDL::Segment& s = branch.robot.tree.getSegments().find("l1")->second.segment;
+    check(near(s.getInertia().getMass(), 1.0 + 0.01 * n), "the side branch's mass is lumped into l1");
+  }
+}
+
+// copyTree on a KDL tree deeper than KDL's own (recursive) copy survives with an 8 MB stack.
+void testCopyTree() {
+  const int n = 400000;
+  KDL::Tree deep("root");
+  std::string previous = "root";
+  for (int k = 0; k < n; ++k) {
+    const std::string name = "s" + std::to_string(k);
+    deep.addSegment(KDL::Segment(name, KDL::Joint(k % 3 == 2 ? KDL::Joint::None : KDL::Joint::RotZ)), previous);
+    previous = name;
+  }
+  KDL::Tree copy;
+  vereshchagin::copyTree(deep, copy);
+  const auto last = copy.getSegments().find(previous);
+  check(copy.getNrOfSegments() == static_cast<unsigned>(n) && copy.getNrOfJoints() == deep.getNrOfJoints() &&
+            last != copy.getSegments().end() &&
+            GetTreeElementQNr(last->second) == GetTreeElementQNr(deep.getSegments().find(previous)->second) &&
+            GetTreeElementParent(last->second)->first == "s" + std::to_string(n - 2),
+        "copyTree of a 400000-deep tree");
 }
 
 }  // namespace
@@ -266,8 +349,11 @@ int main() {
   if (r.ok) {
     testOrderAndJoints(r.robot);
     testPlacementsAndInertia(r.robot);
+    testBaseMassNote(r.robot);
   }
   testPathsAgainstChains();
   testErrors();
+  testDeep();
+  testCopyTree();
   return checker.finish("");
 }

@@ -106,7 +106,7 @@ void PyTree::setRotorInertia(const py::object& values) {
     appendSegment(rebuilt, robot, KDL::Segment(seg.getName(), joint, seg.getFrameToTip(), seg.getInertia()),
                   robot.parent[static_cast<std::size_t>(i)], "rotor_inertia");
   }
-  robot.tree = rebuilt;
+  vereshchagin::copyTree(rebuilt, robot.tree);  // KDL::Tree's assignment recurses per level
 }
 
 py::array_t<double> PyTree::fk(const py::object& q_obj, const py::object& which) const {

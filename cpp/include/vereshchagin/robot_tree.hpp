@@ -18,7 +18,16 @@
 
 namespace vereshchagin {
 
+// Copies and moves rebuild `tree` without recursion (copyTree below): KDL::Tree's own copy
+// recurses once per segment of the deepest path and overflows the stack on very deep trees.
 struct RobotTree {
+  RobotTree() = default;
+  RobotTree(const RobotTree& other);
+  RobotTree(RobotTree&& other);
+  RobotTree& operator=(const RobotTree& other);
+  RobotTree& operator=(RobotTree&& other);
+  ~RobotTree() = default;
+
   KDL::Tree tree;                          // root segment named root_link (the base frame)
   std::vector<std::string> segment_names;  // segment order (see above), root excluded
   std::vector<int> parent;                 // per segment: index of the parent segment, -1 = the base
@@ -32,5 +41,10 @@ struct RobotTree {
 // root). Allocates; call once per model, not per solve.
 void treeSegmentOrder(const KDL::Tree& tree, std::vector<KDL::SegmentMap::const_iterator>& order,
                       std::vector<int>& parent);
+
+// to = a copy of from, built without recursion (any depth): the same segments under the same
+// root, inserted in segment order, so q_nr is numbered depth-first exactly as KDL's own copy
+// numbers it. Use it instead of KDL::Tree's copy constructor or assignment for deep trees.
+void copyTree(const KDL::Tree& from, KDL::Tree& to);
 
 }  // namespace vereshchagin

@@ -29,6 +29,17 @@
 // Joint axes may point in any direction (normalised); revolute, continuous and prismatic joints
 // are supported on the path. Side branches that hang off the path through moving joints are
 // lumped rigidly at joint position 0 (recorded in RobotChain::notes).
+//
+// The base: the root link is welded to the world, so the mass and inertia of the root link and of
+// the links fixed to it enter no result. When they carry mass (e.g. the trunk of a quadruped or
+// humanoid), notes says so with the mass in kg and the root link's name; a floating base is not
+// supported yet.
+//
+// Size: the loaders walk the links without recursion, so a path of any length loads (a
+// 20000-link chain in about a second). Documents are refused before urdfdom parses them when they
+// have more than 50000 <link> elements (urdfdom releases a model recursively along its links) or
+// XML elements nested more than 1000 levels deep (its XML reader recurses per level).
+// File paths: a missing file, a directory or an unreadable file is an error that says which.
 #pragma once
 
 #include <string>
