@@ -163,13 +163,14 @@ PyChain PyTree::pathChain(const py::object& tip) const {
     chain_index[static_cast<std::size_t>(path[k])] = static_cast<int>(k);
     c.robot.chain.addSegment(segment(path[k]));
   }
+  std::vector<int> joint_of(robot.segment_names.size(), -1);  // one pass: linear in the tree's size
+  for (std::size_t k = 0; k < robot.joints.size(); ++k) joint_of[robot.joints[k].segment] = static_cast<int>(k);
   for (int s : path) {
-    for (const auto& j : robot.joints) {
-      if (static_cast<int>(j.segment) != s) continue;
-      vereshchagin::JointInfo info = j;
-      info.segment = static_cast<unsigned int>(chain_index[static_cast<std::size_t>(s)]);
-      c.robot.joints.push_back(info);
-    }
+    const int j = joint_of[static_cast<std::size_t>(s)];
+    if (j < 0) continue;
+    vereshchagin::JointInfo info = robot.joints[static_cast<std::size_t>(j)];
+    info.segment = static_cast<unsigned int>(chain_index[static_cast<std::size_t>(s)]);
+    c.robot.joints.push_back(info);
   }
   for (const auto& l : robot.links) {
     if (l.segment >= 0 && chain_index[static_cast<std::size_t>(l.segment)] < 0) continue;
@@ -177,6 +178,8 @@ PyChain PyTree::pathChain(const py::object& tip) const {
         {l.link, l.segment < 0 ? -1 : chain_index[static_cast<std::size_t>(l.segment)], l.in_segment_tip});
   }
   c.robot.root_link = robot.root_link;
+  for (const std::string& note : robot.notes)  // the base is the chain's base too
+    if (note.rfind("root link '", 0) == 0) c.robot.notes.push_back(note);
   if (path.size() < robot.segment_names.size())
     c.robot.notes.push_back("extracted from a tree: the " + std::to_string(robot.segment_names.size() - path.size()) +
                             " segments off the path to '" + segmentName(path.back()) + "' are left out");
