@@ -382,6 +382,30 @@ void deprecatedNameChecks(testutil::Checker& ck) {
   ck.check(kdl.rc == 0 && ours.rc == 0 && e <= 1e-10, "ChainIdSolver_Vereshchagin vs KDL's: rel err " + str(e));
 }
 
+// KDL's massless test chain (its solvertest's chain2: five segments without inertia): KDL
+// returns 0 with NaN outputs, the drop-in an error code (the one documented difference left in
+// KDL's solvertest, extern_patches/run_kdl_solvertest.sh).
+void masslessChecks(testutil::Checker& ck) {
+  KDL::Chain chain;
+  const KDL::Joint::JointType types[5] = {KDL::Joint::RotZ, KDL::Joint::RotX, KDL::Joint::RotX, KDL::Joint::RotX,
+                                          KDL::Joint::RotZ};
+  const double len[5] = {0.5, 0.4, 0.3, 0.2, 0.1};
+  for (int i = 0; i < 5; ++i)
+    chain.addSegment(KDL::Segment(KDL::Joint(types[i]), KDL::Frame(KDL::Vector(0.0, 0.0, len[i]))));
+  Scenario s;
+  s.chain = chain;
+  s.root_acc = KDL::Twist::Zero();
+  s.q = KDL::JntArray(5), s.qd = KDL::JntArray(5), s.ff = KDL::JntArray(5);
+  for (int j = 0; j < 5; ++j) s.q(j) = 0.3 * j - 0.5, s.qd(j) = 0.2 * j + 0.1;
+  s.f_ext.assign(5, KDL::Wrench::Zero());
+  s.alfa = KDL::Jacobian(4);
+  s.beta = KDL::JntArray(4);
+  const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
+  ck.check(kdl.rc == 0 && !kdl.qdd.allFinite(), "massless chain: KDL no longer returns 0 with NaN");
+  ck.check(ours.rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA,
+           "massless chain: ours returns " + str(ours.rc) + ", expected E_DEGENERATE_INERTIA");
+}
+
 }  // namespace
 
 int main() {
@@ -394,5 +418,6 @@ int main() {
   errorChecks(ck);
   growthChecks(ck);
   deprecatedNameChecks(ck);
+  masslessChecks(ck);
   return ck.finish("");
 }
