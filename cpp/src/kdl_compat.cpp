@@ -1,8 +1,13 @@
-// KDL-compatible drop-in class over ChainHdSolver. Conventions and differences in kdl_compat.hpp.
+// KDL-compatible drop-in classes over ChainHdSolver: KDL 1.5.1 (kdl_compat.hpp) and the secorolab
+// fork (kdl_fork_compat.hpp). Conventions and differences in those headers.
 #include "vereshchagin/kdl_compat.hpp"
 
 #include <Eigen/Geometry>
 #include <kdl/rigidbodyinertia.hpp>
+
+#include <utility>
+
+#include "vereshchagin/kdl_fork_compat.hpp"
 
 namespace vereshchagin {
 namespace kdl_compat {
@@ -248,4 +253,44 @@ void ChainHdSolver_Vereshchagin::getLinkAcceleration(Twists& xDotdot_local) {
 }
 
 }  // namespace kdl_compat
+}  // namespace vereshchagin
+
+// ---- kdl_fork_compat.hpp: the secorolab fork's classes ----
+
+namespace vereshchagin {
+namespace kdl_fork {
+
+void ChainHdSolver_Vereshchagin::effectiveBeta(const KDL::Jacobian& alfa, const KDL::JntArray& beta,
+                                               Eigen::VectorXd& out) const {
+  const KDL::Twist& a = rootAcceleration();
+  Eigen::Matrix<double, 6, 1> acc;
+  acc << a.vel.x(), a.vel.y(), a.vel.z(), a.rot.x(), a.rot.y(), a.rot.z();
+  out = beta.data;
+  out.noalias() += alfa.data.transpose() * acc;
+}
+
+ChainHdSolver_Vereshchagin_Fext_FixedJoint::ChainHdSolver_Vereshchagin_Fext_FixedJoint(const KDL::Chain& chain,
+                                                                                       const KDL::Twist& root_acc,
+                                                                                       const unsigned int nc)
+    : ChainHdSolver_Vereshchagin(chain, root_acc, nc), nc_(nc) {
+  prioritizeExternalWrenches();
+}
+
+ChainHdSolver_Vereshchagin_Fext_FixedJoint::ChainHdSolver_Vereshchagin_Fext_FixedJoint(KDL::Chain&& chain,
+                                                                                       const KDL::Twist& root_acc,
+                                                                                       const unsigned int nc)
+    : ChainHdSolver_Vereshchagin(std::move(chain), root_acc, nc), nc_(nc) {
+  prioritizeExternalWrenches();
+}
+
+void ChainHdSolver_Vereshchagin_Fext_FixedJoint::updateInternalDataStructures() {
+  ChainHdSolver_Vereshchagin::updateInternalDataStructures();
+  prioritizeExternalWrenches();
+}
+
+void ChainHdSolver_Vereshchagin_Fext_FixedJoint::prioritizeExternalWrenches() {
+  setDriverWeights(Eigen::VectorXd::Ones(nc_), Eigen::VectorXd::Zero(nc_));
+}
+
+}  // namespace kdl_fork
 }  // namespace vereshchagin
