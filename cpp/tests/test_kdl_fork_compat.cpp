@@ -226,6 +226,31 @@ void holdStill(testutil::Checker& ck) {
   std::printf("hold still: beta_fork = 0, tool acceleration minus root_acc %.1e\n", e);
 }
 
+// The Fext classes keep their f_ext priority across updateInternalDataStructures(), and
+// setDriverWeights(0, 0) on them gives the plain class's results.
+void fextWeightsKept(testutil::Checker& ck) {
+  const KDL::Chain chain = kinovaLike();
+  const KDL::Twist root_acc(KDL::Vector(0.0, 0.0, 9.81), KDL::Vector::Zero());
+  const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments();
+  KDL::Jacobian alfa(3);
+  KDL::SetToZero(alfa);
+  alfa(0, 0) = alfa(1, 1) = alfa(5, 2) = 1.0;
+  KDL::JntArray q(n), qd(n), ff(n), beta(3), a(n), b(n), c(n), t(n);
+  for (unsigned int j = 0; j < n; ++j) q(j) = 0.2 * j - 0.3, qd(j) = 0.1 * j;
+  KDL::Wrenches f(ns, KDL::Wrench::Zero());
+  f[ns - 1] = KDL::Wrench(KDL::Vector(3.0, -2.0, -8.0), KDL::Vector(0.1, 0.0, 0.2));
+  vereshchagin::kdl_fork::ChainHdSolver_Vereshchagin_Fext fext(chain, root_acc, 3);
+  vereshchagin::kdl_fork::ChainHdSolver_Vereshchagin plain(chain, root_acc, 3);
+  bool ok = fext.CartToJnt(q, qd, a, alfa, beta, f, ff, t) == 0;
+  fext.updateInternalDataStructures();
+  ok = ok && fext.CartToJnt(q, qd, b, alfa, beta, f, ff, t) == 0;
+  ck.check(ok && a.data == b.data, "Fext: weights kept across updateInternalDataStructures");
+  ok = fext.setDriverWeights(Eigen::VectorXd::Zero(3), Eigen::VectorXd::Zero(3)) == 0 &&
+       fext.CartToJnt(q, qd, b, alfa, beta, f, ff, t) == 0 && plain.CartToJnt(q, qd, c, alfa, beta, f, ff, t) == 0;
+  ck.check(ok && b.data == c.data && relErr(a.data, c.data) > 1e-3,
+           "Fext with weights 0 equals the plain class (and differs from weights 1)");
+}
+
 }  // namespace
 
 int main() {
@@ -233,5 +258,6 @@ int main() {
   closedLoop(ck, "Fixed_Joint + setDriverWeights", /*weights_by_setter=*/true);
   closedLoop(ck, "Fixed_Joint + Fext_FixedJoint", /*weights_by_setter=*/false);
   holdStill(ck);
+  fextWeightsKept(ck);
   return ck.finish("");
 }
