@@ -112,9 +112,56 @@ def native_kdl_chain(rng):
     return chain
 
 
+def kuka_lwr4_kdl():
+    """KDL's own KUKA LWR 4 test model (orocos_kdl/tests/solvertest.cpp, KDL 1.5.1), built with
+    PyKDL's API: the identified parameters of Jubien, Gautier and Janot (IFAC 2014), modified DH
+    frames, 2 kg per link, rotor inertias. Several link inertias are not positive semi-definite."""
+    h = 1.5707963  # the published model's pi / 2
+    # alpha, d, rotor, (cx, cy, cz), (ixx, iyy, izz, iyz) in each link's DH frame
+    links = [
+        (h, 0.0, 3.19, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0115343, 0.0)),
+        (-h, 0.4, 3.05, (0.0, -0.3120511, -0.0038871), (-0.5471572, -0.0000302, -0.5423253, 0.0018828)),
+        (-h, 0.0, 1.98, (0.0, -0.0015515, 0.0), (0.0063507, 0.0, 0.0107804, -0.0005147)),
+        (h, 0.39, 2.05, (0.0, 0.5216809, 0.0), (-1.0436952, 0.0, -1.0392780, 0.0005324)),
+        (h, 0.0, 0.787, (0.0, 0.0119891, 0.0), (0.0036654, 0.0, 0.0060429, 0.0004226)),
+        (-h, 0.0, 0.391, (0.0, 0.0080787, 0.0), (0.0010431, 0.0, 0.0036376, 0.0000101)),
+        (0.0, 0.0, 0.394, (0.0, 0.0, 0.0), (0.000001, 0.0, 0.0001203, 0.0)),
+    ]
+    chain = kdl.Chain()
+    for k, (alpha, d, rotor, com, (ixx, iyy, izz, iyz)) in enumerate(links):
+        frame = kdl.Frame.DH_Craig1989(0.0, alpha, d, 0.0) if k < 6 else kdl.Frame()
+        in_dh = kdl.RigidBodyInertia(2.0, kdl.Vector(*com), kdl.RotationalInertia(ixx, iyy, izz, 0.0, 0.0, iyz))
+        joint = kdl.Joint(f"lwr_j{k + 1}", kdl.Joint.RotZ, 1.0, 0.0, rotor)
+        chain.addSegment(kdl.Segment(f"lwr_link{k + 1}", joint, frame, frame.Inverse() * in_dh))
+    return chain
+
+
 # ------------------------------------------------------------------------------------------------
 # Checks
 # ------------------------------------------------------------------------------------------------
+def check_kdl_lwr(report, rng):
+    """KDL's LWR 4 comes through from_kdl as KDL takes it (the physical check on request), and
+    solves like KDL: companions against KDL's solvers, forward dynamics against KDL's M, C, g."""
+    lwr = kuka_lwr4_kdl()
+    chain = vs.Chain.from_kdl(lwr)  # default: accepted, as by KDL and the C++ drop-in
+    try:
+        vs.Chain.from_kdl(lwr, inertia_check="physical")
+    except vs.SolverError as err:
+        assert "joint_space" in str(err), err
+    else:
+        raise AssertionError("inertia_check='physical' accepted the LWR's non-rigid-body inertias")
+    compare_with_kdl(report, chain, lwr, rng, "KDL's LWR 4")
+    solver = vs.Solver(chain, gravity=G, inertia_check="joint_space")
+    n = chain.n_joints
+    for _ in range(4):
+        q, qd, tau = rng.uniform(-1.5, 1.5, n), rng.uniform(-2, 2, n), rng.normal(size=n) * 10.0
+        ref = kdl_dynamics(lwr, q, qd, np.zeros(n), np.zeros((n, 6)))
+        expected = np.linalg.solve(ref["M"], tau - ref["c"] - ref["g"])
+        report.check(
+            "KDL's LWR 4: Solver qdd vs KDL M^-1 (tau - C qd - g)", solver.solve(q, qd, tau_ff=tau).qdd, expected, 1e-10
+        )
+
+
 def compare_with_kdl(report, chain, kdl_chain, rng, tag):
     """Our companions on ``chain`` against KDL's solvers on ``kdl_chain`` (the same robot)."""
     n, ns = chain.n_joints, chain.n_segments
@@ -206,6 +253,7 @@ def run_all(panda_urdf, ur5_urdf):
         chain.rotor_inertia = rng.uniform(0.0, 0.4, chain.n_joints)
         compare_with_kdl(report, chain, chain.to_kdl(), rng, tag)
         check_round_trip(report, chain, rng, tag)
+    check_kdl_lwr(report, rng)
     check_rejections()
     return report.worst
 

@@ -66,3 +66,47 @@ def test_to_kdl_without_pykdl_says_how_to_get_it():
         pytest.skip("PyKDL is importable here; the message is for interpreters without it")
     with pytest.raises(ImportError, match="python3-pykdl"):
         vs.robots.gen3().to_kdl()
+
+
+# The README's recipe for PyKDL and vereshchagin in one interpreter, run as written.
+RECIPE_MARK = "<!-- pykdl-venv-recipe -->"
+ROOT = Path(__file__).resolve().parents[1]
+SOURCES = ("CMakeLists.txt", "pyproject.toml", "README.md", "LICENSE", "cpp", "python")
+
+
+def readme_recipe() -> str:
+    """The ``bash`` block that follows the recipe marker in README.md."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert RECIPE_MARK in text, "README.md lost the PyKDL venv recipe"
+    block = text.split(RECIPE_MARK, 1)[1].lstrip()
+    assert block.startswith("```bash\n"), block[:40]
+    return block[len("```bash\n") :].split("```", 1)[0]
+
+
+def test_readme_venv_recipe_gets_pykdl_and_vereshchagin_into_one_interpreter(tmp_path):
+    """``/usr/bin/python3 -m venv --system-site-packages`` then ``pip install .`` in a copy of the
+    sources (a full build of the package, with pip's isolated build environment), then the
+    recipe's own import line; afterwards the venv's interpreter passes pykdl_checks.py."""
+    recipe = readme_recipe()
+    assert "/usr/bin/python3 -m venv --system-site-packages" in recipe and "/bin/pip install ." in recipe
+    src = tmp_path / "src"
+    src.mkdir()
+    for name in SOURCES:
+        path = ROOT / name
+        if path.is_dir():
+            shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
+        else:
+            shutil.copy2(path, src / name)
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("PYTHON", "VIRTUAL_ENV"))}
+    env["PYTHONNOUSERSITE"] = "1"
+    run = subprocess.run(
+        ["bash", "-euo", "pipefail", "-c", recipe], cwd=src, env=env, capture_output=True, text=True, timeout=3600
+    )
+    assert run.returncode == 0, f"README recipe failed:\n{recipe}\n{run.stdout[-3000:]}\n{run.stderr[-6000:]}"
+    assert run.stdout.strip().splitlines()[-1] == "0"
+    venv_python = next(src.glob(".venv*/bin/python"))
+    checks = subprocess.run(
+        [str(venv_python), str(CHECKS), *_urdfs()], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600
+    )
+    assert checks.returncode == 0, f"pykdl_checks.py in the recipe's venv:\n{checks.stdout}\n{checks.stderr}"
+    assert "PYKDL CHECKS PASSED" in checks.stdout

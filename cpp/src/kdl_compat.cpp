@@ -1,5 +1,13 @@
-// KDL-compatible drop-in class over ChainHdSolver. Conventions and differences in kdl_compat.hpp.
+// KDL-compatible drop-in classes over ChainHdSolver: KDL 1.5.1 (kdl_compat.hpp) and the secorolab
+// fork (kdl_fork_compat.hpp). Conventions and differences in those headers.
 #include "vereshchagin/kdl_compat.hpp"
+
+#include <Eigen/Geometry>
+#include <kdl/rigidbodyinertia.hpp>
+
+#include <utility>
+
+#include "vereshchagin/kdl_fork_compat.hpp"
 
 namespace vereshchagin {
 namespace kdl_compat {
@@ -25,22 +33,50 @@ ChainHdSolver_Vereshchagin::ChainHdSolver_Vereshchagin(const KDL::Chain& chain, 
   allocate();
 }
 
+ChainHdSolver_Vereshchagin::ChainHdSolver_Vereshchagin(KDL::Chain&& chain, const KDL::Twist& root_acc,
+                                                       const unsigned int nc)
+    : source_(nullptr), root_acc_(root_acc), nc_(nc), solver_(chain, root_acc, compatOptions()) {
+  allocate();
+}
+
 void ChainHdSolver_Vereshchagin::allocate() {
   nj_ = solver_.nrOfJoints();
   ns_ = solver_.nrOfSegments();
   active_ = 0;
   alfa_on_ = ChainHdSolver::Matrix6X::Zero(6, nc_);
   f_ext_ = ChainHdSolver::Matrix6X::Zero(6, ns_);
-  beta_on_ = nu_ = w_f_ = w_t_ = w_f_on_ = w_t_on_ = Eigen::VectorXd::Zero(nc_);
+  beta_all_ = beta_on_ = nu_ = w_f_ = w_t_ = w_f_on_ = w_t_on_ = Eigen::VectorXd::Zero(nc_);
   column_ = Eigen::VectorXi::Zero(nc_);
-  total_ = Eigen::VectorXd::Zero(nj_);
+  total_ = felt_ = d_ = Eigen::VectorXd::Zero(nj_);
+  not_up_to_date_ = false;
   weighted_ = false;
   poses_.assign(ns_, KDL::Frame::Identity());
 }
 
 void ChainHdSolver_Vereshchagin::updateInternalDataStructures() {
-  solver_ = ChainHdSolver(*source_, root_acc_, compatOptions());
+  if (source_ != nullptr) {
+    solver_ = ChainHdSolver(*source_, root_acc_, compatOptions());
+  } else {
+    const KDL::Chain own = solver_.chain();
+    solver_ = ChainHdSolver(own, root_acc_, compatOptions());
+  }
   allocate();
+}
+
+void ChainHdSolver_Vereshchagin::effectiveBeta(const KDL::Jacobian&, const KDL::JntArray& beta,
+                                               Eigen::VectorXd& out) const {
+  out = beta.data;
+}
+
+const char* ChainHdSolver_Vereshchagin::errorMessage() const {
+  if (not_up_to_date_)
+    return "the chain given to the constructor has another number of segments than the solver's model: call "
+           "updateInternalDataStructures()";
+  return solver_.errorMessage();
+}
+
+const char* ChainHdSolver_Vereshchagin::strError(const int error) const {
+  return solver_.strError(error);
 }
 
 int ChainHdSolver_Vereshchagin::setDriverWeights(const Eigen::VectorXd& w_f_ext, const Eigen::VectorXd& w_ff_torques) {
@@ -58,15 +94,19 @@ int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::Jnt
                                           const KDL::Jacobian& alfa, const KDL::JntArray& beta,
                                           const KDL::Wrenches& f_ext, const KDL::JntArray& ff_torques,
                                           KDL::JntArray& constraint_torques) {
+  // As KDL: a changed number of segments of the caller's chain is reported first.
+  not_up_to_date_ = source_ != nullptr && source_->getNrOfSegments() != ns_;
+  if (not_up_to_date_) return error = E_NOT_UP_TO_DATE;
   if (q.rows() != nj_ || q_dot.rows() != nj_ || q_dotdot.rows() != nj_ || ff_torques.rows() != nj_ ||
       constraint_torques.rows() != nj_ || f_ext.size() != ns_ || alfa.columns() != nc_ || beta.rows() != nc_)
     return error = E_SIZE_MISMATCH;
+  effectiveBeta(alfa, beta, beta_all_);
   // Zero columns disable their constraints (KDL's convention): solve with the others only.
   active_ = 0;
   for (unsigned int c = 0; c < nc_; ++c) {
     if ((alfa.data.col(c).array() == 0.0).all()) continue;
     alfa_on_.col(active_) = alfa.data.col(c);
-    beta_on_(active_) = beta(c);
+    beta_on_(active_) = beta_all_(c);
     w_f_on_(active_) = w_f_(c);
     w_t_on_(active_) = w_t_(c);
     column_(active_++) = static_cast<int>(c);
@@ -85,11 +125,17 @@ int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::Jnt
       solver_.solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_, ff_torques.data);
   if (rc != E_NOERROR) return error = rc;
   q_dotdot.data = solver_.qdd();
-  constraint_torques.data = solver_.commandTorques();
-  total_ = ff_torques.data + solver_.commandTorques();
   nu_.setZero();
   const auto nu = solver_.nu();
   for (int k = 0; k < active_; ++k) nu_(column_(k)) = nu(k);
+  if (convention_ == TorqueConvention::Command) {
+    constraint_torques.data = solver_.commandTorques();
+    total_ = ff_torques.data + solver_.commandTorques();
+  } else {
+    feltTorques(q, nu_, alfa);
+    constraint_torques.data = felt_;
+    total_ = d_.cwiseProduct(solver_.qdd());
+  }
   return error = E_NOERROR;
 }
 
@@ -104,6 +150,61 @@ void ChainHdSolver_Vereshchagin::getTransformedLinkAcceleration(Twists& x_dotdot
 void ChainHdSolver_Vereshchagin::getTotalTorque(KDL::JntArray& total_tau) {
   if (total_tau.rows() != nj_) total_tau.resize(nj_);
   total_tau.data = total_;
+}
+
+void ChainHdSolver_Vereshchagin::getCommandTorques(KDL::JntArray& tau) {
+  if (tau.rows() != nj_) tau.resize(nj_);
+  tau.data = solver_.commandTorques();
+}
+
+// KDL's constraint_torques entry j is -Z_j^T E_j nu: the constraint wrench alfa nu on the last
+// tip, carried inward through the articulated bodies, each joint passed on the way projected
+// out (E_{i-1} = E_i - U_i Z_i^T E_i / D_i, U_i = P_i Z_i, D_i = Z_i^T P_i Z_i + rotor_i, P_i the
+// articulated inertia), and felt at joint j before its own projection. Computed here in one
+// inward sweep with every quantity in base axes about the base origin (frame-independent
+// scalars), KDL's articulated inertia D_j along the way (for getTotalTorque()).
+void ChainHdSolver_Vereshchagin::feltTorques(const KDL::JntArray& q, const Eigen::VectorXd& nu_all,
+                                             const KDL::Jacobian& alfa) {
+  updateBasePoses();
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  using Matrix3 = Eigen::Matrix<double, 3, 3>;
+  const KDL::Chain& chain = solver_.chain();
+  // alfa nu: force f and moment about the last tip's origin -> moment about the base origin.
+  Vector6 e = alfa.data * nu_all;
+  const KDL::Vector tip = ns_ > 0 ? poses_[ns_ - 1].p : KDL::Vector::Zero();
+  const Eigen::Vector3d p(tip.x(), tip.y(), tip.z());
+  e.tail<3>() += p.cross(Eigen::Vector3d(e.head<3>()));
+  Matrix6 P = Matrix6::Zero();
+  int j = static_cast<int>(nj_) - 1;
+  for (int i = static_cast<int>(ns_) - 1; i >= 0; --i) {
+    const KDL::Segment& seg = chain.getSegment(i);
+    // Rigid-body inertia in base axes about the base origin: [m 1, -m [c]x; m [c]x, I_O].
+    const KDL::RigidBodyInertia I = poses_[i] * seg.getInertia();
+    const double m = I.getMass();
+    const KDL::Vector h = m * I.getCOG();
+    Matrix3 hx;
+    hx << 0.0, -h.z(), h.y(), h.z(), 0.0, -h.x(), -h.y(), h.x(), 0.0;
+    P.topLeftCorner<3, 3>() += m * Matrix3::Identity();
+    P.topRightCorner<3, 3>() -= hx;
+    P.bottomLeftCorner<3, 3>() += hx;
+    P.bottomRightCorner<3, 3>() +=
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(I.getRotationalInertia().data);
+    if (seg.getJoint().getType() == KDL::Joint::Fixed) continue;
+    // Joint unit twist: in the segment's root axes about its tip -> base axes about the base origin.
+    const KDL::Rotation R_parent = i > 0 ? poses_[i - 1].M : KDL::Rotation::Identity();
+    const KDL::Twist t = (R_parent * seg.twist(q(j), 1.0)).RefPoint(-poses_[i].p);
+    Vector6 S;
+    S << t.vel.x(), t.vel.y(), t.vel.z(), t.rot.x(), t.rot.y(), t.rot.z();
+    const Vector6 U = P * S;
+    const double D = S.dot(U) + seg.getJoint().getInertia();
+    const double se = S.dot(e);
+    felt_(j) = -se;
+    d_(j) = D;
+    e.noalias() -= U * (se / D);
+    P.noalias() -= U * (U.transpose() / D);
+    --j;
+  }
 }
 
 void ChainHdSolver_Vereshchagin::getContraintForceMagnitude(Eigen::VectorXd& nu_out) {
@@ -152,4 +253,44 @@ void ChainHdSolver_Vereshchagin::getLinkAcceleration(Twists& xDotdot_local) {
 }
 
 }  // namespace kdl_compat
+}  // namespace vereshchagin
+
+// ---- kdl_fork_compat.hpp: the secorolab fork's classes ----
+
+namespace vereshchagin {
+namespace kdl_fork {
+
+void ChainHdSolver_Vereshchagin::effectiveBeta(const KDL::Jacobian& alfa, const KDL::JntArray& beta,
+                                               Eigen::VectorXd& out) const {
+  const KDL::Twist& a = rootAcceleration();
+  Eigen::Matrix<double, 6, 1> acc;
+  acc << a.vel.x(), a.vel.y(), a.vel.z(), a.rot.x(), a.rot.y(), a.rot.z();
+  out = beta.data;
+  out.noalias() += alfa.data.transpose() * acc;
+}
+
+ChainHdSolver_Vereshchagin_Fext_FixedJoint::ChainHdSolver_Vereshchagin_Fext_FixedJoint(const KDL::Chain& chain,
+                                                                                       const KDL::Twist& root_acc,
+                                                                                       const unsigned int nc)
+    : ChainHdSolver_Vereshchagin(chain, root_acc, nc), nc_(nc) {
+  prioritizeExternalWrenches();
+}
+
+ChainHdSolver_Vereshchagin_Fext_FixedJoint::ChainHdSolver_Vereshchagin_Fext_FixedJoint(KDL::Chain&& chain,
+                                                                                       const KDL::Twist& root_acc,
+                                                                                       const unsigned int nc)
+    : ChainHdSolver_Vereshchagin(std::move(chain), root_acc, nc), nc_(nc) {
+  prioritizeExternalWrenches();
+}
+
+void ChainHdSolver_Vereshchagin_Fext_FixedJoint::updateInternalDataStructures() {
+  ChainHdSolver_Vereshchagin::updateInternalDataStructures();
+  prioritizeExternalWrenches();
+}
+
+void ChainHdSolver_Vereshchagin_Fext_FixedJoint::prioritizeExternalWrenches() {
+  setDriverWeights(Eigen::VectorXd::Ones(nc_), Eigen::VectorXd::Zero(nc_));
+}
+
+}  // namespace kdl_fork
 }  // namespace vereshchagin

@@ -8,11 +8,15 @@
 //    KDL's published regression values), q_dotdot equals KDL's;
 //  * the same arm with an all-zero alfa: q_dotdot equals KDL's forward dynamics (ChainFdSolver_RNE);
 //  * random chains with a mix of zero and random columns.
-// Ours only (documented differences): constraint_torques realise q_dotdot (KDL forward dynamics
-// with ff + constraint_torques), getTotalTorque = ff + constraint_torques, link poses and
+// By default every output equals KDL's (constraint_torques: the felt torques -Z^T E nu;
+// getTotalTorque: D_j q_dotdot_j), to 1e-10 relative, on the LWR task and random chains. With
+// TorqueConvention::Command (ours): constraint_torques realise q_dotdot (KDL forward dynamics with
+// ff + constraint_torques), getTotalTorque = ff + constraint_torques. Also ours: link poses and
 // velocities against KDL's forward kinematics, setDriverWeights with weight 1 on ff torques
-// against the dense formula (the task solved without ff, plus H^-1 ff), error codes.
+// against the dense formula (the task solved without ff, plus H^-1 ff), error codes, and
+// E_NOT_UP_TO_DATE for a grown chain exactly when KDL returns it.
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/LU>
@@ -20,6 +24,7 @@
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainfksolvervel_recursive.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
+#include <kdl/chainidsolver_vereshchagin.hpp>
 
 #include "kuka_lwr4.hpp"
 #include "random_chain.hpp"
@@ -50,9 +55,12 @@ struct Outcome {
 
 // Written against KDL's API only: the same text for both classes.
 template <class HdSolver>
-Outcome run(const Scenario& s) {
+Outcome run(const Scenario& s, bool command = false) {
   const unsigned int nj = s.chain.getNrOfJoints(), ns = s.chain.getNrOfSegments();
   HdSolver solver(s.chain, s.root_acc, s.alfa.columns());
+  if constexpr (std::is_same<HdSolver, Ours>::value) {
+    if (command) solver.setTorqueConvention(vereshchagin::kdl_compat::TorqueConvention::Command);
+  }
   KDL::JntArray qdd(nj), constraint_tau(nj), total(nj);
   Outcome out;
   out.rc = solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, constraint_tau);
@@ -142,13 +150,29 @@ void lwrTaskChecks(testutil::Checker& ck) {
     ck.check(std::abs(ours.nu(c) - published[c]) <= 1e-3 * std::max(1.0, std::abs(published[c])),
              "LWR task: nu(" + str(c) + ") = " + str(ours.nu(c)) + " vs KDL's published " + str(published[c]));
   ck.check(ours.nu(3) == 0.0 && ours.nu(4) == 0.0, "LWR task: disabled columns have nu exactly 0");
-  // Documented differences: ours realise q_dotdot; total torque = ff + constraint torques.
-  const Eigen::VectorXd fd = kdlForward(s, s.ff.data + ours.constraint_tau);
-  const double e_fd = relErr(fd, ours.qdd), e_kdl_fd = relErr(kdlForward(s, s.ff.data + kdl.constraint_tau), kdl.qdd);
-  ck.check(e_fd <= 1e-9, "LWR task: KDL FD with ff + our constraint_torques rel err " + str(e_fd));
-  ck.check(ours.total_tau == s.ff.data + ours.constraint_tau, "LWR task: getTotalTorque != ff + constraint_torques");
-  std::printf("LWR 4 task: |qdd - KDL| rel %.2e, |nu - KDL| rel %.2e, FD with our torques %.2e (with KDL's: %.2e)\n",
-              e_qdd, e_nu, e_fd, e_kdl_fd);
+  // Default: KDL's torques (felt torques; total = D_j qdd_j), and KDL's published total torques.
+  const double e_ct = relErr(ours.constraint_tau, kdl.constraint_tau), e_tt = relErr(ours.total_tau, kdl.total_tau);
+  ck.check(e_ct <= 1e-10, "LWR task: constraint_torques vs KDL rel err " + str(e_ct));
+  ck.check(e_tt <= 1e-10, "LWR task: getTotalTorque vs KDL rel err " + str(e_tt) + " (ours " +
+                              testutil::mat(ours.total_tau) + ", KDL " + testutil::mat(kdl.total_tau) + ")");
+  const double published_total[7] = {2013.3541, -6073.4999, 2227.4487, 56.87456, -11.3789, -6.05957, 569.0776};
+  for (int j = 0; j < 7; ++j)
+    ck.check(std::abs(ours.total_tau(j) - published_total[j]) <= 1e-3,
+             "LWR task: total torque(" + str(j) + ") = " + str(ours.total_tau(j)) + " vs KDL's published " +
+                 str(published_total[j]));
+  // TorqueConvention::Command: the torques realise q_dotdot; total torque = ff + constraint torques.
+  const Outcome cmd = run<Ours>(s, /*command=*/true);
+  const Eigen::VectorXd fd = kdlForward(s, s.ff.data + cmd.constraint_tau);
+  const double e_fd = relErr(fd, cmd.qdd), e_kdl_fd = relErr(kdlForward(s, s.ff.data + kdl.constraint_tau), kdl.qdd);
+  ck.check(cmd.rc == 0 && cmd.qdd == ours.qdd && cmd.nu == ours.nu, "LWR task: the convention changes only torques");
+  ck.check(e_fd <= 1e-9, "LWR task: KDL FD with ff + our command torques rel err " + str(e_fd));
+  ck.check(e_kdl_fd > 1e-3, "LWR task: KDL's felt torques unexpectedly realise qdd (" + str(e_kdl_fd) + ")");
+  ck.check(cmd.total_tau == s.ff.data + cmd.constraint_tau,
+           "LWR task: Command getTotalTorque != ff + constraint_torques");
+  std::printf(
+      "LWR 4 task: |qdd - KDL| rel %.2e, |nu - KDL| rel %.2e, constraint_torques %.2e, total %.2e; FD with command "
+      "torques %.2e (with KDL's: %.2e)\n",
+      e_qdd, e_nu, e_ct, e_tt, e_fd, e_kdl_fd);
 }
 
 void lwrFreeChecks(testutil::Checker& ck) {
@@ -164,7 +188,7 @@ void lwrFreeChecks(testutil::Checker& ck) {
 
 // Random chains (no fixed joints: KDL needs n_joints = n_segments), zero and random columns.
 void randomChecks(testutil::Checker& ck) {
-  double worst_qdd = 0.0, worst_nu = 0.0;
+  double worst_qdd = 0.0, worst_nu = 0.0, worst_ct = 0.0, worst_tt = 0.0, worst_fd = 0.0;
   int compared = 0;
   for (int k = 0; k < 60; ++k) {
     testutil::RandomGen g(424242ULL + 31ULL * static_cast<unsigned long long>(k));
@@ -190,12 +214,22 @@ void randomChecks(testutil::Checker& ck) {
         "random " + str(k) + " (n=" + str(n) + ", nc=" + str(nc) + ", enabled " + str(on.cols()) + ")";
     ck.check(kdl.rc == 0 && ours.rc == 0, tag + ": return codes");
     const double e_qdd = relErr(ours.qdd, kdl.qdd), e_nu = relErr(ours.nu, kdl.nu);
+    const double e_ct = relErr(ours.constraint_tau, kdl.constraint_tau), e_tt = relErr(ours.total_tau, kdl.total_tau);
     ck.check(e_qdd <= 1e-8 && e_nu <= 1e-8, tag + ": vs KDL rel err qdd " + str(e_qdd) + ", nu " + str(e_nu));
+    ck.check(e_ct <= 1e-10 && e_tt <= 1e-10,
+             tag + ": vs KDL rel err constraint_torques " + str(e_ct) + ", total torque " + str(e_tt));
+    const Outcome cmd = run<Ours>(s, /*command=*/true);
+    const double e_fd = relErr(kdlForward(s, s.ff.data + cmd.constraint_tau), cmd.qdd);
+    ck.check(e_fd <= 1e-9, tag + ": Command torques: KDL FD rel err " + str(e_fd));
     worst_qdd = std::max(worst_qdd, e_qdd), worst_nu = std::max(worst_nu, e_nu);
+    worst_ct = std::max(worst_ct, e_ct), worst_tt = std::max(worst_tt, e_tt), worst_fd = std::max(worst_fd, e_fd);
     ++compared;
   }
   ck.check(compared >= 30, "random chains: too few compared (" + str(compared) + ")");
-  std::printf("random chains: %d compared with KDL, worst rel err qdd %.2e, nu %.2e\n", compared, worst_qdd, worst_nu);
+  std::printf(
+      "random chains: %d compared with KDL, worst rel err qdd %.2e, nu %.2e, constraint_torques %.2e, total torque "
+      "%.2e; Command torques through KDL FD %.2e\n",
+      compared, worst_qdd, worst_nu, worst_ct, worst_tt, worst_fd);
 }
 
 // Link getters (ours only: KDL 1.5.1 declares but does not define them) against KDL's FK.
@@ -286,17 +320,90 @@ void errorChecks(testutil::Checker& ck) {
   ck.check(from_temporary.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
                solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 && qdd.data == qdd2.data,
            "temporary chain");
-  // updateInternalDataStructures re-reads the (changed) chain.
-  Scenario grown = s;
-  Ours follower(grown.chain, s.root_acc, 6);
-  grown.chain.addSegment(
+  // A temporary chain is only copied: updateInternalDataStructures() keeps working on the copy.
+  from_temporary.updateInternalDataStructures();
+  ck.check(from_temporary.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 && qdd.data == qdd2.data,
+           "temporary chain: updateInternalDataStructures");
+}
+
+// The caller's chain grows by one segment: the return codes of a sequence of calls, and the
+// accelerations after updateInternalDataStructures(). Written with KDL's API only.
+struct Growth {
+  std::vector<int> codes;
+  Eigen::VectorXd qdd;
+};
+
+template <class HdSolver>
+Growth growth() {
+  Scenario s = lwrTask();
+  HdSolver solver(s.chain, s.root_acc, 6);
+  KDL::JntArray q8(8), qd8(8), qdd8(8), ff8(8), tc8(8), qdd(7), tc(7);
+  for (int j = 0; j < 7; ++j) q8(j) = s.q(j), qd8(j) = s.qd(j), ff8(j) = s.ff(j);
+  q8(7) = 0.3, qd8(7) = -0.7, ff8(7) = 0.5;
+  KDL::Wrenches f8 = s.f_ext;
+  f8.push_back(KDL::Wrench(KDL::Vector(1.0, -2.0, 3.0), KDL::Vector(0.1, 0.2, -0.3)));
+  Growth g;
+  g.codes.push_back(solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc));
+  s.chain.addSegment(
       KDL::Segment("extra", KDL::Joint(KDL::Joint::RotZ), KDL::Frame(KDL::Vector(0, 0, 0.1)),
                    KDL::RigidBodyInertia(1.0, KDL::Vector(0, 0, 0.05), KDL::RotationalInertia(0.01, 0.01, 0.01))));
-  follower.updateInternalDataStructures();
-  KDL::JntArray q8(8), qd8(8), qdd8(8), ff8(8), tc8(8);
-  KDL::Wrenches f8(8, KDL::Wrench::Zero());
-  ck.check(follower.CartToJnt(q8, qd8, qdd8, s.alfa, s.beta, f8, ff8, tc8) == 0,
-           "updateInternalDataStructures: 8 joints");
+  g.codes.push_back(solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc));  // old sizes
+  g.codes.push_back(solver.CartToJnt(q8, qd8, qdd8, s.alfa, s.beta, f8, ff8, tc8));        // new sizes
+  solver.updateInternalDataStructures();
+  g.codes.push_back(solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc));  // old sizes
+  g.codes.push_back(solver.CartToJnt(q8, qd8, qdd8, s.alfa, s.beta, f8, ff8, tc8));        // new sizes
+  g.qdd = qdd8.data;
+  return g;
+}
+
+void growthChecks(testutil::Checker& ck) {
+  const Growth kdl = growth<Theirs>(), ours = growth<Ours>();
+  ck.check(kdl.codes == std::vector<int>{0, KDL::SolverI::E_NOT_UP_TO_DATE, KDL::SolverI::E_NOT_UP_TO_DATE,
+                                         KDL::SolverI::E_SIZE_MISMATCH, 0},
+           "grown chain: KDL's return codes changed");
+  std::string codes;
+  for (std::size_t k = 0; k < ours.codes.size(); ++k) codes += str(ours.codes[k]) + "/" + str(kdl.codes[k]) + " ";
+  ck.check(ours.codes == kdl.codes, "grown chain: return codes ours/KDL " + codes);
+  const double e = relErr(ours.qdd, kdl.qdd);
+  ck.check(e <= 1e-9, "grown chain: qdd after updateInternalDataStructures vs KDL rel err " + str(e));
+  std::printf("grown chain: return codes (ours/KDL) %s; qdd after update rel err %.2e\n", codes.c_str(), e);
+}
+
+// KDL's deprecated name: the same results as KDL's ChainIdSolver_Vereshchagin.
+void deprecatedNameChecks(testutil::Checker& ck) {
+  const Scenario s = lwrTask();
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+  const Outcome kdl = run<KDL::ChainIdSolver_Vereshchagin>(s);
+  const Outcome ours = run<vereshchagin::kdl_compat::ChainIdSolver_Vereshchagin>(s);
+#pragma GCC diagnostic pop
+  const double e = std::max({relErr(ours.qdd, kdl.qdd), relErr(ours.nu, kdl.nu),
+                             relErr(ours.constraint_tau, kdl.constraint_tau), relErr(ours.total_tau, kdl.total_tau)});
+  ck.check(kdl.rc == 0 && ours.rc == 0 && e <= 1e-10, "ChainIdSolver_Vereshchagin vs KDL's: rel err " + str(e));
+}
+
+// KDL's massless test chain (its solvertest's chain2: five segments without inertia): KDL
+// returns 0 with NaN outputs, the drop-in an error code (the one documented difference left in
+// KDL's solvertest, extern_patches/run_kdl_solvertest.sh).
+void masslessChecks(testutil::Checker& ck) {
+  KDL::Chain chain;
+  const KDL::Joint::JointType types[5] = {KDL::Joint::RotZ, KDL::Joint::RotX, KDL::Joint::RotX, KDL::Joint::RotX,
+                                          KDL::Joint::RotZ};
+  const double len[5] = {0.5, 0.4, 0.3, 0.2, 0.1};
+  for (int i = 0; i < 5; ++i)
+    chain.addSegment(KDL::Segment(KDL::Joint(types[i]), KDL::Frame(KDL::Vector(0.0, 0.0, len[i]))));
+  Scenario s;
+  s.chain = chain;
+  s.root_acc = KDL::Twist::Zero();
+  s.q = KDL::JntArray(5), s.qd = KDL::JntArray(5), s.ff = KDL::JntArray(5);
+  for (int j = 0; j < 5; ++j) s.q(j) = 0.3 * j - 0.5, s.qd(j) = 0.2 * j + 0.1;
+  s.f_ext.assign(5, KDL::Wrench::Zero());
+  s.alfa = KDL::Jacobian(4);
+  s.beta = KDL::JntArray(4);
+  const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
+  ck.check(kdl.rc == 0 && !kdl.qdd.allFinite(), "massless chain: KDL no longer returns 0 with NaN");
+  ck.check(ours.rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA,
+           "massless chain: ours returns " + str(ours.rc) + ", expected E_DEGENERATE_INERTIA");
 }
 
 }  // namespace
@@ -309,5 +416,8 @@ int main() {
   getterChecks(ck);
   driverWeightChecks(ck);
   errorChecks(ck);
+  growthChecks(ck);
+  deprecatedNameChecks(ck);
+  masslessChecks(ck);
   return ck.finish("");
 }

@@ -136,7 +136,7 @@ def _segment_arguments(kdl, segment, index: int) -> dict[str, Any]:
     )
 
 
-def chain_from_kdl(kdl_chain, inertia_check: str = "physical") -> Chain:
+def chain_from_kdl(kdl_chain, inertia_check: str = "joint_space") -> Chain:
     """Build a :class:`Chain` from a PyKDL ``Chain``.
 
     Parameters
@@ -148,9 +148,14 @@ def chain_from_kdl(kdl_chain, inertia_check: str = "physical") -> Chain:
         reference point, the tip origin, to the centre of mass). Rotor inertias
         (``Joint::getInertia()``) are carried over. Segments and joints named KDL's default
         ``'NoName'`` become ``'segment<i>'`` and ``'segment<i>_joint'``.
-    inertia_check : {'physical', 'joint_space'}
-        As in :meth:`Chain.add_segment`: 'joint_space' accepts the identified (non-rigid-body)
-        inertias KDL models often have; solve them with ``Solver(..., inertia_check='joint_space')``.
+    inertia_check : {'joint_space', 'physical'}
+        As in :meth:`Chain.add_segment`. 'joint_space' (default) accepts every inertia KDL accepts,
+        e.g. the identified (non-rigid-body) link inertias of KDL's own KUKA LWR 4 model, as the
+        C++ drop-in ``kdl_compat::ChainHdSolver_Vereshchagin`` does; solve such a chain with
+        ``Solver(..., inertia_check='joint_space')``, which checks at each solve that the
+        joint-space inertia is positive definite. 'physical' additionally requires every body to
+        be a rigid body (positive semi-definite inertia obeying the triangle inequality) and
+        names the offending segment.
 
     Returns
     -------
