@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <kdl/rigidbodyinertia.hpp>
 
+#include <memory>
 #include <utility>
 
 #include "vereshchagin/kdl_fork_compat.hpp"
@@ -18,6 +19,16 @@ SolverOptions compatOptions() {
   SolverOptions o;
   o.inertia_check = InertiaCheck::JointSpace;  // identified models, as KDL accepts them
   return o;
+}
+
+// No segment carries mass or rotational inertia and no joint a rotor inertia.
+bool massless(const KDL::Chain& chain) {
+  for (const KDL::Segment& seg : chain.segments) {
+    const KDL::RigidBodyInertia& I = seg.getInertia();
+    const Eigen::Map<const Eigen::Matrix3d> rot(I.getRotationalInertia().data);
+    if (I.getMass() != 0.0 || !(rot.array() == 0.0).all() || seg.getJoint().getInertia() != 0.0) return false;
+  }
+  return chain.getNrOfJoints() > 0;
 }
 
 template <typename T>
@@ -50,7 +61,22 @@ void ChainHdSolver_Vereshchagin::allocate() {
   total_ = felt_ = d_ = Eigen::VectorXd::Zero(nj_);
   not_up_to_date_ = false;
   weighted_ = false;
+  degraded_ = false;
   poses_.assign(ns_, KDL::Frame::Identity());
+  unit_.reset();
+  if (massless(solver_.chain())) {
+    KDL::Chain unit;
+    for (const KDL::Segment& seg : solver_.chain().segments) {
+      const KDL::Joint& j = seg.getJoint();
+      const bool axis = j.getType() == KDL::Joint::RotAxis || j.getType() == KDL::Joint::TransAxis;
+      const double rotor = j.getType() == KDL::Joint::Fixed ? 0.0 : 1.0;
+      const KDL::Joint unit_joint =
+          axis ? KDL::Joint(j.getName(), j.JointOrigin(), j.JointAxis(), j.getType(), 1.0, 0.0, rotor)
+               : KDL::Joint(j.getName(), j.getType(), 1.0, 0.0, rotor);
+      unit.addSegment(KDL::Segment(seg.getName(), unit_joint, seg.getFrameToTip(), seg.getInertia()));
+    }
+    unit_ = std::make_unique<ChainHdSolver>(unit, root_acc_, compatOptions());
+  }
 }
 
 void ChainHdSolver_Vereshchagin::updateInternalDataStructures() {
@@ -69,6 +95,9 @@ void ChainHdSolver_Vereshchagin::effectiveBeta(const KDL::Jacobian&, const KDL::
 }
 
 const char* ChainHdSolver_Vereshchagin::errorMessage() const {
+  if (degraded_ && error == E_DEGRADED)
+    return "the chain has no mass and no rotor inertia: its dynamics leave q_dotdot free; q_dotdot is the smallest "
+           "one that meets the constraints (no torque is needed)";
   if (not_up_to_date_)
     return "the chain given to the constructor has another number of segments than the solver's model: call "
            "updateInternalDataStructures()";
@@ -121,8 +150,11 @@ int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::Jnt
   } else if (solver_.passThroughColumns() >= 0) {
     solver_.clearPassThrough();
   }
+  degraded_ = false;
   const int rc =
       solver_.solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_, ff_torques.data);
+  if (rc == ChainHdSolver::E_DEGENERATE_INERTIA && masslessAnswer(q, q_dot, ff_torques, q_dotdot, constraint_torques))
+    return error = E_DEGRADED;
   if (rc != E_NOERROR) return error = rc;
   q_dotdot.data = solver_.qdd();
   nu_.setZero();
@@ -139,9 +171,33 @@ int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::Jnt
   return error = E_NOERROR;
 }
 
+// A chain without any mass or rotor inertia, driven by no torque and no wrench, has dynamics that
+// leave every acceleration free (KDL computes NaN there and returns 0). The answer given instead:
+// the smallest q_dotdot that meets the constraints (least squares where they conflict), which is
+// the Gauss-optimal motion of the same chain with unit rotor inertia on every joint (H = I, the
+// Gauss function 1/2 |q_dotdot|^2), solved by unit_; no torque is needed for it.
+bool ChainHdSolver_Vereshchagin::masslessAnswer(const KDL::JntArray& q, const KDL::JntArray& q_dot,
+                                                const KDL::JntArray& ff_torques, KDL::JntArray& q_dotdot,
+                                                KDL::JntArray& constraint_torques) {
+  if (!unit_ || !(ff_torques.data.array() == 0.0).all() || !(f_ext_.array() == 0.0).all()) return false;
+  if (weighted_)
+    unit_->setPassThrough(w_f_on_.head(active_), w_t_on_.head(active_));
+  else if (unit_->passThroughColumns() >= 0)
+    unit_->clearPassThrough();
+  const Eigen::VectorXd& zero = total_;  // nj zeros after setZero()
+  total_.setZero();
+  if (unit_->solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_, zero) != E_NOERROR)
+    return false;
+  q_dotdot.data = unit_->qdd();
+  nu_.setZero();
+  constraint_torques.data.setZero();
+  degraded_ = true;
+  return true;
+}
+
 void ChainHdSolver_Vereshchagin::getTransformedLinkAcceleration(Twists& x_dotdot) {
   ensureSize(x_dotdot, ns_ + 1);
-  const auto& acc = solver_.linkAccelerations();
+  const auto& acc = answered().linkAccelerations();
   for (unsigned int i = 0; i <= ns_; ++i)
     x_dotdot[i] =
         KDL::Twist(KDL::Vector(acc(0, i), acc(1, i), acc(2, i)), KDL::Vector(acc(3, i), acc(4, i), acc(5, i)));
@@ -154,7 +210,10 @@ void ChainHdSolver_Vereshchagin::getTotalTorque(KDL::JntArray& total_tau) {
 
 void ChainHdSolver_Vereshchagin::getCommandTorques(KDL::JntArray& tau) {
   if (tau.rows() != nj_) tau.resize(nj_);
-  tau.data = solver_.commandTorques();
+  if (degraded_)
+    tau.data.setZero();  // a massless chain needs no torque for any motion
+  else
+    tau.data = solver_.commandTorques();
 }
 
 // KDL's constraint_torques entry j is -Z_j^T E_j nu: the constraint wrench alfa nu on the last
@@ -214,7 +273,7 @@ void ChainHdSolver_Vereshchagin::getContraintForceMagnitude(Eigen::VectorXd& nu_
 void ChainHdSolver_Vereshchagin::updateBasePoses() {
   KDL::Frame parent = KDL::Frame::Identity();
   for (unsigned int i = 0; i < ns_; ++i) {
-    parent = parent * solver_.linkLocalPose(i);
+    parent = parent * answered().linkLocalPose(i);
     poses_[i] = parent;
   }
 }
@@ -228,28 +287,28 @@ void ChainHdSolver_Vereshchagin::getLinkCartesianPose(Frames& x_base) {
 void ChainHdSolver_Vereshchagin::getLinkCartesianVelocity(Twists& xDot_base) {
   updateBasePoses();
   ensureSize(xDot_base, ns_);
-  for (unsigned int i = 0; i < ns_; ++i) xDot_base[i] = poses_[i].M * solver_.linkLocalVelocity(i);
+  for (unsigned int i = 0; i < ns_; ++i) xDot_base[i] = poses_[i].M * answered().linkLocalVelocity(i);
 }
 
 void ChainHdSolver_Vereshchagin::getLinkCartesianAcceleration(Twists& xDotDot_base) {
   updateBasePoses();
   ensureSize(xDotDot_base, ns_);
-  for (unsigned int i = 0; i < ns_; ++i) xDotDot_base[i] = poses_[i].M * solver_.linkLocalAcceleration(i);
+  for (unsigned int i = 0; i < ns_; ++i) xDotDot_base[i] = poses_[i].M * answered().linkLocalAcceleration(i);
 }
 
 void ChainHdSolver_Vereshchagin::getLinkPose(Frames& x_local) {
   ensureSize(x_local, ns_);
-  for (unsigned int i = 0; i < ns_; ++i) x_local[i] = solver_.linkLocalPose(i);
+  for (unsigned int i = 0; i < ns_; ++i) x_local[i] = answered().linkLocalPose(i);
 }
 
 void ChainHdSolver_Vereshchagin::getLinkVelocity(Twists& xDot_local) {
   ensureSize(xDot_local, ns_);
-  for (unsigned int i = 0; i < ns_; ++i) xDot_local[i] = solver_.linkLocalVelocity(i);
+  for (unsigned int i = 0; i < ns_; ++i) xDot_local[i] = answered().linkLocalVelocity(i);
 }
 
 void ChainHdSolver_Vereshchagin::getLinkAcceleration(Twists& xDotdot_local) {
   ensureSize(xDotdot_local, ns_);
-  for (unsigned int i = 0; i < ns_; ++i) xDotdot_local[i] = solver_.linkLocalAcceleration(i);
+  for (unsigned int i = 0; i < ns_; ++i) xDotdot_local[i] = answered().linkLocalAcceleration(i);
 }
 
 }  // namespace kdl_compat

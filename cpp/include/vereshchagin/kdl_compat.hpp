@@ -40,6 +40,12 @@
 //  * Errors are reported, not asserted or computed as NaN: sizes (E_SIZE_MISMATCH, as KDL), and
 //    ChainHdSolver's codes (E_NONFINITE_INPUT, E_INVALID_MODEL, E_DEGENERATE_INERTIA, ...); the
 //    message is in errorMessage(). CartToJnt allocates no heap memory (KDL's does, when nc > 0).
+//  * A chain with no mass and no rotor inertia at all, driven by no ff_torques and no f_ext (KDL's
+//    own test chains): its dynamics leave every acceleration free; KDL returns 0 with NaN outputs.
+//    Here CartToJnt returns E_DEGRADED (+1, KDL's "converged but degraded solution") with the
+//    smallest q_dotdot that meets the constraints (least squares where they conflict), zero
+//    constraint torques, nu and total torque (no torque is needed), and errorMessage() says so.
+//    With ff_torques or f_ext on such a chain the acceleration is unbounded: E_DEGENERATE_INERTIA.
 //  * A rank-deficient constraint set is pseudo-inverted relative to the coupling matrix's scale
 //    (ChainHdSolver's TruncatedPseudoInverse), not with KDL's absolute 1e-14 SVD cut-off.
 //
@@ -63,6 +69,7 @@
 // gravity-free beta) are in vereshchagin/kdl_fork_compat.hpp.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -165,6 +172,11 @@ class ChainHdSolver_Vereshchagin : public KDL::SolverI {
   void updateBasePoses();
   // KDL's felt constraint torques and articulated inertias D_j at the last solve (one inward sweep).
   void feltTorques(const KDL::JntArray& q, const Eigen::VectorXd& nu_all, const KDL::Jacobian& alfa);
+  // The E_DEGRADED answer of a chain with no mass at all (kdl_compat.cpp); false if it does not apply.
+  bool masslessAnswer(const KDL::JntArray& q, const KDL::JntArray& q_dot, const KDL::JntArray& ff_torques,
+                      KDL::JntArray& q_dotdot, KDL::JntArray& constraint_torques);
+  // The solver holding the last solve's results.
+  const ChainHdSolver& answered() const { return degraded_ ? *unit_ : solver_; }
 
   const KDL::Chain* source_;  // the caller's chain (lvalue constructor), or nullptr
   KDL::Twist root_acc_;
@@ -178,7 +190,9 @@ class ChainHdSolver_Vereshchagin : public KDL::SolverI {
   Eigen::VectorXi column_;                       // alfa column of each enabled one
   Eigen::VectorXd w_f_, w_t_, w_f_on_, w_t_on_;  // pass-through weights (nc), of the enabled columns
   bool weighted_ = false;
-  bool not_up_to_date_ = false;  // the last CartToJnt returned E_NOT_UP_TO_DATE
+  bool not_up_to_date_ = false;          // the last CartToJnt returned E_NOT_UP_TO_DATE
+  bool degraded_ = false;                // the last CartToJnt returned E_DEGRADED (a massless chain)
+  std::unique_ptr<ChainHdSolver> unit_;  // massless chains only: the chain with unit rotor inertias
   Frames poses_;
 };
 
