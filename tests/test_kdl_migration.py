@@ -60,10 +60,13 @@ def test_identified_models_solve_like_pinocchio(seed):
     rc = identified_chain(rng, int(rng.integers(2, 8)))
     assert any(np.linalg.eigvalsh(s.inertia)[0] < 0 for s in rc.segments)
     with pytest.raises(vs.SolverError, match="joint_space"):
-        vs.Solver(rc.chain)  # the default, physical, names the option
+        vs.Solver(rc.chain, inertia_check="physical")  # the physical check names the option
     solver = vs.Solver(rc.chain, inertia_check="joint_space")
     assert solver.inertia_check == "joint_space"
     assert pickle.loads(pickle.dumps(solver)).inertia_check == "joint_space"
+    # The chain was built with the joint-space check: a Solver takes it by default (issue 24).
+    assert rc.chain.inertia_check == "joint_space"
+    assert vs.Solver(rc.chain).inertia_check == "joint_space"
     data = rc.data()
     for _ in range(3):
         q, qd = random_state(rng, rc)
@@ -96,7 +99,8 @@ def test_indefinite_joint_space_inertia_fails_at_solve_naming_the_joint():
         inertia_check="joint_space",
     )
     with pytest.raises(vs.SolverError, match="joint_space"):
-        vs.Solver(c)
+        vs.Solver(c, inertia_check="physical")
+    assert vs.Solver(c).inertia_check == "joint_space"  # the model's check by default
     solver = vs.Solver(c, inertia_check="joint_space")
     ok = solver.solve([0.0, 0.0], [0.0, 0.0])  # forearm along x: the shoulder feels m r^2 > 0.2
     assert np.isfinite(ok.qdd).all()
@@ -256,3 +260,43 @@ def test_pass_through_argument_errors():
         solver.solve(q, qd, alpha=a, beta=[0, 0], tau_ff_pass_through=[0.5])
     with pytest.raises(vs.SolverError, match="tau_ff_pass_through"):
         solver.solve(q, qd, alpha=a, beta=[0, 0], tau_ff_pass_through=[np.nan, 0.0])
+
+
+# ------------------------------------------------------------------------------------------------
+# A model remembers the inertia check it was built with; a Solver follows it unless told otherwise
+# ------------------------------------------------------------------------------------------------
+def test_the_model_inertia_check_is_sticky_pickled_and_the_solver_default():
+    rng = np.random.default_rng(7)
+    rc = identified_chain(rng, 4)
+    chain = rc.chain
+    assert chain.inertia_check == "joint_space"
+    assert pickle.loads(pickle.dumps(chain)).inertia_check == "joint_space"
+    assert chain.__copy__().inertia_check == "joint_space"
+    q, qd = random_state(rng, rc)
+    by_default = vs.Solver(chain).solve(q, qd)
+    explicit = vs.Solver(chain, inertia_check="joint_space").solve(q, qd)
+    np.testing.assert_array_equal(by_default.qdd, explicit.qdd)
+    # A rigid segment added with the physical check keeps the model's joint-space check.
+    chain.add_segment("rigid", "rot_z", mass=1.0, inertia=np.diag([0.01, 0.01, 0.01]))
+    assert chain.inertia_check == "joint_space"
+    # Physical models stay physical, and old six-entry pickle states load as physical.
+    physical = vs.Chain()
+    physical.add_segment("rod", "rot_x", mass=1.0, inertia=np.diag([0.1, 0.1, 0.0]))
+    assert physical.inertia_check == "physical" and vs.Solver(physical).inertia_check == "physical"
+    old_state = chain.__getstate__()[:6]
+    restored = vs.Chain.__new__(vs.Chain)
+    restored.__setstate__(old_state)
+    assert restored.inertia_check == "physical"
+    with pytest.raises(vs.SolverError, match="inertia_check must be"):
+        vs.Chain.__new__(vs.Chain).__setstate__((*old_state, "loose"))
+
+
+def test_trees_and_their_paths_keep_the_check(tmp_path):
+    from vereshchagin.robots import example_robot_urdf
+
+    tree = vs.Tree.from_urdf(example_robot_urdf("baxter"), inertia_check="joint_space")
+    assert tree.inertia_check == "joint_space"
+    assert tree.chain("left_wrist").inertia_check == "joint_space"
+    assert pickle.loads(pickle.dumps(tree)).inertia_check == "joint_space"
+    assert vs.Solver(tree).inertia_check == "joint_space"
+    assert vs.Tree.from_urdf(example_robot_urdf("baxter")).inertia_check == "physical"

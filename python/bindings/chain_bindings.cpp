@@ -25,6 +25,7 @@ PyChain PyChain::fromUrdf(const py::object& source, const std::string& root, con
   if (!r.ok) raise(r.message);
   PyChain c;
   c.robot = r.robot;
+  c.inertia_check = inertia_check;
   return c;
 }
 
@@ -33,6 +34,8 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
                          const py::object& rotor_obj, const std::string& joint_name, const std::string& inertia_check) {
   const bool physical =
       inertiaCheckArg(inertia_check, "segment '" + name + "': ") == vereshchagin::InertiaCheck::Physical;
+  const vereshchagin::InertiaCheck model_check =
+      physical ? this->inertia_check : vereshchagin::InertiaCheck::JointSpace;
   // Every failure names the segment and the argument: "segment 'link3': mass must be ...".
   const std::string where = "segment '" + name + "': ";
   const std::string jname = joint_name.empty() ? name + "_joint" : joint_name;
@@ -86,6 +89,7 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   const unsigned int seg = robot.chain.getNrOfSegments();
   robot.chain.addSegment(KDL::Segment(name, j, f_tip, KDL::RigidBodyInertia(mass, c, Ic)));
   robot.links.push_back({name, static_cast<int>(seg), KDL::Frame::Identity()});
+  this->inertia_check = model_check;  // after every check passed
   if (spec.type != KDL::Joint::Fixed) {
     vereshchagin::JointInfo info;
     info.name = jname;
@@ -166,11 +170,13 @@ py::tuple PyChain::getState() const {
     segments.append(segmentState(robot.chain.getSegment(i)));
   for (const auto& j : robot.joints) joints.append(jointInfoState(j));
   for (const auto& l : robot.links) links.append(linkState(l));
-  return py::make_tuple(1, segments, joints, links, robot.root_link, py::cast(robot.notes));
+  return py::make_tuple(1, segments, joints, links, robot.root_link, py::cast(robot.notes),
+                        vereshchagin::inertiaCheckName(inertia_check));
 }
 
 PyChain PyChain::fromState(const py::tuple& state) {
-  if (state.size() != 6 || !py::isinstance<py::int_>(state[0]) || state[0].cast<long long>() != 1)
+  if ((state.size() != 6 && state.size() != 7) || !py::isinstance<py::int_>(state[0]) ||
+      state[0].cast<long long>() != 1)
     raise("Chain state: unknown format");
   PyChain c;
   std::vector<int> moving;
@@ -188,6 +194,7 @@ PyChain PyChain::fromState(const py::tuple& state) {
   checkStateIndices(c.robot.joints, c.robot.links, moving, c.segmentCount(), "Chain state");
   c.robot.root_link = state[4].cast<std::string>();
   c.robot.notes = state[5].cast<std::vector<std::string>>();
+  if (state.size() == 7) c.inertia_check = inertiaCheckArg(state[6].cast<std::string>(), "Chain state: ");
   return c;
 }
 
@@ -314,9 +321,9 @@ joint_name : str, optional
     Defaults to ``name + '_joint'``.
 inertia_check : {'physical', 'joint_space'}
     'physical' (default): the body must be a rigid body (PSD inertia whose principal moments obey
-    the triangle inequality). 'joint_space': any symmetric inertia (identified models); a
-    ``Solver(..., inertia_check='joint_space')`` then checks that H(q) is positive definite at
-    each solve.
+    the triangle inequality). 'joint_space': any symmetric inertia (identified models); the chain
+    then remembers it (:attr:`inertia_check`) and a ``Solver`` of it checks that H(q) is positive
+    definite at each solve.
 )doc",
            py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(), py::arg("mass") = 0.0,
            py::arg("com") = py::none(), py::arg("inertia") = py::none(), py::arg("rotor_inertia") = 0.0,
@@ -336,7 +343,7 @@ leaf. Raises SolverError for malformed XML, unknown links, tip not below root, f
 or mimic joints on the path, negative mass, or (``inertia_check='physical'``, the default) a
 link inertia that no rigid body has (not PSD, or principal moments violating the triangle
 inequality); ``inertia_check='joint_space'`` accepts identified models (any symmetric inertia;
-use ``Solver(..., inertia_check='joint_space')`` with them).
+the chain remembers the option, and a ``Solver`` of it uses the joint-space check).
 )doc")
       .def_property_readonly(
           "n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); },

@@ -80,6 +80,10 @@ inline Array rotorInertiaArg(const py::object& values, size_t n_joints) {
 // segment or from a URDF. Frames and joints are addressed by the rule of addressing.hpp.
 struct PyChain : Addressable {
   vereshchagin::RobotChain robot;
+  // The inertia check the model was built with: JointSpace once any part of it was accepted only
+  // by that check (from_kdl, from_urdf or add_segment with inertia_check='joint_space'). A Solver
+  // uses it unless told otherwise.
+  vereshchagin::InertiaCheck inertia_check = vereshchagin::InertiaCheck::Physical;
 
   int segmentCount() const override { return static_cast<int>(robot.chain.getNrOfSegments()); }
   const std::string& segmentName(int index) const override {

@@ -8,6 +8,8 @@
 
 #include <pybind11/stl.h>
 
+#include "vereshchagin/inertia_check.hpp"
+
 #include "addressing.hpp"
 #include "common.hpp"
 
@@ -62,6 +64,11 @@ void bindNamesAndIndices(py::class_<Model>& cls, const char* notes_doc) {
          "str: name of the base link (the base frame); the base is addressed by this name only.")
       .def_property_readonly(
           "notes", [](const Model& m) { return m.robot.notes; }, notes_doc)
+      .def_property_readonly(
+          "inertia_check", [](const Model& m) { return vereshchagin::inertiaCheckName(m.inertia_check); },
+          "str: the inertia check the model was built with, 'physical' or 'joint_space' (once any part was "
+          "accepted only by 'joint_space': from_kdl, or from_urdf / add_segment with that option). A Solver "
+          "uses it unless given inertia_check.")
       .def_property_readonly(
           "link_names",
           [](const Model& m) {

@@ -69,8 +69,9 @@ inline constexpr const char* kTreeAlpha =
 class PySolver {
  public:
   // model: a Chain or a Tree (copied).
+  // inertia_check: None (the model's, see PyChain::inertia_check), 'physical' or 'joint_space'.
   PySolver(const py::object& model, const py::object& gravity, const py::object& rcond, const py::object& damping,
-           const std::string& inertia_check);
+           const py::object& inertia_check);
 
   // Parses solve()'s arguments (objects may be null for "not given") into `p`.
   // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,

@@ -15,7 +15,7 @@
 namespace vsbind {
 
 PySolver::PySolver(const py::object& model, const py::object& gravity, const py::object& rcond,
-                   const py::object& damping, const std::string& inertia_check)
+                   const py::object& damping, const py::object& inertia_check)
     : damping_arg_(damping) {
   if (py::isinstance<PyChain>(model)) {
     chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
@@ -31,7 +31,10 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
                          std::string(Py_TYPE(model.ptr())->tp_name));
   }
   options_.rcond = scalarArg(rcond, "rcond");
-  options_.inertia_check = inertiaCheckArg(inertia_check, "");
+  if (inertia_check.is_none())  // the check the model was built with
+    options_.inertia_check = tree_ ? tree_->inertia_check : chain_->inertia_check;
+  else
+    options_.inertia_check = inertiaCheckArg(py::str(inertia_check).cast<std::string>(), "");
   if (!damping.is_none()) {
     options_.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
     options_.damping = scalarArg(damping, "damping");
@@ -367,9 +370,9 @@ void bindSolver(py::module_& mod) {
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
   py::class_<PySolver> cls(mod, "Solver", docs::kSolverCore);
-  cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const std::string&>(),
+  cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&>(),
           py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
-          py::arg("damping") = py::none(), py::arg("inertia_check") = "physical")
+          py::arg("damping") = py::none(), py::arg("inertia_check") = py::none())
       .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
            py::arg("friction") = py::none(), py::arg("constraints") = py::none(),
@@ -405,7 +408,7 @@ void bindSolver(py::module_& mod) {
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
                         if (t.size() != 5) raise("Solver state must have 5 entries");
-                        return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4].cast<std::string>());
+                        return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4]);
                       }));
   addFastMethod(cls, &g_solve_def);
   addFastMethod(cls, &g_time_def);

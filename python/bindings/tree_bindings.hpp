@@ -25,6 +25,7 @@ inline bool isPrismatic(KDL::Joint::JointType type) {
 
 struct PyTree : Addressable {
   vereshchagin::RobotTree robot;
+  vereshchagin::InertiaCheck inertia_check = vereshchagin::InertiaCheck::Physical;  // as PyChain's
 
   int segmentCount() const override { return static_cast<int>(robot.segment_names.size()); }
   const std::string& segmentName(int index) const override {

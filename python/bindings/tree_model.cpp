@@ -6,6 +6,7 @@
 
 #include "dynamics_common.hpp"
 #include "model_state.hpp"
+#include "py_solver.hpp"  // inertiaCheckArg
 #include "tree_bindings.hpp"
 #include "vereshchagin/urdf_loader.hpp"
 
@@ -32,6 +33,7 @@ PyTree PyTree::fromUrdf(const py::object& source, const std::string& root, veres
   if (!r.ok) raise(r.message);
   PyTree t;
   t.robot = r.robot;
+  t.inertia_check = inertia_check;
   return t;
 }
 
@@ -40,11 +42,13 @@ py::tuple PyTree::getState() const {
   for (int i = 0; i < segmentCount(); ++i) segments.append(py::make_tuple(segmentState(segment(i)), robot.parent[i]));
   for (const auto& j : robot.joints) joints.append(jointInfoState(j));
   for (const auto& l : robot.links) links.append(linkState(l));
-  return py::make_tuple(1, robot.root_link, segments, joints, links, py::cast(robot.notes));
+  return py::make_tuple(1, robot.root_link, segments, joints, links, py::cast(robot.notes),
+                        vereshchagin::inertiaCheckName(inertia_check));
 }
 
 PyTree PyTree::fromState(const py::tuple& state) {
-  if (state.size() != 6 || !py::isinstance<py::int_>(state[0]) || state[0].cast<long long>() != 1)
+  if ((state.size() != 6 && state.size() != 7) || !py::isinstance<py::int_>(state[0]) ||
+      state[0].cast<long long>() != 1)
     raise("Tree state: unknown format");
   PyTree t;
   t.robot.root_link = state[1].cast<std::string>();
@@ -67,6 +71,7 @@ PyTree PyTree::fromState(const py::tuple& state) {
     t.robot.links.push_back(linkFromState(item, "Tree state: link record"));
   checkStateIndices(t.robot.joints, t.robot.links, moving, t.segmentCount(), "Tree state");
   t.robot.notes = state[5].cast<std::vector<std::string>>();
+  if (state.size() == 7) t.inertia_check = inertiaCheckArg(state[6].cast<std::string>(), "Tree state: ");
   return t;
 }
 
@@ -178,6 +183,7 @@ PyChain PyTree::pathChain(const py::object& tip) const {
         {l.link, l.segment < 0 ? -1 : chain_index[static_cast<std::size_t>(l.segment)], l.in_segment_tip});
   }
   c.robot.root_link = robot.root_link;
+  c.inertia_check = inertia_check;
   for (const std::string& note : robot.notes)  // the base is the chain's base too
     if (note.rfind("root link '", 0) == 0) c.robot.notes.push_back(note);
   if (path.size() < robot.segment_names.size())

@@ -151,9 +151,9 @@ def chain_from_kdl(kdl_chain, inertia_check: str = "joint_space") -> Chain:
     inertia_check : {'joint_space', 'physical'}
         As in :meth:`Chain.add_segment`. 'joint_space' (default) accepts every inertia KDL accepts,
         e.g. the identified (non-rigid-body) link inertias of KDL's own KUKA LWR 4 model, as the
-        C++ drop-in ``kdl_compat::ChainHdSolver_Vereshchagin`` does; solve such a chain with
-        ``Solver(..., inertia_check='joint_space')``, which checks at each solve that the
-        joint-space inertia is positive definite. 'physical' additionally requires every body to
+        C++ drop-in ``kdl_compat::ChainHdSolver_Vereshchagin`` does; the chain remembers it
+        (``chain.inertia_check``), so ``Solver(chain)`` checks at each solve that the joint-space
+        inertia is positive definite. 'physical' additionally requires every body to
         be a rigid body (positive semi-definite inertia obeying the triangle inequality) and
         names the offending segment.
 

@@ -77,11 +77,13 @@ class Solver(_core.Solver):
         treated as zero (truncated pseudo-inverse; the rank is reported).
     damping : float, optional
         If given, use damped least squares ``lambda / (lambda^2 + damping^2)`` instead.
-    inertia_check : {'physical', 'joint_space'}
-        'physical' (default): every body must be a rigid body (checked once). 'joint_space':
-        identified models (e.g. the published KUKA LWR 4 parameters) whose link inertias need
-        not be positive semi-definite; each solve then checks that every articulated joint
-        inertia is positive (H(q) positive definite) and names the joint when not.
+    inertia_check : {None, 'physical', 'joint_space'}
+        'physical': every body must be a rigid body (checked once). 'joint_space': identified
+        models (e.g. the published KUKA LWR 4 parameters) whose link inertias need not be
+        positive semi-definite; each solve then checks that every articulated joint inertia is
+        positive (H(q) positive definite) and names the joint when not. None (default): the
+        check the model was built with (``model.inertia_check``: 'joint_space' for a chain from
+        ``Chain.from_kdl``, as KDL accepts it, or built with that option; else 'physical').
 
     Notes
     -----
