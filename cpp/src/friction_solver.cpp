@@ -30,13 +30,7 @@ FrictionSolver& FrictionSolver::operator=(FrictionSolver&&) noexcept = default;
 namespace {
 
 using detail::EntryGuard;
-using Map6X = Eigen::Map<const ChainHdSolver::Matrix6X, 0, Eigen::OuterStride<>>;
-
-// A 6-row view of a matrix with 6 rows or no columns (6 x 0).
-Map6X sixRows(const Eigen::Ref<const Eigen::MatrixXd>& m) {
-  if (m.cols() == 0) return Map6X(nullptr, 6, 0, Eigen::OuterStride<>(6));
-  return Map6X(m.data(), 6, m.cols(), Eigen::OuterStride<>(m.outerStride()));
-}
+using detail::sixRows;
 
 }  // namespace
 

@@ -37,6 +37,14 @@ using Matrix3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
 using MatrixC = HdSolver::MatrixC;
 using VectorC = HdSolver::VectorC;
 
+// A 6-row view of a caller's matrix with 6 rows or no columns (then 6 x 0), keeping its outer
+// stride: the public entry points check the rows, the algorithm reads fixed-row blocks.
+using Map6X = Eigen::Map<const Matrix6X, 0, Eigen::OuterStride<>>;
+inline Map6X sixRows(const Eigen::Ref<const Eigen::MatrixXd>& m) {
+  if (m.cols() == 0) return Map6X(nullptr, 6, 0, Eigen::OuterStride<>(6));
+  return Map6X(m.data(), 6, m.cols(), Eigen::OuterStride<>(m.outerStride()));
+}
+
 // What a model is built from: the segments in preorder, each one's parent (-1: the base) and its
 // joint index (-1 for a fixed joint; moving joints numbered 0..n_joints-1 in the caller's order).
 struct ModelSource {

@@ -10,13 +10,7 @@ namespace vereshchagin {
 namespace {
 
 using detail::EntryGuard;
-using Map6X = Eigen::Map<const HdSolver::Matrix6X, 0, Eigen::OuterStride<>>;
-
-// A 6-row view of a matrix whose rows sixRowsProblem() checked (no columns: 6 x 0).
-Map6X sixRows(const Eigen::Ref<const Eigen::MatrixXd>& m) {
-  if (m.cols() == 0) return Map6X(nullptr, 6, 0, Eigen::OuterStride<>(6));
-  return Map6X(m.data(), 6, m.cols(), Eigen::OuterStride<>(m.outerStride()));
-}
+using detail::sixRows;
 
 Vector6 toVector(const KDL::Twist& t) {
   Vector6 v;

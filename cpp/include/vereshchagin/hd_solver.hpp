@@ -166,7 +166,8 @@ class HdSolver : public KDL::SolverI {
     E_INVALID_MODEL = -101,         // negative mass, inertia failing options.inertia_check, negative rotor
                                     // inertia, empty tree, unknown root segment, ...
     E_DEGENERATE_INERTIA = -102,    // a joint's articulated inertia D_j <= 0: no unique motion (zero),
-                                    // or H(q) not positive definite here (inertia_check JointSpace)
+                                    // or H(q) not positive definite here (inertia_check JointSpace);
+                                    // a state too large for the arithmetic is E_STATE_OUT_OF_RANGE
     E_TOO_MANY_CONSTRAINTS = -103,  // more than 6 columns on one segment
     E_NO_SOLUTION = -104,           // responseColumns() called before a successful solve
     E_INVALID_OPTIONS = -105,       // rcond < 0, damping <= 0 for the damped policy, non-finite
