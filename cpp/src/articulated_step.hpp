@@ -14,7 +14,7 @@ inline bool HdCore::articulate(int i, double tau, Vector6& pa, double& free) {
   SegmentState& s = ws.seg[i];
   s.u.noalias() = s.IA * sm.S;
   s.D = sm.rotor + sm.S.dot(s.u);
-  if (!(s.D > model.d_tolerance)) return false;
+  if (!(s.D > sm.d_tolerance)) return false;
   s.Dinv = 1.0 / s.D;
   const Vector6 IAc = s.IA * s.c;
   free = s.Dinv * (tau - sm.S.dot(s.pA + IAc));

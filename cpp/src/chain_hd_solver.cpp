@@ -2,6 +2,7 @@
 // KDL's CartToJnt() entry point. Conventions in hd_solver.hpp.
 #include "vereshchagin/chain_hd_solver.hpp"
 
+#include "entry_guard.hpp"
 #include "hd_core.hpp"
 
 namespace vereshchagin {
@@ -30,15 +31,23 @@ ChainHdSolver::ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc
       f_ext_buf_(Matrix6X::Zero(6, chain.getNrOfSegments())) {}
 
 void ChainHdSolver::updateInternalDataStructures() {
+  const detail::EntryGuard guard(core().busy);
+  if (!guard) {
+    core().stale_model.store(true, std::memory_order_relaxed);  // reported by the next solves
+    return;
+  }
   rebuild(chainSource(chain_));
   f_ext_buf_.setZero(6, chain_.getNrOfSegments());
+  core().stale_model.store(false, std::memory_order_relaxed);
 }
 
 int ChainHdSolver::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot,
                              const KDL::Jacobian& alfa, const KDL::JntArray& beta, const KDL::Wrenches& f_ext,
                              const KDL::JntArray& ff_torques, KDL::JntArray& command_torques) {
-  const unsigned int nj = nrOfJoints(), ns = nrOfSegments();
   detail::HdCore& c = core();
+  const detail::EntryGuard guard(c.busy);
+  if (!guard) return E_CONCURRENT_CALL;
+  const unsigned int nj = nrOfJoints(), ns = nrOfSegments();
   if (q_dotdot.rows() != nj)
     return error = c.fail(E_SIZE_MISMATCH, "q_dotdot has %u entries, expected %u", q_dotdot.rows(), nj);
   if (command_torques.rows() != nj)
@@ -53,7 +62,7 @@ int ChainHdSolver::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot,
       f_ext_buf_(3 + k, i) = f_ext[i].torque(k);
     }
   }
-  const int rc = solve(q.data, q_dot.data, alfa.data, beta.data, f_ext_buf_, ff_torques.data);
+  const int rc = solveEntered(q.data, q_dot.data, alfa.data, beta.data, f_ext_buf_, ff_torques.data);
   if (rc != E_NOERROR) return rc;
   q_dotdot.data = qdd();
   command_torques.data = commandTorques();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -36,6 +37,9 @@ class FrictionCore {
   const ChainHdSolver::Matrix6X& linkAccelerations();
   double gaussValue();
   int fail(int code, const char* fmt, ...);
+  int failFromHd(int rc);  // hd_'s error with its message (unless hd_ is busy in another thread)
+  // E_SIZE_MISMATCH naming the argument unless alfa and f_ext have 6 rows (or no columns).
+  int checkRows(const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::MatrixXd>& f_ext);
   int solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                 const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                 const Eigen::Ref<const Eigen::VectorXi>* segments,
@@ -74,6 +78,7 @@ class FrictionCore {
   void gradient(int k);
   void factorDelete(int q, int nf);
 
+  std::atomic<bool> busy_{false};       // a call is inside (entry_guard.hpp)
   std::unique_ptr<HdSolver> hd_owner_;  // the solver of the problem
   HdSolver& hd_;
   unsigned int nj_ = 0;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <utility>
 
+#include "entry_guard.hpp"
 #include "friction_core.hpp"
 #include "hd_core.hpp"
 #include "model_validation.hpp"
@@ -26,21 +27,32 @@ FrictionSolver::~FrictionSolver() = default;
 FrictionSolver::FrictionSolver(FrictionSolver&&) noexcept = default;
 FrictionSolver& FrictionSolver::operator=(FrictionSolver&&) noexcept = default;
 
+namespace {
+
+using detail::EntryGuard;
+using detail::sixRows;
+
+}  // namespace
+
 int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
-                          const Eigen::Ref<const Eigen::VectorXd>& beta,
-                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                          const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                          const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
                           const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
-  return core_->solveImpl(q, q_dot, alfa, beta, nullptr, f_ext, ff_torques, friction);
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return HdSolver::E_CONCURRENT_CALL;
+  if (const int rc = core_->checkRows(alfa, f_ext)) return rc;
+  return core_->solveImpl(q, q_dot, sixRows(alfa), beta, nullptr, sixRows(f_ext), ff_torques, friction);
 }
 
 int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa,
-                          const Eigen::Ref<const Eigen::VectorXd>& beta,
+                          const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                           const Eigen::Ref<const Eigen::VectorXi>& segments,
-                          const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+                          const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
                           const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
-  return core_->solveImpl(q, q_dot, alfa, beta, &segments, f_ext, ff_torques, friction);
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return HdSolver::E_CONCURRENT_CALL;
+  if (const int rc = core_->checkRows(alfa, f_ext)) return rc;
+  return core_->solveImpl(q, q_dot, sixRows(alfa), beta, &segments, sixRows(f_ext), ff_torques, friction);
 }
 
 const Eigen::VectorXd& FrictionSolver::qdd() const {
@@ -62,6 +74,8 @@ Eigen::Map<const Eigen::VectorXd> FrictionSolver::nu() const {
   return Eigen::Map<const Eigen::VectorXd>(core_->nu_.data(), core_->m_keep_);
 }
 const ChainHdSolver::Matrix6X& FrictionSolver::linkAccelerations() {
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return core_->hd_.linkAccelerations();  // another thread is inside: what hd_ holds
   return core_->linkAccelerations();
 }
 int FrictionSolver::constraintRank() const {
@@ -71,6 +85,8 @@ int FrictionSolver::iterations() const {
   return core_->iterations_;
 }
 double FrictionSolver::gaussValue() {
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return std::numeric_limits<double>::quiet_NaN();  // another thread is inside
   return core_->gaussValue();
 }
 HdSolver& FrictionSolver::hdSolver() {
@@ -82,17 +98,25 @@ const char* FrictionSolver::errorMessage() const {
 int FrictionSolver::modelError() const {
   return core_->hd_.modelError();
 }
-void FrictionSolver::setRootAcceleration(const KDL::Twist& root_acc) {
-  core_->hd_.setRootAcceleration(root_acc);
+int FrictionSolver::setRootAcceleration(const KDL::Twist& root_acc) {
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return HdSolver::E_CONCURRENT_CALL;
+  return core_->hd_.setRootAcceleration(root_acc);
 }
 int FrictionSolver::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                                    const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return HdSolver::E_CONCURRENT_CALL;
   return core_->setPassThrough(f_ext_pass_through, ff_pass_through);
 }
-void FrictionSolver::clearPassThrough() {
-  core_->hd_.clearPassThrough();
+int FrictionSolver::clearPassThrough() {
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return HdSolver::E_CONCURRENT_CALL;
+  return core_->hd_.clearPassThrough();
 }
 int FrictionSolver::setOptions(const SolverOptions& options) {
+  const EntryGuard guard(core_->busy_);
+  if (!guard) return HdSolver::E_CONCURRENT_CALL;
   return core_->setOptions(options);
 }
 
@@ -117,16 +141,35 @@ FrictionCore::FrictionCore(std::unique_ptr<HdSolver> hd) : hd_owner_(std::move(h
 
 int FrictionCore::setOptions(const SolverOptions& options) {
   const int rc = hd_.setOptions(options);
-  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   return rc;
 }
 
 int FrictionCore::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                                  const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
   const int rc = hd_.setPassThrough(f_ext_pass_through, ff_pass_through);
-  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   solved_ = false;
   return rc;
+}
+
+int FrictionCore::checkRows(const Eigen::Ref<const Eigen::MatrixXd>& alfa,
+                            const Eigen::Ref<const Eigen::MatrixXd>& f_ext) {
+  if (alfa.rows() != 6 && alfa.cols() != 0)
+    return fail(ChainHdSolver::E_SIZE_MISMATCH, "alfa is %ldx%ld, expected 6 rows (6 x m constraint wrenches)",
+                (long)alfa.rows(), (long)alfa.cols());
+  if (f_ext.rows() != 6 && f_ext.cols() != 0)
+    return fail(ChainHdSolver::E_SIZE_MISMATCH, "f_ext is %ldx%ld, expected 6 x %u (one wrench per segment) or empty",
+                (long)f_ext.rows(), (long)f_ext.cols(), hd_.nrOfSegments());
+  return ChainHdSolver::E_NOERROR;
+}
+
+int FrictionCore::failFromHd(int rc) {
+  if (rc == HdSolver::E_CONCURRENT_CALL)  // hd_'s message belongs to the other thread's call
+    return fail(rc,
+                "the underlying solver (hdSolver()) is in use by another thread: a solver object must not be used "
+                "from two threads at once (use one solver per thread)");
+  return fail(rc, "%s", hd_.errorMessage());
 }
 
 int FrictionCore::fail(int code, const char* fmt, ...) {
@@ -226,7 +269,7 @@ int FrictionCore::optimiseResting(int k) {
   // d qdd and d nu per resting joint; tau_cmd follows from nu (commandTorquesOf), so its columns
   // are not formed.
   int rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), dnu_.leftCols(k));
-  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   for (int a = 0; a < k; ++a) {
     c_(a) = qdd0_(rest_(a));
     for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
@@ -293,11 +336,11 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
       !q.allFinite()) {
     // Let the hybrid-dynamics solver report the size or value problem with its message.
     rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
-    return fail(rc, "%s", hd_.errorMessage());
+    return failFromHd(rc);
   }
   const int k = restingJoints(q, q_dot, ff_torques, friction);
   rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
-  if (rc != ChainHdSolver::E_NOERROR) return fail(rc, "%s", hd_.errorMessage());
+  if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   fstatic_ = friction.static_friction;
   iterations_ = 0;
   if (k > 0) {
@@ -318,6 +361,7 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
                 "friction %g)",
                 n ? friction.static_friction.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
+  message_[0] = '\0';
   return ChainHdSolver::E_NOERROR;
 }
 

@@ -317,6 +317,8 @@ int HdCore::solveLast(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::R
                       const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   res.solved = false;
   res.general = false;
+  state_q = &q;
+  state_q_dot = &q_dot;
   if (!model.is_chain) {
     if (alfa.cols() > kMaxConstraints)
       return fail(HdSolver::E_TOO_MANY_CONSTRAINTS, "alfa has %ld columns, at most %d constraints are supported",

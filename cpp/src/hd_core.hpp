@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,6 +37,14 @@ using Matrix3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
 using MatrixC = HdSolver::MatrixC;
 using VectorC = HdSolver::VectorC;
 
+// A 6-row view of a caller's matrix with 6 rows or no columns (then 6 x 0), keeping its outer
+// stride: the public entry points check the rows, the algorithm reads fixed-row blocks.
+using Map6X = Eigen::Map<const Matrix6X, 0, Eigen::OuterStride<>>;
+inline Map6X sixRows(const Eigen::Ref<const Eigen::MatrixXd>& m) {
+  if (m.cols() == 0) return Map6X(nullptr, 6, 0, Eigen::OuterStride<>(6));
+  return Map6X(m.data(), 6, m.cols(), Eigen::OuterStride<>(m.outerStride()));
+}
+
 // What a model is built from: the segments in preorder, each one's parent (-1: the base) and its
 // joint index (-1 for a fixed joint; moving joints numbered 0..n_joints-1 in the caller's order).
 struct ModelSource {
@@ -53,6 +62,7 @@ struct SegmentModel {
   double rotor = 0.0;         // rotor inertia of the joint
   double w_norm = 0.0;        // |angular part of S| (0 for prismatic joints)
   double v2 = 0.0, w2 = 0.0;  // |linear part of S|^2, |angular part of S|^2
+  double d_tolerance = 0.0;   // articulated inertias of this joint at or below this are degenerate
   int joint = -1;             // joint index or -1 for a fixed joint
 };
 
@@ -65,8 +75,7 @@ struct HdModel {
   int n_branch = 0;                // segments with >= 2 children
   std::vector<int> joint_segment;  // segment index of each joint
   unsigned int nj = 0, ns = 0;
-  bool is_chain = true;      // parent[i] = i - 1 for every i: the chain's fast path applies
-  double d_tolerance = 0.0;  // articulated inertias at or below this are degenerate
+  bool is_chain = true;  // parent[i] = i - 1 for every i: the chain's fast path applies
   int parent(int i) const { return source.parent[i]; }
   const std::string& jointName(int segment) const { return source.segments[segment].getJoint().getName(); }
 };
@@ -212,11 +221,18 @@ class HdCore {
   int model_error = 0;
   int mcap = kMaxConstraints;  // 6 per segment
   std::array<char, 512> message{};
+  std::atomic<bool> busy{false};         // a call is inside (entry_guard.hpp)
+  std::atomic<bool> stale_model{false};  // a rebuild was refused (updateInternalDataStructures())
+  // The state of the current solve, for the messages of degenerate() (nullptr: the generic
+  // configuration of buildModel()).
+  const Eigen::Ref<const Eigen::VectorXd>* state_q = nullptr;
+  const Eigen::Ref<const Eigen::VectorXd>* state_q_dot = nullptr;
 
  private:
   // Model (hd_model.cpp).
   void buildModel();
-  int buildSegment(int i, double& scale);
+  int buildSegment(int i);
+  void buildTolerances();  // SegmentModel::d_tolerance from the subtree sizes
   void buildTopology();
   void allocateWorkspace();
   int checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,

@@ -135,8 +135,8 @@ void HdCore::allocateWorkspace() {
   res.sigma_known = true;
 }
 
-// Constant data of segment i; 0 or an error code. scale accumulates a typical joint inertia.
-int HdCore::buildSegment(int i, double& scale) {
+// Constant data of segment i; 0 or an error code.
+int HdCore::buildSegment(int i) {
   const KDL::Segment& seg = model.source.segments[i];
   const KDL::Joint& joint = seg.getJoint();
   SegmentModel& s = model.seg[i];
@@ -154,12 +154,13 @@ int HdCore::buildSegment(int i, double& scale) {
   // Rotational inertia about the centre of mass, checked as options.inertia_check says.
   const Matrix3 Sc = skew(c);
   const Matrix3 I_com = I_origin + mass * Sc * Sc;
+  // Round-off scale of I_com: its two terms, each exact to a few ulps.
+  const double round_off = std::max(I_origin.cwiseAbs().maxCoeff(), mass * c.squaredNorm());
   std::array<char, 320> why_buf{};
-  if (const char* why = detail::inertiaProblem(mass, I_com, options.inertia_check, why_buf.data(), why_buf.size()))
+  if (const char* why =
+          detail::inertiaProblem(mass, I_com, options.inertia_check, why_buf.data(), why_buf.size(), round_off))
     return fail(HdSolver::E_INVALID_MODEL, "segment %d ('%s'): %s", i, seg.getName().c_str(), why);
   s.I = rigidInertia(mass, c, 0.5 * (I_origin + I_origin.transpose()));
-  scale +=
-      I_com.cwiseAbs().trace() + mass * (c.squaredNorm() + seg.getFrameToTip().p.Norm() * seg.getFrameToTip().p.Norm());
   s.X0 = toPose(seg.pose(0.0));
   s.joint = model.source.joint[i];
   if (s.joint < 0) {
@@ -171,7 +172,6 @@ int HdCore::buildSegment(int i, double& scale) {
   if (!std::isfinite(s.rotor) || s.rotor < 0.0)
     return fail(HdSolver::E_INVALID_MODEL, "joint %d ('%s'): rotor inertia must be >= 0, got %g", s.joint,
                 joint.getName().c_str(), s.rotor);
-  scale += s.rotor;
   // The joint axis is fixed in the child body, so in the tip frame it does not depend on q.
   const KDL::Twist t = seg.twist(0.0, 1.0);            // root axes, tip reference point
   const KDL::Rotation Rt = seg.pose(0.0).M.Inverse();  // root axes -> tip axes
@@ -184,6 +184,38 @@ int HdCore::buildSegment(int i, double& scale) {
     return fail(HdSolver::E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite", s.joint,
                 joint.getName().c_str());
   return 0;
+}
+
+// The degeneracy tolerance of every joint, relative to what it moves (hd_solver.hpp, "Degenerate
+// joints"): 1e-13 s_j with s_j = rotor_j + sum over the segments k of j's subtree of
+// |v_j|^2 m_k + |w_j|^2 (trace|Ic_k| + m_k (d_j + l_jk + |c_k|)^2), S_j = [v_j; w_j], d_j = |v_j| / |w_j|
+// the distance of a rotation axis from j's tip origin, l_jk the path length from j's tip frame to
+// k's (per segment |X0.p| + 2 d: a tip origin moves at most 2 d about its axis). O(n x depth).
+void HdCore::buildTolerances() {
+  const int ns = static_cast<int>(model.ns);
+  std::vector<double> path(ns, 0.0), own(ns, 0.0), mass(ns, 0.0), reach(ns, 0.0), axis(ns, 0.0);
+  for (int k = 0; k < ns; ++k) {
+    const SegmentModel& sm = model.seg[k];
+    const KDL::RigidBodyInertia& rbi = model.source.segments[k].getInertia();
+    mass[k] = rbi.getMass();
+    reach[k] = rbi.getCOG().Norm();
+    const Vector3 c(rbi.getCOG().x(), rbi.getCOG().y(), rbi.getCOG().z());
+    const Matrix3 I_com = sm.I.bottomRightCorner<3, 3>() + mass[k] * skew(c) * skew(c);
+    own[k] = I_com.cwiseAbs().trace();
+    axis[k] = sm.w_norm > 0.0 ? std::sqrt(sm.v2) / sm.w_norm : 0.0;
+    const int p = model.parent(k);
+    path[k] = (p >= 0 ? path[p] : 0.0) + sm.X0.p.norm() + 2.0 * axis[k];
+  }
+  for (int j = 0; j < ns; ++j) {
+    SegmentModel& sj = model.seg[j];
+    if (sj.joint < 0) continue;
+    double size = sj.rotor;
+    for (int k = j; k < model.subtree_end[j]; ++k) {
+      const double dist = axis[j] + (path[k] - path[j]) + reach[k];
+      size += sj.v2 * mass[k] + sj.w2 * (own[k] + mass[k] * dist * dist);
+    }
+    sj.d_tolerance = 1e-13 * std::max(size, std::numeric_limits<double>::min());
+  }
 }
 
 void HdCore::buildModel() {
@@ -202,21 +234,21 @@ void HdCore::buildModel() {
     model_error = fail(HdSolver::E_INVALID_MODEL, "%s", src.problem.c_str());
     return;
   }
-  double scale = 0.0;  // typical size of a joint inertia, for the degeneracy tolerance
   for (unsigned int i = 0; i < model.ns; ++i) {
-    const int rc = buildSegment(static_cast<int>(i), scale);
+    const int rc = buildSegment(static_cast<int>(i));
     if (rc != 0) {
       model_error = rc;
       return;
     }
   }
-  model.d_tolerance = 1e-13 * std::max(scale, std::numeric_limits<double>::min());
+  buildTolerances();
 
   // Reject robots whose joints have no inertia to move. Checked at a generic configuration (not
   // q = 0, where a body may sit on an axis by coincidence); a configuration-dependent loss of
   // inertia is reported by solve().
   Eigen::VectorXd q_generic(model.nj);
   for (unsigned int k = 0; k < model.nj; ++k) q_generic(k) = 0.7 + 0.61 * k;
+  state_q = state_q_dot = nullptr;
   outwardSweep(q_generic, ws.zero_joints, ws.zero_f_ext);
   const int rc = model.is_chain ? inwardSweep(ws.alfa_buf.leftCols(0), ws.zero_joints)
                                 : inwardSweepGeneral(ws.alfa_buf.leftCols(0), ws.zero_joints);
@@ -276,10 +308,31 @@ int HdCore::checkBounded(const Eigen::Ref<const Eigen::VectorXd>& nu, const Eige
               f_ext.size() ? f_ext.cwiseAbs().maxCoeff() : 0.0, beta.size() ? beta.cwiseAbs().maxCoeff() : 0.0);
 }
 
+namespace {
+
+double maxAbs(const Eigen::Ref<const Eigen::VectorXd>* v) {
+  return v && v->size() ? v->cwiseAbs().maxCoeff() : 0.0;
+}
+
+}  // namespace
+
+// Joint i's articulated inertia failed the test of articulate(). A model problem (the joint moves
+// nothing) or a state whose size let round-off take over (hd_solver.hpp, "Degenerate joints").
 int HdCore::degenerate(int i) {
   const SegmentState& s = ws.seg[i];
   const int joint = model.seg[i].joint;
   const char* name = model.jointName(i).c_str();
+  const double size = model.seg[i].d_tolerance / 1e-13;  // what the joint moves
+  const bool physical = options.inertia_check == InertiaCheck::Physical;
+  const double q_max = maxAbs(state_q), q_dot_max = maxAbs(state_q_dot);
+  if (state_q != nullptr &&
+      (!std::isfinite(s.D) || !s.IA.allFinite() || (physical && s.D < -model.seg[i].d_tolerance) || q_max > 1e15 ||
+       s.IA.cwiseAbs().maxCoeff() > 1e8 * size))
+    return fail(HdSolver::E_STATE_OUT_OF_RANGE,
+                "the state is out of range: joint %d ('%s') gets an articulated inertia of %g where what it moves "
+                "has size %g; round-off dominates at this state (max |q| %g, max |q_dot| %g): not a model problem, "
+                "the state is not physical (a diverged simulation?)",
+                joint, name, s.D, size, q_max, q_dot_max);
   if (options.inertia_check == InertiaCheck::JointSpace && s.D < 0.0)
     return fail(HdSolver::E_DEGENERATE_INERTIA,
                 "joint %d ('%s') has articulated inertia D = %g <= 0 at this configuration: the model's "

@@ -2,11 +2,15 @@
 // KDL::SolverI::error. Conventions in hd_solver.hpp.
 #include "vereshchagin/hd_solver.hpp"
 
+#include "entry_guard.hpp"
 #include "hd_core.hpp"
 
 namespace vereshchagin {
 
 namespace {
+
+using detail::EntryGuard;
+using detail::sixRows;
 
 Vector6 toVector(const KDL::Twist& t) {
   Vector6 v;
@@ -35,25 +39,72 @@ void HdSolver::rebuild(const detail::ModelSource& source) {
 }
 
 void HdSolver::updateInternalDataStructures() {
+  const EntryGuard guard(core_->busy);
+  if (!guard) {
+    core_->stale_model.store(true, std::memory_order_relaxed);  // reported by the next solves
+    return;
+  }
   core_->rebuild(core_->model.source);
+  core_->stale_model.store(false, std::memory_order_relaxed);
 }
 
 int HdSolver::record(int rc) {
-  if (rc != E_NOERROR) error = rc;
+  if (rc != E_NOERROR) {
+    error = rc;
+  } else {
+    core_->message[0] = '\0';
+  }
   return rc;
 }
 
-int HdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-                    const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-                    const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  return error = core_->solveLast(q, q_dot, alfa, beta, f_ext, ff_torques);
+int HdSolver::solveChecked(int rc) {
+  if (rc == E_NOERROR) core_->message[0] = '\0';
+  return error = rc;
+}
+
+// 0 if alfa and f_ext have 6 rows (or no columns) and the model was not left stale, else the
+// error code with its message.
+int HdSolver::solveArgsProblem(const Eigen::Ref<const Eigen::MatrixXd>& alfa,
+                               const Eigen::Ref<const Eigen::MatrixXd>& f_ext) {
+  if (core_->stale_model.load(std::memory_order_relaxed))
+    return core_->fail(E_CONCURRENT_CALL,
+                       "updateInternalDataStructures() was called while another thread was inside a call on this "
+                       "solver and could not rebuild the model: call it again (a solver object must not be used "
+                       "from two threads at once; use one solver per thread)");
+  if (alfa.rows() != 6 && alfa.cols() != 0)
+    return core_->fail(E_SIZE_MISMATCH, "alfa is %ldx%ld, expected 6 rows (6 x m constraint wrenches, m <= %d)",
+                       (long)alfa.rows(), (long)alfa.cols(), maxConstraints());
+  if (f_ext.rows() != 6 && f_ext.cols() != 0)
+    return core_->fail(E_SIZE_MISMATCH, "f_ext is %ldx%ld, expected 6 x %u (one wrench per segment) or empty",
+                       (long)f_ext.rows(), (long)f_ext.cols(), nrOfSegments());
+  return E_NOERROR;
 }
 
 int HdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-                    const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-                    const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
+                    const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                    const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
                     const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  return error = core_->solveSegments(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
+  return solveEntered(q, q_dot, alfa, beta, f_ext, ff_torques);
+}
+
+int HdSolver::solveEntered(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                           const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                           const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
+                           const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  if (const int rc = solveArgsProblem(alfa, f_ext)) return solveChecked(rc);
+  return solveChecked(core_->solveLast(q, q_dot, sixRows(alfa), beta, sixRows(f_ext), ff_torques));
+}
+
+int HdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                    const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
+                    const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
+  if (const int rc = solveArgsProblem(alfa, f_ext)) return solveChecked(rc);
+  return solveChecked(core_->solveSegments(q, q_dot, sixRows(alfa), beta, segments, sixRows(f_ext), ff_torques));
 }
 
 int HdSolver::maxConstraints() const {
@@ -69,18 +120,24 @@ Eigen::Map<const Eigen::VectorXd> HdSolver::nu() const {
   return core_->nu();
 }
 const HdSolver::Matrix6X& HdSolver::linkAccelerations() const {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return core_->res.link_acc;  // another thread is inside: no lazy computation
   return core_->linkAccelerations();
 }
 int HdSolver::setJointAccelerations(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   if (!core_->res.solved)
     return record(core_->fail(E_NO_SOLUTION, "setJointAccelerations() needs a successful solve() first"));
   if (qdd.size() != static_cast<Eigen::Index>(nrOfJoints()))
     return record(
         core_->fail(E_SIZE_MISMATCH, "qdd has %ld entries, expected %u (joints)", (long)qdd.size(), nrOfJoints()));
   core_->accelerationsOf(qdd);
-  return E_NOERROR;
+  return record(E_NOERROR);
 }
 int HdSolver::inverseInertiaTimes(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> out) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   if (!core_->res.solved)
     return record(core_->fail(E_NO_SOLUTION, "inverseInertiaTimes() needs a successful solve() first"));
   const auto n = static_cast<Eigen::Index>(nrOfJoints());
@@ -88,7 +145,7 @@ int HdSolver::inverseInertiaTimes(const Eigen::Ref<const Eigen::VectorXd>& tau, 
     return record(core_->fail(E_SIZE_MISMATCH, "tau has %ld and out %ld entries, expected %u (joints)",
                               (long)tau.size(), (long)out.size(), nrOfJoints()));
   core_->inverseInertia(tau, out);
-  return E_NOERROR;
+  return record(E_NOERROR);
 }
 int HdSolver::constraintCount() const {
   return core_->res.m;
@@ -112,6 +169,8 @@ int HdSolver::constraintRank() const {
   return core_->res.rank;
 }
 double HdSolver::smallestSingularValue() const {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return core_->res.sigma_min;  // another thread is inside: no lazy computation
   return core_->smallestSingularValue();
 }
 
@@ -123,11 +182,15 @@ void HdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot)
 
 int HdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                               Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   return record(core_->responseColumns(joints, dqdd, dtau_cmd, nullptr));
 }
 
 int HdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                               Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd> dnu) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   const int m = core_->res.m;
   if (core_->res.solved && (dnu.rows() < m || dnu.cols() < joints.size()))
     return record(core_->fail(E_SIZE_MISMATCH, "dnu is %ldx%ld, expected at least %dx%ld", (long)dnu.rows(),
@@ -136,24 +199,36 @@ int HdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, E
 }
 
 int HdSolver::commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   return record(core_->commandTorquesOf(nu, tau_cmd));
 }
 
 int HdSolver::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                              const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   return record(core_->setPassThrough(f_ext_pass_through, ff_pass_through));
 }
-void HdSolver::clearPassThrough() {
+int HdSolver::clearPassThrough() {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   core_->clearPassThrough();
+  return E_NOERROR;
 }
 int HdSolver::passThroughColumns() const {
   return core_->ws.pt.m;
 }
 
-void HdSolver::setRootAcceleration(const KDL::Twist& root_acc) {
+int HdSolver::setRootAcceleration(const KDL::Twist& root_acc) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   core_->root_acc = toVector(root_acc);
+  return E_NOERROR;
 }
 int HdSolver::setOptions(const SolverOptions& options) {
+  const EntryGuard guard(core_->busy);
+  if (!guard) return E_CONCURRENT_CALL;
   return record(core_->setOptions(options));
 }
 const SolverOptions& HdSolver::options() const {
@@ -188,6 +263,11 @@ const char* HdSolver::strError(const int code) const {
       return "Invalid solver options";
     case E_NONFINITE_RESULT:
       return "The results overflow (inputs too large)";
+    case E_CONCURRENT_CALL:
+      return "Another thread is inside a call on this solver: a solver object must not be used from two threads "
+             "at once (use one solver per thread)";
+    case E_STATE_OUT_OF_RANGE:
+      return "The state is out of range: round-off dominates the articulated inertias (a diverged state?)";
     default:
       return KDL::SolverI::strError(code);
   }

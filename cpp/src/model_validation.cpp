@@ -47,13 +47,15 @@ const char* segmentGeometryProblem(const KDL::Segment& segment) {
   return nullptr;
 }
 
-const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaCheck check, char* buf, std::size_t size) {
+const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaCheck check, char* buf, std::size_t size,
+                           double round_off) {
   if (!std::isfinite(mass) || !I_com.allFinite()) return "inertial parameters are not finite";
   if (mass < 0.0) {
     std::snprintf(buf, size, "negative mass %g (must be >= 0)", mass);
     return buf;
   }
-  const double tol = 1e-12 * std::max(1.0, I_com.cwiseAbs().maxCoeff());
+  constexpr double kRobotLength2 = 1.0;  // (1 m)^2: the length scale of a robot
+  const double tol = 1e-12 * std::max({I_com.cwiseAbs().maxCoeff(), round_off, mass * kRobotLength2});
   if ((I_com - I_com.transpose()).cwiseAbs().maxCoeff() > tol) return "rotational inertia is not symmetric";
   if (check == InertiaCheck::JointSpace) return nullptr;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (I_com + I_com.transpose()), Eigen::EigenvaluesOnly);
@@ -65,7 +67,7 @@ const char* inertiaProblem(double mass, const Eigen::Matrix3d& I_com, InertiaChe
                   I(0), I(1), I(2));
     return buf;
   }
-  if (I(0) + I(1) < I(2) - 1e-6 * I(2)) {
+  if (I(0) + I(1) < I(2) - std::max(1e-6 * I(2), tol)) {
     std::snprintf(buf, size,
                   "principal moments of inertia about the centre of mass (%g, %g, %g) violate the triangle "
                   "inequality I1 + I2 >= I3: no rigid body has them; identified models are accepted with "

@@ -43,6 +43,8 @@ int HdCore::solveGeneral(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   res.solved = false;
   res.general = false;
+  state_q = &q;
+  state_q_dot = &q_dot;
   int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques, mcap);
   if (rc != 0) return rc;
   rc = sortColumns(segments);

@@ -43,6 +43,11 @@
 //    resting joints with friction or on a limit; the argument is in friction_box_qp.cpp's
 //    boxQp()). Bland's smallest-index rule takes over if a face-optimal value fails to decrease.
 // No heap allocation in solve() or gaussValue().
+// Threads: as HdSolver (hd_solver.hpp, "Threads"): solve(), setRootAcceleration(),
+// setPassThrough(), clearPassThrough() and setOptions() entered while another thread is inside a
+// call on the same object return HdSolver::E_CONCURRENT_CALL without touching it (errorMessage()
+// belongs to the other call; HdSolver::strError() has the text); linkAccelerations() then returns
+// what it holds and gaussValue() NaN. One solver object per thread.
 #pragma once
 
 #include <memory>
@@ -87,15 +92,18 @@ class FrictionSolver {
   FrictionSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options = SolverOptions(),
                  const std::string& root_segment = std::string());
 
+  // alfa (6 x m) and f_ext (6 x n_segments or empty) as in HdSolver::solve(): any column-major
+  // matrix with 6 rows (or no columns), else E_SIZE_MISMATCH naming the argument. Returns 0 or an
+  // error code (message in errorMessage(), emptied by a successful solve).
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-            const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-            const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
+            const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const Eigen::MatrixXd>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
             const FrictionModel& friction);
   // The same with constraints on any segments (column c of alfa on segment segments(c); see
   // ChainHdSolver's overload).
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-            const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-            const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
+            const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
             const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
 
   const Eigen::VectorXd& qdd() const;
@@ -116,13 +124,13 @@ class FrictionSolver {
   HdSolver& hdSolver();
   const char* errorMessage() const;
   int modelError() const;
-  void setRootAcceleration(const KDL::Twist& root_acc);
+  int setRootAcceleration(const KDL::Twist& root_acc);  // 0 or E_CONCURRENT_CALL
   // Driver pass-through weights as ChainHdSolver::setPassThrough: they weight f_ext and
   // ff_torques only; friction (kinetic and the max-min's static) is always compensated along the
   // constraints. Returns ChainHdSolver's codes (message in errorMessage()).
   int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                      const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
-  void clearPassThrough();
+  int clearPassThrough();  // 0 or E_CONCURRENT_CALL
   int setOptions(const SolverOptions& options);
 
   ~FrictionSolver();

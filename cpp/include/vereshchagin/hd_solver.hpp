@@ -94,7 +94,28 @@
 // constraints compensate (pass-through 0, e.g. friction), whatever the weights.
 //
 // Real-time use: construction allocates everything; solve(), CartToJnt() and responseColumns()
-// allocate no heap memory and do bounded work. One instance is not thread-safe; use one per thread.
+// allocate no heap memory and do bounded work.
+//
+// Threads: one instance is not thread-safe; use one per thread. A call that enters an object while
+// another thread is inside a call on it is detected (an atomic flag taken at entry and released
+// at exit by every method that writes the object: the solve() overloads, CartToJnt(),
+// setJointAccelerations(), inverseInertiaTimes(), responseColumns(), commandTorquesOf(),
+// setPassThrough(), clearPassThrough(), setRootAcceleration(), setOptions(),
+// updateInternalDataStructures()) and refused with E_CONCURRENT_CALL, leaving the object
+// untouched, so the other call's results stay exact. The lazily computed linkAccelerations() and
+// smallestSingularValue() then return what they hold without computing. The other getters of
+// results (qdd(), nu(), ...) are not guarded: read them in the thread that solved.
+//
+// Errors: every failing call returns a code and writes a message (errorMessage()); a successful
+// solve (or other successful call returning a code) empties the message.
+//
+// Degenerate joints: a joint's articulated inertia D_j counts as zero when D_j <= 1e-13 s_j, s_j
+// the size of what the joint moves (its rotor plus, over the segments k of its subtree, trace|I_k|
+// + m_k (|c_k| + l_jk)^2, with l_jk the length of the kinematic path from joint j's frame to
+// segment k's frame): relative to the joint's own subtree, so one huge link elsewhere in the robot
+// does not make the others' inertias look like zero. A D_j that round-off made negative
+// (impossible for a physical model), non-finite, or out of a state with |q| > 1e15 (angles without
+// a significant digit) fails with E_STATE_OUT_OF_RANGE instead of E_DEGENERATE_INERTIA.
 #pragma once
 
 #include <array>
@@ -145,11 +166,18 @@ class HdSolver : public KDL::SolverI {
     E_INVALID_MODEL = -101,         // negative mass, inertia failing options.inertia_check, negative rotor
                                     // inertia, empty tree, unknown root segment, ...
     E_DEGENERATE_INERTIA = -102,    // a joint's articulated inertia D_j <= 0: no unique motion (zero),
-                                    // or H(q) not positive definite here (inertia_check JointSpace)
+                                    // or H(q) not positive definite here (inertia_check JointSpace);
+                                    // a state too large for the arithmetic is E_STATE_OUT_OF_RANGE
     E_TOO_MANY_CONSTRAINTS = -103,  // more than 6 columns on one segment
     E_NO_SOLUTION = -104,           // responseColumns() called before a successful solve
     E_INVALID_OPTIONS = -105,       // rcond < 0, damping <= 0 for the damped policy, non-finite
     E_NONFINITE_RESULT = -106,      // finite inputs whose results overflow (Inf/NaN or > 1e150)
+    E_CONCURRENT_CALL = -107,       // another thread is inside a call on this same object: the call was
+                                    // refused without reading or writing the object (errorMessage()
+                                    // and KDL's getError() belong to the other call; strError() has the
+                                    // text). One solver object per thread.
+    E_STATE_OUT_OF_RANGE = -108,    // the state (q, q_dot) is so large that round-off dominates the
+                                    // articulated inertias (e.g. a diverged simulation): not a model problem
   };
 
   ~HdSolver() override;
@@ -158,17 +186,19 @@ class HdSolver : public KDL::SolverI {
 
   // Constraints on the last segment (nrOfSegments() - 1: a chain's tip; for a tree, the last
   // segment of the preorder). alfa: 6 x m, m = 0..6 (0: plain forward dynamics); beta: m entries;
-  // f_ext (6 x n_segments) and ff_torques (n_joints) may be empty (zero). Returns 0 or an error
-  // code (message in errorMessage()).
+  // f_ext (6 x n_segments) and ff_torques (n_joints) may be empty (zero). alfa and f_ext may be
+  // any column-major double matrices (a MatrixXd, a Matrix6X, a block); their row count is checked:
+  // E_SIZE_MISMATCH naming the argument unless it has 6 rows (or no columns). Returns 0 or an error
+  // code (message in errorMessage(), emptied by a successful solve).
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-            const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-            const Eigen::Ref<const Matrix6X>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+            const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const Eigen::MatrixXd>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   // Constraints on any segments: column c of alfa (6 x M) acts on segment segments(c) (segment
   // order above; base axes, moment about that segment's tip origin); beta has M entries. At most 6
   // columns per segment. On a chain, columns all on the last segment give exactly the solve() above.
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
-            const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
-            const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
+            const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+            const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
             const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   // Largest total number of constraint columns: 6 per segment (at least 6).
   int maxConstraints() const;
@@ -233,12 +263,13 @@ class HdSolver : public KDL::SolverI {
   // (updateInternalDataStructures(), setOptions() changing inertia_check) clears them.
   int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                      const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
-  void clearPassThrough();
+  int clearPassThrough();  // 0, or E_CONCURRENT_CALL (weights unchanged)
   // Number of constraint columns the weights are for (-1: no weights set).
   int passThroughColumns() const;
 
   // Base acceleration (base axes, [linear; angular]; gravity as +9.81 along up), see above.
-  void setRootAcceleration(const KDL::Twist& root_acc);
+  // Returns 0, or E_CONCURRENT_CALL (unchanged) while another thread is inside a call.
+  int setRootAcceleration(const KDL::Twist& root_acc);
   // Returns E_INVALID_OPTIONS (options unchanged) or, when inertia_check changed, modelError().
   int setOptions(const SolverOptions& options);
   const SolverOptions& options() const;
@@ -252,12 +283,18 @@ class HdSolver : public KDL::SolverI {
   const char* errorMessage() const;
   const char* strError(const int error) const override;
 
-  // The robot has changed: recompute the model data (KDL::SolverI interface).
+  // The robot has changed: recompute the model data (KDL::SolverI interface). Called while another
+  // thread is inside a call on this object it cannot rebuild, nor return a code: every later solve
+  // then fails with E_CONCURRENT_CALL (message saying so) until a call of it succeeds.
   void updateInternalDataStructures() override;
 
  protected:
   // Construction never throws for a bad model: the error is kept and returned by every solve.
   HdSolver(const detail::ModelSource& source, const KDL::Twist& root_acc, const SolverOptions& options);
+  // solve() without the entry guard, for a caller that holds it (CartToJnt()).
+  int solveEntered(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                   const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                   const Eigen::Ref<const Eigen::MatrixXd>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   // Rebuilds the model from a new source (a changed chain or tree).
   void rebuild(const detail::ModelSource& source);
   detail::HdCore& core() { return *core_; }
@@ -265,7 +302,10 @@ class HdSolver : public KDL::SolverI {
 
  private:
   friend class detail::FrictionCore;  // sets the pass-through driver (its ff_torques carry friction too)
-  int record(int rc);                 // keeps rc in KDL::SolverI::error when it is an error
+  int record(int rc);                 // keeps rc in KDL::SolverI::error when it is an error, else
+                                      // empties the message
+  int solveChecked(int rc);           // a solve's rc: kept in error, message emptied on success
+  int solveArgsProblem(const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::MatrixXd>& f_ext);
   std::unique_ptr<detail::HdCore> core_;
 };
 

@@ -7,9 +7,14 @@ namespace vereshchagin {
 enum class InertiaCheck {
   // Every body must be a rigid body: mass >= 0 and a rotational inertia about its centre of mass
   // that is symmetric, positive semi-definite and whose principal moments obey the triangle
-  // inequality I1 + I2 >= I3 (to 1e-6 of the largest, for rounded model files; a PSD tensor such
-  // as diag(0.1, 0.01, 0.01) belongs to no mass distribution). Checked once, when the model is
-  // built. The default of this library's own classes.
+  // inequality I1 + I2 >= I3 (a PSD tensor such as diag(0.1, 0.01, 0.01) belongs to no mass
+  // distribution). Checked once, when the model is built. The default of this library's own
+  // classes. Tolerances, relative to the body's own inertia scale
+  //     s = max(max |I_ij|, m x (1 m)^2, the size of the terms I was computed from),  t = 1e-12 s:
+  // symmetric to t, every principal moment >= -t, and I1 + I2 >= I3 - max(1e-6 I3, t) (1e-6 for
+  // rounded model files). So a tensor of round-off (iCub's l_ankle_2 in example-robot-data:
+  // moments -1.4e-20, 0, 1.4e-20 kg m^2 for 0.27 kg) passes, while a real violation (the Allegro
+  // hand's link_3.0: moments 2.3e-6, 3.5e-6, 7.3e-6 kg m^2) is refused, naming JointSpace.
   Physical,
   // Identified models (parameters fitted on the real arm, e.g. the KUKA LWR 4 of Jubien, Gautier
   // and Janot, IFAC 2014) often have link inertias that are not positive semi-definite; only the
