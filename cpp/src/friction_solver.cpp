@@ -141,6 +141,11 @@ FrictionCore::FrictionCore(std::unique_ptr<HdSolver> hd) : hd_owner_(std::move(h
 
 int FrictionCore::setOptions(const SolverOptions& options) {
   const int rc = hd_.setOptions(options);
+  const int mcap = hd_.maxConstraints();
+  if (dnu_.rows() != mcap) {  // the constraint capacity changed (not on the solve path)
+    dnu_ = Eigen::MatrixXd::Zero(mcap, static_cast<int>(nj_));
+    nu0_ = nu_ = Eigen::VectorXd::Zero(mcap);
+  }
   if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   return rc;
 }

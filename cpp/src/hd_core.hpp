@@ -124,16 +124,20 @@ struct CouplingGeneral {
 
 // Workspace of responseColumns().
 struct ResponseWorkspace {
+  // Requested columns are computed in chunks of `width` = min(n_joints, kMaxWidth): the workspace
+  // stays O(n) for long robots (a full n x n response is computed chunk by chunk).
+  static constexpr long kMaxWidth = 64;
+  long width = 1;
   Eigen::MatrixXd cmd_per_nu;   // d tau_cmd / d nu (n_joints x mcap)
-  Eigen::MatrixXd energy;       // d U per requested column (mcap x n_joints)
-  Eigen::MatrixXd dnu;          // d nu per requested column (mcap x n_joints)
-  Eigen::MatrixXd sdp;          // S_i^T (apparent force change from the child), n_segments x n_joints
+  Eigen::MatrixXd energy;       // d U per requested column (mcap x width)
+  Eigen::MatrixXd dnu;          // d nu per requested column (mcap x width)
+  Eigen::MatrixXd sdp;          // S_i^T (apparent force change from the child), n_segments x width
   Matrix6X axis, axis_inertia;  // joint axes S and IA S per segment, base axes, about each tip origin
   Matrix3X offset;              // tip origin - parent's tip origin, base axes
   Matrix6X force;               // per requested column: apparent force change, then acceleration change
   Matrix3X tmp3;
   Eigen::VectorXi holder;  // per requested column: the segment whose tip its force change is about
-  Matrix6X branch_acc;     // per branching segment: its accelerations of every column (6 x n_joints slots)
+  Matrix6X branch_acc;     // per branching segment: its accelerations of every column (6 x width slots)
 };
 
 // Workspace of the driver pass-through.
@@ -174,6 +178,10 @@ struct HdResults {
   mutable bool sigma_known = false;
   mutable double sigma_min = 0.0;
 };
+
+// Constraint columns a solve may have (SolverOptions::max_constraints, hd_solver.hpp): the
+// workspace of the coupling matrix is sized for them.
+int constraintCapacity(const SolverOptions& opts, unsigned int ns);
 
 class HdCore {
  public:
@@ -219,7 +227,7 @@ class HdCore {
   SolverOptions options;
   Vector6 root_acc = Vector6::Zero();
   int model_error = 0;
-  int mcap = kMaxConstraints;  // 6 per segment
+  int mcap = kMaxConstraints;  // constraint columns of a solve: constraintCapacity(options, ns)
   std::array<char, 512> message{};
   std::atomic<bool> busy{false};         // a call is inside (entry_guard.hpp)
   std::atomic<bool> stale_model{false};  // a rebuild was refused (updateInternalDataStructures())

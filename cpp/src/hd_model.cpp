@@ -41,6 +41,12 @@ void HdCore::rebuild(const ModelSource& source) {
   buildModel();
 }
 
+int constraintCapacity(const SolverOptions& opts, unsigned int ns) {
+  const int all = std::max<int>(kMaxConstraints, kMaxConstraints * static_cast<int>(ns));  // 6 per segment
+  const int wanted = opts.max_constraints > 0 ? opts.max_constraints : SolverOptions::kDefaultConstraintCapacity;
+  return std::min(all, wanted);
+}
+
 int HdCore::setOptions(const SolverOptions& opts) {
   if (!std::isfinite(opts.rcond) || opts.rcond < 0.0 || opts.rcond >= 1.0) {
     return fail(HdSolver::E_INVALID_OPTIONS, "options.rcond must be finite and in [0, 1), got %g", opts.rcond);
@@ -50,7 +56,11 @@ int HdCore::setOptions(const SolverOptions& opts) {
     return fail(HdSolver::E_INVALID_OPTIONS,
                 "options.damping must be finite and > 0 for the damped least-squares policy, got %g", opts.damping);
   }
-  const bool rebuild_model = opts.inertia_check != options.inertia_check;
+  if (opts.max_constraints < 0)
+    return fail(HdSolver::E_INVALID_OPTIONS, "options.max_constraints must be >= 0 (0: the default), got %d",
+                opts.max_constraints);
+  const bool rebuild_model = opts.inertia_check != options.inertia_check ||
+                             constraintCapacity(opts, model.ns) != constraintCapacity(options, model.ns);
   options = opts;
   res.solved = false;
   if (rebuild_model) {
@@ -95,20 +105,21 @@ void HdCore::allocateWorkspace() {
   res.qdd = res.tau_cmd = Eigen::VectorXd::Zero(nj);
   ws.zero_joints = Eigen::VectorXd::Zero(nj);
   ResponseWorkspace& r = ws.response;
-  r.sdp = Eigen::MatrixXd::Zero(ns, nj);
+  r.width = std::max<long>(1, std::min<long>(nj, ResponseWorkspace::kMaxWidth));
+  r.sdp = Eigen::MatrixXd::Zero(ns, r.width);
   r.axis = r.axis_inertia = Matrix6X::Zero(6, ns);
   r.offset = Matrix3X::Zero(3, ns);
-  r.force = Matrix6X::Zero(6, std::max<unsigned int>(nj, kMaxConstraints));
-  r.tmp3 = Matrix3X::Zero(3, std::max<unsigned int>(nj, kMaxConstraints));
-  r.holder = Eigen::VectorXi::Zero(nj);
-  r.branch_acc = Matrix6X::Zero(6, static_cast<Eigen::Index>(nj) * model.n_branch);
+  r.force = Matrix6X::Zero(6, std::max<long>(r.width, kMaxConstraints));
+  r.tmp3 = Matrix3X::Zero(3, std::max<long>(r.width, kMaxConstraints));
+  r.holder = Eigen::VectorXi::Zero(r.width);
+  r.branch_acc = Matrix6X::Zero(6, static_cast<Eigen::Index>(r.width) * model.n_branch);
   res.link_acc = Matrix6X::Zero(6, ns + 1);
   res.link_acc_known = true;  // zeros until the first solve
   ws.zero_f_ext = Matrix6X::Zero(6, ns);
   ws.alfa_buf.setZero();
   ws.inertia_force = ws.inertia_acc = Matrix6X::Zero(6, ns);
   ws.inertia_joint = Eigen::VectorXd::Zero(nj);
-  mcap = std::max<int>(kMaxConstraints, kMaxConstraints * static_cast<int>(ns));
+  mcap = constraintCapacity(options, ns);
   PassThroughState& pt = ws.pt;
   pt.f = pt.t = pt.energy = pt.tmp = Eigen::VectorXd::Zero(mcap);
   pt.free = Eigen::VectorXd::Zero(nj);
@@ -127,8 +138,8 @@ void HdCore::allocateWorkspace() {
   g.work_v = Eigen::MatrixXd::Zero(mcap, 4);  // smallestEigenvalue's scratch: 4 columns
   g.seg_force = Matrix6X::Zero(6, ns);
   r.cmd_per_nu = Eigen::MatrixXd::Zero(nj, mcap);
-  r.energy = Eigen::MatrixXd::Zero(mcap, nj);
-  r.dnu = Eigen::MatrixXd::Zero(mcap, nj);
+  r.energy = Eigen::MatrixXd::Zero(mcap, r.width);
+  r.dnu = Eigen::MatrixXd::Zero(mcap, r.width);
   res.m = 0;
   res.rank = 0;
   res.sigma_min = 0.0;
@@ -269,7 +280,9 @@ int HdCore::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen:
   if (f_ext.cols() != ns && f_ext.cols() != 0)
     return fail(E_SIZE, "f_ext has %ld wrenches, expected %ld (segments) or 0", (long)f_ext.cols(), ns);
   if (alfa.cols() > max_columns)
-    return fail(HdSolver::E_TOO_MANY_CONSTRAINTS, "alfa has %ld columns, at most %d constraints are supported",
+    return fail(HdSolver::E_TOO_MANY_CONSTRAINTS,
+                "alfa has %ld columns, at most %d constraints are supported (6 per segment, and at most "
+                "SolverOptions::max_constraints in all)",
                 (long)alfa.cols(), max_columns);
   if (beta.size() != alfa.cols())
     return fail(E_SIZE, "beta has %ld entries, expected %ld (one per alfa column)", (long)beta.size(),

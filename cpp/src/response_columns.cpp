@@ -44,10 +44,10 @@ int HdCore::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eig
   const int m = res.m;
   if (want_tau) commandPerNu();
   baseAxes();
-  // All columns at once, in chunks of at most n_joints (the workspace width).
-  const long k = joints.size(), nj = model.nj;
-  for (long c0 = 0; c0 < k; c0 += nj) {
-    const long kc = std::min<long>(nj, k - c0);
+  // All columns, in chunks of at most the workspace width (n_joints, at most kResponseWidth).
+  const long k = joints.size(), width = ws.response.width;
+  for (long c0 = 0; c0 < k; c0 += width) {
+    const long kc = std::min<long>(width, k - c0);
     responseInward(joints, c0, kc);
     responseCoupling(c0, kc, dnu_out);
     responseOutward(joints, c0, kc, dqdd);
@@ -218,7 +218,7 @@ void HdCore::responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, lo
     const int p = model.parent(i);
     if (i > 0 && p != static_cast<int>(i) - 1) {  // a later child: its parent's accelerations again
       if (p >= 0) {
-        ACC = r.branch_acc.middleCols(model.branch_slot[p] * nj, kc);
+        ACC = r.branch_acc.middleCols(model.branch_slot[p] * r.width, kc);
       } else {
         ACC.setZero();
       }
@@ -243,7 +243,7 @@ void HdCore::responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, lo
       dqdd(sm.joint, c0 + c) = v;
       for (int t = 0; t < 3; ++t) acc[t] = a(t) + S0(t) * v, acc[3 + t] = w(t) + S0(3 + t) * v;
     }
-    if (model.branch_slot[i] >= 0) r.branch_acc.middleCols(model.branch_slot[i] * nj, kc) = ACC;
+    if (model.branch_slot[i] >= 0) r.branch_acc.middleCols(model.branch_slot[i] * r.width, kc) = ACC;
     if (symmetric && sm.joint >= 0) {
       for (long c = sm.joint + 1; c < kc; ++c) dqdd(c, sm.joint) = dqdd(sm.joint, c);
       first = sm.joint + 1;

@@ -1,6 +1,6 @@
 // Public contracts not covered elsewhere, each against an oracle the library did not compute:
-//  * maxConstraints() = 6 x n_segments: that many columns (6 per segment) solve, one more is
-//    E_TOO_MANY_CONSTRAINTS.
+//  * maxConstraints() = 6 x n_segments (capped by SolverOptions::max_constraints): that many
+//    columns solve, one more is E_TOO_MANY_CONSTRAINTS.
 //  * articulatedInertia(j) = 1 / (H_jj^-1 of the joints j moves), i.e. the Schur complement of the
 //    block of joint j's subtree joints in H(q), with every other joint held. H from KDL's
 //    ChainDynParam (chains) and from KDL's TreeIdSolver_RNE columns (trees).
@@ -121,7 +121,8 @@ Matrix6X accelerationsByDifferences(const std::vector<PathChain>& paths, const E
 
 void maxConstraintChecks(testutil::Checker& ck, HdSolver& s, testutil::RandomGen& g, const std::string& tag) {
   const unsigned int n = s.nrOfJoints(), ns = s.nrOfSegments();
-  ck.check(s.maxConstraints() == static_cast<int>(6 * ns), tag + ": maxConstraints " + str(s.maxConstraints()));
+  const int expected = std::min(static_cast<int>(6 * ns), vereshchagin::SolverOptions::kDefaultConstraintCapacity);
+  ck.check(s.maxConstraints() == expected, tag + ": maxConstraints " + str(s.maxConstraints()));
   const int m = s.maxConstraints();
   Matrix6X alfa = g.alfa(m + 1).data;
   Eigen::VectorXd beta = g.beta(m + 1).data;
@@ -133,6 +134,53 @@ void maxConstraintChecks(testutil::Checker& ck, HdSolver& s, testutil::RandomGen
            tag + ": " + str(m) + " columns: rc " + str(rc) + " " + s.errorMessage());
   rc = s.solve(q, qd, alfa, beta, seg, Matrix6X(6, 0), Eigen::VectorXd());
   ck.check(rc == HdSolver::E_TOO_MANY_CONSTRAINTS, tag + ": " + str(m + 1) + " columns: rc " + str(rc));
+}
+
+// SolverOptions::max_constraints: the capacity it sets (capped at 6 per segment), a solve within
+// it equal to the default solver's bit for bit, one column more refused naming the option,
+// negative values refused; and a 2,000-segment chain (12,000 columns by the old rule: its
+// coupling workspace alone was 4 x 12,000^2 doubles, 4.6 GB) builds and solves.
+void capacityChecks(testutil::Checker& ck) {
+  testutil::RandomGen g(37);
+  testutil::ChainSpec spec;
+  spec.n_joints = 9;
+  const KDL::Chain chain = g.chain(spec);
+  const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments();
+  vereshchagin::SolverOptions small;
+  small.max_constraints = 8;
+  vereshchagin::ChainHdSolver capped(chain, kGrav, small), full(chain, kGrav);
+  ck.check(capped.maxConstraints() == 8 && full.maxConstraints() == static_cast<int>(6 * ns),
+           "capacity: maxConstraints " + str(capped.maxConstraints()) + " / " + str(full.maxConstraints()));
+  const Eigen::VectorXd q = g.q(n).data, qd = g.qdot(n).data;
+  const Matrix6X alfa = g.alfa(9).data;
+  const Eigen::VectorXd beta = g.beta(9).data;
+  Eigen::VectorXi seg(9);
+  for (int c = 0; c < 9; ++c) seg(c) = (c * 5) % static_cast<int>(ns);
+  int rc = capped.solve(q, qd, alfa.leftCols(8), beta.head(8), seg.head(8), Matrix6X(6, 0), Eigen::VectorXd());
+  const int rc_full = full.solve(q, qd, alfa.leftCols(8), beta.head(8), seg.head(8), Matrix6X(6, 0), Eigen::VectorXd());
+  ck.check(rc == 0 && rc_full == 0 && capped.qdd() == full.qdd() && capped.nu() == full.nu(),
+           "capacity: 8 columns within the capacity equal the default solver's");
+  rc = capped.solve(q, qd, alfa, beta, seg, Matrix6X(6, 0), Eigen::VectorXd());
+  ck.check(rc == HdSolver::E_TOO_MANY_CONSTRAINTS &&
+               std::string(capped.errorMessage()).find("max_constraints") != std::string::npos,
+           "capacity: 9 columns refused naming max_constraints: " + std::string(capped.errorMessage()));
+  vereshchagin::SolverOptions bad;
+  bad.max_constraints = -1;
+  ck.check(full.setOptions(bad) == HdSolver::E_INVALID_OPTIONS, "capacity: max_constraints = -1 refused");
+  small.max_constraints = 1000;  // beyond 6 per segment: capped there
+  ck.check(full.setOptions(small) == 0 && full.maxConstraints() == static_cast<int>(6 * ns),
+           "capacity: 1000 capped at 6 per segment");
+  KDL::Chain long_chain;
+  for (int i = 0; i < 2000; ++i)
+    long_chain.addSegment(KDL::Segment(
+        KDL::Joint(i % 2 ? KDL::Joint::RotY : KDL::Joint::RotX), KDL::Frame(KDL::Vector(0.0, 0.0, 0.01)),
+        KDL::RigidBodyInertia(0.1, KDL::Vector(0.0, 0.0, -0.005), KDL::RotationalInertia(1e-5, 1e-5, 1e-6))));
+  vereshchagin::ChainHdSolver big(long_chain, kGrav);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(2000);
+  rc = big.solve(zero, zero, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), Eigen::VectorXd());
+  ck.check(big.modelError() == 0 && rc == 0 &&
+               big.maxConstraints() == vereshchagin::SolverOptions::kDefaultConstraintCapacity && big.qdd().allFinite(),
+           "capacity: a 2,000-segment chain builds and solves: rc " + str(rc) + " " + big.errorMessage());
 }
 
 // D_j against the Schur complement of H on the joints j moves (sub: their indices, j first).
@@ -293,5 +341,6 @@ int main() {
   testutil::Checker ck("test_public_contracts");
   chainChecks(ck);
   treeChecks(ck);
+  capacityChecks(ck);
   return ck.finish("");
 }

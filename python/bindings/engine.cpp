@@ -53,8 +53,10 @@ KDL::Rotation SegmentKinematics::tipRotation(int segment, const double* q) const
 }
 
 Engine::Engine(const EngineModel& model, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt)
-    : hd_(makeSolver(model, upward(gravity), opt)),
-      friction_(makeFriction(model, upward(gravity), opt)),
+    : model_(model),
+      gravity_(gravity),
+      options_(opt),
+      hd_(makeSolver(model, upward(gravity), opt)),
       kinematics_(model, *hd_) {
   nj = hd_->nrOfJoints();
   ns = hd_->nrOfSegments();
@@ -65,9 +67,17 @@ Engine::Engine(const EngineModel& model, const KDL::Vector& gravity, const veres
 }
 
 void Engine::setGravity(const KDL::Vector& gravity) {
+  gravity_ = gravity;
   const KDL::Twist up = upward(gravity);  // the base accelerates against gravity
   hd_->setRootAcceleration(up);
-  friction_->setRootAcceleration(up);
+  if (friction_) friction_->setRootAcceleration(up);
+}
+
+// Built at the first friction-aware solve: its dense joint-space workspace (n x n matrices) costs
+// nothing for solvers that never see friction.
+vereshchagin::FrictionSolver& Engine::frictionSolver() {
+  if (!friction_) friction_ = makeFriction(model_, upward(gravity_), options_);
+  return *friction_;
 }
 
 const char* Engine::errorMessage() const {
@@ -127,7 +137,7 @@ int Engine::run(const RowInputs& in) {
   const MapV pf(in.f_ext_pass_through, in.f_ext_pass_through ? columns : 0);
   const MapV pt(in.tau_ff_pass_through, in.tau_ff_pass_through ? columns : 0);
   last_friction_ = in.friction != nullptr;  // errorMessage() of the right solver
-  int rc = in.friction ? friction_->setPassThrough(pf, pt) : hd_->setPassThrough(pf, pt);
+  int rc = in.friction ? frictionSolver().setPassThrough(pf, pt) : hd_->setPassThrough(pf, pt);
   if (rc == ChainHdSolver::E_NOERROR) rc = runWeighted(in);
   if (in.friction)  // the weights hold for this row only
     friction_->clearPassThrough();
@@ -151,10 +161,10 @@ int Engine::runWeighted(const RowInputs& in) {
   last_general_ = in.general;
   if (in.general) {
     const auto sg = segs_.head(columns_);
-    return last_friction_ ? friction_->solve(q, qd, A, b, sg, f, tau, *in.friction)
+    return last_friction_ ? frictionSolver().solve(q, qd, A, b, sg, f, tau, *in.friction)
                           : hd_->solve(q, qd, A, b, sg, f, tau);
   }
-  return last_friction_ ? friction_->solve(q, qd, A, b, f, tau, *in.friction) : hd_->solve(q, qd, A, b, f, tau);
+  return last_friction_ ? frictionSolver().solve(q, qd, A, b, f, tau, *in.friction) : hd_->solve(q, qd, A, b, f, tau);
 }
 
 void Engine::writeCore(double* qdd, double* tau_cmd, double* nu, double* link_acc, int* rank, double* smin) {

@@ -97,7 +97,7 @@ class Engine {
   void writeFriction(double* friction_torque, double* limit_torque, int* status, double* gauss, int* iterations);
   bool lastHadFriction() const { return last_friction_; }
   vereshchagin::HdSolver& answered() { return last_friction_ ? friction_->hdSolver() : *hd_; }
-  vereshchagin::FrictionSolver& frictionSolver() { return *friction_; }
+  vereshchagin::FrictionSolver& frictionSolver();  // built at first use
 
   unsigned int nj, ns;
 
@@ -106,8 +106,11 @@ class Engine {
   const double* assembleExternal(const RowInputs& in);
   KDL::Vector tipOffsetInBase(int segment, const KDL::Vector& offset) const;
 
+  EngineModel model_;  // pointers into the PySolver's model, which outlives its engines
+  KDL::Vector gravity_;
+  vereshchagin::SolverOptions options_;
   std::unique_ptr<vereshchagin::HdSolver> hd_;
-  std::unique_ptr<vereshchagin::FrictionSolver> friction_;
+  std::unique_ptr<vereshchagin::FrictionSolver> friction_;  // nullptr until a friction-aware solve
   SegmentKinematics kinematics_;
   const double* q_ = nullptr;     // the row being solved
   ChainHdSolver::Matrix6X alfa_;  // constraint columns of a solve (6 x maxConstraints())

@@ -70,8 +70,9 @@ class PySolver {
  public:
   // model: a Chain or a Tree (copied).
   // inertia_check: None (the model's, see PyChain::inertia_check), 'physical' or 'joint_space'.
+  // max_constraints: None (SolverOptions' default) or an int >= 1.
   PySolver(const py::object& model, const py::object& gravity, const py::object& rcond, const py::object& damping,
-           const py::object& inertia_check);
+           const py::object& inertia_check, const py::object& max_constraints);
 
   // Parses solve()'s arguments (objects may be null for "not given") into `p`.
   // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
@@ -122,6 +123,8 @@ class PySolver {
   void parseFExt(PyObject* f_ext, ParsedSolve& p) const;
   void parseConstraints(PyObject* constraints, ParsedSolve& p) const;
   bool parseFriction(PyObject* friction, ParsedSolve& p);
+  // Raises unless a solve's constraint columns fit the engines' workspace.
+  void checkColumnCount(py::ssize_t columns) const;
   bool frictionUnchanged(PyObject* friction) const;
   void rememberFriction(PyObject* friction);
   Engine& engine(std::size_t k);
@@ -135,6 +138,7 @@ class PySolver {
   vereshchagin::SolverOptions options_;
   py::object damping_arg_;
   std::vector<std::unique_ptr<Engine>> engines_;
+  py::ssize_t max_columns_ = 0;                 // HdSolver::maxConstraints() of every engine
   vereshchagin::FrictionModel chain_friction_;  // friction=True
   // The last vereshchagin.Friction parsed and its six attribute objects: reused only while every
   // attribute is the same object (the arrays cannot be written: friction.py).

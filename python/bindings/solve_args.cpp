@@ -65,6 +65,13 @@ void checkWeights(const double* w, py::ssize_t m, const std::string& name) {
             fmtDouble(w[c]));
 }
 
+void PySolver::checkColumnCount(py::ssize_t columns) const {
+  if (columns > max_columns_)
+    raise("this solve has " + std::to_string(columns) + " constraint columns; the solver takes at most " +
+          std::to_string(max_columns_) +
+          " in all (6 per segment, and Solver(..., max_constraints=) sizes its workspace)");
+}
+
 void PySolver::parse(PyObject* const* a, ParsedSolve& p) {
   PyObject *q = a[0], *qd = a[1], *alpha = a[2], *beta = a[3], *f_ext = a[4], *tau_ff = a[5], *friction = a[6],
            *constraints = a[7];
@@ -95,6 +102,7 @@ void PySolver::parse(PyObject* const* a, ParsedSolve& p) {
   parseFriction(friction, p);
   py::ssize_t columns = 0;
   for (const ConstraintBlock& b : p.blocks) columns += b.cols;
+  checkColumnCount(columns);
   const char* weight_names[2] = {"f_ext_pass_through", "tau_ff_pass_through"};
   F64View* weights[2] = {&p.f_ext_pass_through, &p.tau_ff_pass_through};
   for (int k = 0; k < 2; ++k) {

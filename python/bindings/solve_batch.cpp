@@ -328,6 +328,7 @@ py::dict PySolver::solveBatch(const py::object& q_obj, const py::object& qd_obj,
   br.B = br.bs.B < 0 ? 1 : br.bs.B;
   br.finishFExt();
   const py::ssize_t B = br.B, M = br.M;
+  checkColumnCount(M);
   long threads = std::min<long>(threadsArg(threads_obj), std::max<py::ssize_t>(B, 1));
   for (long t = 0; t < threads; ++t) engine(static_cast<std::size_t>(t));
 

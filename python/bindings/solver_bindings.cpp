@@ -15,7 +15,7 @@
 namespace vsbind {
 
 PySolver::PySolver(const py::object& model, const py::object& gravity, const py::object& rcond,
-                   const py::object& damping, const py::object& inertia_check)
+                   const py::object& damping, const py::object& inertia_check, const py::object& max_constraints)
     : damping_arg_(damping) {
   if (py::isinstance<PyChain>(model)) {
     chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
@@ -39,6 +39,15 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
     options_.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
     options_.damping = scalarArg(damping, "damping");
   }
+  if (!max_constraints.is_none()) {
+    if (PyBool_Check(max_constraints.ptr()) || !PyIndex_Check(max_constraints.ptr()))
+      raise("max_constraints must be an int >= 1 (None: the default), got " +
+            py::repr(max_constraints).cast<std::string>());
+    const py::int_ value = py::reinterpret_steal<py::int_>(PyNumber_Index(max_constraints.ptr()));
+    if (value < py::int_(1) || value > py::int_(1 << 24))
+      raise("max_constraints must be in 1 .. 16777216 (None: the default), got " + py::str(value).cast<std::string>());
+    options_.max_constraints = value.cast<int>();
+  }
   gravity_ = vec3(gravity, "gravity");
   auto probe = std::make_unique<Engine>(engine_model_, gravity_, options_);
   const vereshchagin::HdSolver& hd = probe->answered();
@@ -47,6 +56,7 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
   engines_.push_back(std::move(probe));
   nj = hd.nrOfJoints();
   ns = hd.nrOfSegments();
+  max_columns_ = hd.maxConstraints();
   const std::vector<vereshchagin::JointInfo>& joints = model_->jointInfos();
   const auto n = static_cast<Eigen::Index>(joints.size());
   chain_friction_.static_friction = chain_friction_.lower = chain_friction_.upper = Eigen::VectorXd::Zero(n);
@@ -238,7 +248,8 @@ py::object PySolver::model() const {
 
 py::tuple PySolver::getState() const {
   return py::make_tuple(model(), gravity(), options_.rcond, damping_arg_,
-                        vereshchagin::inertiaCheckName(options_.inertia_check));
+                        vereshchagin::inertiaCheckName(options_.inertia_check),
+                        options_.max_constraints > 0 ? py::object(py::int_(options_.max_constraints)) : py::none());
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -370,9 +381,11 @@ void bindSolver(py::module_& mod) {
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
   py::class_<PySolver> cls(mod, "Solver", docs::kSolverCore);
-  cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&>(),
+  cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
+                   const py::object&>(),
           py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
-          py::arg("damping") = py::none(), py::arg("inertia_check") = py::none())
+          py::arg("damping") = py::none(), py::arg("inertia_check") = py::none(),
+          py::arg("max_constraints") = py::none())
       .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
            py::arg("friction") = py::none(), py::arg("constraints") = py::none(),
@@ -407,8 +420,9 @@ void bindSolver(py::module_& mod) {
           "str: 'physical' or 'joint_space' (see Solver).")
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
-                        if (t.size() != 5) raise("Solver state must have 5 entries");
-                        return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4]);
+                        if (t.size() != 5 && t.size() != 6) raise("Solver state must have 5 or 6 entries");
+                        return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4],
+                                                          t.size() == 6 ? py::object(t[5]) : py::none());
                       }));
   addFastMethod(cls, &g_solve_def);
   addFastMethod(cls, &g_time_def);

@@ -201,6 +201,7 @@ class Solver:
         rcond: float = 1e-12,
         damping: Optional[float] = None,
         inertia_check: Optional[str] = None,
+        max_constraints: Optional[int] = None,
     ) -> None: ...
     def solve(
         self,

@@ -84,6 +84,10 @@ class Solver(_core.Solver):
         positive (H(q) positive definite) and names the joint when not. None (default): the
         check the model was built with (``model.inertia_check``: 'joint_space' for a chain from
         ``Chain.from_kdl``, as KDL accepts it, or built with that option; else 'physical').
+    max_constraints : int, optional
+        Constraint columns one solve may have in all; the coupling workspace is sized for them
+        once (memory O(n m + m^2), n segments). Default: the smaller of 6 per segment and 256.
+        A solve with more columns raises :class:`SolverError` naming this argument.
 
     Notes
     -----

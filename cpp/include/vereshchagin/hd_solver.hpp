@@ -68,10 +68,10 @@
 // of the cost.
 //
 // Constraints on any segments (Shakhimardanov's extension of the recursion, KU Leuven 2015): at
-// most 6 columns per segment, any number of segments (maxConstraints() = 6 x n_segments in total),
-// on any branches. In the inward sweep a segment's own columns join the wrenches felt from its
-// subtree, so the sweeps stay O(n) (times the active columns), and one M x M matrix K couples all
-// constraints, also across branches (through their common ancestors). nu() and the rows of
+// most 6 columns per segment, any number of segments (maxConstraints() in total: 6 x n_segments,
+// capped by SolverOptions::max_constraints, 256 by default), on any branches. In the inward sweep a segment's own
+// columns join the wrenches felt from its subtree, so the sweeps stay O(n) (times the active columns), and one M x M
+// matrix K couples all constraints, also across branches (through their common ancestors). nu() and the rows of
 // responseColumns()'s dnu follow the caller's column order.
 //
 // Affine structure: qdd and tau_cmd are affine in ff_torques. After a solve, responseColumns()
@@ -143,6 +143,12 @@ struct SolverOptions {
   // models and instead requires every articulated joint inertia D_j > 0 at each solve.
   // Changing it through setOptions() rebuilds the model.
   InertiaCheck inertia_check = InertiaCheck::Physical;
+  // Constraint columns one solve may have in all (its coupling workspace is sized for them once:
+  // memory O(n_segments * m + m^2) instead of O(n_segments^2)). 0 (default): the smaller of
+  // 6 per segment and kDefaultConstraintCapacity; larger values are capped at 6 per segment.
+  // A solve with more columns fails with E_TOO_MANY_CONSTRAINTS naming this option. >= 0.
+  int max_constraints = 0;
+  static constexpr int kDefaultConstraintCapacity = 256;
 };
 
 namespace detail {
@@ -200,7 +206,8 @@ class HdSolver : public KDL::SolverI {
             const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
             const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
             const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
-  // Largest total number of constraint columns: 6 per segment (at least 6).
+  // Largest total number of constraint columns of a solve: 6 per segment (at least 6), capped by
+  // options().max_constraints (0: SolverOptions::kDefaultConstraintCapacity).
   int maxConstraints() const;
 
   // Results of the last successful solve.
