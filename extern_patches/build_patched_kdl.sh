@@ -46,22 +46,9 @@ if [ -n "$missing" ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing > /dev/null
 fi
 
-# ---- source package ----
-APT="$OUT/apt"
-mkdir -p "$APT/lists/partial" "$APT/cache/archives/partial" "$APT/sources.list.d" "$APT/preferences.d" "$OUT/download"
-echo "deb-src http://deb.debian.org/debian bookworm main" > "$APT/sources.list"
-APT_OPTS=(-o "Dir::Etc::SourceList=$APT/sources.list" -o "Dir::Etc::SourceParts=$APT/sources.list.d"
-          -o "Dir::Etc::PreferencesParts=$APT/preferences.d" -o "Dir::State::Lists=$APT/lists"
-          -o "Dir::Cache=$APT/cache" -o "APT::Sandbox::User=$(id -un)")
-DSC="$OUT/download/orocos-kdl_$VERSION.dsc"
-if [ ! -f "$DSC" ]; then
-  echo "[patched-kdl] apt-get source --download-only orocos-kdl=$VERSION"
-  apt-get "${APT_OPTS[@]}" -qq update
-  (cd "$OUT/download" && apt-get "${APT_OPTS[@]}" -qq source --download-only "orocos-kdl=$VERSION")
-fi
-rm -rf "$OUT/src"
-# Unpacks the upstream tarball and applies Debian's own (build-system) patches.
-dpkg-source --no-check -x "$DSC" "$OUT/src" > /dev/null
+# ---- source package (unpacked with Debian's own build-system patches) ----
+source "$HERE/kdl_source.sh"
+unpack_kdl_source "$OUT" "$VERSION" patched-kdl
 
 # ---- the series ----
 for p in "${PATCHES[@]}"; do

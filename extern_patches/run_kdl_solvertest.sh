@@ -30,25 +30,8 @@ GEN=()
 if command -v ninja > /dev/null; then GEN=(-G Ninja); fi
 
 # ---- source package (private apt configuration; the machine's sources are not touched) ----
-DSC="$OUT/download/orocos-kdl_$VERSION.dsc"
-for cached in "$ROOT/build/patched_kdl/download/orocos-kdl_$VERSION.dsc"; do
-  if [ ! -f "$DSC" ] && [ -f "$cached" ]; then
-    mkdir -p "$OUT/download" && cp "$(dirname "$cached")"/orocos-kdl_* "$OUT/download/"
-  fi
-done
-if [ ! -f "$DSC" ]; then
-  APT="$OUT/apt"
-  mkdir -p "$APT/lists/partial" "$APT/cache/archives/partial" "$APT/sources.list.d" "$APT/preferences.d" "$OUT/download"
-  echo "deb-src http://deb.debian.org/debian bookworm main" > "$APT/sources.list"
-  APT_OPTS=(-o "Dir::Etc::SourceList=$APT/sources.list" -o "Dir::Etc::SourceParts=$APT/sources.list.d"
-            -o "Dir::Etc::PreferencesParts=$APT/preferences.d" -o "Dir::State::Lists=$APT/lists"
-            -o "Dir::Cache=$APT/cache" -o "APT::Sandbox::User=$(id -un)")
-  echo "[kdl-solvertest] apt-get source --download-only orocos-kdl=$VERSION"
-  apt-get "${APT_OPTS[@]}" -qq update
-  (cd "$OUT/download" && apt-get "${APT_OPTS[@]}" -qq source --download-only "orocos-kdl=$VERSION")
-fi
-rm -rf "$OUT/src"
-dpkg-source --no-check -x "$DSC" "$OUT/src" > /dev/null
+source "$HERE/kdl_source.sh"
+unpack_kdl_source "$OUT" "$VERSION" kdl-solvertest "$ROOT/build/patched_kdl/download"
 
 # ---- the copy, swapped to the drop-in ----
 TESTS="$OUT/tests"

@@ -213,4 +213,23 @@ inline Eigen::Matrix3d toMatrix(const KDL::Rotation& R) {
   return m;
 }
 
+// The arguments of one solve drawn at random: state, feed-forward torques, a wrench on every
+// segment, nc constraint columns and their set-points (segments of the columns are the caller's).
+struct SolveInputs {
+  Eigen::VectorXd q, qd, beta, ff;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> alfa, fext;
+  Eigen::VectorXi segments;
+};
+
+inline SolveInputs randomInputs(RandomGen& g, unsigned int n, unsigned int ns, int nc) {
+  SolveInputs in;
+  in.q = g.q(n).data;
+  in.qd = g.qdot(n).data;
+  in.ff = g.torques(n).data;
+  in.fext = toMatrix(g.fext(ns));
+  in.alfa = g.alfa(nc).data;
+  in.beta = g.beta(nc).data;
+  return in;
+}
+
 }  // namespace testutil

@@ -47,20 +47,11 @@ struct Access : HdSolver {
   }
 };
 
-struct Inputs {
-  Eigen::VectorXd q, qd, beta, ff;
-  Matrix6X alfa, fext;
-  Eigen::VectorXi segments;
-};
+using Inputs = testutil::SolveInputs;
 
-Inputs randomInputs(testutil::RandomGen& g, unsigned int n, unsigned int ns, int nc) {
-  Inputs in;
-  in.q = g.q(n).data;
-  in.qd = g.qdot(n).data;
-  in.ff = g.torques(n).data;
-  in.fext = testutil::toMatrix(g.fext(ns));
-  in.alfa = g.alfa(nc).data;
-  in.beta = g.beta(nc).data;
+// testutil::randomInputs with the columns on random segments.
+Inputs randomSegmentInputs(testutil::RandomGen& g, unsigned int n, unsigned int ns, int nc) {
+  Inputs in = testutil::randomInputs(g, n, ns, nc);
   in.segments.resize(nc);
   for (int c = 0; c < nc; ++c) in.segments(c) = g.integer(0, static_cast<int>(ns) - 1);
   return in;
@@ -147,8 +138,8 @@ void shapeAndMessageChecks(testutil::Checker& ck) {
   vereshchagin::ChainHdSolver chain_solver(chain, kGrav);
   vereshchagin::TreeHdSolver tree_solver(tree, kGrav);
   vereshchagin::FrictionSolver chain_friction(chain, kGrav), tree_friction(tree, kGrav);
-  const Inputs cin = randomInputs(g, chain_solver.nrOfJoints(), chain_solver.nrOfSegments(), 3);
-  const Inputs tin = randomInputs(g, tree_solver.nrOfJoints(), tree_solver.nrOfSegments(), 3);
+  const Inputs cin = randomSegmentInputs(g, chain_solver.nrOfJoints(), chain_solver.nrOfSegments(), 3);
+  const Inputs tin = randomSegmentInputs(g, tree_solver.nrOfJoints(), tree_solver.nrOfSegments(), 3);
   shapeChecksHd(ck, chain_solver, cin, "chain");
   shapeChecksHd(ck, tree_solver, tin, "tree");
   shapeChecksFriction(ck, chain_friction, cin, "friction chain");
@@ -172,7 +163,7 @@ void heldFlagChecks(testutil::Checker& ck) {
   testutil::RandomGen g(99);
   const KDL::Chain chain = g.chain(5);
   vereshchagin::ChainHdSolver s(chain, kGrav);
-  const Inputs in = randomInputs(g, 5, 5, 2);
+  const Inputs in = randomSegmentInputs(g, 5, 5, 2);
   ck.check(s.solve(in.q, in.qd, in.alfa, in.beta, in.fext, in.ff) == 0, "held flag: reference solve");
   const Eigen::VectorXd qdd = s.qdd(), nu = s.nu();
   std::atomic<bool>& busy = Access::busy(s);

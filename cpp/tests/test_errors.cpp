@@ -81,21 +81,8 @@ auto quiet(F&& f) -> decltype(f()) {
   return f();
 }
 
-struct Inputs {
-  Eigen::VectorXd q, qd, beta, ff;
-  Matrix6X alfa, fext;
-};
-
-Inputs randomInputs(testutil::RandomGen& g, unsigned int n, unsigned int ns, int nc) {
-  Inputs in;
-  in.q = g.q(n).data;
-  in.qd = g.qdot(n).data;
-  in.ff = g.torques(n).data;
-  in.fext = testutil::toMatrix(g.fext(ns));
-  in.alfa = g.alfa(nc).data;
-  in.beta = g.beta(nc).data;
-  return in;
-}
+using Inputs = testutil::SolveInputs;
+using testutil::randomInputs;
 
 int solveWith(Solver& s, const Inputs& in) {
   return quiet([&] { return s.solve(in.q, in.qd, in.alfa, in.beta, in.fext, in.ff); });
