@@ -24,8 +24,9 @@ SolverOptions compatOptions() {
 // No segment carries mass or rotational inertia and no joint a rotor inertia.
 bool massless(const KDL::Chain& chain) {
   for (const KDL::Segment& seg : chain.segments) {
-    const KDL::RigidBodyInertia& I = seg.getInertia();
-    const Eigen::Map<const Eigen::Matrix3d> rot(I.getRotationalInertia().data);
+    const KDL::RigidBodyInertia I = seg.getInertia();
+    const KDL::RotationalInertia Io = I.getRotationalInertia();  // a copy: the getter returns by value
+    const Eigen::Map<const Eigen::Matrix3d> rot(Io.data);
     if (I.getMass() != 0.0 || !(rot.array() == 0.0).all() || seg.getJoint().getInertia() != 0.0) return false;
   }
   return chain.getNrOfJoints() > 0;
