@@ -134,6 +134,24 @@ class SegmentSpec:
         return self.joint_pose(q) @ np.linalg.inv(self.joint_pose(0.0)) @ self.tip
 
 
+def planar_rot_z_links(n, inertia, rotor):
+    """n rot_z links of length 1 along x, 1 kg with the COM at mid-link (tip frame) and the given
+    rotational inertia about it (3x3, tip axes) and rotor inertia: a planar arm along x at q = 0."""
+    return [
+        SegmentSpec(
+            "rot_z",
+            np.array([0.0, 0.0, 1.0]),
+            np.zeros(3),
+            homogeneous(None, [1.0, 0.0, 0.0]),
+            1.0,
+            np.array([-0.5, 0.0, 0.0]),
+            np.asarray(inertia, dtype=float),
+            rotor,
+        )
+        for _ in range(n)
+    ]
+
+
 @dataclass
 class RandomChain:
     segments: list

@@ -12,9 +12,9 @@ import pytest
 import vereshchagin as vs
 from chains import (
     G_EARTH,
-    SegmentSpec,
     assert_close,
     build,
+    planar_rot_z_links,
     homogeneous,
     random_alpha,
     random_chain,
@@ -634,20 +634,7 @@ def test_stretched_arm_damped_value_matches_dense_oracle(damping):
     damping^2): (K^2 + d^2 I)^-1 K r of the dense formulation from Pinocchio (tests/dense_oracle.py),
     the same planar arm built through tests/chains.py."""
     q, qd, alpha, beta = _stretched_case()
-    link = [
-        SegmentSpec(
-            "rot_z",
-            np.array([0.0, 0.0, 1.0]),
-            np.zeros(3),
-            homogeneous(None, [1.0, 0.0, 0.0]),
-            1.0,
-            np.array([-0.5, 0.0, 0.0]),
-            np.diag([1e-3, 1 / 12, 1 / 12]),
-            0.0,
-        )
-        for _ in range(2)
-    ]
-    rc = build(link)
+    rc = build(planar_rot_z_links(2, np.diag([1e-3, 1 / 12, 1 / 12]), 0.0))
     dense = dense_task(rc.model, rc.tip_frames, q, qd, G_EARTH, np.zeros(2), [(rc.tip_frames[-1], alpha, beta)])
     res = vs.Solver(planar_arm(), damping=damping).solve(q, qd, alpha, beta)
     nu = dense.damped(damping)

@@ -31,6 +31,7 @@ from chains import (
     G_EARTH,
     SegmentSpec,
     build,
+    planar_rot_z_links,
     fext_generalized,
     fext_to_pinocchio,
     homogeneous,
@@ -621,20 +622,7 @@ def test_zero_friction_is_the_plain_solve(seed):
 # ------------------------------------------------------------------------------------------------
 def _planar_2link():
     """Two rot_z links of length 1 (COM 0.5, mass 1, Izz 0.1), rotors 0.05; arm along x at q = 0."""
-    segs = [
-        SegmentSpec(
-            "rot_z",
-            np.array([0.0, 0.0, 1.0]),
-            np.zeros(3),
-            homogeneous(None, [1.0, 0.0, 0.0]),
-            1.0,
-            np.array([-0.5, 0.0, 0.0]),
-            np.diag([0.01, 0.1, 0.1]),
-            0.05,
-        )
-        for _ in range(2)
-    ]
-    return build(segs)
+    return build(planar_rot_z_links(2, np.diag([0.01, 0.1, 0.1]), 0.05))
 
 
 def _tie_break_case(rc, q, g, alpha, beta, static, tau_ff):

@@ -158,15 +158,11 @@ int FrictionCore::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_
   return rc;
 }
 
+// The argument shapes HdSolver checks before its entry (6 rows or no columns), with its message.
 int FrictionCore::checkRows(const Eigen::Ref<const Eigen::MatrixXd>& alfa,
                             const Eigen::Ref<const Eigen::MatrixXd>& f_ext) {
-  if (alfa.rows() != 6 && alfa.cols() != 0)
-    return fail(ChainHdSolver::E_SIZE_MISMATCH, "alfa is %ldx%ld, expected 6 rows (6 x m constraint wrenches)",
-                (long)alfa.rows(), (long)alfa.cols());
-  if (f_ext.rows() != 6 && f_ext.cols() != 0)
-    return fail(ChainHdSolver::E_SIZE_MISMATCH, "f_ext is %ldx%ld, expected 6 x %u (one wrench per segment) or empty",
-                (long)f_ext.rows(), (long)f_ext.cols(), hd_.nrOfSegments());
-  return ChainHdSolver::E_NOERROR;
+  const int rc = hd_.solveArgsProblem(alfa, f_ext);
+  return rc == ChainHdSolver::E_NOERROR ? rc : failFromHd(rc);
 }
 
 int FrictionCore::failFromHd(int rc) {

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "vereshchagin/kdl_fork_compat.hpp"
+#include "vereshchagin/robot_chain.hpp"  // withRotorInertia
 
 namespace vereshchagin {
 namespace kdl_compat {
@@ -68,13 +69,9 @@ void ChainHdSolver_Vereshchagin::allocate() {
   if (massless(solver_.chain())) {
     KDL::Chain unit;
     for (const KDL::Segment& seg : solver_.chain().segments) {
-      const KDL::Joint& j = seg.getJoint();
-      const bool axis = j.getType() == KDL::Joint::RotAxis || j.getType() == KDL::Joint::TransAxis;
-      const double rotor = j.getType() == KDL::Joint::Fixed ? 0.0 : 1.0;
-      const KDL::Joint unit_joint =
-          axis ? KDL::Joint(j.getName(), j.JointOrigin(), j.JointAxis(), j.getType(), 1.0, 0.0, rotor)
-               : KDL::Joint(j.getName(), j.getType(), 1.0, 0.0, rotor);
-      unit.addSegment(KDL::Segment(seg.getName(), unit_joint, seg.getFrameToTip(), seg.getInertia()));
+      const bool fixed = seg.getJoint().getType() == KDL::Joint::Fixed;
+      unit.addSegment(KDL::Segment(seg.getName(), withRotorInertia(seg.getJoint(), fixed ? 0.0 : 1.0),
+                                   seg.getFrameToTip(), seg.getInertia()));
     }
     unit_ = std::make_unique<ChainHdSolver>(unit, root_acc_, compatOptions());
   }
@@ -146,11 +143,7 @@ int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::Jnt
       f_ext_(k, i) = f_ext[i].force(k);
       f_ext_(3 + k, i) = f_ext[i].torque(k);
     }
-  if (weighted_) {
-    solver_.setPassThrough(w_f_on_.head(active_), w_t_on_.head(active_));
-  } else if (solver_.passThroughColumns() >= 0) {
-    solver_.clearPassThrough();
-  }
+  applyDriverWeights(solver_);
   degraded_ = false;
   const int rc =
       solver_.solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_, ff_torques.data);
@@ -172,6 +165,15 @@ int ChainHdSolver_Vereshchagin::CartToJnt(const KDL::JntArray& q, const KDL::Jnt
   return error = E_NOERROR;
 }
 
+// The driver pass-through weights of the enabled columns (setDriverWeights()) on `solver`, or none.
+void ChainHdSolver_Vereshchagin::applyDriverWeights(ChainHdSolver& solver) {
+  if (weighted_) {
+    solver.setPassThrough(w_f_on_.head(active_), w_t_on_.head(active_));
+  } else if (solver.passThroughColumns() >= 0) {
+    solver.clearPassThrough();
+  }
+}
+
 // A chain without any mass or rotor inertia, driven by no torque and no wrench, has dynamics that
 // leave every acceleration free (KDL computes NaN there and returns 0). The answer given instead:
 // the smallest q_dotdot that meets the constraints (least squares where they conflict), which is
@@ -181,15 +183,13 @@ bool ChainHdSolver_Vereshchagin::masslessAnswer(const KDL::JntArray& q, const KD
                                                 const KDL::JntArray& ff_torques, KDL::JntArray& q_dotdot,
                                                 KDL::JntArray& constraint_torques) {
   if (!unit_ || !(ff_torques.data.array() == 0.0).all() || !(f_ext_.array() == 0.0).all()) return false;
-  if (weighted_)
-    unit_->setPassThrough(w_f_on_.head(active_), w_t_on_.head(active_));
-  else if (unit_->passThroughColumns() >= 0)
-    unit_->clearPassThrough();
-  const Eigen::VectorXd& zero = total_;  // nj zeros after setZero()
-  total_.setZero();
-  if (unit_->solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_, zero) != E_NOERROR)
+  applyDriverWeights(*unit_);
+  const Eigen::VectorXd no_torques;  // empty: zero torques (no allocation)
+  if (unit_->solve(q.data, q_dot.data, alfa_on_.leftCols(active_), beta_on_.head(active_), f_ext_, no_torques) !=
+      E_NOERROR)
     return false;
   q_dotdot.data = unit_->qdd();
+  total_.setZero();
   nu_.setZero();
   constraint_torques.data.setZero();
   degraded_ = true;

@@ -27,15 +27,12 @@ namespace {
 // The int value of an index argument, or raises naming the valid range (an int beyond the C range
 // is out of range like any other).
 int indexInRange(PyObject* which, int n, const std::string& label, const char* what) {
-  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(which));
-  if (!index) throw py::error_already_set();
-  int overflow = 0;
-  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
-  if (overflow != 0 || v < -n || v >= n)
-    raise(label + ": " + what + " index " + py::str(index).cast<std::string>() + " out of range for " +
+  const std::optional<long long> v = intWithin(which, -n, n - 1);
+  if (!v)
+    raise(label + ": " + what + " index " + py::str(which).cast<std::string>() + " out of range for " +
           std::to_string(n) + " " + what + "s (valid " + std::to_string(-n) + " .. " + std::to_string(n - 1) +
           (std::string(what) == "segment" ? "; the base is addressed by its name only)" : ")"));
-  return static_cast<int>(v < 0 ? v + n : v);
+  return static_cast<int>(*v < 0 ? *v + n : *v);
 }
 
 }  // namespace

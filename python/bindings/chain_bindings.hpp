@@ -59,13 +59,7 @@ inline JointSpec jointFromString(const std::string& s) {
         "Joint.revolute(axis, origin) or Joint.prismatic(axis, origin)");
 }
 
-// A copy of `joint` (a moving joint) with rotor inertia `rotor` reflected to it, kg m^2 or kg.
-inline KDL::Joint withRotorInertia(const KDL::Joint& joint, double rotor) {
-  if (joint.getType() == KDL::Joint::RotAxis || joint.getType() == KDL::Joint::TransAxis)
-    return KDL::Joint(joint.getName(), joint.JointOrigin(), joint.JointAxis(), joint.getType(), 1.0, 0.0, rotor,
-                      joint.getDamping(), joint.getStiffness());
-  return KDL::Joint(joint.getName(), joint.getType(), 1.0, 0.0, rotor, joint.getDamping(), joint.getStiffness());
-}
+using vereshchagin::withRotorInertia;
 
 // The value of a `rotor_inertia` setter: shape (n_joints,), finite, every entry >= 0.
 inline Array rotorInertiaArg(const py::object& values, size_t n_joints) {

@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -27,6 +28,18 @@ struct SolverError : std::runtime_error {
 }
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// The value of an integer argument (an int or anything with __index__; each caller refuses bool
+// and other types with its own message) when it lies in [lo, hi], else std::nullopt: a value
+// beyond the C range is out of range like any other. Raises the error of a failing __index__.
+inline std::optional<long long> intWithin(PyObject* obj, long long lo, long long hi) {
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(obj));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0 || v < lo || v > hi) return std::nullopt;
+  return v;
+}
 
 inline std::string shapeStr(const py::array& a) {
   std::ostringstream s;

@@ -1,7 +1,6 @@
 // Pickle states of model parts and the URDF source argument (model_state.hpp).
 #include "model_state.hpp"
 
-#include <sys/stat.h>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -24,11 +23,16 @@ py::tuple inertiaState(const KDL::RigidBodyInertia& I) {
   return t;
 }
 
+// A state record: a tuple of exactly n entries.
+py::tuple record(const py::handle& obj, std::size_t n, const std::string& what) {
+  if (!py::isinstance<py::tuple>(obj) || py::len(obj) != n)
+    raise(what + " must be a tuple of " + std::to_string(n) + " entries");
+  return py::reinterpret_borrow<py::tuple>(obj);
+}
+
 // The entries of a state tuple as doubles: exactly `n` finite reals, or raises naming `what`.
 void finiteEntries(const py::handle& obj, std::size_t n, const std::string& what, double* out) {
-  if (!py::isinstance<py::tuple>(obj) || py::len(obj) != n)
-    raise(what + " must be a tuple of " + std::to_string(n) + " reals");
-  const py::tuple t = py::reinterpret_borrow<py::tuple>(obj);
+  const py::tuple t = record(obj, n, what);
   for (std::size_t k = 0; k < n; ++k) {
     out[k] = t[k].cast<double>();
     if (!std::isfinite(out[k])) raise(what + " holds a non-finite value");
@@ -65,22 +69,13 @@ KDL::Vector vectorFromState(const py::handle& obj, const std::string& what) {
   return KDL::Vector(d[0], d[1], d[2]);
 }
 
-// A state record: a tuple of exactly n entries.
-py::tuple record(const py::handle& obj, std::size_t n, const std::string& what) {
-  if (!py::isinstance<py::tuple>(obj) || py::len(obj) != n)
-    raise(what + " must be a tuple of " + std::to_string(n) + " entries");
-  return py::reinterpret_borrow<py::tuple>(obj);
-}
-
 }  // namespace
 
 long long stateInt(const py::handle& obj, long long lo, long long hi, const std::string& what) {
   if (PyBool_Check(obj.ptr()) || !PyLong_Check(obj.ptr())) raise(what + " must be an int");
-  int overflow = 0;
-  const long long v = PyLong_AsLongLongAndOverflow(obj.ptr(), &overflow);
-  if (overflow != 0 || v < lo || v > hi)
-    raise(what + " is out of range (" + std::to_string(lo) + " .. " + std::to_string(hi) + ")");
-  return v;
+  const std::optional<long long> v = intWithin(obj.ptr(), lo, hi);
+  if (!v) raise(what + " is out of range (" + std::to_string(lo) + " .. " + std::to_string(hi) + ")");
+  return *v;
 }
 
 py::tuple segmentState(const KDL::Segment& s) {
@@ -168,9 +163,6 @@ UrdfSource urdfSourceArg(const py::object& source) {
   out.text_or_path = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
   out.is_text = out.text_or_path.find('<') != std::string::npos;
   if (!out.is_text) {
-    struct stat info {};
-    if (::stat(out.text_or_path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
-      raise("URDF source '" + out.text_or_path + "' is a directory, not a URDF file");
     std::ifstream probe(out.text_or_path);
     if (!probe) raise("URDF source is neither XML text nor a readable file: '" + out.text_or_path + "'");
   }

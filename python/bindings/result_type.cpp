@@ -8,6 +8,7 @@
 
 #include "common.hpp"
 #include "docstrings.hpp"
+#include "model_state.hpp"
 
 namespace vsbind {
 
@@ -42,14 +43,9 @@ Py_ssize_t bufferDoubles(const ResultLayout& l) {
 // Sizes a result can have: up to kMaxSize joints or segments, m <= 6 per segment.
 constexpr long long kMaxSize = 1 << 24;
 
+// A size entry of a SolveResult state, in [0, hi] (model_state.hpp's stateInt).
 int stateSize(const py::handle& obj, long long hi, const char* what) {
-  if (PyBool_Check(obj.ptr()) || !PyLong_Check(obj.ptr()))
-    throw SolverError(std::string("SolveResult state: ") + what + " must be an int");
-  int overflow = 0;
-  const long long v = PyLong_AsLongLongAndOverflow(obj.ptr(), &overflow);
-  if (overflow != 0 || v < 0 || v > hi)
-    throw SolverError(std::string("SolveResult state: ") + what + " out of range (0 .. " + std::to_string(hi) + ")");
-  return static_cast<int>(v);
+  return static_cast<int>(stateInt(obj, 0, hi, std::string("SolveResult state: ") + what));
 }
 
 ResultObject* self(PyObject* o) {

@@ -263,15 +263,12 @@ long threadsArg(const py::object& obj) {
   if (PyBool_Check(obj.ptr()) || !PyIndex_Check(obj.ptr()))
     raise("threads must be an int (0: one per core), got " + std::string(Py_TYPE(obj.ptr())->tp_name) + " " +
           py::repr(obj).cast<std::string>());
-  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(obj.ptr()));
-  if (!index) throw py::error_already_set();
-  int overflow = 0;
-  const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
-  if (overflow != 0 || v < 0 || v > kMaxBatchThreads)
+  const std::optional<long long> v = intWithin(obj.ptr(), 0, kMaxBatchThreads);
+  if (!v)
     raise("threads must be in 0 .. " + std::to_string(kMaxBatchThreads) + " (0: one per core), got " +
-          py::str(index).cast<std::string>());
-  if (v == 0) return std::max(1u, std::thread::hardware_concurrency());
-  return static_cast<long>(v);
+          py::str(obj).cast<std::string>());
+  if (*v == 0) return std::max(1u, std::thread::hardware_concurrency());
+  return static_cast<long>(*v);
 }
 
 }  // namespace

@@ -43,10 +43,11 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
     if (PyBool_Check(max_constraints.ptr()) || !PyIndex_Check(max_constraints.ptr()))
       raise("max_constraints must be an int >= 1 (None: the default), got " +
             py::repr(max_constraints).cast<std::string>());
-    const py::int_ value = py::reinterpret_steal<py::int_>(PyNumber_Index(max_constraints.ptr()));
-    if (value < py::int_(1) || value > py::int_(1 << 24))
-      raise("max_constraints must be in 1 .. 16777216 (None: the default), got " + py::str(value).cast<std::string>());
-    options_.max_constraints = value.cast<int>();
+    const std::optional<long long> value = intWithin(max_constraints.ptr(), 1, 1 << 24);
+    if (!value)
+      raise("max_constraints must be in 1 .. 16777216 (None: the default), got " +
+            py::str(max_constraints).cast<std::string>());
+    options_.max_constraints = static_cast<int>(*value);
   }
   gravity_ = vec3(gravity, "gravity");
   auto probe = std::make_unique<Engine>(engine_model_, gravity_, options_);

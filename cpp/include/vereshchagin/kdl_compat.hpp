@@ -175,6 +175,8 @@ class ChainHdSolver_Vereshchagin : public KDL::SolverI {
   // The E_DEGRADED answer of a chain with no mass at all (kdl_compat.cpp); false if it does not apply.
   bool masslessAnswer(const KDL::JntArray& q, const KDL::JntArray& q_dot, const KDL::JntArray& ff_torques,
                       KDL::JntArray& q_dotdot, KDL::JntArray& constraint_torques);
+  // setDriverWeights()'s weights of the enabled columns on `solver` (solver_ or unit_).
+  void applyDriverWeights(ChainHdSolver& solver);
   // The solver holding the last solve's results.
   const ChainHdSolver& answered() const { return degraded_ ? *unit_ : solver_; }
 

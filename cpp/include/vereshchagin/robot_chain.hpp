@@ -7,8 +7,18 @@
 
 #include <kdl/chain.hpp>
 #include <kdl/frames.hpp>
+#include <kdl/joint.hpp>
 
 namespace vereshchagin {
+
+// A copy of `joint` with rotor inertia `rotor` reflected to it (kg m^2 or kg); origin, axis, type,
+// damping and stiffness kept. (A fixed joint's rotor inertia is never read.)
+inline KDL::Joint withRotorInertia(const KDL::Joint& joint, double rotor) {
+  if (joint.getType() == KDL::Joint::RotAxis || joint.getType() == KDL::Joint::TransAxis)
+    return KDL::Joint(joint.getName(), joint.JointOrigin(), joint.JointAxis(), joint.getType(), 1.0, 0.0, rotor,
+                      joint.getDamping(), joint.getStiffness());
+  return KDL::Joint(joint.getName(), joint.getType(), 1.0, 0.0, rotor, joint.getDamping(), joint.getStiffness());
+}
 
 // One moving joint of the chain. Units: rad or m, rad/s or m/s, N m or N.
 struct JointInfo {
