@@ -29,12 +29,10 @@ import vereshchagin as vs
 from chains import (
     pin_configuration,
     G_EARTH,
-    SegmentSpec,
     build,
     planar_rot_z_links,
     fext_generalized,
     fext_to_pinocchio,
-    homogeneous,
     random_alpha,
     random_chain,
     random_f_ext,
@@ -166,17 +164,7 @@ def both_oracles(prob):
 # The 1-DOF arm of Vukcevic 2018, ch. 6: mass 1, length 1, COM 0.5, joint-axis inertia 2.25, revolute about z
 # ------------------------------------------------------------------------------------------------
 def arm_1dof():
-    seg = SegmentSpec(
-        "rot_z",
-        np.array([0.0, 0.0, 1.0]),
-        np.zeros(3),
-        homogeneous(None, [1.0, 0.0, 0.0]),
-        1.0,
-        np.array([-0.5, 0.0, 0.0]),
-        np.diag([1.0, 1.0, 2.0]),
-        0.0,
-    )
-    return build([seg])
+    return build(planar_rot_z_links(1, np.diag([1.0, 1.0, 2.0]), 0.0))
 
 
 def _arm_problem(rc, gravity, tau_ff=0.0, f_tip=None, alpha=None, beta=None, f=10.0):
