@@ -7,9 +7,9 @@
 
 namespace vereshchagin {
 
-namespace {
+namespace detail {
 
-detail::ModelSource chainSource(const KDL::Chain& chain) {
+ModelSource chainModelSource(const KDL::Chain& chain) {
   detail::ModelSource src;
   const unsigned int ns = chain.getNrOfSegments();
   src.segments.reserve(ns);
@@ -23,10 +23,14 @@ detail::ModelSource chainSource(const KDL::Chain& chain) {
   return src;
 }
 
+}  // namespace detail
+
+namespace {
+using detail::chainModelSource;
 }  // namespace
 
 ChainHdSolver::ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
-    : HdSolver(chainSource(chain), root_acc, options),
+    : HdSolver(chainModelSource(chain), root_acc, options),
       chain_(chain),
       f_ext_buf_(Matrix6X::Zero(6, chain.getNrOfSegments())) {}
 
@@ -36,7 +40,7 @@ void ChainHdSolver::updateInternalDataStructures() {
     core().stale_model.store(true, std::memory_order_relaxed);  // reported by the next solves
     return;
   }
-  rebuild(chainSource(chain_));
+  rebuild(chainModelSource(chain_));
   f_ext_buf_.setZero(6, chain_.getNrOfSegments());
   core().stale_model.store(false, std::memory_order_relaxed);
 }

@@ -30,7 +30,11 @@ void preorder(Element root, std::vector<Element>& order, std::vector<int>& paren
   }
 }
 
-detail::ModelSource treeSource(const KDL::Tree& tree, const std::string& root_name) {
+}  // namespace
+
+namespace detail {
+
+ModelSource treeModelSource(const KDL::Tree& tree, const std::string& root_name) {
   detail::ModelSource src;
   const std::string name = root_name.empty() ? tree.getRootSegment()->first : root_name;
   const auto root = tree.getSegment(name);
@@ -55,11 +59,11 @@ detail::ModelSource treeSource(const KDL::Tree& tree, const std::string& root_na
   return src;
 }
 
-}  // namespace
+}  // namespace detail
 
 TreeHdSolver::TreeHdSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options,
                            const std::string& root_segment)
-    : HdSolver(treeSource(tree, root_segment), root_acc, options), root_name_(root_segment) {
+    : HdSolver(detail::treeModelSource(tree, root_segment), root_acc, options), root_name_(root_segment) {
   if (root_name_.empty()) root_name_ = tree.getRootSegment()->first;
   const detail::ModelSource& src = core().model.source;
   joint_names_.assign(nrOfJoints(), std::string());

@@ -15,6 +15,7 @@ using Vector3 = Eigen::Matrix<double, 3, 1>;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 using Matrix3 = Eigen::Matrix<double, 3, 3>;
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // one spatial vector per column
 
 struct Pose {
   Matrix3 R = Matrix3::Identity();
