@@ -23,6 +23,10 @@ struct SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The docstring `key` of vereshchagin/_docstrings.py, where the Python API is documented once
+// (module.cpp). The text stays alive for the interpreter's lifetime.
+const char* doc(const char* key);
+
 [[noreturn]] inline void raise(const std::string& msg) {
   throw SolverError(msg);
 }

@@ -12,10 +12,24 @@ void bindSolver(py::module_& mod);
 void bindResultType(py::module_& mod);
 void bindDynamics(py::module_& mod);
 void bindSegmentSpec(py::module_& mod);
+
+namespace {
+PyObject* g_docs = nullptr;  // vereshchagin._docstrings.DOCS, referenced for the interpreter's lifetime
+}  // namespace
+
+const char* doc(const char* key) {
+  PyObject* text = PyDict_GetItemString(g_docs, key);  // borrowed
+  if (text == nullptr) throw std::runtime_error(std::string("vereshchagin._docstrings has no entry '") + key + "'");
+  const char* utf8 = PyUnicode_AsUTF8(text);
+  if (utf8 == nullptr) throw py::error_already_set();
+  return utf8;
+}
+
 }  // namespace vsbind
 
 PYBIND11_MODULE(_core, mod) {
   mod.doc() = "C++ core of vereshchagin (Popov-Vereshchagin hybrid dynamics on KDL chains).";
+  vsbind::g_docs = pybind11::object(pybind11::module_::import("vereshchagin._docstrings").attr("DOCS")).release().ptr();
   pybind11::register_exception<vsbind::SolverError>(mod, "SolverError", PyExc_ValueError);
   vsbind::bindChain(mod);
   vsbind::bindTree(mod);

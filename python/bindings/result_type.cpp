@@ -7,7 +7,6 @@
 #include <string>
 
 #include "common.hpp"
-#include "docstrings.hpp"
 #include "model_state.hpp"
 
 namespace vsbind {
@@ -263,20 +262,19 @@ PyObject* deepcopyResult(PyObject* o, PyObject*) {
   return copyResult(o, nullptr);
 }
 
-PyGetSetDef g_getset[] = {
-    {"qdd", getView, nullptr, docs::kQdd, reinterpret_cast<void*>(kQdd)},
-    {"tau_command", getView, nullptr, docs::kTauCommand, reinterpret_cast<void*>(kTau)},
-    {"nu", getView, nullptr, docs::kNu, reinterpret_cast<void*>(kNu)},
-    {"link_acc", getView, nullptr, docs::kLinkAcc, reinterpret_cast<void*>(kLinkAcc)},
-    {"constraint_rank", getRank, nullptr, docs::kConstraintRank, nullptr},
-    {"smallest_singular_value", getSmin, nullptr, docs::kSmallestSingularValue, nullptr},
-    {"friction_torque", getView, nullptr, docs::kFrictionTorque, reinterpret_cast<void*>(kFriction)},
-    {"limit_torque", getView, nullptr, docs::kLimitTorque, reinterpret_cast<void*>(kLimit)},
-    {"status", getView, nullptr, docs::kStatus, reinterpret_cast<void*>(kStatus)},
-    {"gauss_value", getGauss, nullptr, docs::kGaussValue, nullptr},
-    {"iterations", getIterations, nullptr, docs::kIterations, nullptr},
-    {"segment_nu", getSegmentNu, nullptr, docs::kSegmentNu, nullptr},
-    {nullptr, nullptr, nullptr, nullptr, nullptr}};
+PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, reinterpret_cast<void*>(kQdd)},
+                          {"tau_command", getView, nullptr, nullptr, reinterpret_cast<void*>(kTau)},
+                          {"nu", getView, nullptr, nullptr, reinterpret_cast<void*>(kNu)},
+                          {"link_acc", getView, nullptr, nullptr, reinterpret_cast<void*>(kLinkAcc)},
+                          {"constraint_rank", getRank, nullptr, nullptr, nullptr},
+                          {"smallest_singular_value", getSmin, nullptr, nullptr, nullptr},
+                          {"friction_torque", getView, nullptr, nullptr, reinterpret_cast<void*>(kFriction)},
+                          {"limit_torque", getView, nullptr, nullptr, reinterpret_cast<void*>(kLimit)},
+                          {"status", getView, nullptr, nullptr, reinterpret_cast<void*>(kStatus)},
+                          {"gauss_value", getGauss, nullptr, nullptr, nullptr},
+                          {"iterations", getIterations, nullptr, nullptr, nullptr},
+                          {"segment_nu", getSegmentNu, nullptr, nullptr, nullptr},
+                          {nullptr, nullptr, nullptr, nullptr, nullptr}};
 
 PyMethodDef g_methods[] = {{"__reduce__", reduce, METH_NOARGS, "Pickle support."},
                            {"__copy__", copyResult, METH_NOARGS, "An independent copy (its own data)."},
@@ -288,11 +286,13 @@ PyMethodDef g_from_state_def = {"_result_from_state", fromState, METH_VARARGS, "
 }  // namespace
 
 void bindResultType(py::module_& mod) {
+  for (PyGetSetDef* g = g_getset; g->name != nullptr; ++g)
+    g->doc = doc((std::string("SolveResult.") + g->name).c_str());
   static PyType_Slot slots[] = {{Py_tp_dealloc, reinterpret_cast<void*>(dealloc)},
                                 {Py_tp_repr, reinterpret_cast<void*>(repr)},
                                 {Py_tp_getset, g_getset},
                                 {Py_tp_methods, g_methods},
-                                {Py_tp_doc, const_cast<char*>(docs::kSolveResult)},
+                                {Py_tp_doc, const_cast<char*>(doc("SolveResult"))},
                                 {0, nullptr}};
   static PyType_Spec spec = {"vereshchagin._core.SolveResult", static_cast<int>(offsetof(ResultObject, data)),
                              static_cast<int>(sizeof(double)), Py_TPFLAGS_DEFAULT, slots};

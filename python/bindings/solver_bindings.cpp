@@ -9,7 +9,6 @@
 #include <Eigen/QR>
 #include <limits>
 
-#include "docstrings.hpp"
 #include "py_solver.hpp"
 
 namespace vsbind {
@@ -363,7 +362,7 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
 }
 
 PyMethodDef g_solve_def = {"solve", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(solveEntry)),
-                           METH_FASTCALL | METH_KEYWORDS, docs::kSolve};
+                           METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
 PyMethodDef g_time_def = {
     "_time_cpp", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(timeCppEntry)),
     METH_FASTCALL | METH_KEYWORDS,
@@ -379,9 +378,10 @@ void addFastMethod(py::handle cls, PyMethodDef* def) {
 
 void bindSolver(py::module_& mod) {
   g_solver_error = mod.attr("SolverError").ptr();
+  g_solve_def.ml_doc = doc("_core.Solver.solve");
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
-  py::class_<PySolver> cls(mod, "Solver", docs::kSolverCore);
+  py::class_<PySolver> cls(mod, "Solver", doc("_core.Solver"));
   cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
                    const py::object&>(),
           py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
@@ -391,10 +391,10 @@ void bindSolver(py::module_& mod) {
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
            py::arg("friction") = py::none(), py::arg("constraints") = py::none(),
            py::arg("f_ext_pass_through") = py::none(), py::arg("tau_ff_pass_through") = py::none(),
-           py::arg("threads") = 1, docs::kSolveBatch)
+           py::arg("threads") = 1, doc("_core.Solver.solve_batch"))
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
-           docs::kResponseColumns)
-      .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, docs::kGravity)
+           doc("_core.Solver.response_columns"))
+      .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, doc("_core.Solver.gravity"))
       .def_property_readonly(
           "n_joints", [](const PySolver& s) { return s.nj; }, "Number of moving joints n.")
       .def_property_readonly(

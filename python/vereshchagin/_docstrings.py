@@ -1,11 +1,12 @@
-// numpy-style docstrings of the Python Solver and SolveResult (kept apart from the binding code).
-#pragma once
+"""Docstrings of the compiled module ``vereshchagin._core``, written once, here.
 
-namespace vsbind {
-namespace docs {
+The bindings (``python/bindings``) attach ``DOCS[key]`` to the class, method or property named by
+``key`` when the module is imported; the type stubs (``_core.pyi``) hold the signatures only.
+"""
 
-inline constexpr const char* kSolve =
-    R"doc(solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
+DOCS = {}
+
+DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -70,70 +71,66 @@ Notes
 -----
 The GIL is released during the solve. One solver serialises concurrent calls; use one solver
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
-)doc";
+"""
 
-inline constexpr const char* kSolveBatch =
-    R"doc(solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1)
+DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
-)doc";
+"""
 
-inline constexpr const char* kResponseColumns =
-    R"doc(Affine response of the last solve to unit feed-forward torques (see the wrapper in vereshchagin.Solver).)doc";
+DOCS["_core.Solver.response_columns"] = r"""Affine response of the last solve to unit feed-forward torques (see the wrapper in vereshchagin.Solver)."""
 
-inline constexpr const char* kGravity = R"doc(Physical gravity in the base frame, shape (3,), m/s^2 (settable).
+DOCS["_core.Solver.gravity"] = r"""Physical gravity in the base frame, shape (3,), m/s^2 (settable).
 
 The base is accelerated by ``-gravity`` internally, so ``beta`` and ``link_acc`` include that
 acceleration.
-)doc";
+"""
 
-inline constexpr const char* kSolverCore = R"doc(C++ core of :class:`vereshchagin.Solver` (use that class).)doc";
+DOCS["_core.Solver"] = r"""C++ core of :class:`vereshchagin.Solver` (use that class)."""
 
-inline constexpr const char* kSolveResult = R"doc(Result of :meth:`Solver.solve`.
+DOCS["SolveResult"] = r"""Result of :meth:`Solver.solve`.
 
 All arrays are float64 (``status``: int32). Frames: base-frame axes; moments and spatial
 accelerations about each segment's tip origin. Results pickle and deep-copy.
-)doc";
+"""
 
-inline constexpr const char* kQdd = R"doc(ndarray, shape (n,): joint accelerations, rad/s^2 or m/s^2.)doc";
-inline constexpr const char* kTauCommand =
-    R"doc(ndarray, shape (n,): torques the motors add to ``tau_ff`` to realise ``qdd``, N m or N.
+DOCS["SolveResult.qdd"] = r"""ndarray, shape (n,): joint accelerations, rad/s^2 or m/s^2."""
+
+DOCS["SolveResult.tau_command"] = r"""ndarray, shape (n,): torques the motors add to ``tau_ff`` to realise ``qdd``, N m or N.
 
 ``-sum_i J_i^T alpha_i nu_i`` over the constrained segments; applied with ``tau_ff`` (and, with
 friction, the friction torques acting) to the unconstrained arm under the same gravity and
 ``f_ext`` it reproduces ``qdd``. With friction: the least such command among the optima.
-)doc";
-inline constexpr const char* kNu = R"doc(ndarray, shape (m,): constraint force magnitudes (N or N m per unit of alpha).
+"""
+
+DOCS["SolveResult.nu"] = r"""ndarray, shape (m,): constraint force magnitudes (N or N m per unit of alpha).
 
 The wrench the constraints apply on their segment is ``-alpha @ nu``. Order: the end-segment
 ``alpha`` columns first, then each ``constraints`` entry's columns in dict order.
-)doc";
-inline constexpr const char* kLinkAcc =
-    R"doc(ndarray, shape (n_segments + 1, 6): spatial accelerations ``[linear, angular]``.
+"""
+
+DOCS["SolveResult.link_acc"] = r"""ndarray, shape (n_segments + 1, 6): spatial accelerations ``[linear, angular]``.
 
 Row 0 is the base (its acceleration is ``-gravity``); row ``k + 1`` is segment k's tip frame:
 base-frame axes, tip origin, including ``-gravity`` (m/s^2, rad/s^2).
-)doc";
-inline constexpr const char* kConstraintRank =
-    R"doc(int: rank of the coupling matrix ``K = A H^-1 A^T`` (``A = alpha^T J``) under the singularity policy.)doc";
-inline constexpr const char* kSmallestSingularValue =
-    R"doc(float: smallest eigenvalue of ``K`` (0 when m = 0); small values flag a near-singular task.)doc";
-inline constexpr const char* kFrictionTorque =
-    R"doc(ndarray, shape (n,) or None: physical friction torques acting on the joints (N m or N).
+"""
+
+DOCS["SolveResult.constraint_rank"] = r"""int: rank of the coupling matrix ``K = A H^-1 A^T`` (``A = alpha^T J``) under the singularity policy."""
+
+DOCS["SolveResult.smallest_singular_value"] = r"""float: smallest eigenvalue of ``K`` (0 when m = 0); small values flag a near-singular task."""
+
+DOCS["SolveResult.friction_torque"] = r"""ndarray, shape (n,) or None: physical friction torques acting on the joints (N m or N).
 
 Opposes motion on moving joints (kinetic friction); on resting joints the max-min value with
 ``|torque| <= static``. None for solves without ``friction``.
-)doc";
-inline constexpr const char* kLimitTorque =
-    R"doc(ndarray, shape (n,) or None: reactions of joint position limits on resting joints at a limit (N m or N).)doc";
-inline constexpr const char* kStatus =
-    R"doc(ndarray of int32, shape (n,) or None: 0 moving, 1 sticking, 2 slipping +, 3 slipping - (joints at rest).)doc";
-inline constexpr const char* kGaussValue =
-    R"doc(float or None: Gauss' function at the optimum, ``Z0(qdd) + sum f_j |qdd_j|`` over resting joints.)doc";
-inline constexpr const char* kIterations =
-    R"doc(int or None: iterations of the friction max-min (bounded; see the docs).)doc";
-inline constexpr const char* kSegmentNu =
-    R"doc(dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``.)doc";
+"""
 
-}  // namespace docs
-}  // namespace vsbind
+DOCS["SolveResult.limit_torque"] = r"""ndarray, shape (n,) or None: reactions of joint position limits on resting joints at a limit (N m or N)."""
+
+DOCS["SolveResult.status"] = r"""ndarray of int32, shape (n,) or None: 0 moving, 1 sticking, 2 slipping +, 3 slipping - (joints at rest)."""
+
+DOCS["SolveResult.gauss_value"] = r"""float or None: Gauss' function at the optimum, ``Z0(qdd) + sum f_j |qdd_j|`` over resting joints."""
+
+DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max-min (bounded; see the docs)."""
+
+DOCS["SolveResult.segment_nu"] = r"""dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``."""
