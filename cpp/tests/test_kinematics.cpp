@@ -221,3 +221,42 @@ TEST_CASE("errors: codes and messages") {
 }
 
 }  // namespace
+
+// ---- task.hpp ----
+#include "vereshchagin/task.hpp"
+
+namespace {
+
+TEST_CASE("beta from a classical acceleration and pose errors") {
+  testutil::RandomGen g(11);
+  const KDL::Chain chain = g.chain(5);
+  const Model model(chain);
+  KinematicsData kd(model);
+  const Eigen::VectorXd q = g.q(5).data, qd = g.qdot(5).data;
+  REQUIRE(forwardKinematics(model, kd, JointPositions(q), JointVelocities(qd)).ok());
+  const FrameRef frame{4, g.frame(0.3)};
+  Vector6 twist, a;
+  REQUIRE(frameTwist(model, kd, frame, twist).ok());
+  for (int r = 0; r < 6; ++r) a(r) = g.uniform(-3.0, 3.0);
+  const Eigen::MatrixXd alfa = g.alfa(4).data;
+  const KDL::Vector gravity(0.1, -0.2, -9.81);
+  Eigen::VectorXd beta(4);
+  REQUIRE(vereshchagin::betaForFrame(model, kd, frame, alfa, a, gravity, beta).ok());
+  Vector6 spatial;  // [a_lin - w x v - g; a_ang]
+  spatial.head<3>() = a.head<3>() - twist.tail<3>().cross(twist.head<3>()) - vereshchagin::Vector3(0.1, -0.2, -9.81);
+  spatial.tail<3>() = a.tail<3>();
+  CHECK(relErr(beta, alfa.transpose() * spatial) < 1e-14);
+  Eigen::VectorXd wrong(3);
+  CHECK(vereshchagin::betaForFrame(model, kd, frame, alfa, a, gravity, wrong).code() ==
+        vereshchagin::Error::SizeMismatch);
+  for (int k = 0; k < 50; ++k) {
+    const KDL::Frame c = g.frame(), d = g.frame();
+    CHECK(relErr(vereshchagin::poseError(c, d), vec(KDL::diff(c, d))) < 1e-9);
+  }
+  const KDL::Frame c = g.frame();  // angles near 0 and pi
+  CHECK(vereshchagin::poseError(c, c).norm() < 1e-15);
+  const KDL::Frame flipped(c.M * KDL::Rotation::Rot(KDL::Vector(1, 2, 3), M_PI - 1e-9), c.p);
+  CHECK(std::abs(vereshchagin::poseError(c, flipped).tail<3>().norm() - (M_PI - 1e-9)) < 1e-9);
+}
+
+}  // namespace
