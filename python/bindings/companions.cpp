@@ -1,10 +1,12 @@
 // Companions of Chain and Tree (companions.hpp) on the C++ kinematics and dynamics.
 #include "companions.hpp"
 
+#include <optional>
 #include <string>
 
 #include "dynamics_common.hpp"
 #include "numpy_fast.hpp"
+#include "vereshchagin/task.hpp"
 
 namespace vsbind {
 
@@ -212,6 +214,87 @@ py::array coriolisTorquesOf(const CompanionModel& m, const py::handle& q_obj, co
   Eigen::Map<Eigen::VectorXd> tau(doubles(out), n);
   check(vs::coriolisTorques(c.model, c.dyn, vs::JointPositions(q.row(0, n)), vs::JointVelocities(qd.row(0, n)), tau));
   return finiteResult(out, "coriolis_torques");
+}
+
+}  // namespace vsbind
+
+// ---- task.py's beta_for on the C++ helper (task.hpp) ----
+
+namespace vsbind {
+
+namespace {
+
+// A float64 view of a real array, or nothing (nullopt: not convertible, left to task.py's checks).
+std::optional<F64View> realView(const py::handle& obj) {
+  F64View v;
+  if (detail_np::nativeContiguousF64(obj.ptr())) {
+    detail_np::fill(obj.ptr(), v);
+  } else {
+    if (PyBool_Check(obj.ptr()) || obj.is_none()) return std::nullopt;
+    py::array any = py::array::ensure(obj);
+    if (!any) {
+      PyErr_Clear();
+      return std::nullopt;
+    }
+    const char kind = any.dtype().kind();
+    if ((kind != 'f' && kind != 'i' && kind != 'u') || any.ndim() > 3) return std::nullopt;
+    Array a = Array::ensure(any);
+    if (!a) {
+      PyErr_Clear();
+      return std::nullopt;
+    }
+    v.keep = a;
+    detail_np::fill(a.ptr(), v);
+  }
+  for (py::ssize_t k = 0; k < v.size(); ++k)
+    if (!std::isfinite(v.data[k])) return std::nullopt;
+  return v;
+}
+
+// beta (m,) or, for N twists (N, 6), beta rows (N, m); None when an input is not plainly valid
+// (task.py then raises its own message).
+py::object betaFor(const py::handle& alpha, const py::handle& a_desired, const py::handle& twist,
+                   const py::handle& gravity) {
+  const auto A = realView(alpha), a = realView(a_desired), t = realView(twist), g = realView(gravity);
+  if (!A || !a || !t || !g || g->size() != 3) return py::none();
+  py::ssize_t m = 0;
+  if (A->ndim == 1 && A->shape[0] == 6)
+    m = 1;
+  else if (A->ndim == 2 && A->shape[0] == 6)
+    m = A->shape[1];
+  else
+    return py::none();
+  const bool batched = t->ndim == 2 && t->shape[1] == 6 && t->size() != 6;
+  const py::ssize_t rows = batched ? t->shape[0] : 1;
+  if (!batched && t->size() != 6) return py::none();
+  const bool a_rows = a->size() != 6;
+  if (a_rows && !(batched && a->ndim == 2 && a->shape[0] == rows && a->shape[1] == 6)) return py::none();
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Map<const RowMajor> alfa(A->data, 6, m);
+  const KDL::Vector grav(g->data[0], g->data[1], g->data[2]);
+  py::array out = batched ? newDoubles({rows, m}) : newDoubles({m});
+  for (py::ssize_t r = 0; r < rows; ++r) {
+    const vereshchagin::Vector6 acc = Eigen::Map<const vereshchagin::Vector6>(a->data + (a_rows ? 6 * r : 0));
+    const vereshchagin::Vector6 tw = Eigen::Map<const vereshchagin::Vector6>(t->data + 6 * r);
+    Eigen::Map<Eigen::VectorXd> beta(doubles(out) + m * r, m);
+    beta.noalias() = alfa.transpose() * vereshchagin::spatialFromClassical(acc, tw, grav);
+  }
+  if (!Eigen::Map<const Eigen::VectorXd>(doubles(out), out.size()).allFinite())
+    raise("beta_for: the result overflows the double range (inputs too large)");
+  return std::move(out);
+}
+
+}  // namespace
+
+// Task.solve's beta: the chain tip's twist at (q, qd) and beta_for in one call; None as betaFor.
+py::object taskBeta(const CompanionModel& m, const FrameTarget& tip, const py::handle& q, const py::handle& qd,
+                    const py::handle& alpha, const py::handle& a_desired, const py::handle& gravity) {
+  return betaFor(alpha, a_desired, twistOf(m, q, qd, tip), gravity);
+}
+
+void bindTaskHelpers(py::module_& mod) {
+  mod.def("_beta_for", &betaFor, py::arg("alpha"), py::arg("a_desired"), py::arg("twist"), py::arg("gravity"),
+          "task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself.");
 }
 
 }  // namespace vsbind

@@ -53,4 +53,10 @@ py::array massMatrixOf(const CompanionModel& m, const py::handle& q);
 py::array gravityTorquesOf(const CompanionModel& m, const py::handle& q, const py::handle& gravity);
 py::array coriolisTorquesOf(const CompanionModel& m, const py::handle& q, const py::handle& qd);
 
+// _core._beta_for: task.py's beta_for arithmetic (task.hpp), also for (N, 6) twists.
+void bindTaskHelpers(py::module_& mod);
+// Task.solve's beta: beta_for of the twist of `tip` at (q, qd); None for inputs task.py checks.
+py::object taskBeta(const CompanionModel& m, const FrameTarget& tip, const py::handle& q, const py::handle& qd,
+                    const py::handle& alpha, const py::handle& a_desired, const py::handle& gravity);
+
 }  // namespace vsbind

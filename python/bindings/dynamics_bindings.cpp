@@ -43,6 +43,15 @@ py::array fkAll(const PyChain& c, const py::object& q) {
 }  // namespace
 
 void bindDynamics(py::module_& mod) {
+  bindTaskHelpers(mod);
+  mod.def(
+      "_task_beta",
+      [](const PyChain& c, const py::object& q, const py::object& qd, const py::object& alpha,
+         const py::object& a_desired, const py::object& gravity) {
+        return taskBeta(c, c.resolveOptional(py::none(), "segment"), q, qd, alpha, a_desired, gravity);
+      },
+      py::arg("chain"), py::arg("q"), py::arg("qd"), py::arg("alpha"), py::arg("a_desired"), py::arg("gravity"),
+      "Task.solve's beta (the tip twist and beta_for in one call); None for inputs task.py checks itself.");
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
   chain.def("inverse_dynamics", &inverseDynamics, py::arg("q"), py::arg("qd"), py::arg("qdd"),
             py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity,
