@@ -219,6 +219,11 @@ def main():
     face_rc = run(
         [sys.executable, REPO / "benchmarks" / "bench_python_face.py", "--out", face_file], stdout=subprocess.DEVNULL
     ).returncode
+    comp_file = build / "bench_companions.md"
+    comp_file.unlink(missing_ok=True)
+    comp_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_companions.py", "--out", comp_file], stdout=subprocess.DEVNULL
+    ).returncode
     tree_file = build / "bench_tree.md"
     tree_file.unlink(missing_ok=True)
     tree_rc = run(
@@ -294,6 +299,10 @@ def main():
         face_file.read_text().rstrip()
         if face_file.exists()
         else f"**bench_python_face.py exited with code {face_rc} and wrote no report.**",
+        "",
+        comp_file.read_text().rstrip()
+        if comp_file.exists()
+        else f"**bench_companions.py exited with code {comp_rc} and wrote no report.**",
         "",
         tree_file.read_text().rstrip()
         if tree_file.exists()

@@ -2,10 +2,6 @@
 
 #include <pybind11/stl.h>
 
-#include <kdl/chainfksolverpos_recursive.hpp>
-#include <kdl/chainfksolvervel_recursive.hpp>
-#include <kdl/chainjnttojacsolver.hpp>
-
 #include "dynamics_common.hpp"
 #include "model_properties.hpp"
 #include "model_state.hpp"
@@ -89,6 +85,7 @@ void PyChain::addSegment(const std::string& name, const py::object& joint, const
   const unsigned int seg = robot.chain.getNrOfSegments();
   robot.chain.addSegment(KDL::Segment(name, j, f_tip, KDL::RigidBodyInertia(mass, c, Ic)));
   robot.links.push_back({name, static_cast<int>(seg), KDL::Frame::Identity()});
+  invalidateCompanions();
   this->inertia_check = model_check;  // after every check passed
   if (spec.type != KDL::Joint::Fixed) {
     vereshchagin::JointInfo info;
@@ -120,48 +117,25 @@ void PyChain::setRotorInertia(const py::object& values) {
     rebuilt.addSegment(KDL::Segment(seg.getName(), nj, seg.getFrameToTip(), seg.getInertia()));
   }
   robot.chain = rebuilt;
+  invalidateCompanions();
 }
 
-py::array_t<double> PyChain::fk(const py::object& q_obj, const py::object& segment) const {
-  const KDL::JntArray q = jntArrayArg(q_obj, "q", robot.chain.getNrOfJoints());
-  const Target t = resolveOptional(segment, "segment");
-  const int seg = t.segment;
-  const KDL::Frame& link_in_tip = t.link_in_tip;
-  KDL::Frame f = KDL::Frame::Identity();
-  if (seg >= 0) {
-    KDL::ChainFkSolverPos_recursive solver(robot.chain);
-    if (solver.JntToCart(q, f, seg + 1) < 0) raise("forward kinematics failed");
-  }
-  return homogeneous(f * link_in_tip);
+py::array PyChain::fk(const py::object& q_obj, const py::object& segment) const {
+  return fkOf(*this, q_obj, resolveOptional(segment, "segment"));
 }
 
-py::array_t<double> PyChain::jacobian(const py::object& q_obj, const py::object& segment) const {
-  const unsigned int n = robot.chain.getNrOfJoints();
-  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
-  const Target t = resolveOptional(segment, "segment");
-  const int seg = t.segment;
-  const KDL::Frame& link_in_tip = t.link_in_tip;
-  KDL::Jacobian J(n);
-  J.data.setZero();
-  if (seg >= 0) {
-    KDL::ChainJntToJacSolver solver(robot.chain);
-    if (solver.JntToJac(q, J, seg + 1) < 0) raise("Jacobian computation failed");
-    // Move the reference point from the segment tip to the link origin (base axes).
-    KDL::ChainFkSolverPos_recursive fks(robot.chain);
-    KDL::Frame f;
-    fks.JntToCart(q, f, seg + 1);
-    J.changeRefPoint(f.M * link_in_tip.p);
-  }
-  py::array_t<double> out({static_cast<py::ssize_t>(6), static_cast<py::ssize_t>(n)});
-  auto o = out.mutable_unchecked<2>();
-  for (int r = 0; r < 6; ++r)
-    for (unsigned int c = 0; c < n; ++c) o(r, c) = J.data(r, c);
-  return out;
+py::array PyChain::jacobian(const py::object& q_obj, const py::object& segment) const {
+  return jacobianOf(*this, q_obj, resolveOptional(segment, "segment"));
 }
 
-py::array_t<double> PyChain::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& segment) const {
-  py::array_t<double> J = jacobian(q_obj, segment);
-  return twistOf(J, vectorArg(qd_obj, "qd", robot.chain.getNrOfJoints()));
+py::array PyChain::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& segment) const {
+  return twistOf(*this, q_obj, qd_obj, resolveOptional(segment, "segment"));
+}
+
+vereshchagin::Model PyChain::buildModel() const {
+  vereshchagin::ModelOptions options;
+  options.inertia_check = inertia_check;
+  return vereshchagin::Model(robot, options);
 }
 
 py::tuple PyChain::getState() const {

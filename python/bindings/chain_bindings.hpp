@@ -11,6 +11,7 @@
 
 #include "addressing.hpp"
 #include "common.hpp"
+#include "companions.hpp"
 
 namespace vsbind {
 
@@ -72,7 +73,7 @@ inline Array rotorInertiaArg(const py::object& values, size_t n_joints) {
 
 // The Python Chain: a RobotChain (KDL::Chain plus joint and link metadata), built segment by
 // segment or from a URDF. Frames and joints are addressed by the rule of addressing.hpp.
-struct PyChain : Addressable {
+struct PyChain : CompanionModel {
   vereshchagin::RobotChain robot;
   // The inertia check the model was built with: JointSpace once any part of it was accepted only
   // by that check (from_kdl, from_urdf or add_segment with inertia_check='joint_space'). A Solver
@@ -97,9 +98,12 @@ struct PyChain : Addressable {
                   const std::string& joint_name, const std::string& inertia_check);
   py::array_t<double> rotorInertia() const;
   void setRotorInertia(const py::object& values);
-  py::array_t<double> fk(const py::object& q, const py::object& segment) const;
-  py::array_t<double> jacobian(const py::object& q, const py::object& segment) const;
-  py::array_t<double> twist(const py::object& q, const py::object& qd, const py::object& segment) const;
+  py::array fk(const py::object& q, const py::object& segment) const;
+  py::array jacobian(const py::object& q, const py::object& segment) const;
+  py::array twist(const py::object& q, const py::object& qd, const py::object& segment) const;
+
+ protected:
+  vereshchagin::Model buildModel() const override;
 };
 
 void bindChain(py::module_& mod);

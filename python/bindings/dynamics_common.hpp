@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include <kdl/jntarray.hpp>
+#include <Eigen/Core>
 
 #include "addressing.hpp"
 #include "common.hpp"
@@ -19,36 +19,6 @@ inline const std::vector<double> kEarthGravity{0.0, 0.0, -9.81};
 inline void requireFiniteResult(const double* p, size_t n, const char* what) {
   for (size_t k = 0; k < n; ++k)
     if (!std::isfinite(p[k])) raise(std::string(what) + ": the result overflows the double range");
-}
-
-// The twist J qd (6,) of a frame from its Jacobian (6, n), checked finite.
-inline py::array_t<double> twistOf(const py::array_t<double>& J, const Array& qd) {
-  const auto j = J.unchecked<2>();
-  py::array_t<double> out(6);
-  for (py::ssize_t r = 0; r < 6; ++r) {
-    double v = 0.0;
-    for (py::ssize_t c = 0; c < j.shape(1); ++c) v += j(r, c) * qd.at(c);
-    out.mutable_data()[r] = v;
-  }
-  requireFiniteResult(out.data(), 6, "twist");
-  return out;
-}
-
-// Joint torques (n,) as a new numpy array, checked finite.
-inline py::array_t<double> jointTorques(const KDL::JntArray& tau, const char* what) {
-  requireFiniteResult(tau.data.data(), tau.rows(), what);
-  return copyVector(tau.data.data(), tau.rows());
-}
-
-// A square joint-space matrix (n, n) as a new numpy array, checked finite.
-inline py::array_t<double> jointMatrix(const Eigen::MatrixXd& H, const char* what) {
-  requireFiniteResult(H.data(), static_cast<size_t>(H.size()), what);
-  const auto n = static_cast<py::ssize_t>(H.rows());
-  py::array_t<double> out({n, n});
-  auto o = out.mutable_unchecked<2>();
-  for (py::ssize_t r = 0; r < n; ++r)
-    for (py::ssize_t k = 0; k < n; ++k) o(r, k) = H(r, k);
-  return out;
 }
 
 // f_ext of the dynamics companions as n_segments rows [force, moment] (base axes, moment about
@@ -84,14 +54,6 @@ std::vector<Eigen::Matrix<double, 6, 1>> externalWrenchRows(const py::object& f_
     for (int k = 0; k < 3; ++k) row(k) += force(k), row(3 + k) += moment(k);
   }
   return rows;
-}
-
-// Frames as a new (n, 4, 4) array of homogeneous transforms.
-inline py::array_t<double> homogeneousStack(const std::vector<KDL::Frame>& frames) {
-  py::array_t<double> out(
-      {static_cast<py::ssize_t>(frames.size()), static_cast<py::ssize_t>(4), static_cast<py::ssize_t>(4)});
-  for (size_t i = 0; i < frames.size(); ++i) writeHomogeneous(frames[i], out.mutable_data() + 16 * i);
-  return out;
 }
 
 }  // namespace vsbind

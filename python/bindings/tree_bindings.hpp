@@ -23,7 +23,7 @@ inline bool isPrismatic(KDL::Joint::JointType type) {
          type == KDL::Joint::TransZ;
 }
 
-struct PyTree : Addressable {
+struct PyTree : CompanionModel {
   vereshchagin::RobotTree robot;
   vereshchagin::InertiaCheck inertia_check = vereshchagin::InertiaCheck::Physical;  // as PyChain's
 
@@ -46,14 +46,17 @@ struct PyTree : Addressable {
   unsigned int qIndex(int index) const;
   // Segment indices from the base's child down to `index`.
   std::vector<int> pathTo(int index) const;
-  py::array_t<double> fk(const py::object& q, const py::object& segment) const;
-  py::array_t<double> jacobian(const py::object& q, const py::object& segment) const;
-  py::array_t<double> twist(const py::object& q, const py::object& qd, const py::object& segment) const;
+  py::array fk(const py::object& q, const py::object& segment) const;
+  py::array jacobian(const py::object& q, const py::object& segment) const;
+  py::array twist(const py::object& q, const py::object& qd, const py::object& segment) const;
   // Rotor inertia of each joint in q order; the setter rebuilds the KDL::Tree with it.
   py::array_t<double> rotorInertia() const;
   void setRotorInertia(const py::object& values);
   // The serial chain from the base to a segment: that path's segments, joints and links only.
   PyChain pathChain(const py::object& tip) const;
+
+ protected:
+  vereshchagin::Model buildModel() const override;
 };
 
 void bindTree(py::module_& mod);

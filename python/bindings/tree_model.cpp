@@ -112,52 +112,29 @@ void PyTree::setRotorInertia(const py::object& values) {
                   robot.parent[static_cast<std::size_t>(i)], "rotor_inertia");
   }
   vereshchagin::copyTree(rebuilt, robot.tree);  // KDL::Tree's assignment recurses per level
+  invalidateCompanions();
 }
 
-py::array_t<double> PyTree::fk(const py::object& q_obj, const py::object& which) const {
-  const KDL::JntArray q = jntArrayArg(q_obj, "q", robot.tree.getNrOfJoints());
-  const Target t = resolveTarget(which.ptr(), "segment");
-  KDL::Frame f = KDL::Frame::Identity();
-  if (t.segment >= 0)
-    for (int s : pathTo(t.segment)) f = f * segment(s).pose(q(qIndex(s)));
-  return homogeneous(f * t.link_in_tip);
+py::array PyTree::fk(const py::object& q_obj, const py::object& which) const {
+  return fkOf(*this, q_obj, resolveTarget(which.ptr(), "segment"));
 }
 
-py::array_t<double> PyTree::jacobian(const py::object& q_obj, const py::object& which) const {
-  const unsigned int n = robot.tree.getNrOfJoints();
-  const KDL::JntArray q = jntArrayArg(q_obj, "q", n);
-  const Target t = resolveTarget(which.ptr(), "segment");
-  py::array_t<double> out({static_cast<py::ssize_t>(6), static_cast<py::ssize_t>(n)});
-  auto o = out.mutable_unchecked<2>();
-  for (int r = 0; r < 6; ++r)
-    for (unsigned int c = 0; c < n; ++c) o(r, c) = 0.0;
-  if (t.segment < 0) return out;
-  const std::vector<int> path = pathTo(t.segment);
-  std::vector<KDL::Frame> root_of(path.size());  // each path segment's root frame in the base
-  KDL::Frame f = KDL::Frame::Identity();
-  for (std::size_t k = 0; k < path.size(); ++k) {
-    root_of[k] = f;
-    f = f * segment(path[k]).pose(q(qIndex(path[k])));
-  }
-  const KDL::Vector point = f * t.link_in_tip.p;  // the reference point: the frame's origin
-  for (std::size_t k = 0; k < path.size(); ++k) {
-    const KDL::Joint& joint = segment(path[k]).getJoint();
-    if (joint.getType() == KDL::Joint::None) continue;
-    const KDL::Vector axis = root_of[k].M * joint.JointAxis();
-    const KDL::Vector linear = isPrismatic(joint.getType()) ? axis : axis * (point - root_of[k] * joint.JointOrigin());
-    const KDL::Vector angular = isPrismatic(joint.getType()) ? KDL::Vector::Zero() : axis;
-    const unsigned int c = qIndex(path[k]);
-    for (int r = 0; r < 3; ++r) {
-      o(r, c) = linear(r);
-      o(r + 3, c) = angular(r);
-    }
-  }
-  return out;
+py::array PyTree::jacobian(const py::object& q_obj, const py::object& which) const {
+  return jacobianOf(*this, q_obj, resolveTarget(which.ptr(), "segment"));
 }
 
-py::array_t<double> PyTree::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& which) const {
-  const Array qd = vectorArg(qd_obj, "qd", robot.tree.getNrOfJoints());
-  return twistOf(jacobian(q_obj, which), qd);
+py::array PyTree::twist(const py::object& q_obj, const py::object& qd_obj, const py::object& which) const {
+  return twistOf(*this, q_obj, qd_obj, resolveTarget(which.ptr(), "segment"));
+}
+
+// The tree's Model: its segment order (preorder of the KDL::Tree's children) is the PyTree's.
+vereshchagin::Model PyTree::buildModel() const {
+  vereshchagin::ModelOptions options;
+  options.inertia_check = inertia_check;
+  vereshchagin::Model model(robot, options);
+  if (model.segmentNames() != robot.segment_names)
+    raise("internal error: the tree's C++ model orders its segments differently");
+  return model;
 }
 
 PyChain PyTree::pathChain(const py::object& tip) const {

@@ -20,7 +20,7 @@ from typing import Sequence, Union
 
 import numpy as np
 
-from ._core import SolverError
+from ._core import Chain, SolverError, _beta_for, _task_beta
 
 __all__ = ["Task", "beta_for", "directions", "pose_error", "twist_error"]
 
@@ -119,16 +119,17 @@ def beta_for(alpha, a_desired, twist, gravity=_G_EARTH) -> np.ndarray:
         ``[a_lin; a_ang]``: classical acceleration of the tip origin (the second time derivative of
         its position, m/s^2) and angular acceleration (rad/s^2), base axes. Components outside the
         span of ``alpha`` are ignored.
-    twist : array_like, shape (6,)
+    twist : array_like, shape (6,) or (N, 6)
         Tip twist ``[v; omega]`` (velocity of the tip origin, angular velocity), base axes, e.g.
-        ``chain.twist(q, qd)``.
+        ``chain.twist(q, qd)``; N rows (``chain.twist`` of (N, n) states) give N rows of beta,
+        with ``a_desired`` one (6,) for all or (N, 6).
     gravity : array_like, shape (3,)
         Physical gravity, the same as the solver's (default ``[0, 0, -9.81]``).
 
     Returns
     -------
-    ndarray, shape (m,)
-        ``alpha.T @ [a_lin - omega x v - gravity; a_ang]``.
+    ndarray, shape (m,) or (N, m)
+        ``alpha.T @ [a_lin - omega x v - gravity; a_ang]`` (computed in C++, vereshchagin/task.hpp).
 
     Raises
     ------
@@ -144,6 +145,9 @@ def beta_for(alpha, a_desired, twist, gravity=_G_EARTH) -> np.ndarray:
     every linear acceleration it reports or constrains. Holding the tip still (``a_desired = 0``)
     therefore needs ``beta = alpha.T @ [-omega x v - gravity; 0]``, not 0.
     """
+    beta = _beta_for(alpha, a_desired, twist, gravity)  # None: not plainly valid, checked below
+    if beta is not None:
+        return beta
     A = _real_array(alpha, "alpha")
     if A.ndim == 1:
         A = A.reshape(6, 1) if A.shape == (6,) else A
@@ -262,5 +266,8 @@ class Task:
         ``chain`` must be the chain the solver was built from; ``kwargs`` (``f_ext``, ``tau_ff``)
         go to :meth:`Solver.solve`.
         """
-        beta = beta_for(self.alpha, a_desired, chain.twist(q, qd), solver.gravity)
+        gravity = solver.gravity
+        beta = _task_beta(chain, q, qd, self.alpha, a_desired, gravity) if type(chain) is Chain else None
+        if beta is None:  # not a Chain, or inputs beta_for must check and report
+            beta = beta_for(self.alpha, a_desired, chain.twist(q, qd), gravity)
         return solver.solve(q, qd, self.alpha, beta, **kwargs)
