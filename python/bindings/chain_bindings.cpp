@@ -176,80 +176,29 @@ namespace {
 
 // Joint: the joint types of Chain.add_segment.
 void bindJointSpec(py::module_& mod) {
-  py::class_<JointSpec>(mod, "Joint", R"doc(A joint type for :meth:`Chain.add_segment`, made by the static methods.
-
-``Joint.revolute(axis, origin)`` and ``Joint.prismatic(axis, origin)`` give a rotation about, or
-a translation along, the line through ``origin`` along ``axis`` (root-frame coordinates, m);
-``Joint.fixed()`` a rigid connection. The strings ``'rot_x'`` ... ``'trans_z'`` and ``'fixed'``
-name the axis-aligned cases.
-)doc")
+  py::class_<JointSpec>(mod, "Joint", doc("Joint"))
       .def_static(
           "revolute",
           [](const py::object& axis, const py::object& origin) {
             return makeAxisJoint(KDL::Joint::RotAxis, axis, origin);
           },
-          py::arg("axis"), py::arg("origin") = py::none(),
-          "Rotation about the line through ``origin`` (3,), m, along ``axis`` (3,), normalised; root-frame "
-          "coordinates.")
+          py::arg("axis"), py::arg("origin") = py::none(), doc("Joint.revolute"))
       .def_static(
           "prismatic",
           [](const py::object& axis, const py::object& origin) {
             return makeAxisJoint(KDL::Joint::TransAxis, axis, origin);
           },
-          py::arg("axis"), py::arg("origin") = py::none(),
-          "Translation along ``axis`` (3,), normalised, root-frame coordinates (``origin`` only places the axis line).")
+          py::arg("axis"), py::arg("origin") = py::none(), doc("Joint.prismatic"))
       .def_static(
-          "fixed", []() { return JointSpec(); }, "A rigid connection (no joint variable).")
+          "fixed", []() { return JointSpec(); }, doc("Joint.fixed"))
       .def("__repr__", &JointSpec::repr);
 }
 
 // fk, jacobian and twist of any segment (or link) of a Chain.
 void bindChainKinematics(py::class_<PyChain>& cls) {
-  cls.def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(), R"doc(Pose of a frame in the base frame.
-
-Parameters
-----------
-q : array_like, shape (n,)
-    Joint positions, rad or m.
-segment : str or int, optional
-    Segment name or index (negative from the end; default: the last segment's tip), a link
-    merged into a segment (its own frame), or the base link's name (identity).
-
-Returns
--------
-ndarray, shape (4, 4)
-    Homogeneous transform of the frame in the base frame (m).
-)doc")
-      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(),
-           R"doc(Geometric Jacobian of a frame.
-
-Parameters
-----------
-q : array_like, shape (n,)
-segment : str or int, optional
-    As in :meth:`fk` (default: the last segment's tip).
-
-Returns
--------
-ndarray, shape (6, n)
-    Rows ``[linear; angular]``: the velocity of the frame's origin and the angular velocity,
-    base-frame axes, per unit joint velocity (zero for the base).
-)doc")
-      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
-           R"doc(Velocity of a frame.
-
-Parameters
-----------
-q, qd : array_like, shape (n,)
-segment : str or int, optional
-    As in :meth:`fk` (default: the last segment's tip).
-
-Returns
--------
-ndarray, shape (6,)
-    ``[v; omega]``: linear velocity of the frame's origin (m/s) and angular velocity (rad/s),
-    base-frame axes; ``jacobian(q, segment) @ qd``.
-)doc");
+  cls.def("fk", &PyChain::fk, py::arg("q"), py::arg("segment") = py::none(), doc("Chain.fk"))
+      .def("jacobian", &PyChain::jacobian, py::arg("q"), py::arg("segment") = py::none(), doc("Chain.jacobian"))
+      .def("twist", &PyChain::twist, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(), doc("Chain.twist"));
 }
 
 }  // namespace
@@ -257,51 +206,14 @@ ndarray, shape (6,)
 void bindChain(py::module_& mod) {
   bindJointSpec(mod);
 
-  py::class_<PyChain> cls(mod, "Chain",
-                          R"doc(A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
-
-Build it segment by segment with :meth:`add_segment`, or from a URDF with :meth:`from_urdf`
-(fixed joints merged into their parent links). Joint metadata (limits, friction, damping, rotor
-inertia) and the names of merged links are kept. Frames are addressed by segment name, merged link
-name, or index (negative from the end); the base only by its link name (:attr:`root_link`).
-Chains pickle and copy.
-)doc");
+  py::class_<PyChain> cls(mod, "Chain", doc("Chain"));
   bindJointData(cls);
-  bindNamesAndIndices(cls,
-                      "list of str: approximations made while building the chain (lumped branches, merged links).");
+  bindNamesAndIndices(cls);
   cls.def(py::init<>())
-      .def("add_segment", &PyChain::addSegment, R"doc(Append a segment (a joint followed by a rigid body).
-
-Parameters
-----------
-name : str
-    Segment (link) name.
-joint : str or Joint
-    'rot_x', 'rot_y', 'rot_z', 'trans_x', 'trans_y', 'trans_z' (about / along the axes of the
-    segment's root frame, i.e. the previous segment's tip frame), 'fixed', or
-    Joint.revolute(axis, origin) (rotation about the line through ``origin`` along ``axis``) /
-    Joint.prismatic(axis) (translation along ``axis``), in the root frame.
-tip : array_like, shape (4, 4), optional
-    Pose of the segment's tip frame in its root frame when the joint is at 0 (KDL convention).
-mass : float
-    kg, >= 0.
-com : array_like, shape (3,), optional
-    Centre of mass in the tip frame, m.
-inertia : array_like, shape (3, 3), optional
-    Rotational inertia about the centre of mass, tip-frame axes, kg m^2 (symmetric PSD).
-rotor_inertia : float
-    Motor rotor inertia reflected to the joint (kg m^2 or kg), added to the joint's inertia.
-joint_name : str, optional
-    Defaults to ``name + '_joint'``.
-inertia_check : {'physical', 'joint_space'}
-    'physical' (default): the body must be a rigid body (PSD inertia whose principal moments obey
-    the triangle inequality). 'joint_space': any symmetric inertia (identified models); the chain
-    then remembers it (:attr:`inertia_check`) and a ``Solver`` of it checks that H(q) is positive
-    definite at each solve.
-)doc",
-           py::arg("name"), py::arg("joint"), py::arg("tip") = py::none(), py::arg("mass") = 0.0,
-           py::arg("com") = py::none(), py::arg("inertia") = py::none(), py::arg("rotor_inertia") = 0.0,
-           py::arg("joint_name") = "", py::arg("inertia_check") = "physical")
+      .def("add_segment", &PyChain::addSegment, doc("Chain.add_segment"), py::arg("name"), py::arg("joint"),
+           py::arg("tip") = py::none(), py::arg("mass") = 0.0, py::arg("com") = py::none(),
+           py::arg("inertia") = py::none(), py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "",
+           py::arg("inertia_check") = "physical")
       .def_static(
           "from_urdf",
           [](const py::object& source, const std::string& root, const std::string& tip,
@@ -309,27 +221,13 @@ inertia_check : {'physical', 'joint_space'}
             return PyChain::fromUrdf(source, root, tip, inertiaCheckArg(inertia_check, ""));
           },
           py::arg("source"), py::arg("root") = "", py::arg("tip") = "", py::arg("inertia_check") = "physical",
-          R"doc(Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
-
-Fixed joints are merged into their parent link (masses and inertias combined); the last
-segment's tip frame is the ``tip`` link's frame. Defaults: the URDF's root link and its single
-leaf. Raises SolverError for malformed XML, unknown links, tip not below root, floating, planar
-or mimic joints on the path, negative mass, or (``inertia_check='physical'``, the default) a
-link inertia that no rigid body has (not PSD, or principal moments violating the triangle
-inequality); ``inertia_check='joint_space'`` accepts identified models (any symmetric inertia;
-the chain remembers the option, and a ``Solver`` of it uses the joint-space check).
-)doc")
+          doc("Chain.from_urdf"))
       .def_property_readonly(
-          "n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); },
-          "int: number of moving joints n (the length of q, qd, tau_ff).")
+          "n_joints", [](const PyChain& c) { return c.robot.chain.getNrOfJoints(); }, doc("Chain.n_joints"))
       .def_property_readonly(
-          "n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); },
-          "int: number of segments (moving joints plus fixed-joint segments; rows of f_ext).")
-      .def_property_readonly("segment_names", &PyChain::segmentNames,
-                             "list of str: segment names, base to tip (a URDF segment is named after its link).")
-      .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia,
-                    "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg (settable; added to the "
-                    "joint's articulated inertia).")
+          "n_segments", [](const PyChain& c) { return c.robot.chain.getNrOfSegments(); }, doc("Chain.n_segments"))
+      .def_property_readonly("segment_names", &PyChain::segmentNames, doc("Chain.segment_names"))
+      .def_property("rotor_inertia", &PyChain::rotorInertia, &PyChain::setRotorInertia, doc("Chain.rotor_inertia"))
       .def_property_readonly(
           "segment_masses",
           [](const PyChain& c) {
@@ -338,7 +236,7 @@ the chain remembers the option, and a ``Solver`` of it uses the joint-space chec
               m.mutable_data()[i] = c.robot.chain.getSegment(i).getInertia().getMass();
             return m;
           },
-          "ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg.");
+          doc("Chain.segment_masses"));
   bindChainKinematics(cls);
   cls.def(py::pickle([](const PyChain& c) { return c.getState(); },
                      [](const py::tuple& t) { return PyChain::fromState(t); }))

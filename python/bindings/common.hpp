@@ -24,8 +24,13 @@ struct SolverError : std::runtime_error {
 };
 
 // The docstring `key` of vereshchagin/_docstrings.py, where the Python API is documented once
-// (module.cpp). The text stays alive for the interpreter's lifetime.
+// (module.cpp); `key` is the Python-visible dotted name ("Chain.fk", "_core.Solver.solve"). Only
+// from the bind functions (DOCS is imported when module initialisation starts), never from a
+// namespace-scope initialiser. The text stays alive for the interpreter's lifetime.
 const char* doc(const char* key);
+inline const char* doc(const std::string& key) {
+  return doc(key.c_str());
+}
 
 [[noreturn]] inline void raise(const std::string& msg) {
   throw SolverError(msg);

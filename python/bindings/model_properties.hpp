@@ -1,6 +1,6 @@
 // The Python properties and methods Chain and Tree share (joint data, names, addressing), bound
 // once for both: Model is PyChain or PyTree (an Addressable with a `robot` holding joints, links,
-// root_link and notes).
+// root_link and notes). Docstrings: DOCS["Chain.<name>"] and DOCS["Tree.<name>"] (_docstrings.py).
 #pragma once
 
 #include <string>
@@ -15,10 +15,18 @@
 
 namespace vsbind {
 
+// docOf("lower") is the docstring DOCS["Chain.lower"] or DOCS["Tree.lower"], after the class's name.
+template <class Model>
+auto memberDocs(const py::class_<Model>& cls) {
+  const std::string prefix = cls.attr("__name__").template cast<std::string>() + ".";
+  return [prefix](const char* member) { return doc(prefix + member); };
+}
+
 // The joints' names, types, limits, friction and damping, in q order.
 template <class Model>
 void bindJointData(py::class_<Model>& cls) {
   using vereshchagin::JointInfo;
+  const auto docOf = memberDocs(cls);
   const auto field = [](double JointInfo::*f) {
     return [f](const Model& m) {
       const std::vector<JointInfo>& joints = m.jointInfos();
@@ -27,7 +35,7 @@ void bindJointData(py::class_<Model>& cls) {
       return a;
     };
   };
-  cls.def_property_readonly("joint_names", &Model::jointNames, "list of str: moving joint names in q order.")
+  cls.def_property_readonly("joint_names", &Model::jointNames, docOf("joint_names"))
       .def_property_readonly(
           "joint_types",
           [](const Model& m) {
@@ -35,40 +43,26 @@ void bindJointData(py::class_<Model>& cls) {
             for (const auto& j : m.jointInfos()) types.push_back(j.type);
             return types;
           },
-          "list of str: 'revolute', 'continuous' or 'prismatic' per moving joint.")
-      .def_property_readonly(
-          "lower", field(&JointInfo::lower),
-          "ndarray (n,): lower position limits, rad or m (-inf: none; URDF continuous joints have none).")
-      .def_property_readonly("upper", field(&JointInfo::upper),
-                             "ndarray (n,): upper position limits, rad or m (+inf: none).")
-      .def_property_readonly(
-          "velocity_limit", field(&JointInfo::velocity_limit),
-          "ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver.")
-      .def_property_readonly("effort_limit", field(&JointInfo::effort_limit),
-                             "ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver.")
-      .def_property_readonly(
-          "friction", field(&JointInfo::friction),
-          "ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>); "
-          "used by friction=True.")
-      .def_property_readonly(
-          "damping", field(&JointInfo::damping),
-          "ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not "
-          "applied by the solver.");
+          docOf("joint_types"))
+      .def_property_readonly("lower", field(&JointInfo::lower), docOf("lower"))
+      .def_property_readonly("upper", field(&JointInfo::upper), docOf("upper"))
+      .def_property_readonly("velocity_limit", field(&JointInfo::velocity_limit), docOf("velocity_limit"))
+      .def_property_readonly("effort_limit", field(&JointInfo::effort_limit), docOf("effort_limit"))
+      .def_property_readonly("friction", field(&JointInfo::friction), docOf("friction"))
+      .def_property_readonly("damping", field(&JointInfo::damping), docOf("damping"));
 }
 
 // The base, the links, the notes, segment_index and joint_index.
 template <class Model>
-void bindNamesAndIndices(py::class_<Model>& cls, const char* notes_doc) {
+void bindNamesAndIndices(py::class_<Model>& cls) {
+  const auto docOf = memberDocs(cls);
   cls.def_property_readonly(
-         "root_link", [](const Model& m) { return m.rootLink(); },
-         "str: name of the base link (the base frame); the base is addressed by this name only.")
+         "root_link", [](const Model& m) { return m.rootLink(); }, docOf("root_link"))
       .def_property_readonly(
-          "notes", [](const Model& m) { return m.robot.notes; }, notes_doc)
+          "notes", [](const Model& m) { return m.robot.notes; }, docOf("notes"))
       .def_property_readonly(
           "inertia_check", [](const Model& m) { return vereshchagin::inertiaCheckName(m.inertia_check); },
-          "str: the inertia check the model was built with, 'physical' or 'joint_space' (once any part was "
-          "accepted only by 'joint_space': from_kdl, or from_urdf / add_segment with that option). A Solver "
-          "uses it unless given inertia_check.")
+          docOf("inertia_check"))
       .def_property_readonly(
           "link_names",
           [](const Model& m) {
@@ -76,46 +70,15 @@ void bindNamesAndIndices(py::class_<Model>& cls, const char* notes_doc) {
             for (const auto& l : m.linkPlacements()) names.push_back(l.link);
             return names;
           },
-          "list of str: every URDF link of the model (segments, merged links, base links); segment and merged link "
-          "names address frames in fk, jacobian, twist, constraints= and f_ext dicts; base links only in fk, jacobian "
-          "and twist.")
+          docOf("link_names"))
       .def(
           "segment_index",
           [](const Model& m, const py::object& which) { return m.resolveMoving(which.ptr(), "segment_index").segment; },
-          py::arg("name"), R"doc(Index of a segment.
-
-Parameters
-----------
-name : str or int
-    A segment name, the name of a link merged into a segment by fixed joints (its segment's
-    index), or an index (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_segments - 1``.
-
-Raises
-------
-SolverError
-    Unknown names (the message lists the segments), indices out of range, and the base link
-    (it is no segment; ``fk``, ``jacobian`` and ``twist`` accept it by name).
-)doc")
+          py::arg("name"), docOf("segment_index"))
       .def(
           "joint_index",
           [](const Model& m, const py::object& which) { return m.resolveJoint(which.ptr(), "joint_index"); },
-          py::arg("name"), R"doc(Index of a moving joint in q.
-
-Parameters
-----------
-name : str or int
-    A joint name or an index (negative from the end).
-
-Returns
--------
-int
-    In ``0 .. n_joints - 1``.
-)doc");
+          py::arg("name"), docOf("joint_index"));
 }
 
 }  // namespace vsbind

@@ -77,25 +77,7 @@ py::dict segmentSpec(const PyChain& c, const py::object& which) {
 
 void bindSegmentSpec(py::module_& mod) {
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
-  chain.def("segment_spec", &segmentSpec, py::arg("segment"),
-            R"doc(One segment described by the arguments of :meth:`add_segment`.
-
-Parameters
-----------
-segment : str or int
-    Segment name or index (negative from the end), or a merged link's name (its segment).
-
-Returns
--------
-dict
-    ``name`` (str); ``joint_type`` ('rot_x', 'rot_y', 'rot_z', 'trans_x', 'trans_y', 'trans_z',
-    'revolute', 'prismatic' or 'fixed'); ``axis`` (ndarray (3,), unit, segment root frame; None
-    for a fixed joint); ``origin`` (ndarray (3,), m: a point on a 'revolute' axis, root frame;
-    zeros for the other types); ``joint_name`` (str); ``tip`` (ndarray (4, 4), tip pose in the
-    root frame at joint position 0); ``mass`` (kg); ``com`` (ndarray (3,), m, tip frame);
-    ``inertia`` (ndarray (3, 3), kg m^2, about the centre of mass, tip-frame axes);
-    ``rotor_inertia`` (kg m^2 or kg; 0 for a fixed joint).
-)doc");
+  chain.def("segment_spec", &segmentSpec, py::arg("segment"), doc("Chain.segment_spec"));
 }
 
 }  // namespace vsbind

@@ -1,10 +1,345 @@
 """Docstrings of the compiled module ``vereshchagin._core``, written once, here.
 
 The bindings (``python/bindings``) attach ``DOCS[key]`` to the class, method or property named by
-``key`` when the module is imported; the type stubs (``_core.pyi``) hold the signatures only.
+``key`` when the module is imported; the type stubs (``_core.pyi``) hold the signatures only. A key
+is the Python-visible dotted name in ``_core`` (``"Chain.fk"``, ``"Tree.mass_matrix"``); the C++
+core of the Python ``Solver`` class and the module's own names carry a ``_core.`` prefix
+(``"_core.Solver.solve"``, ``"_core._beta_for"``). Texts that Chain and Tree share are written
+once below and entered under both keys.
 """
 
+# The texts keep their own line breaks (one docstring line per source line), which ruff format
+# would rearrange around the long first lines: it leaves this file to the end alone.
+# fmt: off
+
 DOCS = {}
+
+# ---- Joint (chain_bindings.cpp) ----
+
+DOCS["Joint"] = r"""A joint type for :meth:`Chain.add_segment`, made by the static methods.
+
+``Joint.revolute(axis, origin)`` and ``Joint.prismatic(axis, origin)`` give a rotation about, or
+a translation along, the line through ``origin`` along ``axis`` (root-frame coordinates, m);
+``Joint.fixed()`` a rigid connection. The strings ``'rot_x'`` ... ``'trans_z'`` and ``'fixed'``
+name the axis-aligned cases.
+"""
+
+DOCS["Joint.revolute"] = r"""Rotation about the line through ``origin`` (3,), m, along ``axis`` (3,), normalised; root-frame coordinates."""
+
+DOCS["Joint.prismatic"] = r"""Translation along ``axis`` (3,), normalised, root-frame coordinates (``origin`` only places the axis line)."""
+
+DOCS["Joint.fixed"] = r"""A rigid connection (no joint variable)."""
+
+# ---- Chain (chain_bindings.cpp, segment_spec_bindings.cpp) ----
+
+DOCS["Chain"] = r"""A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
+
+Build it segment by segment with :meth:`add_segment`, or from a URDF with :meth:`from_urdf`
+(fixed joints merged into their parent links). Joint metadata (limits, friction, damping, rotor
+inertia) and the names of merged links are kept. Frames are addressed by segment name, merged link
+name, or index (negative from the end); the base only by its link name (:attr:`root_link`).
+Chains pickle and copy.
+"""
+
+DOCS["Chain.notes"] = r"""list of str: approximations made while building the chain (lumped branches, merged links)."""
+
+DOCS["Chain.add_segment"] = r"""Append a segment (a joint followed by a rigid body).
+
+Parameters
+----------
+name : str
+    Segment (link) name.
+joint : str or Joint
+    'rot_x', 'rot_y', 'rot_z', 'trans_x', 'trans_y', 'trans_z' (about / along the axes of the
+    segment's root frame, i.e. the previous segment's tip frame), 'fixed', or
+    Joint.revolute(axis, origin) (rotation about the line through ``origin`` along ``axis``) /
+    Joint.prismatic(axis) (translation along ``axis``), in the root frame.
+tip : array_like, shape (4, 4), optional
+    Pose of the segment's tip frame in its root frame when the joint is at 0 (KDL convention).
+mass : float
+    kg, >= 0.
+com : array_like, shape (3,), optional
+    Centre of mass in the tip frame, m.
+inertia : array_like, shape (3, 3), optional
+    Rotational inertia about the centre of mass, tip-frame axes, kg m^2 (symmetric PSD).
+rotor_inertia : float
+    Motor rotor inertia reflected to the joint (kg m^2 or kg), added to the joint's inertia.
+joint_name : str, optional
+    Defaults to ``name + '_joint'``.
+inertia_check : {'physical', 'joint_space'}
+    'physical' (default): the body must be a rigid body (PSD inertia whose principal moments obey
+    the triangle inequality). 'joint_space': any symmetric inertia (identified models); the chain
+    then remembers it (:attr:`inertia_check`) and a ``Solver`` of it checks that H(q) is positive
+    definite at each solve.
+"""
+
+DOCS["Chain.from_urdf"] = r"""Build the serial chain from ``root`` to ``tip`` of a URDF (file path or XML text).
+
+Fixed joints are merged into their parent link (masses and inertias combined); the last
+segment's tip frame is the ``tip`` link's frame. Defaults: the URDF's root link and its single
+leaf. Raises SolverError for malformed XML, unknown links, tip not below root, floating, planar
+or mimic joints on the path, negative mass, or (``inertia_check='physical'``, the default) a
+link inertia that no rigid body has (not PSD, or principal moments violating the triangle
+inequality); ``inertia_check='joint_space'`` accepts identified models (any symmetric inertia;
+the chain remembers the option, and a ``Solver`` of it uses the joint-space check).
+"""
+
+DOCS["Chain.n_joints"] = r"""int: number of moving joints n (the length of q, qd, tau_ff)."""
+
+DOCS["Chain.n_segments"] = r"""int: number of segments (moving joints plus fixed-joint segments; rows of f_ext)."""
+
+DOCS["Chain.segment_names"] = r"""list of str: segment names, base to tip (a URDF segment is named after its link)."""
+
+DOCS["Chain.rotor_inertia"] = r"""ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg (settable; added to the joint's articulated inertia)."""
+
+DOCS["Chain.fk"] = r"""Pose of a frame in the base frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+    Joint positions, rad or m.
+segment : str or int, optional
+    Segment name or index (negative from the end; default: the last segment's tip), a link
+    merged into a segment (its own frame), or the base link's name (identity).
+
+Returns
+-------
+ndarray, shape (4, 4)
+    Homogeneous transform of the frame in the base frame (m).
+"""
+
+DOCS["Chain.jacobian"] = r"""Geometric Jacobian of a frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+segment : str or int, optional
+    As in :meth:`fk` (default: the last segment's tip).
+
+Returns
+-------
+ndarray, shape (6, n)
+    Rows ``[linear; angular]``: the velocity of the frame's origin and the angular velocity,
+    base-frame axes, per unit joint velocity (zero for the base).
+"""
+
+DOCS["Chain.twist"] = r"""Velocity of a frame.
+
+Parameters
+----------
+q, qd : array_like, shape (n,)
+segment : str or int, optional
+    As in :meth:`fk` (default: the last segment's tip).
+
+Returns
+-------
+ndarray, shape (6,)
+    ``[v; omega]``: linear velocity of the frame's origin (m/s) and angular velocity (rad/s),
+    base-frame axes; ``jacobian(q, segment) @ qd``.
+"""
+
+DOCS["Chain.segment_spec"] = r"""One segment described by the arguments of :meth:`add_segment`.
+
+Parameters
+----------
+segment : str or int
+    Segment name or index (negative from the end), or a merged link's name (its segment).
+
+Returns
+-------
+dict
+    ``name`` (str); ``joint_type`` ('rot_x', 'rot_y', 'rot_z', 'trans_x', 'trans_y', 'trans_z',
+    'revolute', 'prismatic' or 'fixed'); ``axis`` (ndarray (3,), unit, segment root frame; None
+    for a fixed joint); ``origin`` (ndarray (3,), m: a point on a 'revolute' axis, root frame;
+    zeros for the other types); ``joint_name`` (str); ``tip`` (ndarray (4, 4), tip pose in the
+    root frame at joint position 0); ``mass`` (kg); ``com`` (ndarray (3,), m, tip frame);
+    ``inertia`` (ndarray (3, 3), kg m^2, about the centre of mass, tip-frame axes);
+    ``rotor_inertia`` (kg m^2 or kg; 0 for a fixed joint).
+"""
+
+# ---- Tree (tree_bindings.cpp, tree_dynamics.cpp) ----
+
+DOCS["Tree"] = r"""A kinematic tree of segments (a joint followed by a rigid body), on a KDL::Tree.
+
+Load it from a URDF with :meth:`from_urdf`: every link below the root, fixed joints merged into
+their parent links exactly as :meth:`Chain.from_urdf` merges them, so every segment has a moving
+joint. Segment order: depth-first preorder from the base, at every link the children in the
+alphabetical order of their joints' names; ``parent[i] < i`` (-1: a child of the base). Joint
+order (q) = segment order. Frames are addressed as for :class:`Chain`: segment name, merged link
+name, index (negative from the end); the base only by its link name (:attr:`root_link`).
+Trees pickle and copy.
+"""
+
+DOCS["Tree.from_urdf"] = r"""Load the tree below ``root`` of a URDF (file path or XML text).
+
+Parameters
+----------
+source : str or os.PathLike
+    URDF XML text (anything containing '<') or the path of a URDF file.
+root : str, optional
+    The base link (default: the URDF's root link). Its links fixed to it form the base.
+inertia_check : {'physical', 'joint_space'}
+    As for :meth:`Chain.from_urdf`: 'physical' (default) rejects link inertias that no rigid
+    body has; 'joint_space' accepts identified models (any symmetric inertia).
+
+Returns
+-------
+Tree
+
+Raises
+------
+SolverError
+    Malformed XML, an unknown root link, no moving joint below it, a floating or planar joint
+    below it (the message names the joint and a ``root=`` below it), invalid limits, friction,
+    damping or inertias. Mimic joints are loaded as independent joints (listed in
+    :attr:`notes`), as Pinocchio's URDF parser does by default.
+"""
+
+DOCS["Tree.n_joints"] = r"""int: number of moving joints n (the length of q, qd)."""
+
+DOCS["Tree.n_segments"] = r"""int: number of segments (one per moving joint)."""
+
+DOCS["Tree.segment_names"] = r"""list of str: segment names in segment order (a segment is named after its tip link)."""
+
+DOCS["Tree.base_name"] = r"""str: the same as :attr:`root_link`."""
+
+DOCS["Tree.parent"] = r"""ndarray of int64 (n_segments,): index of each segment's parent segment, -1 for the children of the base; parent[i] < i."""
+
+DOCS["Tree.notes"] = r"""list of str: approximations made while building the tree (mimic joints modelled as independent joints)."""
+
+DOCS["Tree.rotor_inertia"] = r"""ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg, q order (settable; added to the joint's articulated inertia; a Solver built afterwards uses it, one built before keeps its own copy)."""
+
+DOCS["Tree.fk"] = r"""Pose of a frame in the base frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+    Joint positions in q order, rad or m.
+segment : str or int
+    Segment name or index (negative from the end), a link merged into a segment (its own
+    frame), or the base link's name (identity).
+
+Returns
+-------
+ndarray, shape (4, 4)
+    Homogeneous transform of the frame in the base frame (m).
+"""
+
+DOCS["Tree.jacobian"] = r"""Geometric Jacobian of a frame.
+
+Parameters
+----------
+q : array_like, shape (n,)
+    Joint positions in q order, rad or m.
+segment : str or int
+    As in :meth:`fk`.
+
+Returns
+-------
+ndarray, shape (6, n)
+    Rows ``[linear; angular]``: the velocity of the frame's origin and the angular velocity,
+    base-frame axes, per unit joint velocity; zero columns for joints off the path from the
+    base (all zero for the base).
+"""
+
+DOCS["Tree.twist"] = r"""Velocity of a frame.
+
+Parameters
+----------
+q, qd : array_like, shape (n,)
+    Joint positions (rad or m) and velocities (rad/s or m/s) in q order.
+segment : str or int
+    As in :meth:`fk`.
+
+Returns
+-------
+ndarray, shape (6,)
+    ``[v; omega]``: linear velocity of the frame's origin (m/s) and angular velocity (rad/s),
+    base-frame axes; ``jacobian(q, segment) @ qd``.
+"""
+
+DOCS["Tree.chain"] = r"""The serial chain from the base to a segment.
+
+Parameters
+----------
+tip : str or int
+    A segment (name, merged link name or index); the chain ends at that segment's tip frame.
+
+Returns
+-------
+Chain
+    The path's segments (bit for bit), their joints (limits, friction, damping) and merged
+    links; ``root_link`` is the tree's. Segments off the path, and their masses, are left out
+    (a note says so): unlike ``Chain.from_urdf(root, tip)``, which lumps side branches rigidly
+    into the path, the arms of a two-arm robot become independent chains.
+"""
+
+# ---- Chain and Tree alike (model_properties.hpp and the segment masses) ----
+
+_SHARED = {}
+
+_SHARED["joint_names"] = r"""list of str: moving joint names in q order."""
+
+_SHARED["joint_types"] = r"""list of str: 'revolute', 'continuous' or 'prismatic' per moving joint."""
+
+_SHARED["lower"] = r"""ndarray (n,): lower position limits, rad or m (-inf: none; URDF continuous joints have none)."""
+
+_SHARED["upper"] = r"""ndarray (n,): upper position limits, rad or m (+inf: none)."""
+
+_SHARED["velocity_limit"] = r"""ndarray (n,): URDF velocity limits, rad/s or m/s (inf: none). Not enforced by the solver."""
+
+_SHARED["effort_limit"] = r"""ndarray (n,): URDF effort limits, N m or N (inf: none). Not enforced by the solver."""
+
+_SHARED["friction"] = r"""ndarray (n,): static (breakaway) friction per joint, N m or N (URDF <dynamics friction>); used by friction=True."""
+
+_SHARED["damping"] = r"""ndarray (n,): viscous damping per joint, N m s/rad or N s/m (URDF <dynamics damping>); not applied by the solver."""
+
+_SHARED["root_link"] = r"""str: name of the base link (the base frame); the base is addressed by this name only."""
+
+_SHARED["inertia_check"] = r"""str: the inertia check the model was built with, 'physical' or 'joint_space' (once any part was accepted only by 'joint_space': from_kdl, or from_urdf / add_segment with that option). A Solver uses it unless given inertia_check."""
+
+_SHARED["link_names"] = r"""list of str: every URDF link of the model (segments, merged links, base links); segment and merged link names address frames in fk, jacobian, twist, constraints= and f_ext dicts; base links only in fk, jacobian and twist."""
+
+_SHARED["segment_index"] = r"""Index of a segment.
+
+Parameters
+----------
+name : str or int
+    A segment name, the name of a link merged into a segment by fixed joints (its segment's
+    index), or an index (negative from the end).
+
+Returns
+-------
+int
+    In ``0 .. n_segments - 1``.
+
+Raises
+------
+SolverError
+    Unknown names (the message lists the segments), indices out of range, and the base link
+    (it is no segment; ``fk``, ``jacobian`` and ``twist`` accept it by name).
+"""
+
+_SHARED["joint_index"] = r"""Index of a moving joint in q.
+
+Parameters
+----------
+name : str or int
+    A joint name or an index (negative from the end).
+
+Returns
+-------
+int
+    In ``0 .. n_joints - 1``.
+"""
+
+_SHARED["segment_masses"] = r"""ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg."""
+
+for _model in ("Chain", "Tree"):
+    for _name, _text in _SHARED.items():
+        DOCS[f"{_model}.{_name}"] = _text
+
+# ---- Solver (solver_bindings.cpp): the C++ core of vereshchagin.Solver (solver.py) ----
 
 DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
 --
@@ -87,6 +422,8 @@ acceleration.
 """
 
 DOCS["_core.Solver"] = r"""C++ core of :class:`vereshchagin.Solver` (use that class)."""
+
+# ---- SolveResult (result_type.cpp) ----
 
 DOCS["SolveResult"] = r"""Result of :meth:`Solver.solve`.
 
