@@ -294,7 +294,7 @@ py::object taskBeta(const CompanionModel& m, const FrameTarget& tip, const py::h
 
 void bindTaskHelpers(py::module_& mod) {
   mod.def("_beta_for", &betaFor, py::arg("alpha"), py::arg("a_desired"), py::arg("twist"), py::arg("gravity"),
-          "task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself.");
+          doc("_core._beta_for"));
 }
 
 }  // namespace vsbind

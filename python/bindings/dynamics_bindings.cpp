@@ -7,7 +7,6 @@
 #include "chain_bindings.hpp"
 #include "companions.hpp"
 #include "dynamics_common.hpp"
-#include "dynamics_docs.hpp"
 
 namespace vsbind {
 
@@ -51,23 +50,17 @@ void bindDynamics(py::module_& mod) {
         return taskBeta(c, c.resolveOptional(py::none(), "segment"), q, qd, alpha, a_desired, gravity);
       },
       py::arg("chain"), py::arg("q"), py::arg("qd"), py::arg("alpha"), py::arg("a_desired"), py::arg("gravity"),
-      "Task.solve's beta (the tip twist and beta_for in one call); None for inputs task.py checks itself.");
+      doc("_core._task_beta"));
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
   chain.def("inverse_dynamics", &inverseDynamics, py::arg("q"), py::arg("qd"), py::arg("qdd"),
-            py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity,
-            docs::inverseDynamicsDoc("recursive Newton-Euler", "", "", "").c_str());
-  chain.def("mass_matrix", &massMatrix, py::arg("q"), docs::massMatrixDoc("composite rigid bodies", "").c_str());
+            py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity, doc("Chain.inverse_dynamics"));
+  chain.def("mass_matrix", &massMatrix, py::arg("q"), doc("Chain.mass_matrix"));
   chain.def("gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
-            docs::gravityTorquesDoc("chain", "").c_str());
-  chain.def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"), docs::coriolisTorquesDoc("").c_str());
+            doc("Chain.gravity_torques"));
+  chain.def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"), doc("Chain.coriolis_torques"));
   chain.def("jacobian_dot_times_qd", &jacobianDotTimesQd, py::arg("q"), py::arg("qd"), py::arg("segment") = py::none(),
-            docs::jacobianDotDoc("jacobian_dot_times_qd(q, qd)",
-                                 "Computed from the joint axes and velocities of the frame's path to the base.",
-                                 "segment : str or int, optional\n"
-                                 "    As in :meth:`fk`: a segment name or index (negative from the end), or a merged "
-                                 "link's name;\n    default the last segment. A base link gives zeros.\n")
-                .c_str());
-  chain.def("fk_all", &fkAll, py::arg("q"), docs::fkAllDoc("").c_str());
+            doc("Chain.jacobian_dot_times_qd"));
+  chain.def("fk_all", &fkAll, py::arg("q"), doc("Chain.fk_all"));
 }
 
 }  // namespace vsbind

@@ -6,7 +6,6 @@
 
 #include "companions.hpp"
 #include "dynamics_common.hpp"
-#include "dynamics_docs.hpp"
 #include "tree_bindings.hpp"
 
 namespace vsbind {
@@ -43,31 +42,15 @@ py::array fkAll(const PyTree& t, const py::object& q) {
 
 void bindTreeDynamics(py::class_<PyTree>& cls) {
   cls.def("inverse_dynamics", &inverseDynamics, py::arg("q"), py::arg("qd"), py::arg("qdd"),
-          py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity,
-          docs::inverseDynamicsDoc("recursive Newton-Euler over the tree", ",\n    in q order (:attr:`joint_names`)",
-                                   "; rows in\n    segment order, :attr:`segment_names`", ", in q order")
-              .c_str())
-      .def("mass_matrix", &massMatrix, py::arg("q"),
-           docs::massMatrixDoc("composite rigid bodies over the tree",
-                               "\n    Rows and columns in q order; the entries of two joints on different branches "
-                               "(neither on\n    the other's path to the base) are zero.")
-               .c_str())
+          py::arg("f_ext") = py::none(), py::arg("gravity") = kEarthGravity, doc("Tree.inverse_dynamics"))
+      .def("mass_matrix", &massMatrix, py::arg("q"), doc("Tree.mass_matrix"))
       .def("gravity_torques", &gravityTorques, py::arg("q"), py::arg("gravity") = kEarthGravity,
-           docs::gravityTorquesDoc("tree", "").c_str())
-      .def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"), docs::coriolisTorquesDoc("").c_str())
+           doc("Tree.gravity_torques"))
+      .def("coriolis_torques", &coriolisTorques, py::arg("q"), py::arg("qd"), doc("Tree.coriolis_torques"))
       .def("jacobian_dot_times_qd", &jacobianDotTimesQd, py::arg("q"), py::arg("qd"), py::arg("segment"),
-           docs::jacobianDotDoc("jacobian_dot_times_qd(q, qd, segment)",
-                                "Only the joints on the frame's path to the base contribute.",
-                                "segment : str or int\n"
-                                "    As in :meth:`fk`: a segment name or index (negative from the end), a merged "
-                                "link's name, or\n    the base link's name (zeros). Required: a tree has no last "
-                                "segment.\n")
-               .c_str())
-      .def("fk_all", &fkAll, py::arg("q"), docs::fkAllDoc(", in segment order").c_str())
-      .def_property("rotor_inertia", &PyTree::rotorInertia, &PyTree::setRotorInertia,
-                    "ndarray (n,): motor rotor inertia reflected to each joint, kg m^2 or kg, q order (settable; "
-                    "added to the joint's articulated inertia; a Solver built afterwards uses it, one built before "
-                    "keeps its own copy).");
+           doc("Tree.jacobian_dot_times_qd"))
+      .def("fk_all", &fkAll, py::arg("q"), doc("Tree.fk_all"))
+      .def_property("rotor_inertia", &PyTree::rotorInertia, &PyTree::setRotorInertia, doc("Tree.rotor_inertia"));
 }
 
 }  // namespace vsbind

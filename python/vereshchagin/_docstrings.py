@@ -339,6 +339,155 @@ for _model in ("Chain", "Tree"):
     for _name, _text in _SHARED.items():
         DOCS[f"{_model}.{_name}"] = _text
 
+# ---- Dynamics companions of Chain and Tree (dynamics_bindings.cpp, tree_dynamics.cpp) ----
+# One text for both models; the arguments are the words in which the two differ (how the result
+# is computed, in which order rows come, what a segment argument defaults to).
+
+_Q_PARAM = r"""q : array_like, shape (n_joints,)
+    Joint positions, rad or m.
+"""
+
+_Q_QD_PARAM = r"""q, qd : array_like, shape (n_joints,)
+    Joint positions (rad or m) and velocities (rad/s or m/s).
+"""
+
+_GRAVITY_PARAM = r"""gravity : array_like, shape (3,)
+    Physical gravity in the base frame, m/s^2 (default ``[0, 0, -9.81]``).
+"""
+
+
+def _inverse_dynamics(how, q_order="", f_ext_note="", tau_order=""):
+    """how: the algorithm; q_order, f_ext_note, tau_order: model-specific remarks."""
+    return rf"""Joint torques that realise ``qdd`` ({how}).
+
+``tau = M(q) qdd + C(q, qd) qd + g(q) - sum_i J_i(q)^T f_ext[i]``, rotor inertia included
+(``rotor_inertia * qdd`` on each joint's diagonal).
+
+Parameters
+----------
+q, qd, qdd : array_like, shape (n_joints,)
+    Joint positions (rad or m), velocities (rad/s or m/s) and accelerations (rad/s^2 or m/s^2){q_order}.
+f_ext : array_like, shape (n_segments, 6), or dict, optional
+    Wrench ``[force, moment]`` (N, N m) applied ON each segment BY the environment, base-frame
+    axes, moment about that segment's tip origin (the solver's convention{f_ext_note}). ``J_i`` above is the base-axes Jacobian of segment i's tip.
+    Dict: ``{{segment: wrench (6,)}}`` keyed by segment name, merged link name or index, the
+    moment about the named frame's origin, as :meth:`Solver.solve` reads it.
+{_GRAVITY_PARAM}
+Returns
+-------
+ndarray, shape (n_joints,)
+    Joint torques / forces, N m or N{tau_order}.
+"""
+
+
+def _mass_matrix(how, note=""):
+    return rf"""Joint-space mass matrix ``M(q)`` ({how}).
+
+Parameters
+----------
+{_Q_PARAM}
+Returns
+-------
+ndarray, shape (n_joints, n_joints)
+    Symmetric positive definite, kg m^2 / kg m / kg; ``rotor_inertia`` is included on the diagonal
+    (Pinocchio's ``armature``).{note}
+"""
+
+
+def _gravity_torques(model):
+    return rf"""Generalised gravity ``g(q)``: the torques that hold the {model} still.
+
+Parameters
+----------
+{_Q_PARAM}{_GRAVITY_PARAM}
+Returns
+-------
+ndarray, shape (n_joints,)
+    ``inverse_dynamics(q, 0, 0, gravity=gravity)``, N m or N.
+"""
+
+
+_CORIOLIS_TORQUES = rf"""Coriolis and centrifugal torques ``C(q, qd) qd``.
+
+Parameters
+----------
+{_Q_QD_PARAM}
+Returns
+-------
+ndarray, shape (n_joints,)
+    ``inverse_dynamics(q, qd, 0, gravity=[0, 0, 0])``, N m or N.
+"""
+
+
+def _jacobian_dot_times_qd(call, how, segment_param):
+    """call: the call as in ``a = J qdd + call``; how: a line on how it is computed; segment_param:
+    the ``segment`` entry."""
+    return rf"""Time derivative of the Jacobian times the joint velocities, ``(d/dt J(q)) qd``.
+
+``J`` is :meth:`jacobian`: the (6, n) base-axes Jacobian ``[linear; angular]`` of the segment's
+tip origin (or of a merged link's origin). The result is the acceleration of that point at
+``qdd = 0`` without gravity: rows 0-2 the *classical* linear acceleration of the point (not the
+spatial one: it includes ``omega x v``), rows 3-5 the angular acceleration, base-frame axes, so
+that ``a = J qdd + {call}``.
+Pinocchio: ``getFrameJacobianTimeVariation(..., LOCAL_WORLD_ALIGNED) @ v``.
+{how}
+
+Parameters
+----------
+{_Q_QD_PARAM}{segment_param}
+Returns
+-------
+ndarray, shape (6,)
+    m/s^2 and rad/s^2.
+"""
+
+
+def _fk_all(order=""):
+    return rf"""Pose of every segment's tip frame in the base frame.
+
+Parameters
+----------
+{_Q_PARAM}
+Returns
+-------
+ndarray, shape (n_segments, 4, 4)
+    ``fk_all(q)[i] == fk(q, i)``: homogeneous transforms, metres{order}.
+"""
+
+
+DOCS["Chain.inverse_dynamics"] = _inverse_dynamics("recursive Newton-Euler")
+DOCS["Tree.inverse_dynamics"] = _inverse_dynamics(
+    "recursive Newton-Euler over the tree",
+    q_order=",\n    in q order (:attr:`joint_names`)",
+    f_ext_note="; rows in\n    segment order, :attr:`segment_names`",
+    tau_order=", in q order",
+)
+DOCS["Chain.mass_matrix"] = _mass_matrix("composite rigid bodies")
+DOCS["Tree.mass_matrix"] = _mass_matrix(
+    "composite rigid bodies over the tree",
+    note="\n    Rows and columns in q order; the entries of two joints on different branches (neither on\n"
+    "    the other's path to the base) are zero.",
+)
+DOCS["Chain.gravity_torques"] = _gravity_torques("chain")
+DOCS["Tree.gravity_torques"] = _gravity_torques("tree")
+DOCS["Chain.coriolis_torques"] = DOCS["Tree.coriolis_torques"] = _CORIOLIS_TORQUES
+DOCS["Chain.jacobian_dot_times_qd"] = _jacobian_dot_times_qd(
+    "jacobian_dot_times_qd(q, qd)",
+    "Computed from the joint axes and velocities of the frame's path to the base.",
+    "segment : str or int, optional\n"
+    "    As in :meth:`fk`: a segment name or index (negative from the end), or a merged link's name;\n"
+    "    default the last segment. A base link gives zeros.\n",
+)
+DOCS["Tree.jacobian_dot_times_qd"] = _jacobian_dot_times_qd(
+    "jacobian_dot_times_qd(q, qd, segment)",
+    "Only the joints on the frame's path to the base contribute.",
+    "segment : str or int\n"
+    "    As in :meth:`fk`: a segment name or index (negative from the end), a merged link's name, or\n"
+    "    the base link's name (zeros). Required: a tree has no last segment.\n",
+)
+DOCS["Chain.fk_all"] = _fk_all()
+DOCS["Tree.fk_all"] = _fk_all(", in segment order")
+
 # ---- Solver (solver_bindings.cpp): the C++ core of vereshchagin.Solver (solver.py) ----
 
 DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
@@ -471,3 +620,9 @@ DOCS["SolveResult.gauss_value"] = r"""float or None: Gauss' function at the opti
 DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max-min (bounded; see the docs)."""
 
 DOCS["SolveResult.segment_nu"] = r"""dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``."""
+
+# ---- helpers of the Python layer (companions.cpp, dynamics_bindings.cpp, result_type.cpp) ----
+
+DOCS["_core._beta_for"] = r"""task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself."""
+
+DOCS["_core._task_beta"] = r"""Task.solve's beta (the tip twist and beta_for in one call); None for inputs task.py checks itself."""
