@@ -28,8 +28,8 @@ const char* doc(const char* key) {
 }  // namespace vsbind
 
 PYBIND11_MODULE(_core, mod) {
-  mod.doc() = "C++ core of vereshchagin (Popov-Vereshchagin hybrid dynamics on KDL chains).";
   vsbind::g_docs = pybind11::object(pybind11::module_::import("vereshchagin._docstrings").attr("DOCS")).release().ptr();
+  mod.doc() = vsbind::doc("_core");
   pybind11::register_exception<vsbind::SolverError>(mod, "SolverError", PyExc_ValueError);
   vsbind::bindChain(mod);
   vsbind::bindTree(mod);

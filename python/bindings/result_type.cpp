@@ -276,18 +276,21 @@ PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, reinterpret_cast<vo
                           {"segment_nu", getSegmentNu, nullptr, nullptr, nullptr},
                           {nullptr, nullptr, nullptr, nullptr, nullptr}};
 
-PyMethodDef g_methods[] = {{"__reduce__", reduce, METH_NOARGS, "Pickle support."},
-                           {"__copy__", copyResult, METH_NOARGS, "An independent copy (its own data)."},
-                           {"__deepcopy__", deepcopyResult, METH_O, "An independent copy (its own data)."},
+// Docstrings (and those of g_getset, g_from_state_def) are set in bindResultType().
+PyMethodDef g_methods[] = {{"__reduce__", reduce, METH_NOARGS, nullptr},
+                           {"__copy__", copyResult, METH_NOARGS, nullptr},
+                           {"__deepcopy__", deepcopyResult, METH_O, nullptr},
                            {nullptr, nullptr, 0, nullptr}};
 
-PyMethodDef g_from_state_def = {"_result_from_state", fromState, METH_VARARGS, "Unpickle a SolveResult."};
+PyMethodDef g_from_state_def = {"_result_from_state", fromState, METH_VARARGS, nullptr};
 
 }  // namespace
 
 void bindResultType(py::module_& mod) {
-  for (PyGetSetDef* g = g_getset; g->name != nullptr; ++g)
-    g->doc = doc((std::string("SolveResult.") + g->name).c_str());
+  for (PyGetSetDef* g = g_getset; g->name != nullptr; ++g) g->doc = doc(std::string("SolveResult.") + g->name);
+  for (PyMethodDef* m = g_methods; m->ml_name != nullptr; ++m)
+    m->ml_doc = doc(std::string("SolveResult.") + m->ml_name);
+  g_from_state_def.ml_doc = doc("_core._result_from_state");
   static PyType_Slot slots[] = {{Py_tp_dealloc, reinterpret_cast<void*>(dealloc)},
                                 {Py_tp_repr, reinterpret_cast<void*>(repr)},
                                 {Py_tp_getset, g_getset},

@@ -363,10 +363,8 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
 
 PyMethodDef g_solve_def = {"solve", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(solveEntry)),
                            METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
-PyMethodDef g_time_def = {
-    "_time_cpp", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(timeCppEntry)),
-    METH_FASTCALL | METH_KEYWORDS,
-    "_time_cpp(reps, q, qd, ...) -> float: seconds per C++ solve of these arguments (benchmarks)."};
+PyMethodDef g_time_def = {"_time_cpp", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(timeCppEntry)),
+                          METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
 
 void addFastMethod(py::handle cls, PyMethodDef* def) {
   PyObject* descr = PyDescr_NewMethod(reinterpret_cast<PyTypeObject*>(cls.ptr()), def);
@@ -379,6 +377,7 @@ void addFastMethod(py::handle cls, PyMethodDef* def) {
 void bindSolver(py::module_& mod) {
   g_solver_error = mod.attr("SolverError").ptr();
   g_solve_def.ml_doc = doc("_core.Solver.solve");
+  g_time_def.ml_doc = doc("_core.Solver._time_cpp");
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
   py::class_<PySolver> cls(mod, "Solver", doc("_core.Solver"));
@@ -396,29 +395,27 @@ void bindSolver(py::module_& mod) {
            doc("_core.Solver.response_columns"))
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, doc("_core.Solver.gravity"))
       .def_property_readonly(
-          "n_joints", [](const PySolver& s) { return s.nj; }, "Number of moving joints n.")
+          "n_joints", [](const PySolver& s) { return s.nj; }, doc("_core.Solver.n_joints"))
       .def_property_readonly(
-          "n_segments", [](const PySolver& s) { return s.ns; },
-          "Number of segments (moving and fixed-joint segments of the chain or tree).")
+          "n_segments", [](const PySolver& s) { return s.ns; }, doc("_core.Solver.n_segments"))
       .def_property_readonly(
-          "model", [](const PySolver& s) { return s.model(); }, "A copy of the solver's Chain or Tree.")
+          "model", [](const PySolver& s) { return s.model(); }, doc("_core.Solver.model"))
       .def_property_readonly(
           "chain",
           [](const PySolver& s) {
             if (s.isTree()) raise("this Solver is for a Tree: use solver.tree (or solver.model)");
             return s.model();
           },
-          "A copy of the solver's Chain (SolverError for a Tree solver).")
+          doc("_core.Solver.chain"))
       .def_property_readonly(
           "tree",
           [](const PySolver& s) {
             if (!s.isTree()) raise("this Solver is for a Chain: use solver.chain (or solver.model)");
             return s.model();
           },
-          "A copy of the solver's Tree (SolverError for a Chain solver).")
+          doc("_core.Solver.tree"))
       .def_property_readonly(
-          "inertia_check", [](const PySolver& s) { return s.inertiaCheck(); },
-          "str: 'physical' or 'joint_space' (see Solver).")
+          "inertia_check", [](const PySolver& s) { return s.inertiaCheck(); }, doc("_core.Solver.inertia_check"))
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
                         if (t.size() != 5 && t.size() != 6) raise("Solver state must have 5 or 6 entries");

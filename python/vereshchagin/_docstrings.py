@@ -14,6 +14,8 @@ once below and entered under both keys.
 
 DOCS = {}
 
+DOCS["_core"] = r"""C++ core of vereshchagin (Popov-Vereshchagin hybrid dynamics on KDL chains)."""
+
 # ---- Joint (chain_bindings.cpp) ----
 
 DOCS["Joint"] = r"""A joint type for :meth:`Chain.add_segment`, made by the static methods.
@@ -572,6 +574,20 @@ acceleration.
 
 DOCS["_core.Solver"] = r"""C++ core of :class:`vereshchagin.Solver` (use that class)."""
 
+DOCS["_core.Solver.n_joints"] = r"""Number of moving joints n."""
+
+DOCS["_core.Solver.n_segments"] = r"""Number of segments (moving and fixed-joint segments of the chain or tree)."""
+
+DOCS["_core.Solver.model"] = r"""A copy of the solver's Chain or Tree."""
+
+DOCS["_core.Solver.chain"] = r"""A copy of the solver's Chain (SolverError for a Tree solver)."""
+
+DOCS["_core.Solver.tree"] = r"""A copy of the solver's Tree (SolverError for a Chain solver)."""
+
+DOCS["_core.Solver.inertia_check"] = r"""str: 'physical' or 'joint_space' (see Solver)."""
+
+DOCS["_core.Solver._time_cpp"] = r"""_time_cpp(reps, q, qd, ...) -> float: seconds per C++ solve of these arguments (benchmarks)."""
+
 # ---- SolveResult (result_type.cpp) ----
 
 DOCS["SolveResult"] = r"""Result of :meth:`Solver.solve`.
@@ -621,8 +637,16 @@ DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max
 
 DOCS["SolveResult.segment_nu"] = r"""dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``."""
 
+DOCS["SolveResult.__reduce__"] = r"""Pickle support."""
+
+DOCS["SolveResult.__copy__"] = r"""An independent copy (its own data)."""
+
+DOCS["SolveResult.__deepcopy__"] = r"""An independent copy (its own data)."""
+
 # ---- helpers of the Python layer (companions.cpp, dynamics_bindings.cpp, result_type.cpp) ----
 
 DOCS["_core._beta_for"] = r"""task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself."""
 
 DOCS["_core._task_beta"] = r"""Task.solve's beta (the tip twist and beta_for in one call); None for inputs task.py checks itself."""
+
+DOCS["_core._result_from_state"] = r"""Unpickle a SolveResult."""
