@@ -566,11 +566,7 @@ Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented w
 
 DOCS["_core.Solver.response_columns"] = r"""Affine response of the last solve to unit feed-forward torques (see the wrapper in vereshchagin.Solver)."""
 
-DOCS["_core.Solver.gravity"] = r"""Physical gravity in the base frame, shape (3,), m/s^2 (settable).
-
-The base is accelerated by ``-gravity`` internally, so ``beta`` and ``link_acc`` include that
-acceleration.
-"""
+DOCS["_core.Solver.gravity"] = r"""Physical gravity in the base frame, shape (3,), m/s^2 (settable; see :class:`Solver`)."""
 
 DOCS["_core.Solver"] = r"""C++ core of :class:`vereshchagin.Solver` (use that class)."""
 
