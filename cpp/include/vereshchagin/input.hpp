@@ -96,6 +96,9 @@ struct SolveInput {
   // gravity, base_acceleration and all capacity.
   void clear();
   void reserve(int blocks, int wrenches);
+
+ private:
+  int segments_ = 0;  // the model's segment count (addConstraint's and addWrench's range check)
 };
 
 }  // namespace vereshchagin
