@@ -248,9 +248,9 @@ TEST_CASE("points of blocks and frame wrenches equal tip loads shifted by KDL's 
     fext.col(wseg).tail<3>() += wrench.tail<3>() + rw.cross(Vector3(wrench.head<3>()));
     ChainHdSolver hd(chain, kUp);
     REQUIRE(hd.solve(in.q, in.qd, alfa, in.beta, Eigen::VectorXi::Constant(m, seg), fext, in.ff) == 0);
-    CHECK(close(data.qdd(), hd.qdd(), 1e-10));
-    CHECK(close(data.nu(), hd.nu(), 1e-10));
-    CHECK(close(data.commandTorques(), hd.commandTorques(), 1e-10));
+    CHECK(close(data.qdd(), hd.qdd(), 1e-12));
+    CHECK(close(data.nu(), hd.nu(), 1e-12));
+    CHECK(close(data.commandTorques(), hd.commandTorques(), 1e-12));
   }
 }
 
