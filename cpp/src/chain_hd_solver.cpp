@@ -3,6 +3,7 @@
 #include "vereshchagin/chain_hd_solver.hpp"
 
 #include "entry_guard.hpp"
+#include "facade_state.hpp"
 #include "hd_core.hpp"
 
 namespace vereshchagin {
@@ -26,23 +27,32 @@ ModelSource chainModelSource(const KDL::Chain& chain) {
 }  // namespace detail
 
 namespace {
-using detail::chainModelSource;
+
+ModelOptions modelOptions(const SolverOptions& options) {
+  ModelOptions m;
+  m.inertia_check = options.inertia_check;
+  return m;
+}
+
 }  // namespace
 
 ChainHdSolver::ChainHdSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
-    : HdSolver(chainModelSource(chain), root_acc, options),
+    : HdSolver(Model(chain, modelOptions(options)), root_acc, options),
       chain_(chain),
       f_ext_buf_(Matrix6X::Zero(6, chain.getNrOfSegments())) {}
 
 void ChainHdSolver::updateInternalDataStructures() {
-  const detail::EntryGuard guard(core().busy);
-  if (!guard) {
-    core().stale_model.store(true, std::memory_order_relaxed);  // reported by the next solves
-    return;
+  {
+    const detail::EntryGuard guard(core().busy);
+    if (!guard) {
+      state().stale_model.store(true, std::memory_order_relaxed);  // reported by the next solves
+      return;
+    }
+    rebuild(Model(chain_, modelOptions(options())));
+    f_ext_buf_.setZero(6, chain_.getNrOfSegments());
+    state().stale_model.store(false, std::memory_order_relaxed);
   }
-  rebuild(chainModelSource(chain_));
-  f_ext_buf_.setZero(6, chain_.getNrOfSegments());
-  core().stale_model.store(false, std::memory_order_relaxed);
+  state().dropRetired();  // the guard above held its flag
 }
 
 int ChainHdSolver::CartToJnt(const KDL::JntArray& q, const KDL::JntArray& q_dot, KDL::JntArray& q_dotdot,

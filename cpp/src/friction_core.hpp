@@ -13,6 +13,8 @@
 
 #include "vereshchagin/friction_solver.hpp"
 
+#include "hd_core.hpp"
+
 namespace vereshchagin {
 namespace detail {
 
@@ -30,16 +32,15 @@ class FrictionCore {
   static constexpr int E_INVALID_FRICTION = FrictionSolver::E_INVALID_FRICTION,
                        E_NOT_CONVERGED = FrictionSolver::E_NOT_CONVERGED;
 
-  explicit FrictionCore(std::unique_ptr<HdSolver> hd);
-  int setOptions(const SolverOptions& options);
-  int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
-                     const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
+  // The friction stage on `hd` (a Data's core): workspace O(n^2 + n m).
+  explicit FrictionCore(HdCore& hd);
+  // The core to run on (a face's Data is replaced when its options change); resizes for its
+  // constraint capacity (not on the solve path).
+  void bind(HdCore& hd);
   const ChainHdSolver::Matrix6X& linkAccelerations();
   double gaussValue();
   int fail(int code, const char* fmt, ...);
   int failFromHd(int rc);  // hd_'s error with its message (unless hd_ is busy in another thread)
-  // E_SIZE_MISMATCH naming the argument unless alfa and f_ext have 6 rows (or no columns).
-  int checkRows(const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::MatrixXd>& f_ext);
   int solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                 const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                 const Eigen::Ref<const Eigen::VectorXi>* segments,
@@ -78,9 +79,8 @@ class FrictionCore {
   void gradient(int k);
   void factorDelete(int q, int nf);
 
-  std::atomic<bool> busy_{false};       // a call is inside (entry_guard.hpp)
-  std::unique_ptr<HdSolver> hd_owner_;  // the solver of the problem
-  HdSolver& hd_;
+  std::atomic<bool> busy_{false};  // a call is inside (entry_guard.hpp)
+  HdCore* hd_;                     // the core of the problem (bind())
   unsigned int nj_ = 0;
   std::array<char, 512> message_{};
   Eigen::VectorXd qdd_, tau_cmd_, friction_, limit_, tau0_, qdd0_, tau_cmd0_, nu0_, nu_;

@@ -52,10 +52,10 @@ void FrictionCore::leastCommand(int k) {
 
   // Target t = tau_cmd - x on St, tau_cmd at the stage-1 optimum from its nu; start y = x*_St
   // (feasible). (No restrict on what the solvers below write.)
-  const int m = hd_.constraintCount();
+  const int m = hd_->res.m;
   nu_.head(m) = nu0_.head(m);
   nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * Eigen::Map<const Eigen::VectorXd>(x, k);
-  hd_.commandTorquesOf(nu_.head(m), tau_cmd_);
+  (void)hd_->commandTorquesOf(nu_.head(m), tau_cmd_);
   double* y = ys_.data();
   double* t = ts_.data();
   double* lo = p_.data();    // bounds on St

@@ -8,20 +8,23 @@
 #include <utility>
 
 #include "entry_guard.hpp"
+#include "facade_state.hpp"
 #include "friction_core.hpp"
 #include "hd_core.hpp"
 #include "model_validation.hpp"
 
 namespace vereshchagin {
 
-// The public API: forwards to the core.
+// The public API: a ChainHdSolver or TreeHdSolver face (its Model and Data) and the friction
+// stage on that Data's core.
 FrictionSolver::FrictionSolver(const KDL::Chain& chain, const KDL::Twist& root_acc, const SolverOptions& options)
-    : core_(std::make_unique<detail::FrictionCore>(std::make_unique<ChainHdSolver>(chain, root_acc, options))) {}
+    : hd_(std::make_unique<ChainHdSolver>(chain, root_acc, options)),
+      core_(std::make_unique<detail::FrictionCore>(hd_->core())) {}
 
 FrictionSolver::FrictionSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options,
                                const std::string& root_segment)
-    : core_(std::make_unique<detail::FrictionCore>(
-          std::make_unique<TreeHdSolver>(tree, root_acc, options, root_segment))) {}
+    : hd_(std::make_unique<TreeHdSolver>(tree, root_acc, options, root_segment)),
+      core_(std::make_unique<detail::FrictionCore>(hd_->core())) {}
 
 FrictionSolver::~FrictionSolver() = default;
 FrictionSolver::FrictionSolver(FrictionSolver&&) noexcept = default;
@@ -34,14 +37,34 @@ using detail::sixRows;
 
 }  // namespace
 
+// The friction stage bound to the face's current core (setOptions() may have replaced it).
+detail::FrictionCore& FrictionSolver::core() const {
+  core_->bind(hd_->core());
+  return *core_;
+}
+
+int FrictionSolver::solveEntered(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                 const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& alfa,
+                                 const Eigen::Ref<const Eigen::VectorXd>& beta,
+                                 const Eigen::Ref<const Eigen::VectorXi>* segments,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
+                                 const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
+  detail::FrictionCore& c = core();
+  const EntryGuard hd_guard(hd_->core().busy);
+  if (!hd_guard) return c.failFromHd(HdSolver::E_CONCURRENT_CALL);
+  if (const int rc = hd_->solveArgsProblem(alfa, f_ext)) return c.failFromHd(rc);
+  hd_->state().install();
+  return c.solveImpl(q, q_dot, sixRows(alfa), beta, segments, sixRows(f_ext), ff_torques, friction);
+}
+
 int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                           const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                           const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
                           const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
   const EntryGuard guard(core_->busy_);
   if (!guard) return HdSolver::E_CONCURRENT_CALL;
-  if (const int rc = core_->checkRows(alfa, f_ext)) return rc;
-  return core_->solveImpl(q, q_dot, sixRows(alfa), beta, nullptr, sixRows(f_ext), ff_torques, friction);
+  return solveEntered(q, q_dot, alfa, beta, nullptr, f_ext, ff_torques, friction);
 }
 
 int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
@@ -51,8 +74,7 @@ int FrictionSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
                           const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
   const EntryGuard guard(core_->busy_);
   if (!guard) return HdSolver::E_CONCURRENT_CALL;
-  if (const int rc = core_->checkRows(alfa, f_ext)) return rc;
-  return core_->solveImpl(q, q_dot, sixRows(alfa), beta, &segments, sixRows(f_ext), ff_torques, friction);
+  return solveEntered(q, q_dot, alfa, beta, &segments, f_ext, ff_torques, friction);
 }
 
 const Eigen::VectorXd& FrictionSolver::qdd() const {
@@ -75,11 +97,11 @@ Eigen::Map<const Eigen::VectorXd> FrictionSolver::nu() const {
 }
 const ChainHdSolver::Matrix6X& FrictionSolver::linkAccelerations() {
   const EntryGuard guard(core_->busy_);
-  if (!guard) return core_->hd_.linkAccelerations();  // another thread is inside: what hd_ holds
-  return core_->linkAccelerations();
+  if (!guard) return hd_->linkAccelerations();  // another thread is inside: what hd_ holds
+  return core().linkAccelerations();
 }
 int FrictionSolver::constraintRank() const {
-  return core_->hd_.constraintRank();
+  return hd_->constraintRank();
 }
 int FrictionSolver::iterations() const {
   return core_->iterations_;
@@ -87,43 +109,55 @@ int FrictionSolver::iterations() const {
 double FrictionSolver::gaussValue() {
   const EntryGuard guard(core_->busy_);
   if (!guard) return std::numeric_limits<double>::quiet_NaN();  // another thread is inside
-  return core_->gaussValue();
+  return core().gaussValue();
 }
 HdSolver& FrictionSolver::hdSolver() {
-  return core_->hd_;
+  return *hd_;
+}
+const Model& FrictionSolver::model() const {
+  return hd_->model();
+}
+Data& FrictionSolver::data() {
+  return hd_->data();
 }
 const char* FrictionSolver::errorMessage() const {
   return core_->message_.data();
 }
 int FrictionSolver::modelError() const {
-  return core_->hd_.modelError();
+  return hd_->modelError();
 }
 int FrictionSolver::setRootAcceleration(const KDL::Twist& root_acc) {
   const EntryGuard guard(core_->busy_);
   if (!guard) return HdSolver::E_CONCURRENT_CALL;
-  return core_->hd_.setRootAcceleration(root_acc);
+  return hd_->setRootAcceleration(root_acc);
 }
 int FrictionSolver::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                                    const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
   const EntryGuard guard(core_->busy_);
   if (!guard) return HdSolver::E_CONCURRENT_CALL;
-  return core_->setPassThrough(f_ext_pass_through, ff_pass_through);
+  const int rc = hd_->setPassThrough(f_ext_pass_through, ff_pass_through);
+  if (rc != HdSolver::E_NOERROR) return core().failFromHd(rc);
+  core_->solved_ = false;
+  return rc;
 }
 int FrictionSolver::clearPassThrough() {
   const EntryGuard guard(core_->busy_);
   if (!guard) return HdSolver::E_CONCURRENT_CALL;
-  return core_->hd_.clearPassThrough();
+  return hd_->clearPassThrough();
 }
 int FrictionSolver::setOptions(const SolverOptions& options) {
   const EntryGuard guard(core_->busy_);
   if (!guard) return HdSolver::E_CONCURRENT_CALL;
-  return core_->setOptions(options);
+  const int rc = hd_->setOptions(options);
+  detail::FrictionCore& c = core();  // resized for a new constraint capacity
+  if (rc != HdSolver::E_NOERROR) return c.failFromHd(rc);
+  return rc;
 }
 
 namespace detail {
 
-FrictionCore::FrictionCore(std::unique_ptr<HdSolver> hd) : hd_owner_(std::move(hd)), hd_(*hd_owner_) {
-  nj_ = hd_.nrOfJoints();
+FrictionCore::FrictionCore(HdCore& hd) : hd_(&hd) {
+  nj_ = hd.model.nj;
   const int n = static_cast<int>(nj_);
   qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = ff_driver_ = Eigen::VectorXd::Zero(n);
   fstatic_ = Eigen::VectorXd::Zero(n);
@@ -134,35 +168,16 @@ FrictionCore::FrictionCore(std::unique_ptr<HdSolver> hd) : hd_owner_(std::move(h
   ys_ = ts_ = lam_ = Eigen::VectorXd::Zero(n);
   side_ = cols_ = piv_ = Eigen::VectorXi::Zero(n);
   c_ = x_ = lo_ = hi_ = grad_ = p_ = d_ = tmp_ = tmp2_ = eig_ = invdiag_ = dpiv_ = Eigen::VectorXd::Zero(n);
-  const int mcap = hd_.maxConstraints();
-  dnu_ = Eigen::MatrixXd::Zero(mcap, n);
-  nu0_ = nu_ = Eigen::VectorXd::Zero(mcap);
+  bind(hd);
 }
 
-int FrictionCore::setOptions(const SolverOptions& options) {
-  const int rc = hd_.setOptions(options);
-  const int mcap = hd_.maxConstraints();
+void FrictionCore::bind(HdCore& hd) {
+  hd_ = &hd;
+  const int mcap = hd.mcap;
   if (dnu_.rows() != mcap) {  // the constraint capacity changed (not on the solve path)
     dnu_ = Eigen::MatrixXd::Zero(mcap, static_cast<int>(nj_));
     nu0_ = nu_ = Eigen::VectorXd::Zero(mcap);
   }
-  if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
-  return rc;
-}
-
-int FrictionCore::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
-                                 const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
-  const int rc = hd_.setPassThrough(f_ext_pass_through, ff_pass_through);
-  if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
-  solved_ = false;
-  return rc;
-}
-
-// The argument shapes HdSolver checks before its entry (6 rows or no columns), with its message.
-int FrictionCore::checkRows(const Eigen::Ref<const Eigen::MatrixXd>& alfa,
-                            const Eigen::Ref<const Eigen::MatrixXd>& f_ext) {
-  const int rc = hd_.solveArgsProblem(alfa, f_ext);
-  return rc == ChainHdSolver::E_NOERROR ? rc : failFromHd(rc);
 }
 
 int FrictionCore::failFromHd(int rc) {
@@ -170,7 +185,7 @@ int FrictionCore::failFromHd(int rc) {
     return fail(rc,
                 "the underlying solver (hdSolver()) is in use by another thread: a solver object must not be used "
                 "from two threads at once (use one solver per thread)");
-  return fail(rc, "%s", hd_.errorMessage());
+  return fail(rc, "%s", hd_->message.data());
 }
 
 int FrictionCore::fail(int code, const char* fmt, ...) {
@@ -189,10 +204,11 @@ int FrictionCore::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
                           const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
                           const Eigen::Ref<const Eigen::VectorXd>& tau) {
   // The pass-through's feed-forward driver is ff_torques alone, not the friction in tau.
-  hd_.core().ws.pt.driver = &ff_driver_;
-  const int rc =
-      segments ? hd_.solve(q, q_dot, alfa, beta, *segments, f_ext, tau) : hd_.solve(q, q_dot, alfa, beta, f_ext, tau);
-  hd_.core().ws.pt.driver = nullptr;
+  hd_->ws.pt.driver = &ff_driver_;
+  const int rc = segments ? hd_->solveSegments(q, q_dot, alfa, beta, *segments, f_ext, tau)
+                          : hd_->solveLast(q, q_dot, alfa, beta, f_ext, tau);
+  hd_->ws.pt.driver = nullptr;
+  if (rc == ChainHdSolver::E_NOERROR) hd_->message[0] = '\0';
   return rc;
 }
 
@@ -264,12 +280,13 @@ int FrictionCore::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
 // the box QP on Q = W G W^T, the least-command tie-break, and the outputs updated from the
 // response columns (they are affine in the friction torques: no new solve).
 int FrictionCore::optimiseResting(int k) {
-  qdd0_ = hd_.qdd();
-  tau_cmd0_ = hd_.commandTorques();
-  nu0_.head(hd_.constraintCount()) = hd_.nu();
+  qdd0_ = hd_->res.qdd;
+  tau_cmd0_ = hd_->res.tau_cmd;
+  nu0_.head(hd_->res.m) = hd_->nu();
   // d qdd and d nu per resting joint; tau_cmd follows from nu (commandTorquesOf), so its columns
   // are not formed.
-  int rc = hd_.responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), dnu_.leftCols(k));
+  Eigen::Ref<Eigen::MatrixXd> dnu = dnu_.leftCols(k);
+  int rc = hd_->responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), &dnu);
   if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   for (int a = 0; a < k; ++a) {
     c_(a) = qdd0_(rest_(a));
@@ -280,17 +297,17 @@ int FrictionCore::optimiseResting(int k) {
   // scale for themselves).
   qscale_ = 0.0;
   for (int a = 0; a < k; ++a)
-    qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_.articulatedInertia(static_cast<unsigned int>(rest_(a)))});
+    qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_->ws.seg[hd_->model.joint_segment[rest_(a)]].D});
   rc = boxQp(k);
   if (rc != ChainHdSolver::E_NOERROR) return rc;
   tau_cmd_known_ = false;
   leastCommand(k);
   qdd_ = qdd0_;
   qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
-  const int m = hd_.constraintCount();
+  const int m = hd_->res.m;
   nu_.head(m) = nu0_.head(m);
   nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);
-  if (!tau_cmd_known_) hd_.commandTorquesOf(nu_.head(m), tau_cmd_);  // (else kept by leastCommand)
+  if (!tau_cmd_known_) (void)hd_->commandTorquesOf(nu_.head(m), tau_cmd_);  // (else kept by leastCommand)
   return ChainHdSolver::E_NOERROR;
 }
 
@@ -348,11 +365,11 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
     rc = optimiseResting(k);
     if (rc != ChainHdSolver::E_NOERROR) return rc;
   } else {
-    qdd_ = hd_.qdd();
-    tau_cmd_ = hd_.commandTorques();
-    nu_.head(hd_.constraintCount()) = hd_.nu();
+    qdd_ = hd_->res.qdd;
+    tau_cmd_ = hd_->res.tau_cmd;
+    nu_.head(hd_->res.m) = hd_->nu();
   }
-  m_keep_ = hd_.constraintCount();
+  m_keep_ = hd_->res.m;
   link_acc_known_ = k == 0;
   frictionOutputs(q_dot, friction, k);
   // The optimum is affine in finite friction bounds, but huge values can still overflow.
@@ -370,10 +387,10 @@ const ChainHdSolver::Matrix6X& FrictionCore::linkAccelerations() {
   if (!link_acc_known_ && solved_) {
     // The optimum's joint accelerations through the last solve's kinematics (same q, q_dot): one
     // outward pass instead of a solve with the friction torques as feed-forward.
-    hd_.setJointAccelerations(qdd_);
+    if (hd_->res.solved) hd_->accelerationsOf(qdd_);
     link_acc_known_ = true;
   }
-  return hd_.linkAccelerations();
+  return hd_->linkAccelerations();
 }
 
 double FrictionCore::gaussValue() {
@@ -389,7 +406,8 @@ double FrictionCore::gaussValue() {
     // overflow the sum.
     if (resting && status_[j] != Stick) dissipation += fstatic_(j) * std::abs(qdd_(j));
   }
-  if (hd_.inverseInertiaTimes(tmp_, tmp2_) != ChainHdSolver::E_NOERROR) return std::numeric_limits<double>::quiet_NaN();
+  if (!hd_->res.solved) return std::numeric_limits<double>::quiet_NaN();
+  hd_->inverseInertia(tmp_, tmp2_);
   return 0.5 * tmp_.dot(tmp2_) + dissipation;
 }
 

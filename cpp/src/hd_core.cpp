@@ -330,6 +330,7 @@ int HdCore::solveLast(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::R
   int rc = checkInputs(q, q_dot, alfa, beta, f_ext, ff_torques, kMaxConstraints);
   if (rc != 0) return rc;
   outwardSweep(q, q_dot, f_ext);
+  if (loads != nullptr) applyFrameLoads();
   rc = inwardSweep(alfa, ff_torques);
   if (rc != 0) return rc;
   rc = passThroughEnergy(f_ext, ff_torques);

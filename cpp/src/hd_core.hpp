@@ -17,6 +17,7 @@
 
 #include <array>
 #include <atomic>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,6 +27,7 @@
 #include <kdl/segment.hpp>
 
 #include "vereshchagin/hd_solver.hpp"
+#include "vereshchagin/input.hpp"
 #include "vereshchagin/spatial.hpp"
 
 namespace vereshchagin {
@@ -75,7 +77,10 @@ struct HdModel {
   int n_branch = 0;                // segments with >= 2 children
   std::vector<int> joint_segment;  // segment index of each joint
   unsigned int nj = 0, ns = 0;
-  bool is_chain = true;  // parent[i] = i - 1 for every i: the chain's fast path applies
+  bool is_chain = true;                                 // parent[i] = i - 1 for every i: the chain's fast path applies
+  InertiaCheck inertia_check = InertiaCheck::Physical;  // what the segments were validated against
+  int error = 0;                                        // 0, or why the robot is invalid (message)
+  std::string message;
   int parent(int i) const { return source.parent[i]; }
   const std::string& jointName(int segment) const { return source.segments[segment].getJoint().getName(); }
 };
@@ -140,15 +145,23 @@ struct ResponseWorkspace {
   Matrix6X branch_acc;     // per branching segment: its accelerations of every column (6 x width slots)
 };
 
+// Driver pass-through weights per constraint column (hd_solver.hpp): a facade's state
+// (HdSolver::setPassThrough) or one SolveInput's blocks; a solve reads them through
+// PassThroughState::weights.
+struct PassThroughWeights {
+  Eigen::VectorXd f, t;               // weights per caller's column (mcap)
+  int m = -1;                         // columns they are for; -1: none
+  bool f_any = false, t_any = false;  // some weight is non-zero
+  void resize(int mcap) { f = t = Eigen::VectorXd::Zero(mcap); }
+};
+
 // Workspace of the driver pass-through.
 struct PassThroughState {
-  Eigen::VectorXd f, t;                     // weights per caller's column (mcap)
-  int m = -1;                               // columns they are for; -1: none
-  bool f_any = false, t_any = false;        // some weight is non-zero
-  bool used = false;                        // the last solve applied energy
-  Eigen::VectorXd free;                     // driverFree() per joint (n_joints)
-  Eigen::VectorXd energy, tmp;              // p_f .* a_fext + p_t .* a_ff, and one driver's a (mcap)
-  const Eigen::VectorXd* driver = nullptr;  // ff driver if not ff_torques (FrictionSolver)
+  const PassThroughWeights* weights = nullptr;  // of the current solve (nullptr: none)
+  bool used = false;                            // the last solve applied energy
+  Eigen::VectorXd free;                         // driverFree() per joint (n_joints)
+  Eigen::VectorXd energy, tmp;                  // p_f .* a_fext + p_t .* a_ff, and one driver's a (mcap)
+  const Eigen::VectorXd* driver = nullptr;      // ff driver if not ff_torques (FrictionSolver)
 };
 
 struct HdWorkspace {
@@ -179,14 +192,32 @@ struct HdResults {
   mutable double sigma_min = 0.0;
 };
 
+// Loads of the (model, data, input) API given about points of segment frames (input.hpp):
+// moved to the tip origins with the outward sweep's own rotations (frame_loads.cpp).
+struct FrameLoads {
+  const SolveInput* input = nullptr;  // its frame wrenches and its constraint blocks with a point
+  Matrix6X* f_ext = nullptr;          // the solve's f_ext: a copy of the input's, the wrenches added
+  Matrix6X* alfa = nullptr;           // the solve's columns (the blocks in order)
+  bool wrenches = false, points = false;
+};
+
 // Constraint columns a solve may have (SolverOptions::max_constraints, hd_solver.hpp): the
 // workspace of the coupling matrix is sized for them.
 int constraintCapacity(const SolverOptions& opts, unsigned int ns);
 
+// Builds the model of a source (segment data, topology, degeneracy tolerances) and validates it
+// against `check`, including a sweep at a generic configuration; model.error and model.message
+// say why it is invalid. Construction-time only (allocates).
+std::shared_ptr<const HdModel> buildHdModel(ModelSource source, InertiaCheck check);
+
+// The workspace and results of solves on one shared, immutable model (many HdCore per model).
 class HdCore {
  public:
-  HdCore(const ModelSource& source, const Vector6& root_acc, const SolverOptions& options);
-  void rebuild(const ModelSource& source);
+  // options.inertia_check is the model's (ignored). model_error: the model's error, or
+  // E_INVALID_OPTIONS for invalid options.
+  HdCore(std::shared_ptr<const HdModel> model, const Vector6& root_acc, const SolverOptions& options);
+  // The generic-configuration sweep of buildHdModel(): 0 or an error code (message).
+  int checkGenericConfiguration();
 
   int solveLast(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                 const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
@@ -198,9 +229,9 @@ class HdCore {
   int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                       Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd>* dnu);
   int commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
+  // Validates weights (messages of HdSolver::setPassThrough) into `out`; 0 or an error code.
   int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
-                     const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through);
-  void clearPassThrough();
+                     const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through, PassThroughWeights& out);
   int setOptions(const SolverOptions& options);
   const Matrix6X& linkAccelerations() const;
   // Segment accelerations of given joint accelerations at the last solve's state (poses and
@@ -221,27 +252,24 @@ class HdCore {
   }
   int fail(int code, const char* fmt, ...);
 
-  HdModel model;
+  std::shared_ptr<const HdModel> model_owner;
+  const HdModel& model;
   HdWorkspace ws;
   HdResults res;
   SolverOptions options;
   Vector6 root_acc = Vector6::Zero();
+  FrameLoads* loads = nullptr;  // of the current solve (the API's), applied after the outward sweep
   int model_error = 0;
   int mcap = kMaxConstraints;  // constraint columns of a solve: constraintCapacity(options, ns)
   std::array<char, 512> message{};
-  std::atomic<bool> busy{false};         // a call is inside (entry_guard.hpp)
-  std::atomic<bool> stale_model{false};  // a rebuild was refused (updateInternalDataStructures())
+  mutable std::atomic<bool> busy{false};  // a call is inside (entry_guard.hpp)
   // The state of the current solve, for the messages of degenerate() (nullptr: the generic
-  // configuration of buildModel()).
+  // configuration of checkGenericConfiguration()).
   const Eigen::Ref<const Eigen::VectorXd>* state_q = nullptr;
   const Eigen::Ref<const Eigen::VectorXd>* state_q_dot = nullptr;
 
  private:
-  // Model (hd_model.cpp).
-  void buildModel();
-  int buildSegment(int i);
-  void buildTolerances();  // SegmentModel::d_tolerance from the subtree sizes
-  void buildTopology();
+  // Workspace and checks (hd_model.cpp).
   void allocateWorkspace();
   int checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                   const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
@@ -251,6 +279,9 @@ class HdCore {
                    const Eigen::Ref<const Eigen::VectorXd>& beta, const Eigen::Ref<const Matrix6X>& f_ext,
                    const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   int degenerate(int i);
+
+  // Frame loads after the outward sweep (frame_loads.cpp).
+  void applyFrameLoads();
 
   // Sweeps shared by both paths (hd_core.cpp, articulated_step.hpp).
   void screwPose(const SegmentModel& sm, SegmentState& s, double q) const;

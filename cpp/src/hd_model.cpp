@@ -13,32 +13,19 @@
 namespace vereshchagin {
 namespace detail {
 
-namespace {
-
-Pose toPose(const KDL::Frame& f) {
-  Pose X;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) X.R(r, c) = f.M(r, c);
-    X.p(r) = f.p(r);
+HdCore::HdCore(std::shared_ptr<const HdModel> model_in, const Vector6& root_acc_in, const SolverOptions& opts)
+    : options(opts), root_acc(root_acc_in), model_owner(std::move(model_in)), model(*model_owner) {
+  options.inertia_check = model.inertia_check;
+  allocateWorkspace();
+  model_error = model.error;
+  if (model_error != 0) {
+    std::snprintf(message.data(), message.size(), "%s", model.message.c_str());
+    return;
   }
-  return X;
-}
-
-}  // namespace
-
-HdCore::HdCore(const ModelSource& source, const Vector6& root_acc_in, const SolverOptions& opts)
-    : options(opts), root_acc(root_acc_in) {
-  model.source = source;
-  buildModel();
-  if (model_error == 0) {
-    const int rc = setOptions(opts);
-    if (rc != 0) model_error = rc;
-  }
-}
-
-void HdCore::rebuild(const ModelSource& source) {
-  model.source = source;
-  buildModel();
+  SolverOptions wanted = opts;
+  wanted.inertia_check = model.inertia_check;
+  const int rc = setOptions(wanted);
+  if (rc != 0) model_error = rc;
 }
 
 int constraintCapacity(const SolverOptions& opts, unsigned int ns) {
@@ -59,14 +46,11 @@ int HdCore::setOptions(const SolverOptions& opts) {
   if (opts.max_constraints < 0)
     return fail(HdSolver::E_INVALID_OPTIONS, "options.max_constraints must be >= 0 (0: the default), got %d",
                 opts.max_constraints);
-  const bool rebuild_model = opts.inertia_check != options.inertia_check ||
-                             constraintCapacity(opts, model.ns) != constraintCapacity(options, model.ns);
+  const bool resize = constraintCapacity(opts, model.ns) != mcap;
   options = opts;
+  options.inertia_check = model.inertia_check;  // the model's (a model is rebuilt by its owner)
   res.solved = false;
-  if (rebuild_model) {
-    buildModel();
-    return model_error;
-  }
+  if (resize) allocateWorkspace();
   return 0;
 }
 
@@ -76,27 +60,6 @@ int HdCore::fail(int code, const char* fmt, ...) {
   std::vsnprintf(message.data(), message.size(), fmt, args);
   va_end(args);
   return code;
-}
-
-// Parent-array bookkeeping: subtree ranges, branching segments, the chain test.
-void HdCore::buildTopology() {
-  const int ns = static_cast<int>(model.ns);
-  const std::vector<int>& parent = model.source.parent;
-  model.subtree_end.assign(ns + 1, ns);
-  model.branch_slot.assign(ns, -1);
-  model.is_chain = true;
-  std::vector<int> children(ns, 0);
-  for (int i = 0; i < ns; ++i) {
-    model.is_chain = model.is_chain && parent[i] == i - 1;
-    if (parent[i] >= 0) ++children[parent[i]];
-  }
-  // Preorder: walking backwards, every child is done before its parent takes its subtree's end.
-  for (int i = 0; i < ns; ++i) model.subtree_end[i] = i + 1;
-  for (int i = ns - 1; i >= 0; --i)
-    if (parent[i] >= 0) model.subtree_end[parent[i]] = std::max(model.subtree_end[parent[i]], model.subtree_end[i]);
-  model.n_branch = 0;
-  for (int i = 0; i < ns; ++i)
-    if (children[i] >= 2) model.branch_slot[i] = model.n_branch++;
 }
 
 void HdCore::allocateWorkspace() {
@@ -121,10 +84,9 @@ void HdCore::allocateWorkspace() {
   ws.inertia_joint = Eigen::VectorXd::Zero(nj);
   mcap = constraintCapacity(options, ns);
   PassThroughState& pt = ws.pt;
-  pt.f = pt.t = pt.energy = pt.tmp = Eigen::VectorXd::Zero(mcap);
+  pt.energy = pt.tmp = Eigen::VectorXd::Zero(mcap);
   pt.free = Eigen::VectorXd::Zero(nj);
-  pt.m = -1;  // weights are per column of a model: cleared with it
-  pt.f_any = pt.t_any = pt.used = false;
+  pt.used = false;
   res.general = false;
   CouplingGeneral& g = ws.general;
   g.order = Eigen::VectorXi::Zero(mcap);
@@ -146,124 +108,16 @@ void HdCore::allocateWorkspace() {
   res.sigma_known = true;
 }
 
-// Constant data of segment i; 0 or an error code.
-int HdCore::buildSegment(int i) {
-  const KDL::Segment& seg = model.source.segments[i];
-  const KDL::Joint& joint = seg.getJoint();
-  SegmentModel& s = model.seg[i];
-  if (const char* why = detail::segmentGeometryProblem(seg))
-    return fail(HdSolver::E_INVALID_MODEL, "segment %d ('%s'): %s", i, seg.getName().c_str(), why);
-  const KDL::RigidBodyInertia& rbi = seg.getInertia();
-  const double mass = rbi.getMass();
-  const KDL::Vector cog = rbi.getCOG();
-  const KDL::RotationalInertia Io = rbi.getRotationalInertia();  // about the tip origin
-  Vector3 c(cog.x(), cog.y(), cog.z());
-  Matrix3 I_origin = Eigen::Map<const Matrix3>(Io.data);
-  if (!c.allFinite())
-    return fail(HdSolver::E_INVALID_MODEL, "segment %d ('%s'): non-finite inertial parameters", i,
-                seg.getName().c_str());
-  // Rotational inertia about the centre of mass, checked as options.inertia_check says.
-  const Matrix3 Sc = skew(c);
-  const Matrix3 I_com = I_origin + mass * Sc * Sc;
-  // Round-off scale of I_com: its two terms, each exact to a few ulps.
-  const double round_off = std::max(I_origin.cwiseAbs().maxCoeff(), mass * c.squaredNorm());
-  std::array<char, 320> why_buf{};
-  if (const char* why =
-          detail::inertiaProblem(mass, I_com, options.inertia_check, why_buf.data(), why_buf.size(), round_off))
-    return fail(HdSolver::E_INVALID_MODEL, "segment %d ('%s'): %s", i, seg.getName().c_str(), why);
-  s.I = rigidInertia(mass, c, 0.5 * (I_origin + I_origin.transpose()));
-  s.X0 = toPose(seg.pose(0.0));
-  s.joint = model.source.joint[i];
-  if (s.joint < 0) {
-    s.S.setZero();
-    return 0;
-  }
-  model.joint_segment[s.joint] = i;
-  s.rotor = joint.getInertia();
-  if (!std::isfinite(s.rotor) || s.rotor < 0.0)
-    return fail(HdSolver::E_INVALID_MODEL, "joint %d ('%s'): rotor inertia must be >= 0, got %g", s.joint,
-                joint.getName().c_str(), s.rotor);
-  // The joint axis is fixed in the child body, so in the tip frame it does not depend on q.
-  const KDL::Twist t = seg.twist(0.0, 1.0);            // root axes, tip reference point
-  const KDL::Rotation Rt = seg.pose(0.0).M.Inverse();  // root axes -> tip axes
-  const KDL::Vector v = Rt * t.vel, w = Rt * t.rot;
-  s.S << v.x(), v.y(), v.z(), w.x(), w.y(), w.z();
-  s.w_norm = s.S.tail<3>().norm();
-  s.v2 = s.S.head<3>().squaredNorm();
-  s.w2 = s.S.tail<3>().squaredNorm();
-  if (!s.S.allFinite() || s.S.norm() == 0.0)
-    return fail(HdSolver::E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite", s.joint,
-                joint.getName().c_str());
-  return 0;
-}
-
-// The degeneracy tolerance of every joint, relative to what it moves (hd_solver.hpp, "Degenerate
-// joints"): 1e-13 s_j with s_j = rotor_j + sum over the segments k of j's subtree of
-// |v_j|^2 m_k + |w_j|^2 (trace|Ic_k| + m_k (d_j + l_jk + |c_k|)^2), S_j = [v_j; w_j], d_j = |v_j| / |w_j|
-// the distance of a rotation axis from j's tip origin, l_jk the path length from j's tip frame to
-// k's (per segment |X0.p| + 2 d: a tip origin moves at most 2 d about its axis). O(n x depth).
-void HdCore::buildTolerances() {
-  const int ns = static_cast<int>(model.ns);
-  std::vector<double> path(ns, 0.0), own(ns, 0.0), mass(ns, 0.0), reach(ns, 0.0), axis(ns, 0.0);
-  for (int k = 0; k < ns; ++k) {
-    const SegmentModel& sm = model.seg[k];
-    const KDL::RigidBodyInertia& rbi = model.source.segments[k].getInertia();
-    mass[k] = rbi.getMass();
-    reach[k] = rbi.getCOG().Norm();
-    const Vector3 c(rbi.getCOG().x(), rbi.getCOG().y(), rbi.getCOG().z());
-    const Matrix3 I_com = sm.I.bottomRightCorner<3, 3>() + mass[k] * skew(c) * skew(c);
-    own[k] = I_com.cwiseAbs().trace();
-    axis[k] = sm.w_norm > 0.0 ? std::sqrt(sm.v2) / sm.w_norm : 0.0;
-    const int p = model.parent(k);
-    path[k] = (p >= 0 ? path[p] : 0.0) + sm.X0.p.norm() + 2.0 * axis[k];
-  }
-  for (int j = 0; j < ns; ++j) {
-    SegmentModel& sj = model.seg[j];
-    if (sj.joint < 0) continue;
-    double size = sj.rotor;
-    for (int k = j; k < model.subtree_end[j]; ++k) {
-      const double dist = axis[j] + (path[k] - path[j]) + reach[k];
-      size += sj.v2 * mass[k] + sj.w2 * (own[k] + mass[k] * dist * dist);
-    }
-    sj.d_tolerance = 1e-13 * std::max(size, std::numeric_limits<double>::min());
-  }
-}
-
-void HdCore::buildModel() {
-  model_error = 0;
-  message[0] = '\0';
-  res.solved = false;
-  const ModelSource& src = model.source;
-  model.ns = static_cast<unsigned int>(src.segments.size());
-  model.nj = 0;
-  for (int j : src.joint) model.nj += j >= 0 ? 1 : 0;
-  model.seg.assign(model.ns, SegmentModel());
-  model.joint_segment.assign(model.nj, 0);
-  buildTopology();
-  allocateWorkspace();
-  if (!src.problem.empty()) {
-    model_error = fail(HdSolver::E_INVALID_MODEL, "%s", src.problem.c_str());
-    return;
-  }
-  for (unsigned int i = 0; i < model.ns; ++i) {
-    const int rc = buildSegment(static_cast<int>(i));
-    if (rc != 0) {
-      model_error = rc;
-      return;
-    }
-  }
-  buildTolerances();
-
-  // Reject robots whose joints have no inertia to move. Checked at a generic configuration (not
-  // q = 0, where a body may sit on an axis by coincidence); a configuration-dependent loss of
-  // inertia is reported by solve().
+// Reject robots whose joints have no inertia to move. Checked at a generic configuration (not
+// q = 0, where a body may sit on an axis by coincidence); a configuration-dependent loss of
+// inertia is reported by solve().
+int HdCore::checkGenericConfiguration() {
   Eigen::VectorXd q_generic(model.nj);
   for (unsigned int k = 0; k < model.nj; ++k) q_generic(k) = 0.7 + 0.61 * k;
   state_q = state_q_dot = nullptr;
   outwardSweep(q_generic, ws.zero_joints, ws.zero_f_ext);
-  const int rc = model.is_chain ? inwardSweep(ws.alfa_buf.leftCols(0), ws.zero_joints)
-                                : inwardSweepGeneral(ws.alfa_buf.leftCols(0), ws.zero_joints);
-  if (rc != 0) model_error = rc;
+  return model.is_chain ? inwardSweep(ws.alfa_buf.leftCols(0), ws.zero_joints)
+                        : inwardSweepGeneral(ws.alfa_buf.leftCols(0), ws.zero_joints);
 }
 
 int HdCore::checkInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,

@@ -3,7 +3,9 @@
 #include "vereshchagin/hd_solver.hpp"
 
 #include "entry_guard.hpp"
+#include "facade_state.hpp"
 #include "hd_core.hpp"
+#include "model_impl.hpp"
 
 namespace vereshchagin {
 
@@ -27,38 +29,54 @@ KDL::Twist toTwist(const Vector6& v) {
 
 }  // namespace
 
-HdSolver::HdSolver(const detail::ModelSource& source, const KDL::Twist& root_acc, const SolverOptions& options)
-    : core_(std::make_unique<detail::HdCore>(source, toVector(root_acc), options)) {}
+HdSolver::HdSolver(const Model& model, const KDL::Twist& root_acc, const SolverOptions& options)
+    : state_(std::make_unique<detail::FacadeState>(model, toVector(root_acc), options)) {}
 
 HdSolver::~HdSolver() = default;
 HdSolver::HdSolver(HdSolver&&) noexcept = default;
 HdSolver& HdSolver::operator=(HdSolver&&) noexcept = default;
 
-void HdSolver::rebuild(const detail::ModelSource& source) {
-  core_->rebuild(source);
+detail::HdCore& HdSolver::core() {
+  return state_->core();
+}
+const detail::HdCore& HdSolver::core() const {
+  return state_->core();
+}
+const Model& HdSolver::model() const {
+  return state_->model;
+}
+Data& HdSolver::data() {
+  return state_->data;
+}
+
+void HdSolver::rebuild(const Model& model) {
+  state_->reset(model, core().options);
 }
 
 void HdSolver::updateInternalDataStructures() {
-  const EntryGuard guard(core_->busy);
-  if (!guard) {
-    core_->stale_model.store(true, std::memory_order_relaxed);  // reported by the next solves
-    return;
+  {
+    const EntryGuard guard(core().busy);
+    if (!guard) {
+      state_->stale_model.store(true, std::memory_order_relaxed);  // reported by the next solves
+      return;
+    }
+    rebuild(state_->model);
+    state_->stale_model.store(false, std::memory_order_relaxed);
   }
-  core_->rebuild(core_->model.source);
-  core_->stale_model.store(false, std::memory_order_relaxed);
+  state_->dropRetired();  // the guard above held its flag
 }
 
 int HdSolver::record(int rc) {
   if (rc != E_NOERROR) {
     error = rc;
   } else {
-    core_->message[0] = '\0';
+    core().message[0] = '\0';
   }
   return rc;
 }
 
 int HdSolver::solveChecked(int rc) {
-  if (rc == E_NOERROR) core_->message[0] = '\0';
+  if (rc == E_NOERROR) core().message[0] = '\0';
   return error = rc;
 }
 
@@ -66,16 +84,16 @@ int HdSolver::solveChecked(int rc) {
 // error code with its message.
 int HdSolver::solveArgsProblem(const Eigen::Ref<const Eigen::MatrixXd>& alfa,
                                const Eigen::Ref<const Eigen::MatrixXd>& f_ext) {
-  if (core_->stale_model.load(std::memory_order_relaxed))
-    return core_->fail(E_CONCURRENT_CALL,
+  if (state_->stale_model.load(std::memory_order_relaxed))
+    return core().fail(E_CONCURRENT_CALL,
                        "updateInternalDataStructures() was called while another thread was inside a call on this "
                        "solver and could not rebuild the model: call it again (a solver object must not be used "
                        "from two threads at once; use one solver per thread)");
   if (alfa.rows() != 6 && alfa.cols() != 0)
-    return core_->fail(E_SIZE_MISMATCH, "alfa is %ldx%ld, expected 6 rows (6 x m constraint wrenches, m <= %d)",
+    return core().fail(E_SIZE_MISMATCH, "alfa is %ldx%ld, expected 6 rows (6 x m constraint wrenches, m <= %d)",
                        (long)alfa.rows(), (long)alfa.cols(), maxConstraints());
   if (f_ext.rows() != 6 && f_ext.cols() != 0)
-    return core_->fail(E_SIZE_MISMATCH, "f_ext is %ldx%ld, expected 6 x %u (one wrench per segment) or empty",
+    return core().fail(E_SIZE_MISMATCH, "f_ext is %ldx%ld, expected 6 x %u (one wrench per segment) or empty",
                        (long)f_ext.rows(), (long)f_ext.cols(), nrOfSegments());
   return E_NOERROR;
 }
@@ -84,7 +102,7 @@ int HdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref
                     const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                     const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
                     const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
   return solveEntered(q, q_dot, alfa, beta, f_ext, ff_torques);
 }
@@ -94,84 +112,86 @@ int HdSolver::solveEntered(const Eigen::Ref<const Eigen::VectorXd>& q, const Eig
                            const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
                            const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   if (const int rc = solveArgsProblem(alfa, f_ext)) return solveChecked(rc);
-  return solveChecked(core_->solveLast(q, q_dot, sixRows(alfa), beta, sixRows(f_ext), ff_torques));
+  state_->install();
+  return solveChecked(core().solveLast(q, q_dot, sixRows(alfa), beta, sixRows(f_ext), ff_torques));
 }
 
 int HdSolver::solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                     const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                     const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
                     const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
   if (const int rc = solveArgsProblem(alfa, f_ext)) return solveChecked(rc);
-  return solveChecked(core_->solveSegments(q, q_dot, sixRows(alfa), beta, segments, sixRows(f_ext), ff_torques));
+  state_->install();
+  return solveChecked(core().solveSegments(q, q_dot, sixRows(alfa), beta, segments, sixRows(f_ext), ff_torques));
 }
 
 int HdSolver::maxConstraints() const {
-  return core_->mcap;
+  return core().mcap;
 }
 const Eigen::VectorXd& HdSolver::qdd() const {
-  return core_->res.qdd;
+  return core().res.qdd;
 }
 const Eigen::VectorXd& HdSolver::commandTorques() const {
-  return core_->res.tau_cmd;
+  return core().res.tau_cmd;
 }
 Eigen::Map<const Eigen::VectorXd> HdSolver::nu() const {
-  return core_->nu();
+  return core().nu();
 }
 const HdSolver::Matrix6X& HdSolver::linkAccelerations() const {
-  const EntryGuard guard(core_->busy);
-  if (!guard) return core_->res.link_acc;  // another thread is inside: no lazy computation
-  return core_->linkAccelerations();
+  const EntryGuard guard(core().busy);
+  if (!guard) return core().res.link_acc;  // another thread is inside: no lazy computation
+  return core().linkAccelerations();
 }
 int HdSolver::setJointAccelerations(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  if (!core_->res.solved)
-    return record(core_->fail(E_NO_SOLUTION, "setJointAccelerations() needs a successful solve() first"));
+  if (!core().res.solved)
+    return record(core().fail(E_NO_SOLUTION, "setJointAccelerations() needs a successful solve() first"));
   if (qdd.size() != static_cast<Eigen::Index>(nrOfJoints()))
     return record(
-        core_->fail(E_SIZE_MISMATCH, "qdd has %ld entries, expected %u (joints)", (long)qdd.size(), nrOfJoints()));
-  core_->accelerationsOf(qdd);
+        core().fail(E_SIZE_MISMATCH, "qdd has %ld entries, expected %u (joints)", (long)qdd.size(), nrOfJoints()));
+  core().accelerationsOf(qdd);
   return record(E_NOERROR);
 }
 int HdSolver::inverseInertiaTimes(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> out) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  if (!core_->res.solved)
-    return record(core_->fail(E_NO_SOLUTION, "inverseInertiaTimes() needs a successful solve() first"));
+  if (!core().res.solved)
+    return record(core().fail(E_NO_SOLUTION, "inverseInertiaTimes() needs a successful solve() first"));
   const auto n = static_cast<Eigen::Index>(nrOfJoints());
   if (tau.size() != n || out.size() != n)
-    return record(core_->fail(E_SIZE_MISMATCH, "tau has %ld and out %ld entries, expected %u (joints)",
+    return record(core().fail(E_SIZE_MISMATCH, "tau has %ld and out %ld entries, expected %u (joints)",
                               (long)tau.size(), (long)out.size(), nrOfJoints()));
-  core_->inverseInertia(tau, out);
+  core().inverseInertia(tau, out);
   return record(E_NOERROR);
 }
 int HdSolver::constraintCount() const {
-  return core_->res.m;
+  return core().res.m;
 }
 KDL::Frame HdSolver::linkLocalPose(unsigned int i) const {
-  const Pose& X = core_->ws.seg[i].X;
+  const Pose& X = core().ws.seg[i].X;
   return KDL::Frame(
       KDL::Rotation(X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1), X.R(2, 2)),
       KDL::Vector(X.p(0), X.p(1), X.p(2)));
 }
 KDL::Twist HdSolver::linkLocalVelocity(unsigned int i) const {
-  return toTwist(core_->ws.seg[i].v);
+  return toTwist(core().ws.seg[i].v);
 }
 KDL::Twist HdSolver::linkLocalAcceleration(unsigned int i) const {
-  return toTwist(core_->ws.seg[i].xdd);
+  return toTwist(core().ws.seg[i].xdd);
 }
 double HdSolver::articulatedInertia(unsigned int joint) const {
-  return core_->ws.seg[core_->model.joint_segment[joint]].D;
+  return core().ws.seg[core().model.joint_segment[joint]].D;
 }
 int HdSolver::constraintRank() const {
-  return core_->res.rank;
+  return core().res.rank;
 }
 double HdSolver::smallestSingularValue() const {
-  const EntryGuard guard(core_->busy);
-  if (!guard) return core_->res.sigma_min;  // another thread is inside: no lazy computation
-  return core_->smallestSingularValue();
+  const EntryGuard guard(core().busy);
+  if (!guard) return core().res.sigma_min;  // another thread is inside: no lazy computation
+  return core().smallestSingularValue();
 }
 
 void HdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot) const {
@@ -182,69 +202,90 @@ void HdSolver::getTransformedLinkAcceleration(std::vector<KDL::Twist>& x_dotdot)
 
 int HdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                               Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  return record(core_->responseColumns(joints, dqdd, dtau_cmd, nullptr));
+  return record(core().responseColumns(joints, dqdd, dtau_cmd, nullptr));
 }
 
 int HdSolver::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                               Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd> dnu) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  const int m = core_->res.m;
-  if (core_->res.solved && (dnu.rows() < m || dnu.cols() < joints.size()))
-    return record(core_->fail(E_SIZE_MISMATCH, "dnu is %ldx%ld, expected at least %dx%ld", (long)dnu.rows(),
+  const int m = core().res.m;
+  if (core().res.solved && (dnu.rows() < m || dnu.cols() < joints.size()))
+    return record(core().fail(E_SIZE_MISMATCH, "dnu is %ldx%ld, expected at least %dx%ld", (long)dnu.rows(),
                               (long)dnu.cols(), m, (long)joints.size()));
-  return record(core_->responseColumns(joints, dqdd, dtau_cmd, &dnu));
+  return record(core().responseColumns(joints, dqdd, dtau_cmd, &dnu));
 }
 
 int HdSolver::commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  return record(core_->commandTorquesOf(nu, tau_cmd));
+  return record(core().commandTorquesOf(nu, tau_cmd));
 }
 
 int HdSolver::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                              const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  return record(core_->setPassThrough(f_ext_pass_through, ff_pass_through));
+  return record(core().setPassThrough(f_ext_pass_through, ff_pass_through, state_->weights));
 }
 int HdSolver::clearPassThrough() {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  core_->clearPassThrough();
+  state_->weights.m = -1;
+  state_->weights.f_any = state_->weights.t_any = false;
+  core().res.solved = false;
   return E_NOERROR;
 }
 int HdSolver::passThroughColumns() const {
-  return core_->ws.pt.m;
+  return state_->weights.m;
 }
 
 int HdSolver::setRootAcceleration(const KDL::Twist& root_acc) {
-  const EntryGuard guard(core_->busy);
+  const EntryGuard guard(core().busy);
   if (!guard) return E_CONCURRENT_CALL;
-  core_->root_acc = toVector(root_acc);
+  state_->root_acc = toVector(root_acc);
   return E_NOERROR;
 }
 int HdSolver::setOptions(const SolverOptions& options) {
-  const EntryGuard guard(core_->busy);
-  if (!guard) return E_CONCURRENT_CALL;
-  return record(core_->setOptions(options));
+  int rc = E_NOERROR;
+  {
+    const EntryGuard guard(core().busy);
+    if (!guard) return E_CONCURRENT_CALL;
+    rc = setOptionsEntered(options);
+  }
+  state_->dropRetired();  // the guard above held its flag
+  return rc;
+}
+
+int HdSolver::setOptionsEntered(const SolverOptions& options) {
+  const int capacity = core().mcap;
+  const int rc = core().setOptions(options);  // validates; resizes the workspace for a new capacity
+  if (rc != E_NOERROR) return record(rc);
+  if (options.inertia_check != state_->model.options().inertia_check) {
+    ModelOptions model_options = state_->model.options();
+    model_options.inertia_check = options.inertia_check;
+    state_->reset(detail::ModelAccess::withOptions(state_->model, model_options), options);
+    return record(core().model_error);
+  }
+  if (core().mcap != capacity) state_->reset(state_->model, options);  // weights are per capacity
+  return record(core().model_error);
 }
 const SolverOptions& HdSolver::options() const {
-  return core_->options;
+  return core().options;
 }
 unsigned int HdSolver::nrOfJoints() const {
-  return core_->model.nj;
+  return core().model.nj;
 }
 unsigned int HdSolver::nrOfSegments() const {
-  return core_->model.ns;
+  return core().model.ns;
 }
 int HdSolver::modelError() const {
-  return core_->model_error;
+  return core().model_error;
 }
 const char* HdSolver::errorMessage() const {
-  return core_->message.data();
+  return core().message.data();
 }
 
 const char* HdSolver::strError(const int code) const {

@@ -41,14 +41,11 @@ std::shared_ptr<const ModelImpl> finish(detail::ModelSource source, const ModelO
   }
   m->links = std::move(links);
   for (std::size_t k = 0; k < m->links.size(); ++k) m->link_index.emplace(m->links[k].link, static_cast<int>(k));
-  m->source = std::move(source);
-  // Validation: the solver's own model build (every check and message in one place).
-  SolverOptions check;
-  check.inertia_check = options.inertia_check;
-  const detail::HdCore core(m->source, Vector6::Zero(), check);
-  if (core.model_error != 0) {
-    m->error = static_cast<Error>(core.model_error);
-    m->message = core.message.data();
+  // The solver's model, validated (every check and message in one place).
+  m->hd = detail::buildHdModel(std::move(source), options.inertia_check);
+  if (m->hd->error != 0) {
+    m->error = static_cast<Error>(m->hd->error);
+    m->message = m->hd->message;
   }
   return m;
 }
@@ -71,6 +68,21 @@ Model::Model(const RobotTree& robot, const ModelOptions& options)
     : impl_(finish(detail::treeModelSource(robot.tree, std::string()), options, robot.root_link, robot.joints,
                    robot.links)) {}
 
+Model detail::ModelAccess::withOptions(const Model& model, const ModelOptions& options) {
+  const ModelImpl& old = model.impl();
+  if (old.options.inertia_check == options.inertia_check) return model;
+  auto m = std::make_shared<ModelImpl>(old);
+  m->options = options;
+  m->error = Error::None;
+  m->message.clear();
+  m->hd = detail::buildHdModel(old.source(), options.inertia_check);
+  if (m->hd->error != 0) {
+    m->error = static_cast<Error>(m->hd->error);
+    m->message = m->hd->message;
+  }
+  return Model(std::move(m));
+}
+
 Status Model::status() const noexcept {
   return Status(impl_->error, impl_->message.c_str());
 }
@@ -81,22 +93,22 @@ unsigned int Model::nrOfJoints() const noexcept {
   return static_cast<unsigned int>(impl_->segment_of_joint.size());
 }
 unsigned int Model::nrOfSegments() const noexcept {
-  return static_cast<unsigned int>(impl_->source.segments.size());
+  return static_cast<unsigned int>(impl_->source().segments.size());
 }
 bool Model::isChain() const noexcept {
   return impl_->is_chain;
 }
 const KDL::Segment& Model::segment(int i) const {
-  return impl_->source.segments[static_cast<std::size_t>(i)];
+  return impl_->source().segments[static_cast<std::size_t>(i)];
 }
 const std::vector<KDL::Segment>& Model::segments() const noexcept {
-  return impl_->source.segments;
+  return impl_->source().segments;
 }
 const std::vector<int>& Model::parents() const noexcept {
-  return impl_->source.parent;
+  return impl_->source().parent;
 }
 const std::vector<int>& Model::jointOfSegment() const noexcept {
-  return impl_->source.joint;
+  return impl_->source().joint;
 }
 const std::vector<int>& Model::segmentOfJoint() const noexcept {
   return impl_->segment_of_joint;

@@ -1,7 +1,8 @@
 // The immutable robot behind a Model (model.hpp): its segments in preorder with parents and
-// joint indices, names and lookup tables, URDF data, and the validation result.
+// joint indices, the solver's model, names and lookup tables, URDF data, and the validation result.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -14,7 +15,10 @@ namespace vereshchagin {
 namespace detail {
 
 struct ModelImpl {
-  ModelSource source;  // segments, parent, joint (per segment)
+  // The solver's model (segments, parent, joint per segment in hd->source), built and validated
+  // once; every HdCore of this Model shares it.
+  std::shared_ptr<const HdModel> hd;
+  const ModelSource& source() const { return hd->source; }
   ModelOptions options;
   std::vector<int> segment_of_joint;
   std::vector<std::string> segment_names, joint_names;
@@ -25,6 +29,12 @@ struct ModelImpl {
   bool is_chain = true;
   Error error = Error::None;
   std::string message;
+};
+
+// What the solver facades need of a Model beyond its public face.
+struct ModelAccess {
+  // The same robot validated with other options (a facade's setOptions()).
+  static Model withOptions(const Model& model, const ModelOptions& options);
 };
 
 }  // namespace detail

@@ -15,7 +15,7 @@ namespace vereshchagin {
 namespace detail {
 
 int HdCore::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
-                           const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through) {
+                           const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through, PassThroughWeights& pt) {
   const long nf = f_ext_pass_through.size(), nt = ff_pass_through.size();
   if (nf != 0 && nt != 0 && nf != nt)
     return fail(KDL::SolverI::E_SIZE_MISMATCH,
@@ -33,11 +33,12 @@ int HdCore::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_t
   for (long c = 0; c < nt; ++c)
     if (!(ff_pass_through(c) >= 0.0 && ff_pass_through(c) <= 1.0))
       return fail(KDL::SolverI::E_OUT_OF_RANGE, "ff_pass_through(%ld) = %g is not in [0, 1]", c, ff_pass_through(c));
+  res.solved = false;
   if (m == 0) {
-    clearPassThrough();
+    pt.m = -1;
+    pt.f_any = pt.t_any = false;
     return 0;
   }
-  PassThroughState& pt = ws.pt;
   pt.f.head(m).setZero();
   pt.t.head(m).setZero();
   if (nf) pt.f.head(m) = f_ext_pass_through;
@@ -45,14 +46,7 @@ int HdCore::setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_t
   pt.f_any = nf != 0 && (f_ext_pass_through.array() != 0.0).any();
   pt.t_any = nt != 0 && (ff_pass_through.array() != 0.0).any();
   pt.m = static_cast<int>(m);
-  res.solved = false;
   return 0;
-}
-
-void HdCore::clearPassThrough() {
-  ws.pt.m = -1;
-  ws.pt.f_any = ws.pt.t_any = false;
-  res.solved = false;
 }
 
 // After an inward sweep of either path: E_SIZE_MISMATCH if weights are set for another column
@@ -62,27 +56,28 @@ int HdCore::passThroughEnergy(const Eigen::Ref<const Matrix6X>& f_ext,
                               const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   PassThroughState& pt = ws.pt;
   pt.used = false;
-  if (pt.m < 0) return 0;
+  if (pt.weights == nullptr || pt.weights->m < 0) return 0;
+  const PassThroughWeights& w = *pt.weights;
   const int m = res.m;
-  if (pt.m != m)
+  if (w.m != m)
     return fail(KDL::SolverI::E_SIZE_MISMATCH, "the pass-through weights are for %d constraint columns, alfa has %d",
-                pt.m, m);
+                w.m, m);
   const Eigen::Ref<const Eigen::VectorXd> tau = pt.driver ? Eigen::Ref<const Eigen::VectorXd>(*pt.driver) : ff_torques;
-  const bool use_f = pt.f_any && f_ext.cols() != 0, use_t = pt.t_any && tau.size() != 0;
+  const bool use_f = w.f_any && f_ext.cols() != 0, use_t = w.t_any && tau.size() != 0;
   if (!use_f && !use_t) return 0;
   auto energy = pt.energy.head(m);
   energy.setZero();
   // Weight of column k of the path's order: the caller's column order(k) on the general path.
-  const auto weight = [this](const Eigen::VectorXd& w, int k) { return w(res.general ? ws.general.order(k) : k); };
+  const auto weight = [this](const Eigen::VectorXd& p, int k) { return p(res.general ? ws.general.order(k) : k); };
   if (use_f) {
     driverFree(f_ext, ws.zero_joints.head(0));
     driverEnergy(pt.tmp.head(m));
-    for (int k = 0; k < m; ++k) energy(k) += weight(pt.f, k) * pt.tmp(k);
+    for (int k = 0; k < m; ++k) energy(k) += weight(w.f, k) * pt.tmp(k);
   }
   if (use_t) {
     driverFree(ws.zero_f_ext.leftCols(0), tau);
     driverEnergy(pt.tmp.head(m));
-    for (int k = 0; k < m; ++k) energy(k) += weight(pt.t, k) * pt.tmp(k);
+    for (int k = 0; k < m; ++k) energy(k) += weight(w.t, k) * pt.tmp(k);
   }
   pt.used = true;
   return 0;

@@ -51,6 +51,7 @@ int HdCore::solveGeneral(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
   if (rc != 0) return rc;
   res.general = true;
   outwardSweep(q, q_dot, f_ext);
+  if (loads != nullptr) applyFrameLoads();
   rc = inwardSweepGeneral(alfa, ff_torques);
   if (rc == 0) rc = passThroughEnergy(f_ext, ff_torques);
   if (rc != 0) {

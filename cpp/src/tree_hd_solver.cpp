@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "hd_core.hpp"
+#include "vereshchagin/model.hpp"
 
 namespace vereshchagin {
 
@@ -63,20 +64,22 @@ ModelSource treeModelSource(const KDL::Tree& tree, const std::string& root_name)
 
 TreeHdSolver::TreeHdSolver(const KDL::Tree& tree, const KDL::Twist& root_acc, const SolverOptions& options,
                            const std::string& root_segment)
-    : HdSolver(detail::treeModelSource(tree, root_segment), root_acc, options), root_name_(root_segment) {
+    : HdSolver(Model(tree, root_segment, ModelOptions{options.inertia_check}), root_acc, options),
+      root_name_(root_segment) {
   if (root_name_.empty()) root_name_ = tree.getRootSegment()->first;
-  const detail::ModelSource& src = core().model.source;
-  joint_names_.assign(nrOfJoints(), std::string());
-  for (std::size_t i = 0; i < src.segments.size(); ++i) {
-    segment_names_.push_back(src.segments[i].getName());
-    if (src.joint[i] >= 0) joint_names_[src.joint[i]] = src.segments[i].getJoint().getName();
-  }
-  parent_ = src.parent;
 }
 
+const std::vector<std::string>& TreeHdSolver::jointNames() const {
+  return model().jointNames();
+}
+const std::vector<std::string>& TreeHdSolver::segmentNames() const {
+  return model().segmentNames();
+}
+const std::vector<int>& TreeHdSolver::parent() const {
+  return model().parents();
+}
 int TreeHdSolver::segmentIndex(const std::string& name) const {
-  const auto it = std::find(segment_names_.begin(), segment_names_.end(), name);
-  return it == segment_names_.end() ? -1 : static_cast<int>(it - segment_names_.begin());
+  return model().segmentIndex(name);
 }
 
 }  // namespace vereshchagin

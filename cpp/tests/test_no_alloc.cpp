@@ -9,6 +9,7 @@
 #include "random_tree.hpp"
 #include "test_common.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
+#include "vereshchagin/data.hpp"
 #include "vereshchagin/friction_solver.hpp"
 #include "vereshchagin/kdl_compat.hpp"
 #include "vereshchagin/tree_hd_solver.hpp"
@@ -310,9 +311,49 @@ int main() {
     ck.check(
         t1.news == t0.news && t1.mallocs == t0.mallocs,
         "tree solves allocated: operator new " + str(t1.news - t0.news) + ", malloc " + str(t1.mallocs - t0.mallocs));
+
+    // The (model, data, input) API on the same tree: blocks with points, frame wrenches,
+    // pass-through weights, gravity, friction (workspace reserved), kinematics and the companions.
+    const vereshchagin::Model model(tree);
+    vereshchagin::Data data(model);
+    data.reserveFriction();
+    vereshchagin::SolveInput input(model, 4, 4);
+    input.setState(vereshchagin::JointPositions(tq), vereshchagin::JointVelocities(tqd));
+    input.f_ext = tfe;
+    input.ff_torques = tff;
+    const vereshchagin::FrameRef tool{tns - 1, KDL::Frame(KDL::Vector(0.1, -0.2, 0.05))};
+    Eigen::MatrixXd jac(6, tn);
+    Eigen::VectorXd tout(tn);
+    int afail = 0;
+    double asum = 0.0;
+    const Counts a0 = now();
+    for (int it = 0; it < 300; ++it) {
+      input.clear();
+      const int m = 1 + it % 6;
+      if (!input.addConstraint(tool, tA.leftCols(m), tb.head(m)).ok()) ++afail;
+      if (!input.addConstraint(1, tA.leftCols(2), tb.head(2), vereshchagin::Vector3(0.0, 0.1, 0.0)).ok()) ++afail;
+      if (!input.addWrench(tool, vereshchagin::Vector6::Constant(0.5)).ok()) ++afail;
+      input.constraints[0].ff_pass_through(0) = it % 2 ? 0.5 : 0.0;
+      input.f_ext = tfe;
+      input.friction = it % 3 == 0 ? &fm : nullptr;
+      if (!vereshchagin::solve(model, data, input).ok()) ++afail;
+      if (!data.frameJacobian(tool, jac).ok()) ++afail;
+      if (!data.responseColumns(tsome, tdq3, tdt3).ok()) ++afail;
+      if (!data.inverseInertiaTimes(tff, tout).ok()) ++afail;
+      asum += data.qdd()(0) + data.linkAccelerations()(2, tns) + data.framePose(tool).p.x() +
+              data.frameTwist(tool).rot.z() + jac(0, 0) + tdq3(0, 0) + tout(0) + data.smallestSingularValue();
+      if (input.friction) asum += data.gaussValue();
+    }
+    const Counts a1 = now();
+    ck.check(afail == 0, "(model, data, input) solves failed: " + str(afail));
+    ck.check(std::isfinite(asum), "non-finite (model, data, input) results");
+    ck.check(a1.news == a0.news && a1.mallocs == a0.mallocs, "(model, data, input) solves allocated: operator new " +
+                                                                 str(a1.news - a0.news) + ", malloc " +
+                                                                 str(a1.mallocs - a0.mallocs));
   }
 
   return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves + 2000 with segment constraints on a "
-                               "7-joint chain, nc 0..6, 2700 on a 12-joint tree (malloc counted too: ") +
+                               "7-joint chain, nc 0..6, 2700 on a 12-joint tree, 300 through solve(model, data, input) "
+                               "(malloc counted too: ") +
                    (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no") + ")");
 }

@@ -50,6 +50,10 @@ class Data {
 
   Status status() const noexcept;
   const SolverOptions& options() const noexcept;
+  // The workspace of the friction stage (n_joints^2 doubles, a few times over) is allocated at
+  // the first solve with input.friction set, so a frictionless Data stays O(n + m^2); call this
+  // once beforehand to keep that first friction solve allocation-free too.
+  void reserveFriction();
   // The model this Data was built for (solve() with another one: Error::NotUpToDate).
   const Model& model() const noexcept;
 

@@ -111,6 +111,10 @@ class FrictionSolver {
   // accelerations are the optimum's once linkAccelerations() was called) — its responseColumns()
   // are valid for the optimum too.
   HdSolver& hdSolver();
+  // The Model and Data of hdSolver() (hd_solver.hpp): solve(model(), data(), input) with
+  // input.friction set runs this same friction stage on that Data.
+  const Model& model() const;
+  Data& data();
   const char* errorMessage() const;
   int modelError() const;
   int setRootAcceleration(const KDL::Twist& root_acc);  // 0 or E_CONCURRENT_CALL
@@ -127,7 +131,14 @@ class FrictionSolver {
   FrictionSolver& operator=(FrictionSolver&&) noexcept;
 
  private:
-  std::unique_ptr<detail::FrictionCore> core_;  // model, workspace and results (friction_core.hpp)
+  detail::FrictionCore& core() const;
+  int solveEntered(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                   const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                   const Eigen::Ref<const Eigen::VectorXi>* segments, const Eigen::Ref<const Eigen::MatrixXd>& f_ext,
+                   const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+
+  std::unique_ptr<HdSolver> hd_;                // ChainHdSolver or TreeHdSolver: Model and Data
+  std::unique_ptr<detail::FrictionCore> core_;  // the friction stage on hd_'s core (friction_core.hpp)
 };
 
 }  // namespace vereshchagin

@@ -152,12 +152,14 @@ struct SolverOptions {
 };
 
 namespace detail {
-struct ModelSource;
 class HdCore;
 class FrictionCore;
+struct FacadeState;
 }  // namespace detail
 
 class FrictionSolver;
+class Model;
+class Data;
 
 class HdSolver : public KDL::SolverI {
  public:
@@ -290,6 +292,14 @@ class HdSolver : public KDL::SolverI {
   const char* errorMessage() const;
   const char* strError(const int error) const override;
 
+  // The Model and the Data this solver runs on (model.hpp, data.hpp): a C++ caller may solve
+  // with solve(model(), data(), input) between calls of this face (each call of this face sets
+  // its own root acceleration and pass-through weights; the Data keeps the last solve's results).
+  // Both are replaced by updateInternalDataStructures() and by setOptions() changing
+  // inertia_check or max_constraints.
+  const Model& model() const;
+  Data& data();
+
   // The robot has changed: recompute the model data (KDL::SolverI interface). Called while another
   // thread is inside a call on this object it cannot rebuild, nor return a code: every later solve
   // then fails with E_CONCURRENT_CALL (message saying so) until a call of it succeeds.
@@ -297,23 +307,25 @@ class HdSolver : public KDL::SolverI {
 
  protected:
   // Construction never throws for a bad model: the error is kept and returned by every solve.
-  HdSolver(const detail::ModelSource& source, const KDL::Twist& root_acc, const SolverOptions& options);
+  HdSolver(const Model& model, const KDL::Twist& root_acc, const SolverOptions& options);
   // solve() without the entry guard, for a caller that holds it (CartToJnt()).
   int solveEntered(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                    const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                    const Eigen::Ref<const Eigen::MatrixXd>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
-  // Rebuilds the model from a new source (a changed chain or tree).
-  void rebuild(const detail::ModelSource& source);
-  detail::HdCore& core() { return *core_; }
-  const detail::HdCore& core() const { return *core_; }
+  // Replaces the model (a changed chain or tree): a new Data, pass-through weights cleared.
+  void rebuild(const Model& model);
+  detail::HdCore& core();
+  const detail::HdCore& core() const;
+  detail::FacadeState& state() { return *state_; }
 
  private:
-  friend class detail::FrictionCore;  // sets the pass-through driver (its ff_torques carry friction too)
-  int record(int rc);                 // keeps rc in KDL::SolverI::error when it is an error, else
-                                      // empties the message
-  int solveChecked(int rc);           // a solve's rc: kept in error, message emptied on success
+  friend class FrictionSolver;  // runs its friction stage on this face's Data
+  int record(int rc);           // keeps rc in KDL::SolverI::error when it is an error, else
+                                // empties the message
+  int solveChecked(int rc);     // a solve's rc: kept in error, message emptied on success
   int solveArgsProblem(const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::MatrixXd>& f_ext);
-  std::unique_ptr<detail::HdCore> core_;
+  int setOptionsEntered(const SolverOptions& options);
+  std::unique_ptr<detail::FacadeState> state_;  // Model, Data, root acceleration, pass-through weights
 };
 
 }  // namespace vereshchagin

@@ -88,7 +88,8 @@ struct SolveInput {
   // does not matter: alfa is in base axes).
   Status addConstraint(const FrameRef& frame, const Eigen::Ref<const Eigen::MatrixXd>& alfa,
                        const Eigen::Ref<const Eigen::VectorXd>& beta);
-  // Adds a wrench on a frame.
+  // Adds a wrench on a frame (its offset gives `point`); Error::OutOfRange for the base
+  // (segment -1: nothing moves it) or a segment outside the model.
   Status addWrench(const FrameRef& frame, const Vector6& wrench);
   // Constraint columns in all (the size of nu).
   int columns() const;
@@ -96,6 +97,9 @@ struct SolveInput {
   // gravity, base_acceleration and all capacity.
   void clear();
   void reserve(int blocks, int wrenches);
+
+ private:
+  int segments_ = 0;  // the model's segment count (addConstraint's and addWrench's range check)
 };
 
 }  // namespace vereshchagin

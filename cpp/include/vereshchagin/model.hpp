@@ -23,6 +23,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <kdl/chain.hpp>
@@ -39,6 +40,7 @@ namespace vereshchagin {
 
 namespace detail {
 struct ModelImpl;
+struct ModelAccess;
 }  // namespace detail
 
 struct ModelOptions {
@@ -105,6 +107,8 @@ class Model {
   const detail::ModelImpl& impl() const noexcept { return *impl_; }
 
  private:
+  friend struct detail::ModelAccess;
+  explicit Model(std::shared_ptr<const detail::ModelImpl> impl) : impl_(std::move(impl)) {}
   std::shared_ptr<const detail::ModelImpl> impl_;
 };
 

@@ -39,11 +39,11 @@ class TreeHdSolver : public HdSolver {
                const std::string& root_segment = std::string());
 
   // Names of the moving joints in q order (n_joints).
-  const std::vector<std::string>& jointNames() const { return joint_names_; }
+  const std::vector<std::string>& jointNames() const;
   // Names of the segments in the solver's segment order (n_segments).
-  const std::vector<std::string>& segmentNames() const { return segment_names_; }
+  const std::vector<std::string>& segmentNames() const;
   // Parent segment index of every segment (-1: the base), in the segment order.
-  const std::vector<int>& parent() const { return parent_; }
+  const std::vector<int>& parent() const;
   // Index of the named segment in the segment order, or -1 if it is not a solver segment.
   int segmentIndex(const std::string& name) const;
   // Name of the base (root) segment.
@@ -51,8 +51,6 @@ class TreeHdSolver : public HdSolver {
 
  private:
   std::string root_name_;
-  std::vector<std::string> joint_names_, segment_names_;
-  std::vector<int> parent_;
 };
 
 }  // namespace vereshchagin

@@ -1,0 +1,80 @@
+// Data's kinematics at the last solve's state (data.hpp): from the poses X_i (tip in parent tip)
+// and rotations R_base_i the outward sweep stored, walking from the frame's segment to the base:
+// O(depth), no allocation.
+#include "vereshchagin/data.hpp"
+
+#include "data_impl.hpp"
+
+namespace vereshchagin {
+
+namespace {
+
+using detail::HdCore;
+
+Vector3 toVector3(const KDL::Vector& v) {
+  return Vector3(v.x(), v.y(), v.z());
+}
+
+// Rotation of a segment's parent tip frame in the base (identity for the base itself).
+Matrix3 parentRotation(const HdCore& c, int i) {
+  const int p = c.model.parent(i);
+  return p >= 0 ? c.ws.seg[p].R_base : Matrix3::Identity();
+}
+
+// Origin of frame (segment, in_tip) in base coordinates.
+Vector3 frameOrigin(const HdCore& c, const FrameRef& frame) {
+  if (frame.segment < 0) return toVector3(frame.in_tip.p);
+  Vector3 p = c.ws.seg[frame.segment].R_base * toVector3(frame.in_tip.p);
+  for (int i = frame.segment; i >= 0; i = c.model.parent(i)) p += parentRotation(c, i) * c.ws.seg[i].X.p;
+  return p;
+}
+
+}  // namespace
+
+KDL::Frame Data::framePose(const FrameRef& frame) const {
+  const HdCore& c = impl_->core;
+  const Matrix3 R = frame.segment >= 0 ? c.ws.seg[frame.segment].R_base : Matrix3::Identity();
+  const Vector3 p = frameOrigin(c, frame);
+  const KDL::Rotation Rb(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2));
+  return KDL::Frame(Rb * frame.in_tip.M, KDL::Vector(p(0), p(1), p(2)));
+}
+
+// The tip's spatial velocity (tip axes, tip origin) in base axes, moved to the frame's origin.
+KDL::Twist Data::frameTwist(const FrameRef& frame) const {
+  if (frame.segment < 0) return KDL::Twist::Zero();
+  const HdCore& c = impl_->core;
+  const detail::SegmentState& s = c.ws.seg[frame.segment];
+  const Vector3 w = s.R_base * s.v.tail<3>();
+  const Vector3 r = s.R_base * toVector3(frame.in_tip.p);
+  const Vector3 v = s.R_base * s.v.head<3>() + w.cross(r);
+  return KDL::Twist(KDL::Vector(v(0), v(1), v(2)), KDL::Vector(w(0), w(1), w(2)));
+}
+
+// Column of joint j (segment k on the path): S_k in base axes, moved from k's tip origin to the
+// frame's origin: [R v + (R w) x d; R w], d = origin(k) - origin(frame).
+Status Data::frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const {
+  HdCore& c = impl_->core;
+  if (jacobian.rows() != 6 || jacobian.cols() != static_cast<Eigen::Index>(c.model.nj))
+    return impl_->status(c.fail(KDL::SolverI::E_SIZE_MISMATCH, "jacobian is %ldx%ld, expected 6x%u",
+                                (long)jacobian.rows(), (long)jacobian.cols(), c.model.nj));
+  if (frame.segment >= static_cast<int>(c.model.ns))
+    return impl_->status(
+        c.fail(KDL::SolverI::E_OUT_OF_RANGE, "frame.segment = %d is out of range [-1, %u)", frame.segment, c.model.ns));
+  jacobian.setZero();
+  if (frame.segment < 0) return Status();
+  // d: from the frame's origin to the current segment's tip origin, base axes.
+  Vector3 d = -(c.ws.seg[frame.segment].R_base * toVector3(frame.in_tip.p));
+  for (int i = frame.segment; i >= 0; i = c.model.parent(i)) {
+    const detail::SegmentModel& sm = c.model.seg[i];
+    const Matrix3& R = c.ws.seg[i].R_base;
+    if (sm.joint >= 0) {
+      const Vector3 w = R * sm.S.tail<3>();
+      jacobian.col(sm.joint).head<3>() = R * sm.S.head<3>() + w.cross(-d);
+      jacobian.col(sm.joint).tail<3>() = w;
+    }
+    d -= parentRotation(c, i) * c.ws.seg[i].X.p;  // to the parent's tip origin
+  }
+  return Status();
+}
+
+}  // namespace vereshchagin
