@@ -1,5 +1,6 @@
-// Shared test helpers: failure bookkeeping, relative comparisons, and dense reference quantities
-// (joint-space inertia H, end Jacobian J, coupling matrix K) computed with KDL's own solvers.
+// Shared test helpers: failure bookkeeping (for the files not converted to doctest yet), relative
+// comparisons, message formatting, and dense reference quantities (joint-space inertia H, end
+// Jacobian J, coupling matrix K) computed with KDL's own solvers.
 #pragma once
 
 #include <algorithm>
@@ -85,6 +86,14 @@ inline bool nearFrame(const KDL::Frame& a, const KDL::Frame& b, double tol = 1e-
       if (!near(a.M(r, c), b.M(r, c), tol)) return false;
   }
   return true;
+}
+
+// printf-style formatting, for MESSAGE() summaries.
+template <typename... Args>
+std::string format(const char* fmt, Args... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
 }
 
 template <typename T>
