@@ -12,6 +12,7 @@
 //      (The sign of d nu / d tau is checked by finite differences too.)
 // Part (b) uses well-conditioned tasks with nc <= n; part (a) also rank-deficient ones (nc > n) and
 // the damped least-squares policy, where the map stays affine.
+#include <doctest/doctest.h>
 #include <Eigen/Cholesky>
 
 #include "random_chain.hpp"
@@ -23,8 +24,7 @@ using testutil::relErrCols;
 using testutil::str;
 using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-int main() {
-  testutil::Checker ck("test_affine");
+TEST_CASE("response columns vs finite differences and dense formulas on 400 random chains") {
   int fd_samples = 0, dense_samples = 0, skipped = 0, columns = 0;
   double worst_fd = 0.0, worst_dense = 0.0, worst_sym = 0.0;
 
@@ -63,17 +63,18 @@ int main() {
     }
     vereshchagin::ChainHdSolver solver(chain, root_acc, opt), other(chain, root_acc, opt);
     int rc = solver.solve(q.data, qd.data, alfa, beta, fext, ff.data);
-    if (!ck.check(rc == 0, tag + ": solve returned " + str(rc) + " " + solver.errorMessage())) continue;
+    if (!CHECK_MESSAGE(rc == 0, tag << ": solve returned " << str(rc) << " " << solver.errorMessage())) continue;
     const Eigen::VectorXd qdd0 = solver.qdd(), tau0 = solver.commandTorques(), nu0 = solver.nu();
     const Matrix6X acc0 = solver.linkAccelerations();
 
     Eigen::MatrixXd dqdd = Eigen::MatrixXd::Constant(n, k, NAN), dtau = Eigen::MatrixXd::Constant(n, k, NAN);
     rc = solver.responseColumns(joints, dqdd, dtau);
-    if (!ck.check(rc == 0, tag + ": responseColumns returned " + str(rc) + " " + solver.errorMessage())) continue;
-    ck.check(dqdd.allFinite() && dtau.allFinite(), tag + ": non-finite response");
-    ck.check(solver.qdd() == qdd0 && solver.commandTorques() == tau0 && solver.nu() == nu0 &&
-                 solver.linkAccelerations() == acc0,
-             tag + ": responseColumns changed the solve results");
+    if (!CHECK_MESSAGE(rc == 0, tag << ": responseColumns returned " << str(rc) << " " << solver.errorMessage()))
+      continue;
+    CHECK_MESSAGE((dqdd.allFinite() && dtau.allFinite()), tag << ": non-finite response");
+    CHECK_MESSAGE((solver.qdd() == qdd0 && solver.commandTorques() == tau0 && solver.nu() == nu0 &&
+                   solver.linkAccelerations() == acc0),
+                  tag << ": responseColumns changed the solve results");
     columns += k;
 
     // Every joint in chain order takes the symmetric path (half the outward pass, the rest
@@ -83,7 +84,7 @@ int main() {
     Eigen::MatrixXd g_all(n, n), t_all(n, n), g_rev(n, n), t_rev(n, n);
     Eigen::MatrixXd nu_all = Eigen::MatrixXd::Constant(6, n, NAN), nu_rev(6, n), nu_skip(6, n);
     rc = solver.responseColumns(all, g_all, t_all, nu_all) + solver.responseColumns(rev, g_rev, t_rev, nu_rev);
-    if (!ck.check(rc == 0, tag + ": all-joint responseColumns failed: " + solver.errorMessage())) continue;
+    if (!CHECK_MESSAGE(rc == 0, tag << ": all-joint responseColumns failed: " << solver.errorMessage())) continue;
     Eigen::MatrixXd g_back(n, n), t_back(n, n), nu_back(nc, n);
     for (int j = 0; j < n; ++j) {
       g_back.col(j) = g_rev.col(n - 1 - j);
@@ -92,27 +93,27 @@ int main() {
     }
     const double e_sym = std::max(relErrCols(g_all, g_back), relErrCols(t_all, t_back));
     worst_sym = std::max(worst_sym, e_sym);
-    ck.check(e_sym <= 1e-12 && g_all == g_all.transpose(),
-             tag + ": symmetric all-joint response vs reverse order, rel err " + str(e_sym));
-    ck.check(relErrCols(nu_all.topRows(nc), nu_back) <= 1e-12, tag + ": all-joint d nu vs reverse order");
+    CHECK_MESSAGE((e_sym <= 1e-12 && g_all == g_all.transpose()),
+                  tag << ": symmetric all-joint response vs reverse order, rel err " << str(e_sym));
+    CHECK_MESSAGE(relErrCols(nu_all.topRows(nc), nu_back) <= 1e-12, tag << ": all-joint d nu vs reverse order");
     // dtau_cmd may be skipped (empty) beside dnu: the other outputs are unchanged, bit for bit.
     Eigen::MatrixXd g_skip(n, n), none(0, 0);
     rc = solver.responseColumns(all, g_skip, none, nu_skip);
-    ck.check(rc == 0 && g_skip == g_all && nu_skip.topRows(nc) == nu_all.topRows(nc),
-             tag + ": responseColumns without dtau_cmd differs");
+    CHECK_MESSAGE((rc == 0 && g_skip == g_all && nu_skip.topRows(nc) == nu_all.topRows(nc)),
+                  tag << ": responseColumns without dtau_cmd differs");
     // commandTorquesOf: commandTorques() for nu(), linear in nu (the columns of dtau_cmd).
     Eigen::VectorXd tau_of(n);
     rc = solver.commandTorquesOf(nu0, tau_of);
-    ck.check(rc == 0 && tau_of == tau0, tag + ": commandTorquesOf(nu()) != commandTorques()");
+    CHECK_MESSAGE((rc == 0 && tau_of == tau0), tag << ": commandTorquesOf(nu()) != commandTorques()");
     for (int j = 0; j < n && nc > 0; ++j) {
       const Eigen::VectorXd nu_j = nu0 + nu_all.col(j).head(nc);
       solver.commandTorquesOf(nu_j, tau_of);
       const double scale = std::max({1.0, tau0.cwiseAbs().maxCoeff(), t_all.col(j).cwiseAbs().maxCoeff()});
-      ck.check((tau_of - tau0 - t_all.col(j)).cwiseAbs().maxCoeff() <= 1e-12 * scale,
-               tag + ": commandTorquesOf(nu + dnu) - tau_cmd != dtau_cmd, joint " + str(j));
+      CHECK_MESSAGE((tau_of - tau0 - t_all.col(j)).cwiseAbs().maxCoeff() <= 1e-12 * scale,
+                    tag << ": commandTorquesOf(nu + dnu) - tau_cmd != dtau_cmd, joint " << str(j));
     }
-    ck.check(solver.commandTorquesOf(Eigen::VectorXd::Zero(nc + 1), tau_of) == KDL::SolverI::E_SIZE_MISMATCH,
-             tag + ": commandTorquesOf accepted a wrong-size nu");
+    CHECK_MESSAGE(solver.commandTorquesOf(Eigen::VectorXd::Zero(nc + 1), tau_of) == KDL::SolverI::E_SIZE_MISMATCH,
+                  tag << ": commandTorquesOf accepted a wrong-size nu");
 
     // (a) central differences of full solves, step h.
     const double h = 1.0;
@@ -129,14 +130,14 @@ int main() {
       fd_tau.col(c) = (cp - other.commandTorques()) / (2 * h);
       fd_nu.col(c) = (np - other.nu()) / (2 * h);
     }
-    if (!ck.check(ok, tag + ": finite-difference solves failed")) continue;
+    if (!CHECK_MESSAGE(ok, tag << ": finite-difference solves failed")) continue;
     ++fd_samples;
     const double e_fq = relErrCols(dqdd, fd_qdd), e_ft = relErrCols(dtau, fd_tau);
     worst_fd = std::max({worst_fd, e_fq, e_ft});
-    ck.check(e_fq <= 1e-7, tag + ": d qdd / d tau vs finite differences, rel err " + str(e_fq) + "\n  ours " +
-                               testutil::mat(dqdd) + "\n  fd   " + testutil::mat(fd_qdd));
-    ck.check(e_ft <= 1e-7, tag + ": d tau_cmd / d tau vs finite differences, rel err " + str(e_ft) + "\n  ours " +
-                               testutil::mat(dtau) + "\n  fd   " + testutil::mat(fd_tau));
+    CHECK_MESSAGE(e_fq <= 1e-7, tag << ": d qdd / d tau vs finite differences, rel err " << str(e_fq) << "\n  ours "
+                                    << testutil::mat(dqdd) << "\n  fd   " << testutil::mat(fd_qdd));
+    CHECK_MESSAGE(e_ft <= 1e-7, tag << ": d tau_cmd / d tau vs finite differences, rel err " << str(e_ft) << "\n  ours "
+                                    << testutil::mat(dtau) << "\n  fd   " << testutil::mat(fd_tau));
 
     // (b) dense formulas (truncated policy, well-conditioned, nc <= n).
     if (damped || nc > n) continue;
@@ -163,33 +164,35 @@ int main() {
     }
     const double e_g = relErrCols(dqdd, Gc), e_t = relErrCols(dtau, Tc), e_n = relErrCols(fd_nu, Nc);
     worst_dense = std::max({worst_dense, e_g, e_t});
-    ck.check(e_g <= 1e-9, tag + ": d qdd / d tau vs dense G, rel err " + str(e_g) + "\n  ours  " + testutil::mat(dqdd) +
-                              "\n  dense " + testutil::mat(Gc));
-    ck.check(e_t <= 1e-9, tag + ": d tau_cmd / d tau vs dense -A^T K^-1 A H^-1, rel err " + str(e_t) + "\n  ours  " +
-                              testutil::mat(dtau) + "\n  dense " + testutil::mat(Tc));
-    ck.check(e_n <= 1e-7, tag + ": finite differences of nu vs dense K^-1 A H^-1 (sign check), rel err " + str(e_n));
+    CHECK_MESSAGE(e_g <= 1e-9, tag << ": d qdd / d tau vs dense G, rel err " << str(e_g) << "\n  ours  "
+                                   << testutil::mat(dqdd) << "\n  dense " << testutil::mat(Gc));
+    CHECK_MESSAGE(e_t <= 1e-9, tag << ": d tau_cmd / d tau vs dense -A^T K^-1 A H^-1, rel err " << str(e_t)
+                                   << "\n  ours  " << testutil::mat(dtau) << "\n  dense " << testutil::mat(Tc));
+    CHECK_MESSAGE(e_n <= 1e-7,
+                  tag << ": finite differences of nu vs dense K^-1 A H^-1 (sign check), rel err " << str(e_n));
   }
 
-  // An empty joint list is a valid request.
-  {
-    testutil::RandomGen g(3);
-    const KDL::Chain chain = g.chain(4);
-    vereshchagin::ChainHdSolver solver(chain, KDL::Twist::Zero());
-    const Eigen::VectorXd q = Eigen::VectorXd::Zero(4);
-    ck.check(solver.solve(q, q, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), Eigen::VectorXd(0)) == 0,
-             "empty-request setup solve");
-    Eigen::MatrixXd a(4, 0), b(4, 0);
-    ck.check(solver.responseColumns(Eigen::VectorXi(0), a, b) == 0, "responseColumns with no joints");
-    Eigen::VectorXd tau(4);
-    vereshchagin::ChainHdSolver fresh(chain, KDL::Twist::Zero());
-    ck.check(fresh.commandTorquesOf(Eigen::VectorXd(0), tau) == vereshchagin::ChainHdSolver::E_NO_SOLUTION,
-             "commandTorquesOf before a solve");
-    ck.check(solver.commandTorquesOf(Eigen::VectorXd(0), tau) == 0 && tau.isZero(), "commandTorquesOf with m = 0");
-  }
+  CHECK_MESSAGE(
+      (fd_samples >= 350 && dense_samples >= 250 && skipped * 10 <= dense_samples),
+      "too few samples: fd " << str(fd_samples) << ", dense " << str(dense_samples) << ", skipped " << str(skipped));
+  MESSAGE(str(fd_samples) << " samples vs finite differences, " << str(dense_samples) << " vs dense formulas ("
+                          << str(skipped) << " ill-conditioned skipped), " << str(columns)
+                          << " columns; worst rel err fd " << str(worst_fd) << ", dense " << str(worst_dense)
+                          << ", symmetric path " << str(worst_sym));
+}
 
-  ck.check(fd_samples >= 350 && dense_samples >= 250 && skipped * 10 <= dense_samples,
-           "too few samples: fd " + str(fd_samples) + ", dense " + str(dense_samples) + ", skipped " + str(skipped));
-  return ck.finish(str(fd_samples) + " samples vs finite differences, " + str(dense_samples) + " vs dense formulas (" +
-                   str(skipped) + " ill-conditioned skipped), " + str(columns) + " columns; worst rel err fd " +
-                   str(worst_fd) + ", dense " + str(worst_dense) + ", symmetric path " + str(worst_sym));
+TEST_CASE("empty requests: no joints, commandTorquesOf before a solve and with no constraint") {
+  testutil::RandomGen g(3);
+  const KDL::Chain chain = g.chain(4);
+  vereshchagin::ChainHdSolver solver(chain, KDL::Twist::Zero());
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(4);
+  CHECK_MESSAGE(solver.solve(q, q, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), Eigen::VectorXd(0)) == 0,
+                "empty-request setup solve");
+  Eigen::MatrixXd a(4, 0), b(4, 0);
+  CHECK_MESSAGE(solver.responseColumns(Eigen::VectorXi(0), a, b) == 0, "responseColumns with no joints");
+  Eigen::VectorXd tau(4);
+  vereshchagin::ChainHdSolver fresh(chain, KDL::Twist::Zero());
+  CHECK_MESSAGE(fresh.commandTorquesOf(Eigen::VectorXd(0), tau) == vereshchagin::ChainHdSolver::E_NO_SOLUTION,
+                "commandTorquesOf before a solve");
+  CHECK_MESSAGE((solver.commandTorquesOf(Eigen::VectorXd(0), tau) == 0 && tau.isZero()), "commandTorquesOf with m = 0");
 }

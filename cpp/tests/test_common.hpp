@@ -1,5 +1,6 @@
-// Shared test helpers: failure bookkeeping, relative comparisons, and dense reference quantities
-// (joint-space inertia H, end Jacobian J, coupling matrix K) computed with KDL's own solvers.
+// Shared test helpers beside doctest's checks: relative comparisons, message formatting, and dense
+// reference quantities (joint-space inertia H, end Jacobian J, coupling matrix K) computed with
+// KDL's own solvers.
 #pragma once
 
 #include <algorithm>
@@ -21,41 +22,6 @@
 #include <kdl/jntspaceinertiamatrix.hpp>
 
 namespace testutil {
-
-// Collects failures; prints at most `max_print` of them to stderr.
-class Checker {
- public:
-  explicit Checker(std::string name, int max_print = 25) : name_(std::move(name)), max_print_(max_print) {}
-
-  bool check(bool ok, const std::string& what) {
-    ++checks_;
-    if (!ok) {
-      if (failures_ < max_print_) std::fprintf(stderr, "[%s] FAIL: %s\n", name_.c_str(), what.c_str());
-      ++failures_;
-    }
-    return ok;
-  }
-
-  int failures() const { return failures_; }
-  long checks() const { return checks_; }
-  const std::string& name() const { return name_; }
-
-  // Prints the one summary line and returns the process exit code.
-  int finish(const std::string& summary) const {
-    if (failures_ == 0) {
-      std::printf("%s: PASS (%ld checks) %s\n", name_.c_str(), checks_, summary.c_str());
-      return 0;
-    }
-    std::fprintf(stderr, "%s: FAIL (%d of %ld checks failed) %s\n", name_.c_str(), failures_, checks_, summary.c_str());
-    return 1;
-  }
-
- private:
-  std::string name_;
-  int max_print_;
-  int failures_ = 0;
-  long checks_ = 0;
-};
 
 // max |a - b| / max(1, max |b|); +inf if the shapes differ or anything is non-finite.
 inline double relErr(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const Eigen::MatrixXd>& b) {
@@ -85,6 +51,14 @@ inline bool nearFrame(const KDL::Frame& a, const KDL::Frame& b, double tol = 1e-
       if (!near(a.M(r, c), b.M(r, c), tol)) return false;
   }
   return true;
+}
+
+// printf-style formatting, for MESSAGE() summaries.
+template <typename... Args>
+std::string format(const char* fmt, Args... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
 }
 
 template <typename T>

@@ -2,7 +2,6 @@
 // prismatic joints and rotor inertias: ChainIdSolver_RNE and TreeIdSolver_RNE (external wrenches
 // converted to KDL's tip axes; KDL takes physical gravity too), ChainDynParam (mass matrix,
 // gravity, Coriolis), and on trees H from RNE columns. Tolerance 1e-9 relative. Then errors.
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
 #include <doctest/doctest.h>
 
 #include <cmath>

@@ -10,6 +10,7 @@
 // joints), and the merged chain (no fixed joint) against KDL's ChainHdSolver_Vereshchagin.
 // Also: massless moving bodies carried by a massive fixed segment are fine; a joint with nothing to
 // move (zero articulated inertia) is rejected with E_DEGENERATE_INERTIA.
+#include <doctest/doctest.h>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
@@ -140,11 +141,10 @@ struct Stats {
   double worst = 0.0;
 };
 
-void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testutil::RandomGen& g,
-               const std::string& tag0) {
+void runSample(Stats& st, const KDL::Chain& orig, testutil::RandomGen& g, const std::string& tag0) {
   const Merged m = mergeFixed(orig);
   const unsigned int n = orig.getNrOfJoints(), ns = orig.getNrOfSegments(), nsm = m.chain.getNrOfSegments();
-  if (!ck.check(m.chain.getNrOfJoints() == n && nsm == n, tag0 + ": merge bookkeeping")) return;
+  if (!CHECK_MESSAGE((m.chain.getNrOfJoints() == n && nsm == n), tag0 << ": merge bookkeeping")) return;
   const int nc = g.integer(0, std::min(6, static_cast<int>(n)));
   const int root_kind = g.integer(0, 2);  // 0: none, 1: gravity, 2: random spatial base acceleration
   const KDL::Twist root_acc = root_kind == 0   ? KDL::Twist::Zero()
@@ -173,23 +173,24 @@ void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testuti
     const int r1 = id_o.CartToJnt(q, qd, qdd_any, tipAxes(X, fext), t_o);
     const std::vector<KDL::Frame> Xm = tipPoses(m.chain, q);
     const int r2 = id_m.CartToJnt(q, qd, qdd_any, tipAxes(Xm, fext_m), t_m);
-    ck.check(
-        r1 == 0 && r2 == 0 && relErr(t_m.data, t_o.data) <= 1e-10,
-        tag + ": test bug: merged chain has different inverse dynamics, rel err " + str(relErr(t_m.data, t_o.data)));
+    CHECK_MESSAGE(
+        (r1 == 0 && r2 == 0 && relErr(t_m.data, t_o.data) <= 1e-10),
+        tag << ": test bug: merged chain has different inverse dynamics, rel err " << str(relErr(t_m.data, t_o.data)));
   }
 
   vereshchagin::ChainHdSolver so(orig, root_acc), sm(m.chain, root_acc_m);
-  if (!ck.check(so.modelError() == 0 && sm.modelError() == 0,
-                tag + ": modelError " + str(so.modelError()) + "/" + str(sm.modelError()) + " " + so.errorMessage()))
+  if (!CHECK_MESSAGE((so.modelError() == 0 && sm.modelError() == 0), tag << ": modelError " << str(so.modelError())
+                                                                         << "/" << str(sm.modelError()) << " "
+                                                                         << so.errorMessage()))
     return;
   KDL::JntArray qdd_o(n), tau_o(n), qdd_m(n), tau_m(n);
   int rc = so.CartToJnt(q, qd, qdd_o, alfa, beta, fext, ff, tau_o);
-  if (!ck.check(rc == 0, tag + ": original chain solve returned " + str(rc) + " " + so.errorMessage())) return;
+  if (!CHECK_MESSAGE(rc == 0, tag << ": original chain solve returned " << str(rc) << " " << so.errorMessage())) return;
   rc = sm.CartToJnt(q, qd, qdd_m, alfa_m, beta, fext_m, ff, tau_m);
-  if (!ck.check(rc == 0, tag + ": merged chain solve returned " + str(rc) + " " + sm.errorMessage())) return;
-  ck.check(
-      qdd_o.data.allFinite() && tau_o.data.allFinite() && so.nu().allFinite() && so.linkAccelerations().allFinite(),
-      tag + ": non-finite output");
+  if (!CHECK_MESSAGE(rc == 0, tag << ": merged chain solve returned " << str(rc) << " " << sm.errorMessage())) return;
+  CHECK_MESSAGE(
+      (qdd_o.data.allFinite() && tau_o.data.allFinite() && so.nu().allFinite() && so.linkAccelerations().allFinite()),
+      tag << ": non-finite output");
 
   const testutil::DenseModel dense = testutil::denseModel(m.chain, q);
   if (!testutil::wellConditioned(testutil::couplingEigenvalues(dense, alfa_m.data))) {
@@ -200,16 +201,16 @@ void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testuti
   const double e_qdd = relErr(qdd_o.data, qdd_m.data), e_nu = relErr(so.nu(), sm.nu()),
                e_tau = relErr(tau_o.data, tau_m.data);
   st.worst = std::max({st.worst, e_qdd, e_nu, e_tau});
-  ck.check(e_qdd <= 1e-10, tag + ": qdd differs from merged chain, rel err " + str(e_qdd) + "\n  fixed  " +
-                               testutil::mat(qdd_o.data) + "\n  merged " + testutil::mat(qdd_m.data));
-  ck.check(e_nu <= 1e-10, tag + ": nu differs from merged chain, rel err " + str(e_nu));
-  ck.check(e_tau <= 1e-10, tag + ": command torques differ from merged chain, rel err " + str(e_tau));
-  ck.check(so.constraintRank() == sm.constraintRank(), tag + ": rank differs");
+  CHECK_MESSAGE(e_qdd <= 1e-10, tag << ": qdd differs from merged chain, rel err " << str(e_qdd) << "\n  fixed  "
+                                    << testutil::mat(qdd_o.data) << "\n  merged " << testutil::mat(qdd_m.data));
+  CHECK_MESSAGE(e_nu <= 1e-10, tag << ": nu differs from merged chain, rel err " << str(e_nu));
+  CHECK_MESSAGE(e_tau <= 1e-10, tag << ": command torques differ from merged chain, rel err " << str(e_tau));
+  CHECK_MESSAGE(so.constraintRank() == sm.constraintRank(), tag << ": rank differs");
 
   // Link accelerations: every original tip, from the merged chain's (rigid-body reference-point shift).
   const Matrix6X& acc_o = so.linkAccelerations();
   const Matrix6X& acc_m = sm.linkAccelerations();
-  ck.check(relErr(acc_o.col(0), testutil::toVector(root_acc)) == 0.0, tag + ": link acceleration 0 != root_acc");
+  CHECK_MESSAGE(relErr(acc_o.col(0), testutil::toVector(root_acc)) == 0.0, tag << ": link acceleration 0 != root_acc");
   double e_acc = 0.0;
   for (unsigned int i = 0; i < ns; ++i) {
     const int gi = m.group[i];
@@ -224,7 +225,7 @@ void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testuti
     e_acc = std::max(e_acc, relErr(acc_o.col(i + 1), testutil::toVector(expect)));
   }
   st.worst = std::max(st.worst, e_acc);
-  ck.check(e_acc <= 1e-10, tag + ": link accelerations differ from the merged chain's, rel err " + str(e_acc));
+  CHECK_MESSAGE(e_acc <= 1e-10, tag << ": link accelerations differ from the merged chain's, rel err " << str(e_acc));
 
   // The merged chain has no fixed joint, so KDL's solver applies.
   KDL::ChainHdSolver_Vereshchagin kdl(m.chain, root_acc_m, static_cast<unsigned int>(nc));
@@ -233,12 +234,12 @@ void runSample(testutil::Checker& ck, Stats& st, const KDL::Chain& orig, testuti
   Eigen::VectorXd nu_k = Eigen::VectorXd::Zero(nc);
   kdl.getContraintForceMagnitude(nu_k);
   ++st.kdl_compared;
-  ck.check(rc == 0 && relErr(qdd_o.data, qdd_k.data) <= 1e-10 && relErr(so.nu(), nu_k) <= 1e-10,
-           tag + ": chain with fixed joints vs KDL on the merged chain: qdd rel err " +
-               str(relErr(qdd_o.data, qdd_k.data)) + ", nu rel err " + str(relErr(so.nu(), nu_k)));
+  CHECK_MESSAGE((rc == 0 && relErr(qdd_o.data, qdd_k.data) <= 1e-10 && relErr(so.nu(), nu_k) <= 1e-10),
+                tag << ": chain with fixed joints vs KDL on the merged chain: qdd rel err "
+                    << str(relErr(qdd_o.data, qdd_k.data)) << ", nu rel err " << str(relErr(so.nu(), nu_k)));
 }
 
-void degenerateCase(testutil::Checker& ck, const std::string& tag, const KDL::Chain& ch, int nc) {
+void degenerateCase(const std::string& tag, const KDL::Chain& ch, int nc) {
   vereshchagin::ChainHdSolver s(ch, KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero()));
   const unsigned int n = ch.getNrOfJoints(), ns = ch.getNrOfSegments();
   const Eigen::VectorXd q = Eigen::VectorXd::Constant(n, 0.3), qd = Eigen::VectorXd::Constant(n, 0.5);
@@ -247,23 +248,23 @@ void degenerateCase(testutil::Checker& ck, const std::string& tag, const KDL::Ch
   const Eigen::VectorXd beta = Eigen::VectorXd::Zero(nc), ff = Eigen::VectorXd::Constant(n, 1.0);
   const Matrix6X fext = Matrix6X::Zero(6, ns);
   const int rc = s.solve(q, qd, alfa, beta, fext, ff);
-  ck.check(rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA,
-           tag + ": expected E_DEGENERATE_INERTIA, got " + str(rc) + " (modelError " + str(s.modelError()) + ")");
-  ck.check(std::string(s.errorMessage()).size() > 0, tag + ": empty errorMessage()");
-  ck.check(s.qdd().allFinite() && s.commandTorques().allFinite() && s.linkAccelerations().allFinite(),
-           tag + ": NaN in outputs after rejection");
+  CHECK_MESSAGE(rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA, tag << ": expected E_DEGENERATE_INERTIA, got "
+                                                                             << str(rc) << " (modelError "
+                                                                             << str(s.modelError()) << ")");
+  CHECK_MESSAGE(std::string(s.errorMessage()).size() > 0, tag << ": empty errorMessage()");
+  CHECK_MESSAGE((s.qdd().allFinite() && s.commandTorques().allFinite() && s.linkAccelerations().allFinite()),
+                tag << ": NaN in outputs after rejection");
   KDL::JntArray qk(n), qdk(n), qdd(n), tau(n), ffk(n), betak(nc);
   KDL::Jacobian alfak(nc);
   alfak.data = alfa;
   const int rc2 = s.CartToJnt(qk, qdk, qdd, alfak, betak, KDL::Wrenches(ns, KDL::Wrench::Zero()), ffk, tau);
-  ck.check(rc2 == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA && qdd.data.allFinite(),
-           tag + ": CartToJnt: expected E_DEGENERATE_INERTIA, got " + str(rc2));
+  CHECK_MESSAGE((rc2 == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA && qdd.data.allFinite()),
+                tag << ": CartToJnt: expected E_DEGENERATE_INERTIA, got " << str(rc2));
 }
 
 }  // namespace
 
-int main() {
-  testutil::Checker ck("test_fixed_joints");
+TEST_CASE("fixed segments anywhere, and massless moving bodies carried by them, move like the merged chain") {
   Stats st;
 
   const std::vector<Case> cases = {
@@ -309,7 +310,7 @@ int main() {
       spec.n_joints = g.integer(c.min_n, 8);
       spec.fixed_before = c.fixed(spec.n_joints, g);
       const KDL::Chain orig = g.chain(spec);
-      runSample(ck, st, orig, g, std::string(c.name) + " seed " + str(seed) + " n=" + str(spec.n_joints));
+      runSample(st, orig, g, std::string(c.name) + " seed " + str(seed) + " n=" + str(spec.n_joints));
     }
   }
 
@@ -322,36 +323,36 @@ int main() {
     spec.fixed_before = {spec.n_joints};
     KDL::Chain ch = g.chain(spec);
     ch = masslessSegment(ch, ch.getNrOfSegments() - 2);  // the last moving body
-    runSample(ck, st, ch, g, "massless-last-moving seed " + str(seed) + " n=" + str(spec.n_joints));
+    runSample(st, ch, g, "massless-last-moving seed " + str(seed) + " n=" + str(spec.n_joints));
   }
 
-  // Degenerate: nothing for the joint to move.
-  {
-    KDL::Chain one;
-    one.addSegment(KDL::Segment("s0", KDL::Joint("j0", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
-                                KDL::RigidBodyInertia::Zero()));
-    degenerateCase(ck, "1 joint, zero mass, no rotor, nc=0", one, 0);
-    degenerateCase(ck, "1 joint, zero mass, no rotor, nc=1", one, 1);
+  CHECK_MESSAGE(st.compared >= 250, "too few samples compared: " << str(st.compared));
+  CHECK_MESSAGE(st.skipped * 10 <= st.compared, "too many ill-conditioned samples skipped: " << str(st.skipped));
+  MESSAGE(str(st.compared) << " chains compared with their merged versions (" << str(st.skipped)
+                           << " ill-conditioned skipped), " << str(st.kdl_compared) << " with KDL; worst rel err "
+                           << str(st.worst));
+}
 
-    KDL::Chain one_fixed = one;  // a massless fixed segment does not help
-    one_fixed.addSegment(
-        KDL::Segment(KDL::Joint(KDL::Joint::Fixed), KDL::Frame(KDL::Vector(0, 1, 0)), KDL::RigidBodyInertia::Zero()));
-    degenerateCase(ck, "1 joint + massless fixed segment", one_fixed, 0);
+TEST_CASE("a joint with nothing to move is rejected with E_DEGENERATE_INERTIA") {
+  KDL::Chain one;
+  one.addSegment(KDL::Segment("s0", KDL::Joint("j0", KDL::Joint::RotZ), KDL::Frame(KDL::Vector(1, 0, 0)),
+                              KDL::RigidBodyInertia::Zero()));
+  degenerateCase("1 joint, zero mass, no rotor, nc=0", one, 0);
+  degenerateCase("1 joint, zero mass, no rotor, nc=1", one, 1);
 
-    KDL::Chain on_axis;  // a point mass on the revolute axis: no inertia about it
-    on_axis.addSegment(KDL::Segment("s0", KDL::Joint("j0", KDL::Joint::RotZ), KDL::Frame::Identity(),
-                                    KDL::RigidBodyInertia(2.0, KDL::Vector(0, 0, 0.4))));
-    degenerateCase(ck, "point mass on the joint axis", on_axis, 0);
+  KDL::Chain one_fixed = one;  // a massless fixed segment does not help
+  one_fixed.addSegment(
+      KDL::Segment(KDL::Joint(KDL::Joint::Fixed), KDL::Frame(KDL::Vector(0, 1, 0)), KDL::RigidBodyInertia::Zero()));
+  degenerateCase("1 joint + massless fixed segment", one_fixed, 0);
 
-    testutil::RandomGen g(99);
-    KDL::Chain three = g.chain(3, true, true);
-    three = masslessSegment(three, 2);
-    degenerateCase(ck, "3 joints, last body massless, no rotor", three, 0);
-    degenerateCase(ck, "3 joints, last body massless, no rotor, nc=2", three, 2);
-  }
+  KDL::Chain on_axis;  // a point mass on the revolute axis: no inertia about it
+  on_axis.addSegment(KDL::Segment("s0", KDL::Joint("j0", KDL::Joint::RotZ), KDL::Frame::Identity(),
+                                  KDL::RigidBodyInertia(2.0, KDL::Vector(0, 0, 0.4))));
+  degenerateCase("point mass on the joint axis", on_axis, 0);
 
-  ck.check(st.compared >= 250, "too few samples compared: " + str(st.compared));
-  ck.check(st.skipped * 10 <= st.compared, "too many ill-conditioned samples skipped: " + str(st.skipped));
-  return ck.finish(str(st.compared) + " chains compared with their merged versions (" + str(st.skipped) +
-                   " ill-conditioned skipped), " + str(st.kdl_compared) + " with KDL; worst rel err " + str(st.worst));
+  testutil::RandomGen g(99);
+  KDL::Chain three = g.chain(3, true, true);
+  three = masslessSegment(three, 2);
+  degenerateCase("3 joints, last body massless, no rotor", three, 0);
+  degenerateCase("3 joints, last body massless, no rotor, nc=2", three, 2);
 }

@@ -1,7 +1,9 @@
 // Replays the fuzzers' committed inputs (seed corpora and regressions of past findings) through the
 // same property checks as the libFuzzer targets, with any compiler: cpp/fuzz/corpus/urdf/* and
 // cpp/fuzz/regressions/urdf-* through checkUrdf, cpp/fuzz/corpus/solver/* and
-// cpp/fuzz/regressions/solver-* through checkSolver. Arguments: the cpp/fuzz directory.
+// cpp/fuzz/regressions/solver-* through checkSolver. Arguments: the cpp/fuzz directory and
+// doctest's options (this file has its own main(), to take the directory).
+#define DOCTEST_CONFIG_IMPLEMENT
 #include <dirent.h>
 
 #include <algorithm>
@@ -10,8 +12,9 @@
 #include <string>
 #include <vector>
 
+#include <doctest/doctest.h>
+
 #include "../fuzz/fuzz_checks.hpp"
-#include "test_common.hpp"
 
 namespace {
 
@@ -33,27 +36,38 @@ std::string readFile(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+std::string g_root;  // the cpp/fuzz directory (first command-line argument)
+
+// Every committed input of one target (its seed corpus, then its regressions) through `check`.
+void replay(const std::string& kind, std::string (*check)(const std::uint8_t*, std::size_t)) {
+  REQUIRE_MESSAGE(!g_root.empty(), "usage: test_fuzz_corpus <cpp/fuzz directory> [doctest options]");
+  std::vector<std::string> files = filesIn(g_root + "/corpus/" + kind, "");
+  const std::vector<std::string> regressions = filesIn(g_root + "/regressions", kind + "-");
+  files.insert(files.end(), regressions.begin(), regressions.end());
+  CHECK_MESSAGE(files.size() >= 4, "fewer than 4 committed inputs for " << kind);
+  for (const std::string& f : files) {
+    const std::string bytes = readFile(f);
+    const std::string bad = check(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+    CHECK_MESSAGE(bad.empty(), f << ": " << bad);
+  }
+  MESSAGE(files.size() << " " << kind << " inputs");
+}
+
 }  // namespace
 
+TEST_CASE("URDF corpus and regressions replay through checkUrdf") {
+  replay("urdf", fuzzutil::checkUrdf);
+}
+
+TEST_CASE("solver corpus and regressions replay through checkSolver") {
+  replay("solver", fuzzutil::checkSolver);
+}
+
+// The first argument that is not an option is the cpp/fuzz directory (ctest passes it after
+// --test-case=<name>); doctest ignores it and reads the options.
 int main(int argc, char** argv) {
-  testutil::Checker ck("test_fuzz_corpus");
-  if (!ck.check(argc == 2, "usage: test_fuzz_corpus <cpp/fuzz directory>")) return ck.finish("");
-  const std::string root = argv[1];
-  int counts[2] = {0, 0};
-  for (int target = 0; target < 2; ++target) {
-    const char* kind = target == 0 ? "urdf" : "solver";
-    std::vector<std::string> files = filesIn(root + "/corpus/" + kind, "");
-    const std::vector<std::string> regressions = filesIn(root + "/regressions", std::string(kind) + "-");
-    files.insert(files.end(), regressions.begin(), regressions.end());
-    ck.check(files.size() >= 4, std::string("fewer than 4 committed inputs for ") + kind);
-    for (const std::string& f : files) {
-      const std::string bytes = readFile(f);
-      const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
-      const std::string bad =
-          target == 0 ? fuzzutil::checkUrdf(data, bytes.size()) : fuzzutil::checkSolver(data, bytes.size());
-      ck.check(bad.empty(), f + ": " + bad);
-      ++counts[target];
-    }
-  }
-  return ck.finish(std::to_string(counts[0]) + " URDF inputs, " + std::to_string(counts[1]) + " solver inputs");
+  for (int i = 1; i < argc && g_root.empty(); ++i)
+    if (argv[i][0] != '-') g_root = argv[i];
+  doctest::Context context(argc, argv);
+  return context.run();
 }

@@ -10,6 +10,7 @@
 //  * setOptions() switching the check rebuilds the model; the URDF loader's option likewise.
 #include <string>
 
+#include <doctest/doctest.h>
 #include <Eigen/LU>
 #include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
@@ -40,15 +41,17 @@ vereshchagin::SolverOptions jointSpace() {
 
 const KDL::Twist kGravityUp(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero());
 
-void lwrChecks(testutil::Checker& ck) {
+TEST_CASE("KUKA LWR 4: physical check rejects it, joint-space check accepts it and matches KDL") {
   const KDL::Chain lwr = testutil::kukaLwr4();
   Solver physical(lwr, kGravityUp);
-  ck.check(physical.modelError() == Solver::E_INVALID_MODEL && contains(physical.errorMessage(), "inertia_check") &&
-               contains(physical.errorMessage(), "joint_space"),
-           "LWR 4 under physical: E_INVALID_MODEL naming the option (" + std::string(physical.errorMessage()) + ")");
+  CHECK_MESSAGE(
+      (physical.modelError() == Solver::E_INVALID_MODEL && contains(physical.errorMessage(), "inertia_check") &&
+       contains(physical.errorMessage(), "joint_space")),
+      "LWR 4 under physical: E_INVALID_MODEL naming the option (" << std::string(physical.errorMessage()) << ")");
   Solver js(lwr, kGravityUp, jointSpace());
-  ck.check(js.modelError() == 0, "LWR 4 under joint_space accepted: " + std::string(js.errorMessage()));
-  ck.check(physical.setOptions(jointSpace()) == 0 && physical.modelError() == 0, "setOptions(joint_space) rebuilds");
+  CHECK_MESSAGE(js.modelError() == 0, "LWR 4 under joint_space accepted: " << std::string(js.errorMessage()));
+  CHECK_MESSAGE((physical.setOptions(jointSpace()) == 0 && physical.modelError() == 0),
+                "setOptions(joint_space) rebuilds");
   // Forward dynamics and a constrained solve at several states against KDL.
   double worst_fd = 0.0, worst_task = 0.0;
   for (int k = 0; k < 20; ++k) {
@@ -56,7 +59,7 @@ void lwrChecks(testutil::Checker& ck) {
     const KDL::JntArray q = g.q(7), qd = g.qdot(7), ff = g.torques(7);
     const KDL::Wrenches fext = g.fext(7);
     const Matrix6X fe = testutil::toMatrix(fext);
-    ck.check(js.solve(q.data, qd.data, Matrix6X(6, 0), Eigen::VectorXd(0), fe, ff.data) == 0, "LWR FD solve");
+    CHECK_MESSAGE(js.solve(q.data, qd.data, Matrix6X(6, 0), Eigen::VectorXd(0), fe, ff.data) == 0, "LWR FD solve");
     KDL::ChainFdSolver_RNE fd(lwr, KDL::Vector(0, 0, -9.81));
     KDL::JntArray qdd(7);
     fd.CartToJnt(q, qd, ff, testutil::toTipAxes(lwr, q, fext), qdd);
@@ -66,7 +69,7 @@ void lwrChecks(testutil::Checker& ck) {
     const Eigen::VectorXd beta = g.beta(3).data;
     const testutil::DenseModel d = testutil::denseModel(lwr, q);
     if (!testutil::wellConditioned(testutil::couplingEigenvalues(d, alfa))) continue;
-    ck.check(js.solve(q.data, qd.data, alfa, beta, fe, ff.data) == 0, "LWR task solve");
+    CHECK_MESSAGE(js.solve(q.data, qd.data, alfa, beta, fe, ff.data) == 0, "LWR task solve");
     // alfa^T Xdd of the free arm, from KDL's own solver without constraints.
     KDL::ChainHdSolver_Vereshchagin kdl(lwr, kGravityUp, 0);
     KDL::JntArray qdd_k(7), tc(7), no_beta(0);
@@ -79,13 +82,13 @@ void lwrChecks(testutil::Checker& ck) {
     const Eigen::VectorXd nu = (A * HinvAt).ldlt().solve(a_free - beta);
     worst_task = std::max({worst_task, relErr(js.nu(), nu), relErr(js.qdd(), qdd.data - HinvAt * nu)});
   }
-  ck.check(worst_fd <= 1e-9, "LWR joint_space FD vs KDL FD_RNE rel err " + str(worst_fd));
-  ck.check(worst_task <= 1e-9, "LWR joint_space task vs dense formula rel err " + str(worst_task));
-  std::printf("LWR 4 (joint_space): FD vs KDL %.2e, task vs dense %.2e\n", worst_fd, worst_task);
+  CHECK_MESSAGE(worst_fd <= 1e-9, "LWR joint_space FD vs KDL FD_RNE rel err " << str(worst_fd));
+  CHECK_MESSAGE(worst_task <= 1e-9, "LWR joint_space task vs dense formula rel err " << str(worst_task));
+  MESSAGE(testutil::format("LWR 4 (joint_space): FD vs KDL %.2e, task vs dense %.2e", worst_fd, worst_task));
 }
 
 // Static friction on the identified LWR 4 (the max-min needs G PSD: D_j > 0 makes it so).
-void lwrFrictionChecks(testutil::Checker& ck) {
+TEST_CASE("KUKA LWR 4 with static friction: complementarity and KDL forward dynamics") {
   const KDL::Chain lwr = testutil::kukaLwr4();
   vereshchagin::FrictionSolver fs(lwr, kGravityUp, jointSpace());
   vereshchagin::FrictionModel fm;
@@ -97,8 +100,8 @@ void lwrFrictionChecks(testutil::Checker& ck) {
     const Eigen::VectorXd qd = Eigen::VectorXd::Zero(7);
     const Matrix6X alfa = g.alfa(2).data;
     const Eigen::VectorXd beta = g.beta(2).data;
-    if (!ck.check(fs.solve(q.data, qd, alfa, beta, Matrix6X(6, 0), ff.data, fm) == 0,
-                  "LWR friction solve " + str(k) + ": " + fs.errorMessage()))
+    if (!CHECK_MESSAGE(fs.solve(q.data, qd, alfa, beta, Matrix6X(6, 0), ff.data, fm) == 0,
+                       "LWR friction solve " << str(k) << ": " << fs.errorMessage()))
       continue;
     KDL::ChainFdSolver_RNE fd(lwr, KDL::Vector(0, 0, -9.81));
     KDL::JntArray tau(7), qdd(7), qdv(7);
@@ -110,11 +113,11 @@ void lwrFrictionChecks(testutil::Checker& ck) {
       const double f = fs.frictionTorques()(j), a = fs.qdd()(j);
       const bool stick = std::abs(a) <= 1e-8 * scale && std::abs(f) <= 8.0 * (1 + 1e-12);
       const bool slip = std::abs(std::abs(f) - 8.0) <= 1e-10 * 8.0 && f * a <= 0.0;
-      ck.check(stick || slip, "LWR friction " + str(k) + " joint " + str(j) + ": neither stick nor slip");
+      CHECK_MESSAGE((stick || slip), "LWR friction " << str(k) << " joint " << str(j) << ": neither stick nor slip");
     }
   }
-  ck.check(worst <= 1e-9, "LWR friction: KDL FD with ff + command + friction rel err " + str(worst));
-  std::printf("LWR 4 friction (joint_space): FD reproduction %.2e\n", worst);
+  CHECK_MESSAGE(worst <= 1e-9, "LWR friction: KDL FD with ff + command + friction rel err " << str(worst));
+  MESSAGE(testutil::format("LWR 4 friction (joint_space): FD reproduction %.2e", worst));
 }
 
 KDL::Chain oneBody(const KDL::RotationalInertia& I_com) {
@@ -124,15 +127,15 @@ KDL::Chain oneBody(const KDL::RotationalInertia& I_com) {
   return ch;
 }
 
-void triangleChecks(testutil::Checker& ck) {
+TEST_CASE("triangle inequality: a broken PSD tensor is rejected and a thin rod accepted") {
   Solver bad(oneBody(KDL::RotationalInertia(0.1, 0.01, 0.01)), KDL::Twist::Zero());
-  ck.check(bad.modelError() == Solver::E_INVALID_MODEL && contains(bad.errorMessage(), "triangle") &&
-               contains(bad.errorMessage(), "joint_space"),
-           "diag(0.1, 0.01, 0.01) rejected (" + std::string(bad.errorMessage()) + ")");
+  CHECK_MESSAGE((bad.modelError() == Solver::E_INVALID_MODEL && contains(bad.errorMessage(), "triangle") &&
+                 contains(bad.errorMessage(), "joint_space")),
+                "diag(0.1, 0.01, 0.01) rejected (" << std::string(bad.errorMessage()) << ")");
   Solver rod(oneBody(KDL::RotationalInertia(0.0, 0.02, 0.02)), KDL::Twist::Zero());
-  ck.check(rod.modelError() == 0, "thin rod diag(0, 0.02, 0.02) accepted: " + std::string(rod.errorMessage()));
+  CHECK_MESSAGE(rod.modelError() == 0, "thin rod diag(0, 0.02, 0.02) accepted: " << std::string(rod.errorMessage()));
   Solver js(oneBody(KDL::RotationalInertia(0.1, 0.01, 0.01)), KDL::Twist::Zero(), jointSpace());
-  ck.check(js.modelError() == 0, "diag(0.1, 0.01, 0.01) accepted under joint_space");
+  CHECK_MESSAGE(js.modelError() == 0, "diag(0.1, 0.01, 0.01) accepted under joint_space");
 }
 
 // Two RotZ links in a plane; link 1 has inertia -0.5 kg m^2 about its joint, link 2 is 1 kg at
@@ -149,25 +152,25 @@ KDL::Chain partlyDefinite() {
   return ch;
 }
 
-void solveTimeChecks(testutil::Checker& ck) {
+TEST_CASE("joint-space inertia positive definite at some configurations only") {
   const KDL::Chain ch = partlyDefinite();
   Solver s(ch, KDL::Twist::Zero(), jointSpace());
-  ck.check(s.modelError() == 0, "partly definite model accepted: " + std::string(s.errorMessage()));
+  CHECK_MESSAGE(s.modelError() == 0, "partly definite model accepted: " << std::string(s.errorMessage()));
   Eigen::VectorXd q(2), qd = Eigen::VectorXd::Zero(2), tau(2);
   q << 0.3, M_PI / 2;
   tau << 1.0, -0.5;
-  ck.check(s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), tau) == 0, "solves at q2 = pi/2");
+  CHECK_MESSAGE(s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), tau) == 0, "solves at q2 = pi/2");
   KDL::JntArray qk(2);
   qk.data = q;
   const testutil::DenseModel d = testutil::denseModel(ch, qk);
   const double e = relErr(s.qdd(), d.H.lu().solve(tau));
-  ck.check(e <= 1e-12, "q2 = pi/2: qdd vs H^-1 tau (KDL's H) rel err " + str(e));
+  CHECK_MESSAGE(e <= 1e-12, "q2 = pi/2: qdd vs H^-1 tau (KDL's H) rel err " << str(e));
   q(1) = 0.0;
   const int rc = s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0), tau);
-  ck.check(rc == Solver::E_DEGENERATE_INERTIA && contains(s.errorMessage(), "'shoulder'") &&
-               contains(s.errorMessage(), "not positive definite"),
-           "q2 = 0: E_DEGENERATE_INERTIA naming the joint (rc " + str(rc) + ": " + s.errorMessage() + ")");
-  ck.check(s.qdd().allFinite(), "no NaN left in the outputs");
+  CHECK_MESSAGE((rc == Solver::E_DEGENERATE_INERTIA && contains(s.errorMessage(), "'shoulder'") &&
+                 contains(s.errorMessage(), "not positive definite")),
+                "q2 = 0: E_DEGENERATE_INERTIA naming the joint (rc " << str(rc) << ": " << s.errorMessage() << ")");
+  CHECK_MESSAGE(s.qdd().allFinite(), "no NaN left in the outputs");
 }
 
 const char* kUrdf = R"(<robot name="r">
@@ -178,7 +181,7 @@ const char* kUrdf = R"(<robot name="r">
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
 </robot>)";
 
-void urdfChecks(testutil::Checker& ck) {
+TEST_CASE("URDF loader option: physical and joint-space checks") {
   const auto with = [](const std::string& ixx) {
     std::string x = kUrdf;
     x.replace(x.find("IXX"), 3, ixx);
@@ -188,24 +191,14 @@ void urdfChecks(testutil::Checker& ck) {
   js.inertia_check = vereshchagin::InertiaCheck::JointSpace;
   for (const char* ixx : {"-0.5", "0.1"}) {
     const auto phys = vereshchagin::chainFromUrdfString(with(ixx));
-    ck.check(!phys.ok && contains(phys.message.c_str(), "'a'") && contains(phys.message.c_str(), "joint_space"),
-             std::string("URDF ixx = ") + ixx + " rejected under physical naming the option: " + phys.message);
+    CHECK_MESSAGE((!phys.ok && contains(phys.message.c_str(), "'a'") && contains(phys.message.c_str(), "joint_space")),
+                  std::string("URDF ixx = ") << ixx << " rejected under physical naming the option: " << phys.message);
     const auto ok = vereshchagin::chainFromUrdfString(with(ixx), "", "", js);
-    ck.check(ok.ok, std::string("URDF ixx = ") + ixx + " accepted under joint_space: " + ok.message);
+    CHECK_MESSAGE(ok.ok, std::string("URDF ixx = ") << ixx << " accepted under joint_space: " << ok.message);
   }
-  ck.check(contains(vereshchagin::chainFromUrdfString(with("0.1")).message.c_str(), "triangle"),
-           "URDF triangle message");
-  ck.check(vereshchagin::chainFromUrdfString(with("0.02")).ok, "URDF valid inertia accepted");
+  CHECK_MESSAGE(contains(vereshchagin::chainFromUrdfString(with("0.1")).message.c_str(), "triangle"),
+                "URDF triangle message");
+  CHECK_MESSAGE(vereshchagin::chainFromUrdfString(with("0.02")).ok, "URDF valid inertia accepted");
 }
 
 }  // namespace
-
-int main() {
-  testutil::Checker ck("test_inertia_check");
-  lwrChecks(ck);
-  lwrFrictionChecks(ck);
-  triangleChecks(ck);
-  solveTimeChecks(ck);
-  urdfChecks(ck);
-  return ck.finish("");
-}

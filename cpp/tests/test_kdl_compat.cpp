@@ -19,6 +19,7 @@
 #include <type_traits>
 #include <vector>
 
+#include <doctest/doctest.h>
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <kdl/chainfdsolver_recursive_newton_euler.hpp>
@@ -132,65 +133,70 @@ Scenario lwrFree() {
   return s;
 }
 
-void lwrTaskChecks(testutil::Checker& ck) {
+TEST_CASE("KUKA LWR 4 task: nu, q_dotdot and torques equal KDL's and its published values") {
   const Scenario s = lwrTask();
   const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
-  ck.check(kdl.rc == 0 && ours.rc == 0, "LWR task: return codes " + str(kdl.rc) + ", " + str(ours.rc));
+  CHECK_MESSAGE((kdl.rc == 0 && ours.rc == 0), "LWR task: return codes " << str(kdl.rc) << ", " << str(ours.rc));
   // End-effector accelerations along the enabled columns equal beta.
   const Eigen::Matrix<double, 6, 1> a_ours = toVec(ours.xdd[7]), a_kdl = toVec(kdl.xdd[7]);
   for (int c : {0, 1, 2, 5}) {
-    ck.check(std::abs(a_ours(c) - s.beta(c)) <= 1e-9,
-             "LWR task: ours Xdd(" + str(c) + ") = " + str(a_ours(c)) + " vs beta " + str(s.beta(c)));
-    ck.check(std::abs(a_kdl(c) - s.beta(c)) <= 1e-3, "LWR task: KDL Xdd(" + str(c) + ") = " + str(a_kdl(c)));
+    CHECK_MESSAGE(std::abs(a_ours(c) - s.beta(c)) <= 1e-9,
+                  "LWR task: ours Xdd(" << str(c) << ") = " << str(a_ours(c)) << " vs beta " << str(s.beta(c)));
+    CHECK_MESSAGE(std::abs(a_kdl(c) - s.beta(c)) <= 1e-3, "LWR task: KDL Xdd(" << str(c) << ") = " << str(a_kdl(c)));
   }
   // nu equals KDL's, and KDL's published regression values (its tests' tolerance 1e-3).
   const double e_nu = relErr(ours.nu, kdl.nu), e_qdd = relErr(ours.qdd, kdl.qdd);
-  ck.check(e_nu <= 1e-6, "LWR task: nu vs KDL rel err " + str(e_nu) + " (ours " + testutil::mat(ours.nu) + ", KDL " +
-                             testutil::mat(kdl.nu) + ")");
-  ck.check(e_qdd <= 1e-6, "LWR task: qdd vs KDL rel err " + str(e_qdd));
+  CHECK_MESSAGE(e_nu <= 1e-6, "LWR task: nu vs KDL rel err " << str(e_nu) << " (ours " << testutil::mat(ours.nu)
+                                                             << ", KDL " << testutil::mat(kdl.nu) << ")");
+  CHECK_MESSAGE(e_qdd <= 1e-6, "LWR task: qdd vs KDL rel err " << str(e_qdd));
   const double published[6] = {669693.30355, 5930.60826, -639.5238, 0.0, 0.0, 573.90485};
   for (int c = 0; c < 6; ++c)
-    ck.check(std::abs(ours.nu(c) - published[c]) <= 1e-3 * std::max(1.0, std::abs(published[c])),
-             "LWR task: nu(" + str(c) + ") = " + str(ours.nu(c)) + " vs KDL's published " + str(published[c]));
-  ck.check(ours.nu(3) == 0.0 && ours.nu(4) == 0.0, "LWR task: disabled columns have nu exactly 0");
+    CHECK_MESSAGE(
+        std::abs(ours.nu(c) - published[c]) <= 1e-3 * std::max(1.0, std::abs(published[c])),
+        "LWR task: nu(" << str(c) << ") = " << str(ours.nu(c)) << " vs KDL's published " << str(published[c]));
+  CHECK_MESSAGE((ours.nu(3) == 0.0 && ours.nu(4) == 0.0), "LWR task: disabled columns have nu exactly 0");
   // Default: KDL's torques (felt torques; total = D_j qdd_j), and KDL's published total torques.
   const double e_ct = relErr(ours.constraint_tau, kdl.constraint_tau), e_tt = relErr(ours.total_tau, kdl.total_tau);
-  ck.check(e_ct <= 1e-10, "LWR task: constraint_torques vs KDL rel err " + str(e_ct));
-  ck.check(e_tt <= 1e-10, "LWR task: getTotalTorque vs KDL rel err " + str(e_tt) + " (ours " +
-                              testutil::mat(ours.total_tau) + ", KDL " + testutil::mat(kdl.total_tau) + ")");
+  CHECK_MESSAGE(e_ct <= 1e-10, "LWR task: constraint_torques vs KDL rel err " << str(e_ct));
+  CHECK_MESSAGE(e_tt <= 1e-10, "LWR task: getTotalTorque vs KDL rel err " << str(e_tt) << " (ours "
+                                                                          << testutil::mat(ours.total_tau) << ", KDL "
+                                                                          << testutil::mat(kdl.total_tau) << ")");
   const double published_total[7] = {2013.3541, -6073.4999, 2227.4487, 56.87456, -11.3789, -6.05957, 569.0776};
   for (int j = 0; j < 7; ++j)
-    ck.check(std::abs(ours.total_tau(j) - published_total[j]) <= 1e-3,
-             "LWR task: total torque(" + str(j) + ") = " + str(ours.total_tau(j)) + " vs KDL's published " +
-                 str(published_total[j]));
+    CHECK_MESSAGE(std::abs(ours.total_tau(j) - published_total[j]) <= 1e-3,
+                  "LWR task: total torque(" << str(j) << ") = " << str(ours.total_tau(j)) << " vs KDL's published "
+                                            << str(published_total[j]));
   // TorqueConvention::Command: the torques realise q_dotdot; total torque = ff + constraint torques.
   const Outcome cmd = run<Ours>(s, /*command=*/true);
   const Eigen::VectorXd fd = kdlForward(s, s.ff.data + cmd.constraint_tau);
   const double e_fd = relErr(fd, cmd.qdd), e_kdl_fd = relErr(kdlForward(s, s.ff.data + kdl.constraint_tau), kdl.qdd);
-  ck.check(cmd.rc == 0 && cmd.qdd == ours.qdd && cmd.nu == ours.nu, "LWR task: the convention changes only torques");
-  ck.check(e_fd <= 1e-9, "LWR task: KDL FD with ff + our command torques rel err " + str(e_fd));
-  ck.check(e_kdl_fd > 1e-3, "LWR task: KDL's felt torques unexpectedly realise qdd (" + str(e_kdl_fd) + ")");
-  ck.check(cmd.total_tau == s.ff.data + cmd.constraint_tau,
-           "LWR task: Command getTotalTorque != ff + constraint_torques");
-  std::printf(
-      "LWR 4 task: |qdd - KDL| rel %.2e, |nu - KDL| rel %.2e, constraint_torques %.2e, total %.2e; FD with command "
-      "torques %.2e (with KDL's: %.2e)\n",
-      e_qdd, e_nu, e_ct, e_tt, e_fd, e_kdl_fd);
+  CHECK_MESSAGE((cmd.rc == 0 && cmd.qdd == ours.qdd && cmd.nu == ours.nu),
+                "LWR task: the convention changes only torques");
+  CHECK_MESSAGE(e_fd <= 1e-9, "LWR task: KDL FD with ff + our command torques rel err " << str(e_fd));
+  CHECK_MESSAGE(e_kdl_fd > 1e-3, "LWR task: KDL's felt torques unexpectedly realise qdd (" << str(e_kdl_fd) << ")");
+  CHECK_MESSAGE(cmd.total_tau == s.ff.data + cmd.constraint_tau,
+                "LWR task: Command getTotalTorque != ff + constraint_torques");
+  MESSAGE(
+      testutil::format("LWR 4 task: |qdd - KDL| rel %.2e, |nu - KDL| rel %.2e, constraint_torques %.2e, total %.2e; FD "
+                       "with command torques %.2e (with KDL's: %.2e)",
+                       e_qdd, e_nu, e_ct, e_tt, e_fd, e_kdl_fd));
 }
 
-void lwrFreeChecks(testutil::Checker& ck) {
+TEST_CASE("KUKA LWR 4 with an all-zero alfa: KDL forward dynamics") {
   const Scenario s = lwrFree();
   const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
   const Eigen::VectorXd fd = kdlForward(s, s.ff.data);
   const double e_ours = relErr(ours.qdd, fd), e_kdl = relErr(kdl.qdd, fd);
-  ck.check(ours.rc == 0 && e_ours <= 1e-9, "LWR all-zero alfa: ours vs KDL FD rel err " + str(e_ours));
-  ck.check(kdl.rc == 0 && e_kdl <= 1e-9, "LWR all-zero alfa: KDL's Vereshchagin vs KDL FD rel err " + str(e_kdl));
-  ck.check(ours.constraint_tau.isZero(0.0) && ours.nu.isZero(0.0), "LWR all-zero alfa: no constraint torques, nu = 0");
-  std::printf("LWR 4 all-zero alfa: ours vs FD_RNE %.2e, KDL vs FD_RNE %.2e\n", e_ours, e_kdl);
+  CHECK_MESSAGE((ours.rc == 0 && e_ours <= 1e-9), "LWR all-zero alfa: ours vs KDL FD rel err " << str(e_ours));
+  CHECK_MESSAGE((kdl.rc == 0 && e_kdl <= 1e-9),
+                "LWR all-zero alfa: KDL's Vereshchagin vs KDL FD rel err " << str(e_kdl));
+  CHECK_MESSAGE((ours.constraint_tau.isZero(0.0) && ours.nu.isZero(0.0)),
+                "LWR all-zero alfa: no constraint torques, nu = 0");
+  MESSAGE(testutil::format("LWR 4 all-zero alfa: ours vs FD_RNE %.2e, KDL vs FD_RNE %.2e", e_ours, e_kdl));
 }
 
 // Random chains (no fixed joints: KDL needs n_joints = n_segments), zero and random columns.
-void randomChecks(testutil::Checker& ck) {
+TEST_CASE("random chains with zero and random columns equal KDL's") {
   double worst_qdd = 0.0, worst_nu = 0.0, worst_ct = 0.0, worst_tt = 0.0, worst_fd = 0.0;
   int compared = 0;
   for (int k = 0; k < 60; ++k) {
@@ -215,32 +221,33 @@ void randomChecks(testutil::Checker& ck) {
     const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
     const std::string tag =
         "random " + str(k) + " (n=" + str(n) + ", nc=" + str(nc) + ", enabled " + str(on.cols()) + ")";
-    ck.check(kdl.rc == 0 && ours.rc == 0, tag + ": return codes");
+    CHECK_MESSAGE((kdl.rc == 0 && ours.rc == 0), tag << ": return codes");
     const double e_qdd = relErr(ours.qdd, kdl.qdd), e_nu = relErr(ours.nu, kdl.nu);
     const double e_ct = relErr(ours.constraint_tau, kdl.constraint_tau), e_tt = relErr(ours.total_tau, kdl.total_tau);
-    ck.check(e_qdd <= 1e-8 && e_nu <= 1e-8, tag + ": vs KDL rel err qdd " + str(e_qdd) + ", nu " + str(e_nu));
-    ck.check(e_ct <= 1e-10 && e_tt <= 1e-10,
-             tag + ": vs KDL rel err constraint_torques " + str(e_ct) + ", total torque " + str(e_tt));
+    CHECK_MESSAGE((e_qdd <= 1e-8 && e_nu <= 1e-8),
+                  tag << ": vs KDL rel err qdd " << str(e_qdd) << ", nu " << str(e_nu));
+    CHECK_MESSAGE((e_ct <= 1e-10 && e_tt <= 1e-10),
+                  tag << ": vs KDL rel err constraint_torques " << str(e_ct) << ", total torque " << str(e_tt));
     const Outcome cmd = run<Ours>(s, /*command=*/true);
     const double e_fd = relErr(kdlForward(s, s.ff.data + cmd.constraint_tau), cmd.qdd);
-    ck.check(e_fd <= 1e-9, tag + ": Command torques: KDL FD rel err " + str(e_fd));
+    CHECK_MESSAGE(e_fd <= 1e-9, tag << ": Command torques: KDL FD rel err " << str(e_fd));
     worst_qdd = std::max(worst_qdd, e_qdd), worst_nu = std::max(worst_nu, e_nu);
     worst_ct = std::max(worst_ct, e_ct), worst_tt = std::max(worst_tt, e_tt), worst_fd = std::max(worst_fd, e_fd);
     ++compared;
   }
-  ck.check(compared >= 30, "random chains: too few compared (" + str(compared) + ")");
-  std::printf(
-      "random chains: %d compared with KDL, worst rel err qdd %.2e, nu %.2e, constraint_torques %.2e, total torque "
-      "%.2e; Command torques through KDL FD %.2e\n",
-      compared, worst_qdd, worst_nu, worst_ct, worst_tt, worst_fd);
+  CHECK_MESSAGE(compared >= 30, "random chains: too few compared (" << str(compared) << ")");
+  MESSAGE(
+      testutil::format("random chains: %d compared with KDL, worst rel err qdd %.2e, nu %.2e, constraint_torques %.2e, "
+                       "total torque %.2e; Command torques through KDL FD %.2e",
+                       compared, worst_qdd, worst_nu, worst_ct, worst_tt, worst_fd));
 }
 
 // Link getters (ours only: KDL 1.5.1 declares but does not define them) against KDL's FK.
-void getterChecks(testutil::Checker& ck) {
+TEST_CASE("link getters against KDL forward kinematics") {
   const Scenario s = lwrTask();
   Ours solver(s.chain, s.root_acc, 6);
   KDL::JntArray qdd(7), tc(7);
-  ck.check(solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0, "getters: solve");
+  CHECK_MESSAGE(solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0, "getters: solve");
   std::vector<KDL::Frame> pose_base, pose_local;
   std::vector<KDL::Twist> vel_base, vel_local, acc_base, acc_local, xdd;
   solver.getLinkCartesianPose(pose_base);
@@ -264,15 +271,15 @@ void getterChecks(testutil::Checker& ck) {
                       relErr(toVec(pose_base[i].M * vel_local[i]), toVec(vel_base[i])),
                       relErr(toVec(pose_base[i].M * acc_local[i]), toVec(acc_base[i])),
                       relErr(toVec(xdd[i + 1]), toVec(acc_base[i]))});
-    ck.check(KDL::Equal(F, pose_base[i], 1e-12) && KDL::Equal(F_parent * pose_local[i], F, 1e-12),
-             "getters: pose of segment " + str(i));
+    CHECK_MESSAGE((KDL::Equal(F, pose_base[i], 1e-12) && KDL::Equal(F_parent * pose_local[i], F, 1e-12)),
+                  "getters: pose of segment " << str(i));
   }
-  ck.check(worst <= 1e-12, "getters: velocities / accelerations inconsistent, worst " + str(worst));
+  CHECK_MESSAGE(worst <= 1e-12, "getters: velocities / accelerations inconsistent, worst " << str(worst));
 }
 
 // setDriverWeights: with weight 1 on the ff torques in every column the task is solved as if ff
 // were absent and ff then acts unconstrained: nu unchanged, qdd + H^-1 ff.
-void driverWeightChecks(testutil::Checker& ck) {
+TEST_CASE("setDriverWeights: weight 1 on ff torques against the dense formula") {
   Scenario s = lwrTask();
   s.alfa.data.col(3)(3) = 1.0;  // enable all six columns
   s.alfa.data.col(4)(4) = 1.0;
@@ -280,53 +287,56 @@ void driverWeightChecks(testutil::Checker& ck) {
   no_ff.ff.data.setZero();
   Ours passing(s.chain, s.root_acc, 6), plain(s.chain, s.root_acc, 6);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(6), one = Eigen::VectorXd::Ones(6);
-  ck.check(passing.setDriverWeights(zero, one) == 0, "setDriverWeights accepted");
-  ck.check(passing.setDriverWeights(zero, Eigen::VectorXd::Ones(5)) == Ours::E_SIZE_MISMATCH,
-           "5 weights for nc = 6 refused");
-  ck.check(passing.setDriverWeights(zero, 2.0 * one) == Ours::E_OUT_OF_RANGE, "weight 2 refused");
+  CHECK_MESSAGE(passing.setDriverWeights(zero, one) == 0, "setDriverWeights accepted");
+  CHECK_MESSAGE(passing.setDriverWeights(zero, Eigen::VectorXd::Ones(5)) == Ours::E_SIZE_MISMATCH,
+                "5 weights for nc = 6 refused");
+  CHECK_MESSAGE(passing.setDriverWeights(zero, 2.0 * one) == Ours::E_OUT_OF_RANGE, "weight 2 refused");
   KDL::JntArray qdd(7), tc(7), qdd0(7), tc0(7);
-  ck.check(passing.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
-               plain.CartToJnt(no_ff.q, no_ff.qd, qdd0, no_ff.alfa, no_ff.beta, no_ff.f_ext, no_ff.ff, tc0) == 0,
-           "driver weights: solves");
+  CHECK_MESSAGE((passing.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
+                 plain.CartToJnt(no_ff.q, no_ff.qd, qdd0, no_ff.alfa, no_ff.beta, no_ff.f_ext, no_ff.ff, tc0) == 0),
+                "driver weights: solves");
   Eigen::VectorXd nu(6), nu0(6);
   passing.getContraintForceMagnitude(nu);
   plain.getContraintForceMagnitude(nu0);
   const testutil::DenseModel d = testutil::denseModel(s.chain, s.q);
   const Eigen::VectorXd expect = qdd0.data + d.H.lu().solve(s.ff.data);
   const double e_qdd = relErr(qdd.data, expect), e_nu = relErr(nu, nu0);
-  ck.check(e_qdd <= 1e-9 && e_nu <= 1e-9, "ff passed through: qdd rel err " + str(e_qdd) + ", nu rel err " + str(e_nu));
+  CHECK_MESSAGE((e_qdd <= 1e-9 && e_nu <= 1e-9),
+                "ff passed through: qdd rel err " << str(e_qdd) << ", nu rel err " << str(e_nu));
   // Zero weights again: bit for bit KDL's behaviour of this class.
   Ours fresh(s.chain, s.root_acc, 6);
   KDL::JntArray qdd1(7), qdd2(7);
   passing.setDriverWeights(zero, zero);
   passing.CartToJnt(s.q, s.qd, qdd1, s.alfa, s.beta, s.f_ext, s.ff, tc);
   fresh.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc);
-  ck.check(qdd1.data == qdd2.data, "zero driver weights: not bit-identical to none");
+  CHECK_MESSAGE(qdd1.data == qdd2.data, "zero driver weights: not bit-identical to none");
 }
 
-void errorChecks(testutil::Checker& ck) {
+TEST_CASE("error codes and a temporary chain") {
   const Scenario s = lwrTask();
   Ours solver(s.chain, s.root_acc, 6);
   KDL::JntArray qdd(7), tc(7), short_q(6);
   KDL::Jacobian five(5);
-  ck.check(solver.CartToJnt(short_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH, "q size");
-  ck.check(solver.CartToJnt(s.q, s.qd, qdd, five, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH,
-           "alfa columns != nc");
+  CHECK_MESSAGE(solver.CartToJnt(short_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH,
+                "q size");
+  CHECK_MESSAGE(solver.CartToJnt(s.q, s.qd, qdd, five, s.beta, s.f_ext, s.ff, tc) == Ours::E_SIZE_MISMATCH,
+                "alfa columns != nc");
   KDL::JntArray bad_q = s.q;
   bad_q(2) = NAN;
-  ck.check(solver.CartToJnt(bad_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) ==
-               vereshchagin::ChainHdSolver::E_NONFINITE_INPUT,
-           "NaN q: E_NONFINITE_INPUT");
+  CHECK_MESSAGE(solver.CartToJnt(bad_q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) ==
+                    vereshchagin::ChainHdSolver::E_NONFINITE_INPUT,
+                "NaN q: E_NONFINITE_INPUT");
   // A temporary chain: ours copies it (KDL would keep a dangling reference).
   Ours from_temporary(testutil::kukaLwr4(), s.root_acc, 6);
   KDL::JntArray qdd2(7);
-  ck.check(from_temporary.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
-               solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 && qdd.data == qdd2.data,
-           "temporary chain");
+  CHECK_MESSAGE((from_temporary.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 &&
+                 solver.CartToJnt(s.q, s.qd, qdd, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 && qdd.data == qdd2.data),
+                "temporary chain");
   // A temporary chain is only copied: updateInternalDataStructures() keeps working on the copy.
   from_temporary.updateInternalDataStructures();
-  ck.check(from_temporary.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 && qdd.data == qdd2.data,
-           "temporary chain: updateInternalDataStructures");
+  CHECK_MESSAGE(
+      (from_temporary.CartToJnt(s.q, s.qd, qdd2, s.alfa, s.beta, s.f_ext, s.ff, tc) == 0 && qdd.data == qdd2.data),
+      "temporary chain: updateInternalDataStructures");
 }
 
 // The caller's chain grows by one segment: the return codes of a sequence of calls, and the
@@ -359,21 +369,21 @@ Growth growth() {
   return g;
 }
 
-void growthChecks(testutil::Checker& ck) {
+TEST_CASE("a grown chain: E_NOT_UP_TO_DATE exactly when KDL returns it") {
   const Growth kdl = growth<Theirs>(), ours = growth<Ours>();
-  ck.check(kdl.codes == std::vector<int>{0, KDL::SolverI::E_NOT_UP_TO_DATE, KDL::SolverI::E_NOT_UP_TO_DATE,
-                                         KDL::SolverI::E_SIZE_MISMATCH, 0},
-           "grown chain: KDL's return codes changed");
+  CHECK_MESSAGE((kdl.codes == std::vector<int>{0, KDL::SolverI::E_NOT_UP_TO_DATE, KDL::SolverI::E_NOT_UP_TO_DATE,
+                                               KDL::SolverI::E_SIZE_MISMATCH, 0}),
+                "grown chain: KDL's return codes changed");
   std::string codes;
   for (std::size_t k = 0; k < ours.codes.size(); ++k) codes += str(ours.codes[k]) + "/" + str(kdl.codes[k]) + " ";
-  ck.check(ours.codes == kdl.codes, "grown chain: return codes ours/KDL " + codes);
+  CHECK_MESSAGE(ours.codes == kdl.codes, "grown chain: return codes ours/KDL " << codes);
   const double e = relErr(ours.qdd, kdl.qdd);
-  ck.check(e <= 1e-9, "grown chain: qdd after updateInternalDataStructures vs KDL rel err " + str(e));
-  std::printf("grown chain: return codes (ours/KDL) %s; qdd after update rel err %.2e\n", codes.c_str(), e);
+  CHECK_MESSAGE(e <= 1e-9, "grown chain: qdd after updateInternalDataStructures vs KDL rel err " << str(e));
+  MESSAGE(testutil::format("grown chain: return codes (ours/KDL) %s; qdd after update rel err %.2e", codes.c_str(), e));
 }
 
 // KDL's deprecated name: the same results as KDL's ChainIdSolver_Vereshchagin.
-void deprecatedNameChecks(testutil::Checker& ck) {
+TEST_CASE("the deprecated name gives ChainIdSolver_Vereshchagin's results") {
   const Scenario s = lwrTask();
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wdeprecated-declarations"
@@ -382,7 +392,7 @@ void deprecatedNameChecks(testutil::Checker& ck) {
 #pragma GCC diagnostic pop
   const double e = std::max({relErr(ours.qdd, kdl.qdd), relErr(ours.nu, kdl.nu),
                              relErr(ours.constraint_tau, kdl.constraint_tau), relErr(ours.total_tau, kdl.total_tau)});
-  ck.check(kdl.rc == 0 && ours.rc == 0 && e <= 1e-10, "ChainIdSolver_Vereshchagin vs KDL's: rel err " + str(e));
+  CHECK_MESSAGE((kdl.rc == 0 && ours.rc == 0 && e <= 1e-10), "ChainIdSolver_Vereshchagin vs KDL's: rel err " << str(e));
 }
 
 // KDL's massless test chain (its solvertest's chain2: five segments without inertia). Its dynamics
@@ -419,7 +429,7 @@ Eigen::VectorXd leastNormQdd(const Scenario& s) {
   return Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(A).solve(rhs);
 }
 
-void masslessChecks(testutil::Checker& ck) {
+TEST_CASE("KDL's massless chain: E_DEGRADED with the least-norm q_dotdot") {
   Scenario s;
   s.chain = kdlMasslessChain();
   s.root_acc = KDL::Twist(KDL::Vector(0.0, 0.0, 9.81), KDL::Vector::Zero());
@@ -433,37 +443,23 @@ void masslessChecks(testutil::Checker& ck) {
   s.beta = KDL::JntArray(3);                         // column 2 stays zero: disabled, as in KDL
   s.beta(0) = 9.81, s.beta(1) = 0.5;
   const Outcome kdl = run<Theirs>(s), ours = run<Ours>(s);
-  ck.check(kdl.rc == 0 && !kdl.qdd.allFinite(), "massless chain: KDL no longer returns 0 with NaN");
-  ck.check(ours.rc == KDL::SolverI::E_DEGRADED,
-           "massless chain: ours returns " + str(ours.rc) + ", expected E_DEGRADED");
+  CHECK_MESSAGE((kdl.rc == 0 && !kdl.qdd.allFinite()), "massless chain: KDL no longer returns 0 with NaN");
+  CHECK_MESSAGE(ours.rc == KDL::SolverI::E_DEGRADED,
+                "massless chain: ours returns " << str(ours.rc) << ", expected E_DEGRADED");
   const Eigen::VectorXd expected = leastNormQdd(s);
   const double e = relErr(ours.qdd, expected);
-  ck.check(e <= 1e-10, "massless chain: least-norm q_dotdot, rel err " + str(e));
-  ck.check(expected.norm() > 1.0, "massless chain: the oracle's q_dotdot is not trivial");
-  ck.check(ours.constraint_tau.isZero(0.0) && ours.total_tau.isZero(0.0) && ours.nu.isZero(0.0),
-           "massless chain: no torque and no constraint force");
+  CHECK_MESSAGE(e <= 1e-10, "massless chain: least-norm q_dotdot, rel err " << str(e));
+  CHECK_MESSAGE(expected.norm() > 1.0, "massless chain: the oracle's q_dotdot is not trivial");
+  CHECK_MESSAGE((ours.constraint_tau.isZero(0.0) && ours.total_tau.isZero(0.0) && ours.nu.isZero(0.0)),
+                "massless chain: no torque and no constraint force");
   // Torques or wrenches on a massless chain accelerate it without bound: an error, not a guess.
   s.ff(2) = 0.1;
-  ck.check(run<Ours>(s).rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA,
-           "massless chain with ff_torques: E_DEGENERATE_INERTIA");
+  CHECK_MESSAGE(run<Ours>(s).rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA,
+                "massless chain with ff_torques: E_DEGENERATE_INERTIA");
   s.ff(2) = 0.0;
   s.f_ext[4] = KDL::Wrench(KDL::Vector(1.0, 0.0, 0.0), KDL::Vector::Zero());
-  ck.check(run<Ours>(s).rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA,
-           "massless chain with f_ext: E_DEGENERATE_INERTIA");
+  CHECK_MESSAGE(run<Ours>(s).rc == vereshchagin::ChainHdSolver::E_DEGENERATE_INERTIA,
+                "massless chain with f_ext: E_DEGENERATE_INERTIA");
 }
 
 }  // namespace
-
-int main() {
-  testutil::Checker ck("test_kdl_compat");
-  lwrTaskChecks(ck);
-  lwrFreeChecks(ck);
-  randomChecks(ck);
-  getterChecks(ck);
-  driverWeightChecks(ck);
-  errorChecks(ck);
-  growthChecks(ck);
-  deprecatedNameChecks(ck);
-  masslessChecks(ck);
-  return ck.finish("");
-}

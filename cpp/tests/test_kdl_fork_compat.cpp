@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <doctest/doctest.h>
 #include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainfksolvervel_recursive.hpp>
@@ -104,12 +105,13 @@ KdlResult kdlSolve(const KDL::Chain& chain, const KDL::Twist& root_acc, const KD
   return r;
 }
 
-void closedLoop(testutil::Checker& ck, const std::string& name, bool weights_by_setter) {
+// A 200-step closed loop on the Kinova-like arm against KDL on the merged chain.
+void closedLoop(const std::string& name, bool weights_by_setter) {
   using Fork = vereshchagin::kdl_fork::ChainHdSolver_Vereshchagin_Fixed_Joint;
   using ForkFext = vereshchagin::kdl_fork::ChainHdSolver_Vereshchagin_Fext_FixedJoint;
   const KDL::Chain chain = kinovaLike(), oracle_chain = merged(chain);
   const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments(), nm = oracle_chain.getNrOfSegments();
-  ck.check(n == 7 && ns == 10 && nm == 7, name + ": chain sizes");
+  CHECK_MESSAGE((n == 7 && ns == 10 && nm == 7), name << ": chain sizes");
   const KDL::Twist root_acc(KDL::Vector(0.0, 0.0, 9.81), KDL::Vector::Zero());
   // Five columns in a task frame tilted by 0.3 rad about x: linear x', y' and the three
   // rotations; linear z' (the press direction) free. alfa^T root_acc != 0 for y'.
@@ -124,7 +126,8 @@ void closedLoop(testutil::Checker& ck, const std::string& name, bool weights_by_
   ForkFext fext_default(chain, root_acc, nc);
   Fork weighted(chain, root_acc, nc);
   if (weights_by_setter)
-    ck.check(weighted.setDriverWeights(Eigen::VectorXd::Ones(nc), Eigen::VectorXd::Zero(nc)) == 0, name + ": weights");
+    CHECK_MESSAGE(weighted.setDriverWeights(Eigen::VectorXd::Ones(nc), Eigen::VectorXd::Zero(nc)) == 0,
+                  name << ": weights");
   KDL::ChainFkSolverPos_recursive fk(chain);
   KDL::ChainFkSolverVel_recursive fkv(chain);
   KDL::JntArray q(n), qd(n), qdd(n), ctau(n), total(n), ff(n), beta(nc), beta_eff(nc);
@@ -182,32 +185,33 @@ void closedLoop(testutil::Checker& ck, const std::string& name, bool weights_by_
     if (step == 100) {
       const KdlResult unshifted = kdlSolve(oracle_chain, root_acc, q, qd, alfa, beta, f_oracle, ff);
       const double d_beta = relErr(qdd.data, unshifted.qdd), d_w = relErr(qdd_w.data, qdd.data);
-      ck.check(d_beta > 1e-2 && d_w > 1e-3, name + ": the oracle does not discriminate (beta shift changes qdd by " +
-                                                str(d_beta) + ", weights by " + str(d_w) + ")");
+      CHECK_MESSAGE((d_beta > 1e-2 && d_w > 1e-3),
+                    name << ": the oracle does not discriminate (beta shift changes qdd by " << str(d_beta)
+                         << ", weights by " << str(d_w) << ")");
     }
     for (int k = 0; k < 4; ++k) worst[k] = std::max(worst[k], e0[k]);
     for (int k = 0; k < 3; ++k) worst[4] = std::max(worst[4], e1[k]);
     const bool good = ok && *std::max_element(e0, e0 + 4) <= 1e-10 && *std::max_element(e1, e1 + 3) <= 1e-10;
     if (!good && failures++ < 3)
-      ck.check(false, name + ": step " + str(step) + ": weights 0 rel err qdd/nu/ctau/total " + str(e0[0]) + " " +
-                          str(e0[1]) + " " + str(e0[2]) + " " + str(e0[3]) + "; f_ext weights 1: " + str(e1[0]) + " " +
-                          str(e1[1]) + " " + str(e1[2]));
+      CHECK_MESSAGE(false, name << ": step " << str(step) << ": weights 0 rel err qdd/nu/ctau/total " << str(e0[0])
+                                << " " << str(e0[1]) << " " << str(e0[2]) << " " << str(e0[3])
+                                << "; f_ext weights 1: " << str(e1[0]) << " " << str(e1[1]) << " " << str(e1[2]));
     // The controller runs on the plain class (semi-implicit Euler).
     for (unsigned int j = 0; j < n; ++j) qd(j) += dt * qdd(j), q(j) += dt * qd(j);
   }
-  ck.check(failures == 0, name + ": " + str(failures) + " of 200 steps differ from the oracle");
+  CHECK_MESSAGE(failures == 0, name << ": " << str(failures) << " of 200 steps differ from the oracle");
   KDL::Frame end;
   fk.JntToCart(q, end);
-  std::printf(
-      "%s: 200 steps, worst rel err vs KDL (merged chain, beta + alfa^T root_acc): qdd %.1e, nu %.1e, "
-      "constraint_torques %.1e, total %.1e; f_ext weights 1 vs KDL without f_ext + FD(f_ext) %.1e; tool moved "
-      "%.4f m in x\n",
-      name.c_str(), worst[0], worst[1], worst[2], worst[3], worst[4], end.p.x() - start.p.x());
+  MESSAGE(
+      testutil::format("%s: 200 steps, worst rel err vs KDL (merged chain, beta + alfa^T root_acc): qdd %.1e, nu %.1e, "
+                       "constraint_torques %.1e, total %.1e; f_ext weights 1 vs KDL without f_ext + FD(f_ext) %.1e; "
+                       "tool moved %.4f m in x",
+                       name.c_str(), worst[0], worst[1], worst[2], worst[3], worst[4], end.p.x() - start.p.x()));
 }
 
 // beta_fork = 0 (nc = 6) at rest holds the tool still against gravity: its acceleration
 // (getTransformedLinkAcceleration, including root_acc) equals root_acc, i.e. physically zero.
-void holdStill(testutil::Checker& ck) {
+TEST_CASE("beta_fork = 0 at rest holds the tool still against gravity") {
   const KDL::Chain chain = kinovaLike();
   const KDL::Twist root_acc(KDL::Vector(0.0, 0.0, 9.81), KDL::Vector::Zero());
   KDL::Jacobian alfa(6);
@@ -219,16 +223,16 @@ void holdStill(testutil::Checker& ck) {
   for (unsigned int j = 0; j < n; ++j) q(j) = 0.4 * std::cos(j + 0.5);
   KDL::Wrenches f(ns, KDL::Wrench::Zero());
   std::vector<KDL::Twist> xdd(ns + 1);
-  ck.check(fork.CartToJnt(q, qd, qdd, alfa, beta, f, ff, ctau) == 0, "hold still: solve");
+  CHECK_MESSAGE(fork.CartToJnt(q, qd, qdd, alfa, beta, f, ff, ctau) == 0, "hold still: solve");
   fork.getTransformedLinkAcceleration(xdd);
   const double e = relErr(vec(xdd[ns]), vec(root_acc));
-  ck.check(e <= 1e-10, "hold still: beta_fork = 0 gives tool acceleration - root_acc rel err " + str(e));
-  std::printf("hold still: beta_fork = 0, tool acceleration minus root_acc %.1e\n", e);
+  CHECK_MESSAGE(e <= 1e-10, "hold still: beta_fork = 0 gives tool acceleration - root_acc rel err " << str(e));
+  MESSAGE(testutil::format("hold still: beta_fork = 0, tool acceleration minus root_acc %.1e", e));
 }
 
 // The Fext classes keep their f_ext priority across updateInternalDataStructures(), and
 // setDriverWeights(0, 0) on them gives the plain class's results.
-void fextWeightsKept(testutil::Checker& ck) {
+TEST_CASE("the Fext classes keep their f_ext priority across updateInternalDataStructures") {
   const KDL::Chain chain = kinovaLike();
   const KDL::Twist root_acc(KDL::Vector(0.0, 0.0, 9.81), KDL::Vector::Zero());
   const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments();
@@ -244,20 +248,19 @@ void fextWeightsKept(testutil::Checker& ck) {
   bool ok = fext.CartToJnt(q, qd, a, alfa, beta, f, ff, t) == 0;
   fext.updateInternalDataStructures();
   ok = ok && fext.CartToJnt(q, qd, b, alfa, beta, f, ff, t) == 0;
-  ck.check(ok && a.data == b.data, "Fext: weights kept across updateInternalDataStructures");
+  CHECK_MESSAGE((ok && a.data == b.data), "Fext: weights kept across updateInternalDataStructures");
   ok = fext.setDriverWeights(Eigen::VectorXd::Zero(3), Eigen::VectorXd::Zero(3)) == 0 &&
        fext.CartToJnt(q, qd, b, alfa, beta, f, ff, t) == 0 && plain.CartToJnt(q, qd, c, alfa, beta, f, ff, t) == 0;
-  ck.check(ok && b.data == c.data && relErr(a.data, c.data) > 1e-3,
-           "Fext with weights 0 equals the plain class (and differs from weights 1)");
+  CHECK_MESSAGE((ok && b.data == c.data && relErr(a.data, c.data) > 1e-3),
+                "Fext with weights 0 equals the plain class (and differs from weights 1)");
 }
 
 }  // namespace
 
-int main() {
-  testutil::Checker ck("test_kdl_fork_compat");
-  closedLoop(ck, "Fixed_Joint + setDriverWeights", /*weights_by_setter=*/true);
-  closedLoop(ck, "Fixed_Joint + Fext_FixedJoint", /*weights_by_setter=*/false);
-  holdStill(ck);
-  fextWeightsKept(ck);
-  return ck.finish("");
+TEST_CASE("closed loop: Fixed_Joint class with setDriverWeights against KDL on the merged chain") {
+  closedLoop("Fixed_Joint + setDriverWeights", /*weights_by_setter=*/true);
+}
+
+TEST_CASE("closed loop: Fext_FixedJoint class against KDL on the merged chain") {
+  closedLoop("Fixed_Joint + Fext_FixedJoint", /*weights_by_setter=*/false);
 }

@@ -18,6 +18,7 @@
 // grows like cond(K) * eps) or that have more constraints than joints are skipped for the KDL
 // comparison: KDL truncates its SVD at an absolute 1e-14, so there the two solvers legitimately
 // differ. The number of skipped samples is bounded and reported.
+#include <doctest/doctest.h>
 #include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
@@ -29,8 +30,7 @@
 using testutil::relErr;
 using testutil::str;
 
-int main() {
-  testutil::Checker ck("test_kdl_oracle");
+TEST_CASE("1200 random chains and tasks agree with KDL's hybrid solver and forward dynamics") {
   const int kSamples = 1200;
   int compared = 0, skipped_rank = 0, skipped_cond = 0, eligible = 0, kdl_defect_seen = 0, kdl_defect_candidates = 0,
       fd_checked = 0;
@@ -54,11 +54,12 @@ int main() {
                             ", gravity=" + str(gravity) + ")";
 
     vereshchagin::ChainHdSolver ours(chain, root_acc);
-    if (!ck.check(ours.modelError() == 0, tag + ": modelError " + str(ours.modelError()) + " " + ours.errorMessage()))
+    if (!CHECK_MESSAGE(ours.modelError() == 0,
+                       tag << ": modelError " << str(ours.modelError()) << " " << ours.errorMessage()))
       continue;
     KDL::JntArray qdd(n), tau_cmd(n);
     int rc = ours.CartToJnt(q, qd, qdd, alfa, beta, fext, ff, tau_cmd);
-    if (!ck.check(rc == 0, tag + ": CartToJnt returned " + str(rc) + " " + ours.errorMessage())) continue;
+    if (!CHECK_MESSAGE(rc == 0, tag << ": CartToJnt returned " << str(rc) << " " << ours.errorMessage())) continue;
     Eigen::VectorXd nu;
     ours.getContraintForceMagnitude(nu);
     std::vector<KDL::Twist> acc;
@@ -70,23 +71,24 @@ int main() {
       vereshchagin::ChainHdSolver ours2(chain, root_acc);
       const Eigen::Matrix<double, 6, Eigen::Dynamic> fe = testutil::toMatrix(fext);
       rc = ours2.solve(q.data, qd.data, alfa.data, beta.data, fe, ff.data);
-      ck.check(rc == 0, tag + ": solve returned " + str(rc));
-      ck.check(ours2.qdd() == qdd.data && ours2.commandTorques() == tau_cmd.data && ours2.nu() == nu &&
-                   ours2.linkAccelerations() == ours.linkAccelerations() && ours2.constraintCount() == nc,
-               tag + ": solve() and CartToJnt() disagree");
+      CHECK_MESSAGE(rc == 0, tag << ": solve returned " << str(rc));
+      CHECK_MESSAGE((ours2.qdd() == qdd.data && ours2.commandTorques() == tau_cmd.data && ours2.nu() == nu &&
+                     ours2.linkAccelerations() == ours.linkAccelerations() && ours2.constraintCount() == nc),
+                    tag << ": solve() and CartToJnt() disagree");
     }
-    ck.check(static_cast<int>(nu.size()) == nc && acc.size() == ns + 1 &&
-                 ours.linkAccelerations().cols() == static_cast<Eigen::Index>(ns + 1),
-             tag + ": output sizes");
-    ck.check(qdd.data.allFinite() && nu.allFinite() && tau_cmd.data.allFinite() && acc_m.allFinite(),
-             tag + ": non-finite output");
+    CHECK_MESSAGE((static_cast<int>(nu.size()) == nc && acc.size() == ns + 1 &&
+                   ours.linkAccelerations().cols() == static_cast<Eigen::Index>(ns + 1)),
+                  tag << ": output sizes");
+    CHECK_MESSAGE((qdd.data.allFinite() && nu.allFinite() && tau_cmd.data.allFinite() && acc_m.allFinite()),
+                  tag << ": non-finite output");
 
     // Command torques are -J^T alfa nu, always (any nu).
     const testutil::DenseModel dense = testutil::denseModel(chain, q);
     const Eigen::VectorXd tau_ref = -dense.J.transpose() * (alfa.data * nu);
-    ck.check(relErr(tau_cmd.data, tau_ref) <= 1e-10,
-             tag + ": command torques != -J^T alfa nu, rel err " + str(relErr(tau_cmd.data, tau_ref)));
-    ck.check(relErr(acc_m.col(0), testutil::toVector(root_acc)) == 0.0, tag + ": link acceleration 0 != root_acc");
+    CHECK_MESSAGE(relErr(tau_cmd.data, tau_ref) <= 1e-10,
+                  tag << ": command torques != -J^T alfa nu, rel err " << str(relErr(tau_cmd.data, tau_ref)));
+    CHECK_MESSAGE(relErr(acc_m.col(0), testutil::toVector(root_acc)) == 0.0,
+                  tag << ": link acceleration 0 != root_acc");
 
     if (nc > n) {
       ++skipped_rank;
@@ -102,24 +104,26 @@ int main() {
 
     // Rank and smallest eigenvalue of K against the dense K.
     if (nc > 0) {
-      ck.check(ours.constraintRank() == nc, tag + ": constraintRank " + str(ours.constraintRank()));
-      ck.check(std::abs(ours.smallestSingularValue() - eig(0)) <= 1e-8 * eig(nc - 1),
-               tag + ": smallestSingularValue " + str(ours.smallestSingularValue()) + " vs dense " + str(eig(0)));
+      CHECK_MESSAGE(ours.constraintRank() == nc, tag << ": constraintRank " << str(ours.constraintRank()));
+      CHECK_MESSAGE(
+          std::abs(ours.smallestSingularValue() - eig(0)) <= 1e-8 * eig(nc - 1),
+          tag << ": smallestSingularValue " << str(ours.smallestSingularValue()) << " vs dense " << str(eig(0)));
     } else {
-      ck.check(ours.constraintRank() == 0, tag + ": rank with no constraint");
+      CHECK_MESSAGE(ours.constraintRank() == 0, tag << ": rank with no constraint");
     }
 
     // Constraints satisfied: alfa^T Xdd_N = beta.
     if (nc > 0) {
       const Eigen::VectorXd lhs = alfa.data.transpose() * acc_m.col(ns);
-      ck.check(relErr(lhs, beta.data) <= 1e-9, tag + ": alfa^T Xdd_N != beta, rel err " + str(relErr(lhs, beta.data)));
+      CHECK_MESSAGE(relErr(lhs, beta.data) <= 1e-9,
+                    tag << ": alfa^T Xdd_N != beta, rel err " << str(relErr(lhs, beta.data)));
     }
 
     // KDL's hybrid solver.
     KDL::ChainHdSolver_Vereshchagin kdl(chain, root_acc, static_cast<unsigned int>(nc));
     KDL::JntArray qdd_k(n), ct_k(n);
     rc = kdl.CartToJnt(q, qd, qdd_k, alfa, beta, fext, ff, ct_k);
-    if (!ck.check(rc == 0, tag + ": KDL returned " + str(rc))) continue;
+    if (!CHECK_MESSAGE(rc == 0, tag << ": KDL returned " << str(rc))) continue;
     Eigen::VectorXd nu_k = Eigen::VectorXd::Zero(nc);  // KDL asserts the size
     kdl.getContraintForceMagnitude(nu_k);
     std::vector<KDL::Twist> acc_k(ns + 1);
@@ -132,11 +136,11 @@ int main() {
     worst_qdd = std::max(worst_qdd, e_qdd);
     worst_nu = std::max(worst_nu, e_nu);
     worst_acc = std::max(worst_acc, e_acc);
-    ck.check(e_qdd <= 1e-10, tag + ": q_dotdot vs KDL rel err " + str(e_qdd) + "\n  ours " + testutil::mat(qdd.data) +
-                                 "\n  kdl  " + testutil::mat(qdd_k.data));
-    ck.check(e_nu <= 1e-10, tag + ": nu vs KDL rel err " + str(e_nu) + "\n  ours " + testutil::mat(nu) + "\n  kdl  " +
-                                testutil::mat(nu_k));
-    ck.check(e_acc <= 1e-10, tag + ": link accelerations vs KDL rel err " + str(e_acc));
+    CHECK_MESSAGE(e_qdd <= 1e-10, tag << ": q_dotdot vs KDL rel err " << str(e_qdd) << "\n  ours "
+                                      << testutil::mat(qdd.data) << "\n  kdl  " << testutil::mat(qdd_k.data));
+    CHECK_MESSAGE(e_nu <= 1e-10, tag << ": nu vs KDL rel err " << str(e_nu) << "\n  ours " << testutil::mat(nu)
+                                     << "\n  kdl  " << testutil::mat(nu_k));
+    CHECK_MESSAGE(e_acc <= 1e-10, tag << ": link accelerations vs KDL rel err " << str(e_acc));
 
     // Our command torques drive plain forward dynamics to our q_dotdot.
     const KDL::Wrenches fext_tip = testutil::toTipAxes(chain, q, fext);
@@ -144,13 +148,14 @@ int main() {
     KDL::JntArray tau_total(n), qdd_fd(n);
     tau_total.data = ff.data + tau_cmd.data;
     rc = fd.CartToJnt(q, qd, tau_total, fext_tip, qdd_fd);
-    ck.check(rc == 0, tag + ": ChainFdSolver_RNE returned " + str(rc));
+    CHECK_MESSAGE(rc == 0, tag << ": ChainFdSolver_RNE returned " << str(rc));
     const double e_fd = relErr(qdd_fd.data, qdd.data);
     worst_fd = std::max(worst_fd, e_fd);
     ++fd_checked;
-    ck.check(e_fd <= 1e-9, tag + ": forward dynamics with ff + command torques gives a different q_dotdot, rel err " +
-                               str(e_fd) + "\n  fd   " + testutil::mat(qdd_fd.data) + "\n  ours " +
-                               testutil::mat(qdd.data));
+    CHECK_MESSAGE(e_fd <= 1e-9,
+                  tag << ": forward dynamics with ff + command torques gives a different q_dotdot, rel err "
+                      << str(e_fd) << "\n  fd   " << testutil::mat(qdd_fd.data) << "\n  ours "
+                      << testutil::mat(qdd.data));
 
     // KDL's constraint_torques are not such a command (KDL defect 1).
     if (nc > 0 && n >= 3) {
@@ -161,15 +166,16 @@ int main() {
     }
   }
 
-  ck.check(compared >= 600, "too few samples compared: " + str(compared));
-  ck.check(compared >= 0.8 * eligible,
-           "too many ill-conditioned samples skipped: " + str(skipped_cond) + " of " + str(eligible));
-  ck.check(
-      kdl_defect_candidates > 0 && kdl_defect_seen > 0,
+  CHECK_MESSAGE(compared >= 600, "too few samples compared: " << str(compared));
+  CHECK_MESSAGE(compared >= 0.8 * eligible,
+                "too many ill-conditioned samples skipped: " << str(skipped_cond) << " of " << str(eligible));
+  CHECK_MESSAGE(
+      (kdl_defect_candidates > 0 && kdl_defect_seen > 0),
       "KDL's constraint_torques reproduced q_dotdot in every sample: the forward-dynamics check does not discriminate");
 
-  return ck.finish(str(compared) + " samples compared with KDL (skipped: " + str(skipped_rank) + " nc>n, " +
-                   str(skipped_cond) + " ill-conditioned); worst rel err qdd " + str(worst_qdd) + ", nu " +
-                   str(worst_nu) + ", acc " + str(worst_acc) + ", FD " + str(worst_fd) +
-                   "; KDL constraint_torques wrong in " + str(kdl_defect_seen) + "/" + str(kdl_defect_candidates));
+  MESSAGE(str(compared) << " samples compared with KDL (skipped: " << str(skipped_rank) << " nc>n, "
+                        << str(skipped_cond) << " ill-conditioned); worst rel err qdd " << str(worst_qdd) << ", nu "
+                        << str(worst_nu) << ", acc " << str(worst_acc) << ", FD " << str(worst_fd)
+                        << "; KDL constraint_torques wrong in " << str(kdl_defect_seen) << "/"
+                        << str(kdl_defect_candidates));
 }

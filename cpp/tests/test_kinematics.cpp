@@ -4,7 +4,6 @@
 // Jacobians (ChainJntToJacSolver, TreeJntToJacSolver, reference point moved to the frame origin)
 // and bias accelerations (ChainJntToJacDotSolver, HYBRID: base axes, tip origin; on trees along
 // the chain of each segment's path). Tolerance 1e-9 relative. Then every error code.
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
 #include <doctest/doctest.h>
 
 #include <cmath>

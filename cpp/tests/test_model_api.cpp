@@ -2,7 +2,6 @@
 // underlies (ChainHdSolver, TreeHdSolver, FrictionSolver), KDL's forward kinematics and Jacobian
 // solvers as the oracle of frame loads and Jacobians, threads sharing one Model, typed inputs
 // and errors.
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
 #include <doctest/doctest.h>
 
 #include <thread>

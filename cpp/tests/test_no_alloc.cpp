@@ -2,6 +2,7 @@
 // heap memory. Every allocation function is replaced by a counting version (alloc_counter.hpp:
 // operator new/delete and, on glibc, the malloc family, which Eigen uses). The test proves the
 // counters work by allocating on purpose in a counted region.
+#include <doctest/doctest.h>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 
 #include "alloc_counter.hpp"
@@ -18,68 +19,82 @@ namespace {
 void* volatile g_sink = nullptr;  // keeps the deliberate allocations observable
 
 using Counts = testutil::AllocCounts;
+using testutil::str;
+using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+// The allocations counted so far. Only differences between two calls matter, and no doctest
+// macro runs between the two ends of a measured region: doctest's own allocations (its
+// reporters, INFO and CHECK messages) fall outside every region.
 Counts now() {
   return testutil::allocCounts();
 }
-}  // namespace
 
-int main() {
-  using testutil::str;
-  using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
-  testutil::Checker ck("test_no_alloc");
-
-  // Counting must work: a std::vector and an Eigen vector allocated on purpose are seen.
-  {
-    const Counts c0 = now();
-    auto* v = new std::vector<int>(100, 1);
-    g_sink = v->data();
-    delete v;
-    const Counts c1 = now();
-    ck.check(c1.news - c0.news >= 2, "operator new replacement does not count (std::vector)");
-    Eigen::VectorXd* e = new Eigen::VectorXd(Eigen::VectorXd::Ones(100));
-    g_sink = e->data();
-    delete e;
-    const Counts c2 = now();
-    if (VERESHCHAGIN_TEST_COUNT_MALLOC)
-      ck.check(c2.mallocs - c1.mallocs >= 2, "malloc interposition does not count (Eigen)");
-  }
-
-  testutil::RandomGen g(777);
-  const KDL::Chain chain = g.chain(7);
-  const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments();
-  const KDL::Twist grav(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero());
-  vereshchagin::ChainHdSolver solver(chain, grav);
+vereshchagin::SolverOptions dampedLeastSquares() {
   vereshchagin::SolverOptions dls;
   dls.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
-  vereshchagin::ChainHdSolver solver_dls(chain, grav, dls);
+  return dls;
+}
 
-  // All inputs and outputs are prepared before counting.
-  const int kSets = 8;
+// A random 7-joint chain, its solvers (truncated and damped policies) and every input and output
+// of the measured calls, all prepared before counting.
+struct Fixture {
+  testutil::RandomGen g{777};
+  const KDL::Chain chain = g.chain(7);
+  const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments();
+  const KDL::Twist grav{KDL::Vector(0, 0, 9.81), KDL::Vector::Zero()};
+  vereshchagin::ChainHdSolver solver{chain, grav};
+  vereshchagin::ChainHdSolver solver_dls{chain, grav, dampedLeastSquares()};
+  static constexpr int kSets = 8;
   std::vector<KDL::JntArray> q, qd, ff;
   std::vector<KDL::Wrenches> fext;
   std::vector<Matrix6X> fext_m;
-  for (int i = 0; i < kSets; ++i) {
-    q.push_back(g.q(n));
-    qd.push_back(g.qdot(n));
-    ff.push_back(g.torques(n));
-    fext.push_back(g.fext(ns));
-    fext_m.push_back(testutil::toMatrix(fext.back()));
-  }
   std::vector<KDL::Jacobian> alfa;
   std::vector<Matrix6X> alfa_m;
   std::vector<KDL::JntArray> beta;
-  for (int nc = 0; nc <= 6; ++nc) {
-    alfa.push_back(g.alfa(nc));
-    alfa_m.push_back(alfa.back().data);
-    beta.push_back(g.beta(nc));
+  Eigen::VectorXi joints = Eigen::VectorXi(3);
+  Eigen::MatrixXd dqdd = Eigen::MatrixXd(n, 3), dtau = Eigen::MatrixXd(n, 3);
+  KDL::JntArray qdd = KDL::JntArray(n), tau = KDL::JntArray(n);
+  const Eigen::VectorXd empty_tau = Eigen::VectorXd(0);
+  const Matrix6X empty_fext = Matrix6X(6, 0);
+  const Eigen::VectorXd bad_q = Eigen::VectorXd(n + 1);
+
+  Fixture() {
+    for (int i = 0; i < kSets; ++i) {
+      q.push_back(g.q(n));
+      qd.push_back(g.qdot(n));
+      ff.push_back(g.torques(n));
+      fext.push_back(g.fext(ns));
+      fext_m.push_back(testutil::toMatrix(fext.back()));
+    }
+    for (int nc = 0; nc <= 6; ++nc) {
+      alfa.push_back(g.alfa(nc));
+      alfa_m.push_back(alfa.back().data);
+      beta.push_back(g.beta(nc));
+    }
+    joints << 0, 3, 6;
   }
-  Eigen::VectorXi joints(3);
-  joints << 0, 3, 6;
-  Eigen::MatrixXd dqdd(n, 3), dtau(n, 3);
-  KDL::JntArray qdd(n), tau(n);
-  const Eigen::VectorXd empty_tau(0);
-  const Matrix6X empty_fext(6, 0);
-  const Eigen::VectorXd bad_q(n + 1);
+};
+
+}  // namespace
+
+TEST_CASE("the counters see operator new and (on glibc) malloc") {
+  // Counting must work: a std::vector and an Eigen vector allocated on purpose are seen.
+  const Counts c0 = now();
+  auto* v = new std::vector<int>(100, 1);
+  g_sink = v->data();
+  delete v;
+  const Counts c1 = now();
+  CHECK_MESSAGE(c1.news - c0.news >= 2, "operator new replacement does not count (std::vector)");
+  Eigen::VectorXd* e = new Eigen::VectorXd(Eigen::VectorXd::Ones(100));
+  g_sink = e->data();
+  delete e;
+  const Counts c2 = now();
+  if (VERESHCHAGIN_TEST_COUNT_MALLOC)
+    CHECK_MESSAGE(c2.mallocs - c1.mallocs >= 2, "malloc interposition does not count (Eigen)");
+  MESSAGE("malloc family counted too: " << (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no"));
+}
+
+TEST_CASE_FIXTURE(Fixture, "solve, CartToJnt and responseColumns do not allocate (both policies)") {
   int failures = 0;
   double checksum = 0.0;
 
@@ -98,262 +113,259 @@ int main() {
     checksum += solver_dls.qdd()(0) + solver_dls.smallestSingularValue();
   }
   const Counts c1 = now();
-  ck.check(failures == 0, "solver calls failed: " + str(failures));
-  ck.check(std::isfinite(checksum), "non-finite results");
-  ck.check(c1.news == c0.news, "operator new called " + str(c1.news - c0.news) + " times in 1000 iterations");
-  ck.check(c1.mallocs == c0.mallocs,
-           "malloc family called " + str(c1.mallocs - c0.mallocs) + " times in 1000 iterations");
+  CHECK_MESSAGE(failures == 0, "solver calls failed: " << str(failures));
+  CHECK_MESSAGE(std::isfinite(checksum), "non-finite results");
+  CHECK_MESSAGE(c1.news == c0.news, "operator new called " << str(c1.news - c0.news) << " times in 1000 iterations");
+  CHECK_MESSAGE(c1.mallocs == c0.mallocs,
+                "malloc family called " << str(c1.mallocs - c0.mallocs) << " times in 1000 iterations");
+}
 
+TEST_CASE_FIXTURE(Fixture, "error paths do not allocate") {
+  int failures = 0;
   // Error paths (they format a message) do not allocate either.
   const Counts c2 = now();
   for (int it = 0; it < 100; ++it) {
     if (solver.solve(bad_q, qd[0].data, alfa_m[1], beta[1].data, fext_m[0], ff[0].data) == 0) ++failures;
   }
   const Counts c3 = now();
-  ck.check(failures == 0, "size-mismatched solve did not fail");
-  ck.check(c3.news == c2.news && c3.mallocs == c2.mallocs,
-           "error path allocates: new " + str(c3.news - c2.news) + ", malloc " + str(c3.mallocs - c2.mallocs));
+  CHECK_MESSAGE(failures == 0, "size-mismatched solve did not fail");
+  CHECK_MESSAGE((c3.news == c2.news && c3.mallocs == c2.mallocs),
+                "error path allocates: new " << str(c3.news - c2.news) << ", malloc " << str(c3.mallocs - c2.mallocs));
+}
 
+TEST_CASE_FIXTURE(Fixture, "allocations inside KDL (a shared library) are counted") {
   // The counters also see allocations made inside a shared library: KDL's solver allocates on
   // every CartToJnt with constraints (defect 4 of the KDL notes).
-  {
-    KDL::ChainHdSolver_Vereshchagin kdl(chain, grav, 2);
-    const Counts k0 = now();
-    const int rc = kdl.CartToJnt(q[0], qd[0], qdd, alfa[2], beta[2], fext[0], ff[0], tau);
-    const Counts k1 = now();
-    ck.check(rc == 0 && (k1.news - k0.news) + (k1.mallocs - k0.mallocs) > 0,
-             "allocations inside KDL's CartToJnt were not counted");
-  }
+  KDL::ChainHdSolver_Vereshchagin kdl(chain, grav, 2);
+  const Counts k0 = now();
+  const int rc = kdl.CartToJnt(q[0], qd[0], qdd, alfa[2], beta[2], fext[0], ff[0], tau);
+  const Counts k1 = now();
+  CHECK_MESSAGE((rc == 0 && (k1.news - k0.news) + (k1.mallocs - k0.mallocs) > 0),
+                "allocations inside KDL's CartToJnt were not counted");
+}
 
+TEST_CASE_FIXTURE(Fixture, "friction-aware solves do not allocate") {
   // Friction-aware solves: all joints at rest (k = 7 resting joints), some moving, nc 0..6, with
   // the Gauss value on request; also a singular task (the tie-break path) and DLS options.
-  {
-    vereshchagin::FrictionSolver fsolver(chain, grav);
-    vereshchagin::FrictionModel fm;
-    fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
-    fm.kinetic_friction = 0.5 * fm.static_friction;
-    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
-    Eigen::VectorXd mixed = Eigen::VectorXd::Zero(n);
-    mixed(1) = 0.3;
-    mixed(4) = -0.2;
-    const Matrix6X full = Matrix6X::Identity(6, 6);
-    const Eigen::VectorXd hold = (Eigen::VectorXd(6) << 0, 0, 9.81, 0, 0, 0).finished();
-    double fsum = 0.0;
-    int ffail = 0;
-    // Warm-up outside the counted region (first use of every code path).
-    fsolver.solve(q[0].data, rest, alfa_m[6], beta[6].data, fext_m[0], ff[0].data, fm);
-    const Counts f0 = now();
-    for (int it = 0; it < 1000; ++it) {
-      const int s = it % kSets, nc = it % 7;
-      if (fsolver.solve(q[s].data, rest, alfa_m[nc], beta[nc].data, fext_m[s], ff[s].data, fm) != 0) ++ffail;
-      fsum += fsolver.qdd()(0) + fsolver.frictionTorques()(2) + fsolver.gaussValue() + fsolver.iterations();
-      if (fsolver.solve(q[s].data, mixed, alfa_m[nc], beta[nc].data, empty_fext, empty_tau, fm) != 0) ++ffail;
-      if (fsolver.solve(q[s].data, rest, full, hold, empty_fext, ff[s].data, fm) != 0) ++ffail;
-      fsum += fsolver.commandTorques()(0) + fsolver.gaussValue();
-    }
-    const Counts f1 = now();
-    ck.check(ffail == 0, "friction solves failed: " + str(ffail) + " (" + fsolver.errorMessage() + ")");
-    ck.check(std::isfinite(fsum), "non-finite friction results");
-    ck.check(f1.news == f0.news && f1.mallocs == f0.mallocs, "friction-aware solves allocated: operator new " +
-                                                                 str(f1.news - f0.news) + ", malloc " +
-                                                                 str(f1.mallocs - f0.mallocs) + " in 3000 solves");
+  vereshchagin::FrictionSolver fsolver(chain, grav);
+  vereshchagin::FrictionModel fm;
+  fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
+  fm.kinetic_friction = 0.5 * fm.static_friction;
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd mixed = Eigen::VectorXd::Zero(n);
+  mixed(1) = 0.3;
+  mixed(4) = -0.2;
+  const Matrix6X full = Matrix6X::Identity(6, 6);
+  const Eigen::VectorXd hold = (Eigen::VectorXd(6) << 0, 0, 9.81, 0, 0, 0).finished();
+  double fsum = 0.0;
+  int ffail = 0;
+  // Warm-up outside the counted region (first use of every code path).
+  fsolver.solve(q[0].data, rest, alfa_m[6], beta[6].data, fext_m[0], ff[0].data, fm);
+  const Counts f0 = now();
+  for (int it = 0; it < 1000; ++it) {
+    const int s = it % kSets, nc = it % 7;
+    if (fsolver.solve(q[s].data, rest, alfa_m[nc], beta[nc].data, fext_m[s], ff[s].data, fm) != 0) ++ffail;
+    fsum += fsolver.qdd()(0) + fsolver.frictionTorques()(2) + fsolver.gaussValue() + fsolver.iterations();
+    if (fsolver.solve(q[s].data, mixed, alfa_m[nc], beta[nc].data, empty_fext, empty_tau, fm) != 0) ++ffail;
+    if (fsolver.solve(q[s].data, rest, full, hold, empty_fext, ff[s].data, fm) != 0) ++ffail;
+    fsum += fsolver.commandTorques()(0) + fsolver.gaussValue();
   }
+  const Counts f1 = now();
+  CHECK_MESSAGE(ffail == 0, "friction solves failed: " << str(ffail) << " (" << fsolver.errorMessage() << ")");
+  CHECK_MESSAGE(std::isfinite(fsum), "non-finite friction results");
+  CHECK_MESSAGE((f1.news == f0.news && f1.mallocs == f0.mallocs),
+                "friction-aware solves allocated: operator new " << str(f1.news - f0.news) << ", malloc "
+                                                                 << str(f1.mallocs - f0.mallocs) << " in 3000 solves");
+}
 
+TEST_CASE_FIXTURE(Fixture, "constraints on several segments do not allocate") {
   // Constraints on several segments (general path: Cholesky and Jacobi factorisations, both
   // policies, response columns, friction on top), 1..18 columns on up to three segments.
-  {
-    vereshchagin::FrictionSolver fsolver(chain, grav);
-    vereshchagin::FrictionModel fm;
-    fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
-    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
-    Matrix6X A(6, 18);
-    for (int c = 0; c < 18; ++c) A.col(c) = alfa_m[6].col(c % 6);
-    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(18, -1.0, 2.0);
-    Eigen::VectorXi segs(18);
-    for (int c = 0; c < 18; ++c) segs(c) = c < 6 ? 2 : (c < 12 ? static_cast<int>(ns) - 1 : 4);
-    Eigen::MatrixXd dnu(18, 3);
-    double gsum = 0.0;
-    int gfail = 0;
-    solver.solve(q[0].data, qd[0].data, A, b, segs, fext_m[0], ff[0].data);
-    fsolver.solve(q[0].data, rest, A.leftCols(3), b.head(3), segs.head(3), fext_m[0], ff[0].data, fm);
-    const Counts g0 = now();
-    for (int it = 0; it < 500; ++it) {
-      const int s = it % kSets, m = 1 + it % 18;
-      if (solver.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), fext_m[s], ff[s].data) != 0)
-        ++gfail;
-      if (solver.responseColumns(joints, dqdd, dtau, dnu) != 0) ++gfail;
-      gsum += solver.qdd()(0) + solver.nu()(0) + dnu(0, 0) + solver.smallestSingularValue();
-      if (solver_dls.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), empty_fext, empty_tau) != 0)
-        ++gfail;
-      gsum += solver_dls.commandTorques()(1);
-      const int mf = 1 + it % 7;  // at most n columns keeps the friction QP well posed
-      if (fsolver.solve(q[s].data, rest, A.leftCols(mf), b.head(mf), segs.head(mf), fext_m[s], ff[s].data, fm) != 0)
-        ++gfail;
-      gsum += fsolver.qdd()(0) + fsolver.gaussValue();
-    }
-    const Counts g1 = now();
-    ck.check(gfail == 0, "segment-constraint solves failed: " + str(gfail) + " (" + solver.errorMessage() + " / " +
-                             fsolver.errorMessage() + ")");
-    ck.check(std::isfinite(gsum), "non-finite segment-constraint results");
-    ck.check(g1.news == g0.news && g1.mallocs == g0.mallocs, "segment-constraint solves allocated: operator new " +
-                                                                 str(g1.news - g0.news) + ", malloc " +
-                                                                 str(g1.mallocs - g0.mallocs));
+  vereshchagin::FrictionSolver fsolver(chain, grav);
+  vereshchagin::FrictionModel fm;
+  fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+  Matrix6X A(6, 18);
+  for (int c = 0; c < 18; ++c) A.col(c) = alfa_m[6].col(c % 6);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(18, -1.0, 2.0);
+  Eigen::VectorXi segs(18);
+  for (int c = 0; c < 18; ++c) segs(c) = c < 6 ? 2 : (c < 12 ? static_cast<int>(ns) - 1 : 4);
+  Eigen::MatrixXd dnu(18, 3);
+  double gsum = 0.0;
+  int gfail = 0;
+  solver.solve(q[0].data, qd[0].data, A, b, segs, fext_m[0], ff[0].data);
+  fsolver.solve(q[0].data, rest, A.leftCols(3), b.head(3), segs.head(3), fext_m[0], ff[0].data, fm);
+  const Counts g0 = now();
+  for (int it = 0; it < 500; ++it) {
+    const int s = it % kSets, m = 1 + it % 18;
+    if (solver.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), fext_m[s], ff[s].data) != 0)
+      ++gfail;
+    if (solver.responseColumns(joints, dqdd, dtau, dnu) != 0) ++gfail;
+    gsum += solver.qdd()(0) + solver.nu()(0) + dnu(0, 0) + solver.smallestSingularValue();
+    if (solver_dls.solve(q[s].data, qd[s].data, A.leftCols(m), b.head(m), segs.head(m), empty_fext, empty_tau) != 0)
+      ++gfail;
+    gsum += solver_dls.commandTorques()(1);
+    const int mf = 1 + it % 7;  // at most n columns keeps the friction QP well posed
+    if (fsolver.solve(q[s].data, rest, A.leftCols(mf), b.head(mf), segs.head(mf), fext_m[s], ff[s].data, fm) != 0)
+      ++gfail;
+    gsum += fsolver.qdd()(0) + fsolver.gaussValue();
   }
+  const Counts g1 = now();
+  CHECK_MESSAGE(gfail == 0, "segment-constraint solves failed: " << str(gfail) << " (" << solver.errorMessage() << " / "
+                                                                 << fsolver.errorMessage() << ")");
+  CHECK_MESSAGE(std::isfinite(gsum), "non-finite segment-constraint results");
+  CHECK_MESSAGE((g1.news == g0.news && g1.mallocs == g0.mallocs), "segment-constraint solves allocated: operator new "
+                                                                      << str(g1.news - g0.news) << ", malloc "
+                                                                      << str(g1.mallocs - g0.mallocs));
+}
 
+TEST_CASE_FIXTURE(Fixture, "pass-through and the KDL drop-in class do not allocate") {
   // Driver pass-through (both paths, friction on top) and the KDL drop-in class (zero columns,
   // driver weights, every getter with outputs of the right size).
-  {
-    vereshchagin::ChainHdSolver pt(chain, grav);
-    vereshchagin::FrictionSolver fpt(chain, grav);
-    vereshchagin::FrictionModel fm;
-    fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
-    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
-    const Eigen::VectorXd w3 = Eigen::VectorXd::LinSpaced(3, 0.0, 1.0), w6 = Eigen::VectorXd::LinSpaced(6, 1.0, 0.2);
-    Eigen::VectorXi segs3(3);
-    segs3 << 2, static_cast<int>(ns) - 1, 4;
-    vereshchagin::kdl_compat::ChainHdSolver_Vereshchagin compat(chain, grav, 6);
-    KDL::Jacobian alfa_zero = alfa[6];
-    alfa_zero.data.col(2).setZero();
-    alfa_zero.data.col(4).setZero();
-    std::vector<KDL::Twist> tw(ns + 1), tw_n(ns);
-    std::vector<KDL::Frame> fr(ns);
-    Eigen::VectorXd nu6(6);
-    KDL::JntArray total(n);
-    ck.check(pt.setPassThrough(w3, w3.reverse()) == 0 && fpt.setPassThrough(w3, w3) == 0 &&
-                 compat.setDriverWeights(w6, w6.reverse()) == 0,
-             "pass-through weights accepted");
-    pt.solve(q[0].data, qd[0].data, alfa_m[3], beta[3].data, fext_m[0], ff[0].data);
-    fpt.solve(q[0].data, rest, alfa_m[3], beta[3].data, fext_m[0], ff[0].data, fm);
-    compat.CartToJnt(q[0], qd[0], qdd, alfa_zero, beta[6], fext[0], ff[0], tau);
-    double psum = 0.0;
-    int pfail = 0;
-    const Counts p0 = now();
-    for (int it = 0; it < 500; ++it) {
-      const int s = it % kSets;
-      if (pt.solve(q[s].data, qd[s].data, alfa_m[3], beta[3].data, fext_m[s], ff[s].data) != 0) ++pfail;
-      psum += pt.qdd()(0) + pt.nu()(1);
-      if (pt.solve(q[s].data, qd[s].data, alfa_m[3], beta[3].data, segs3, fext_m[s], ff[s].data) != 0) ++pfail;
-      psum += pt.qdd()(1);
-      if (fpt.solve(q[s].data, rest, alfa_m[3], beta[3].data, segs3, fext_m[s], ff[s].data, fm) != 0) ++pfail;
-      psum += fpt.qdd()(2);
-      if (compat.CartToJnt(q[s], qd[s], qdd, it % 2 ? alfa_zero : alfa[6], beta[6], fext[s], ff[s], tau) != 0) ++pfail;
-      compat.getTransformedLinkAcceleration(tw);
-      compat.getTotalTorque(total);
-      compat.getContraintForceMagnitude(nu6);
-      compat.getLinkCartesianPose(fr);
-      compat.getLinkCartesianVelocity(tw_n);
-      compat.getLinkAcceleration(tw_n);
-      psum += qdd(0) + tw[ns].vel.z() + total(0) + nu6(5) + fr[1].p.x() + tw_n[2].rot.x();
-    }
-    const Counts p1 = now();
-    ck.check(pfail == 0, "pass-through / drop-in solves failed: " + str(pfail));
-    ck.check(std::isfinite(psum), "non-finite pass-through results");
-    ck.check(p1.news == p0.news && p1.mallocs == p0.mallocs, "pass-through / drop-in solves allocated: operator new " +
-                                                                 str(p1.news - p0.news) + ", malloc " +
-                                                                 str(p1.mallocs - p0.mallocs));
+  vereshchagin::ChainHdSolver pt(chain, grav);
+  vereshchagin::FrictionSolver fpt(chain, grav);
+  vereshchagin::FrictionModel fm;
+  fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd w3 = Eigen::VectorXd::LinSpaced(3, 0.0, 1.0), w6 = Eigen::VectorXd::LinSpaced(6, 1.0, 0.2);
+  Eigen::VectorXi segs3(3);
+  segs3 << 2, static_cast<int>(ns) - 1, 4;
+  vereshchagin::kdl_compat::ChainHdSolver_Vereshchagin compat(chain, grav, 6);
+  KDL::Jacobian alfa_zero = alfa[6];
+  alfa_zero.data.col(2).setZero();
+  alfa_zero.data.col(4).setZero();
+  std::vector<KDL::Twist> tw(ns + 1), tw_n(ns);
+  std::vector<KDL::Frame> fr(ns);
+  Eigen::VectorXd nu6(6);
+  KDL::JntArray total(n);
+  CHECK_MESSAGE((pt.setPassThrough(w3, w3.reverse()) == 0 && fpt.setPassThrough(w3, w3) == 0 &&
+                 compat.setDriverWeights(w6, w6.reverse()) == 0),
+                "pass-through weights accepted");
+  pt.solve(q[0].data, qd[0].data, alfa_m[3], beta[3].data, fext_m[0], ff[0].data);
+  fpt.solve(q[0].data, rest, alfa_m[3], beta[3].data, fext_m[0], ff[0].data, fm);
+  compat.CartToJnt(q[0], qd[0], qdd, alfa_zero, beta[6], fext[0], ff[0], tau);
+  double psum = 0.0;
+  int pfail = 0;
+  const Counts p0 = now();
+  for (int it = 0; it < 500; ++it) {
+    const int s = it % kSets;
+    if (pt.solve(q[s].data, qd[s].data, alfa_m[3], beta[3].data, fext_m[s], ff[s].data) != 0) ++pfail;
+    psum += pt.qdd()(0) + pt.nu()(1);
+    if (pt.solve(q[s].data, qd[s].data, alfa_m[3], beta[3].data, segs3, fext_m[s], ff[s].data) != 0) ++pfail;
+    psum += pt.qdd()(1);
+    if (fpt.solve(q[s].data, rest, alfa_m[3], beta[3].data, segs3, fext_m[s], ff[s].data, fm) != 0) ++pfail;
+    psum += fpt.qdd()(2);
+    if (compat.CartToJnt(q[s], qd[s], qdd, it % 2 ? alfa_zero : alfa[6], beta[6], fext[s], ff[s], tau) != 0) ++pfail;
+    compat.getTransformedLinkAcceleration(tw);
+    compat.getTotalTorque(total);
+    compat.getContraintForceMagnitude(nu6);
+    compat.getLinkCartesianPose(fr);
+    compat.getLinkCartesianVelocity(tw_n);
+    compat.getLinkAcceleration(tw_n);
+    psum += qdd(0) + tw[ns].vel.z() + total(0) + nu6(5) + fr[1].p.x() + tw_n[2].rot.x();
   }
+  const Counts p1 = now();
+  CHECK_MESSAGE(pfail == 0, "pass-through / drop-in solves failed: " << str(pfail));
+  CHECK_MESSAGE(std::isfinite(psum), "non-finite pass-through results");
+  CHECK_MESSAGE((p1.news == p0.news && p1.mallocs == p0.mallocs),
+                "pass-through / drop-in solves allocated: operator new " << str(p1.news - p0.news) << ", malloc "
+                                                                         << str(p1.mallocs - p0.mallocs));
+}
 
+TEST_CASE_FIXTURE(Fixture, "tree solves do not allocate") {
   // Trees (random branching, fixed joints): forward dynamics, constraints on two branches with
   // the last-segment and segments overloads, pass-through, response columns (all joints and a
   // shuffled subset) and friction on top.
-  {
-    testutil::RandomGen tg(77);
-    testutil::TreeSpec spec;
-    spec.n_joints = 12;
-    const KDL::Tree tree = testutil::randomTree(tg, spec);
-    vereshchagin::TreeHdSolver ts(tree, grav);
-    vereshchagin::FrictionSolver tf(tree, grav);
-    const int tn = static_cast<int>(ts.nrOfJoints()), tns = static_cast<int>(ts.nrOfSegments());
-    vereshchagin::FrictionModel fm;
-    fm.static_friction = Eigen::VectorXd::LinSpaced(tn, 0.5, 3.0);
-    const Eigen::VectorXd tq = Eigen::VectorXd::LinSpaced(tn, -1.0, 1.2),
-                          tqd = Eigen::VectorXd::LinSpaced(tn, 0.3, -0.4);
-    const Eigen::VectorXd tff = Eigen::VectorXd::LinSpaced(tn, -2.0, 2.0), trest = Eigen::VectorXd::Zero(tn);
-    const Matrix6X tfe = Matrix6X::Constant(6, tns, 0.3);
-    Eigen::VectorXi tsegs(9);  // the last segment and two others on other branches
-    for (int c = 0; c < 9; ++c) tsegs(c) = c < 3 ? tns - 1 : (c < 6 ? tns / 2 : 1);
-    Matrix6X tA(6, 9);
-    for (int c = 0; c < 9; ++c) tA.col(c) = alfa_m[6].col(c % 6);
-    const Eigen::VectorXd tb = Eigen::VectorXd::LinSpaced(9, -1.0, 1.0);
-    Eigen::VectorXi tall(tn), tsome(3);
-    for (int j = 0; j < tn; ++j) tall(j) = j;
-    tsome << tn - 1, 0, tn / 2;
-    Eigen::MatrixXd tdq(tn, tn), tdt(tn, tn), tdn(9, tn), tdq3(tn, 3), tdt3(tn, 3);
-    const Eigen::VectorXd w9 = Eigen::VectorXd::LinSpaced(9, 0.0, 1.0), w9r = w9.reverse();
-    ts.solve(tq, tqd, tA, tb, tsegs, tfe, tff);
-    ts.responseColumns(tall, tdq, tdt, tdn);
-    tf.solve(tq, trest, tA.leftCols(3), tb.head(3), tsegs.head(3), tfe, tff, fm);
-    double tsum = 0.0;
-    int tfail = 0;
-    const Counts t0 = now();
-    for (int it = 0; it < 300; ++it) {
-      const int m = 1 + it % 9;
-      if (ts.solve(tq, tqd, tA.leftCols(0), tb.head(0), tfe, tff) != 0) ++tfail;
-      tsum += ts.qdd()(0) + ts.linkAccelerations()(2, tns);
-      if (ts.solve(tq, tqd, tA.leftCols(it % 7), tb.head(it % 7), tfe, tff) != 0) ++tfail;
+  testutil::RandomGen tg(77);
+  testutil::TreeSpec spec;
+  spec.n_joints = 12;
+  const KDL::Tree tree = testutil::randomTree(tg, spec);
+  vereshchagin::TreeHdSolver ts(tree, grav);
+  vereshchagin::FrictionSolver tf(tree, grav);
+  const int tn = static_cast<int>(ts.nrOfJoints()), tns = static_cast<int>(ts.nrOfSegments());
+  vereshchagin::FrictionModel fm;
+  fm.static_friction = Eigen::VectorXd::LinSpaced(tn, 0.5, 3.0);
+  const Eigen::VectorXd tq = Eigen::VectorXd::LinSpaced(tn, -1.0, 1.2), tqd = Eigen::VectorXd::LinSpaced(tn, 0.3, -0.4);
+  const Eigen::VectorXd tff = Eigen::VectorXd::LinSpaced(tn, -2.0, 2.0), trest = Eigen::VectorXd::Zero(tn);
+  const Matrix6X tfe = Matrix6X::Constant(6, tns, 0.3);
+  Eigen::VectorXi tsegs(9);  // the last segment and two others on other branches
+  for (int c = 0; c < 9; ++c) tsegs(c) = c < 3 ? tns - 1 : (c < 6 ? tns / 2 : 1);
+  Matrix6X tA(6, 9);
+  for (int c = 0; c < 9; ++c) tA.col(c) = alfa_m[6].col(c % 6);
+  const Eigen::VectorXd tb = Eigen::VectorXd::LinSpaced(9, -1.0, 1.0);
+  Eigen::VectorXi tall(tn), tsome(3);
+  for (int j = 0; j < tn; ++j) tall(j) = j;
+  tsome << tn - 1, 0, tn / 2;
+  Eigen::MatrixXd tdq(tn, tn), tdt(tn, tn), tdn(9, tn), tdq3(tn, 3), tdt3(tn, 3);
+  const Eigen::VectorXd w9 = Eigen::VectorXd::LinSpaced(9, 0.0, 1.0), w9r = w9.reverse();
+  ts.solve(tq, tqd, tA, tb, tsegs, tfe, tff);
+  ts.responseColumns(tall, tdq, tdt, tdn);
+  tf.solve(tq, trest, tA.leftCols(3), tb.head(3), tsegs.head(3), tfe, tff, fm);
+  double tsum = 0.0;
+  int tfail = 0;
+  const Counts t0 = now();
+  for (int it = 0; it < 300; ++it) {
+    const int m = 1 + it % 9;
+    if (ts.solve(tq, tqd, tA.leftCols(0), tb.head(0), tfe, tff) != 0) ++tfail;
+    tsum += ts.qdd()(0) + ts.linkAccelerations()(2, tns);
+    if (ts.solve(tq, tqd, tA.leftCols(it % 7), tb.head(it % 7), tfe, tff) != 0) ++tfail;
+    if (ts.solve(tq, tqd, tA.leftCols(m), tb.head(m), tsegs.head(m), tfe, tff) != 0) ++tfail;
+    if (ts.responseColumns(tall, tdq, tdt, tdn) != 0) ++tfail;
+    if (ts.responseColumns(tsome, tdq3, tdt3) != 0) ++tfail;
+    tsum += ts.commandTorques()(1) + tdq(0, 0) + tdq3(1, 1) + ts.smallestSingularValue();
+    if (it % 3 == 0) {
+      if (ts.setPassThrough(w9.head(m), w9r.head(m)) != 0) ++tfail;
       if (ts.solve(tq, tqd, tA.leftCols(m), tb.head(m), tsegs.head(m), tfe, tff) != 0) ++tfail;
-      if (ts.responseColumns(tall, tdq, tdt, tdn) != 0) ++tfail;
-      if (ts.responseColumns(tsome, tdq3, tdt3) != 0) ++tfail;
-      tsum += ts.commandTorques()(1) + tdq(0, 0) + tdq3(1, 1) + ts.smallestSingularValue();
-      if (it % 3 == 0) {
-        if (ts.setPassThrough(w9.head(m), w9r.head(m)) != 0) ++tfail;
-        if (ts.solve(tq, tqd, tA.leftCols(m), tb.head(m), tsegs.head(m), tfe, tff) != 0) ++tfail;
-        ts.clearPassThrough();
-      }
-      const int mf = 1 + it % 4;
-      if (tf.solve(tq, trest, tA.leftCols(mf), tb.head(mf), tsegs.head(mf), tfe, tff, fm) != 0) ++tfail;
-      tsum += tf.qdd()(0) + tf.gaussValue();
+      ts.clearPassThrough();
     }
-    const Counts t1 = now();
-    ck.check(tfail == 0,
-             "tree solves failed: " + str(tfail) + " (" + ts.errorMessage() + " / " + tf.errorMessage() + ")");
-    ck.check(std::isfinite(tsum), "non-finite tree results");
-    ck.check(
-        t1.news == t0.news && t1.mallocs == t0.mallocs,
-        "tree solves allocated: operator new " + str(t1.news - t0.news) + ", malloc " + str(t1.mallocs - t0.mallocs));
-
-    // The (model, data, input) API on the same tree: blocks with points, frame wrenches,
-    // pass-through weights, gravity, friction (workspace reserved), kinematics and the companions.
-    const vereshchagin::Model model(tree);
-    vereshchagin::Data data(model);
-    data.reserveFriction();
-    vereshchagin::SolveInput input(model, 4, 4);
-    input.setState(vereshchagin::JointPositions(tq), vereshchagin::JointVelocities(tqd));
-    input.f_ext = tfe;
-    input.ff_torques = tff;
-    const vereshchagin::FrameRef tool{tns - 1, KDL::Frame(KDL::Vector(0.1, -0.2, 0.05))};
-    Eigen::MatrixXd jac(6, tn);
-    Eigen::VectorXd tout(tn);
-    int afail = 0;
-    double asum = 0.0;
-    const Counts a0 = now();
-    for (int it = 0; it < 300; ++it) {
-      input.clear();
-      const int m = 1 + it % 6;
-      if (!input.addConstraint(tool, tA.leftCols(m), tb.head(m)).ok()) ++afail;
-      if (!input.addConstraint(1, tA.leftCols(2), tb.head(2), vereshchagin::Vector3(0.0, 0.1, 0.0)).ok()) ++afail;
-      if (!input.addWrench(tool, vereshchagin::Vector6::Constant(0.5)).ok()) ++afail;
-      input.constraints[0].ff_pass_through(0) = it % 2 ? 0.5 : 0.0;
-      input.f_ext = tfe;
-      input.friction = it % 3 == 0 ? &fm : nullptr;
-      if (!vereshchagin::solve(model, data, input).ok()) ++afail;
-      if (!data.frameJacobian(tool, jac).ok()) ++afail;
-      if (!data.responseColumns(tsome, tdq3, tdt3).ok()) ++afail;
-      if (!data.inverseInertiaTimes(tff, tout).ok()) ++afail;
-      asum += data.qdd()(0) + data.linkAccelerations()(2, tns) + data.framePose(tool).p.x() +
-              data.frameTwist(tool).rot.z() + jac(0, 0) + tdq3(0, 0) + tout(0) + data.smallestSingularValue();
-      if (input.friction) asum += data.gaussValue();
-    }
-    const Counts a1 = now();
-    ck.check(afail == 0, "(model, data, input) solves failed: " + str(afail));
-    ck.check(std::isfinite(asum), "non-finite (model, data, input) results");
-    ck.check(a1.news == a0.news && a1.mallocs == a0.mallocs, "(model, data, input) solves allocated: operator new " +
-                                                                 str(a1.news - a0.news) + ", malloc " +
-                                                                 str(a1.mallocs - a0.mallocs));
+    const int mf = 1 + it % 4;
+    if (tf.solve(tq, trest, tA.leftCols(mf), tb.head(mf), tsegs.head(mf), tfe, tff, fm) != 0) ++tfail;
+    tsum += tf.qdd()(0) + tf.gaussValue();
   }
+  const Counts t1 = now();
+  CHECK_MESSAGE(tfail == 0,
+                "tree solves failed: " << str(tfail) << " (" << ts.errorMessage() << " / " << tf.errorMessage() << ")");
+  CHECK_MESSAGE(std::isfinite(tsum), "non-finite tree results");
+  CHECK_MESSAGE((t1.news == t0.news && t1.mallocs == t0.mallocs), "tree solves allocated: operator new "
+                                                                      << str(t1.news - t0.news) << ", malloc "
+                                                                      << str(t1.mallocs - t0.mallocs));
 
-  return ck.finish(std::string("8000 counted calls + 3000 friction-aware solves + 2000 with segment constraints on a "
-                               "7-joint chain, nc 0..6, 2700 on a 12-joint tree, 300 through solve(model, data, input) "
-                               "(malloc counted too: ") +
-                   (VERESHCHAGIN_TEST_COUNT_MALLOC ? "yes" : "no") + ")");
+  // The (model, data, input) API on the same tree: blocks with points, frame wrenches,
+  // pass-through weights, gravity, friction (workspace reserved), kinematics and the companions.
+  const vereshchagin::Model model(tree);
+  vereshchagin::Data data(model);
+  data.reserveFriction();
+  vereshchagin::SolveInput input(model, 4, 4);
+  input.setState(vereshchagin::JointPositions(tq), vereshchagin::JointVelocities(tqd));
+  input.f_ext = tfe;
+  input.ff_torques = tff;
+  const vereshchagin::FrameRef tool{tns - 1, KDL::Frame(KDL::Vector(0.1, -0.2, 0.05))};
+  Eigen::MatrixXd jac(6, tn);
+  Eigen::VectorXd tout(tn);
+  int afail = 0;
+  double asum = 0.0;
+  const Counts a0 = now();
+  for (int it = 0; it < 300; ++it) {
+    input.clear();
+    const int m = 1 + it % 6;
+    if (!input.addConstraint(tool, tA.leftCols(m), tb.head(m)).ok()) ++afail;
+    if (!input.addConstraint(1, tA.leftCols(2), tb.head(2), vereshchagin::Vector3(0.0, 0.1, 0.0)).ok()) ++afail;
+    if (!input.addWrench(tool, vereshchagin::Vector6::Constant(0.5)).ok()) ++afail;
+    input.constraints[0].ff_pass_through(0) = it % 2 ? 0.5 : 0.0;
+    input.f_ext = tfe;
+    input.friction = it % 3 == 0 ? &fm : nullptr;
+    if (!vereshchagin::solve(model, data, input).ok()) ++afail;
+    if (!data.frameJacobian(tool, jac).ok()) ++afail;
+    if (!data.responseColumns(tsome, tdq3, tdt3).ok()) ++afail;
+    if (!data.inverseInertiaTimes(tff, tout).ok()) ++afail;
+    asum += data.qdd()(0) + data.linkAccelerations()(2, tns) + data.framePose(tool).p.x() +
+            data.frameTwist(tool).rot.z() + jac(0, 0) + tdq3(0, 0) + tout(0) + data.smallestSingularValue();
+    if (input.friction) asum += data.gaussValue();
+  }
+  const Counts a1 = now();
+  CHECK_MESSAGE(afail == 0, "(model, data, input) solves failed: " << str(afail));
+  CHECK_MESSAGE(std::isfinite(asum), "non-finite (model, data, input) results");
+  CHECK_MESSAGE((a1.news == a0.news && a1.mallocs == a0.mallocs), "(model, data, input) solves allocated: operator new "
+                                                                      << str(a1.news - a0.news) << ", malloc "
+                                                                      << str(a1.mallocs - a0.mallocs));
 }

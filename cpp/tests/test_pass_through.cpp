@@ -16,6 +16,7 @@
 // and the stick/slip complementarity; bad weights are refused.
 #include <algorithm>
 
+#include <doctest/doctest.h>
 #include <Eigen/LU>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
@@ -160,7 +161,7 @@ struct Worst {
   int compared = 0, skipped = 0;
 };
 
-void oracleCase(testutil::Checker& ck, testutil::RandomGen& g, bool general, int sample, Worst& w) {
+void oracleCase(testutil::RandomGen& g, bool general, int sample, Worst& w) {
   const Problem p = randomProblem(g, general);
   const int n = static_cast<int>(p.chain.getNrOfJoints()), M = static_cast<int>(p.alfa.cols());
   const std::string tag =
@@ -177,14 +178,14 @@ void oracleCase(testutil::Checker& ck, testutil::RandomGen& g, bool general, int
   }
   vereshchagin::ChainHdSolver ours(p.chain, p.root_acc);
   int rc = ours.setPassThrough(p.p_f, p.p_t);
-  if (!ck.check(rc == 0, tag + ": setPassThrough " + str(rc) + " " + ours.errorMessage())) return;
+  if (!CHECK_MESSAGE(rc == 0, tag << ": setPassThrough " << str(rc) << " " << ours.errorMessage())) return;
   rc = solveWith(ours, p, general);
-  if (!ck.check(rc == 0, tag + ": solve " + str(rc) + " " + ours.errorMessage())) return;
+  if (!CHECK_MESSAGE(rc == 0, tag << ": solve " << str(rc) << " " << ours.errorMessage())) return;
   const Dense ref = denseFormula(p, Eigen::VectorXd::Zero(n));
   const double e_qdd = relErr(ours.qdd(), ref.qdd), e_nu = relErr(ours.nu(), ref.nu);
-  ck.check(ref.sum_err <= 1e-10, tag + ": oracle drivers do not add up, rel err " + str(ref.sum_err));
-  ck.check(e_qdd <= 1e-9, tag + ": qdd vs dense formula rel err " + str(e_qdd));
-  ck.check(e_nu <= 1e-9, tag + ": nu vs dense formula rel err " + str(e_nu));
+  CHECK_MESSAGE(ref.sum_err <= 1e-10, tag << ": oracle drivers do not add up, rel err " << str(ref.sum_err));
+  CHECK_MESSAGE(e_qdd <= 1e-9, tag << ": qdd vs dense formula rel err " << str(e_qdd));
+  CHECK_MESSAGE(e_nu <= 1e-9, tag << ": nu vs dense formula rel err " << str(e_nu));
   // The command torques realise qdd (KDL forward dynamics with ff + tau_cmd).
   Eigen::VectorXd qdd_fd;
   Matrix6X acc;
@@ -192,13 +193,13 @@ void oracleCase(testutil::Checker& ck, testutil::RandomGen& g, bool general, int
   ff_cmd.data = p.ff.data + ours.commandTorques();
   kdlFree(p, p.qd, p.fext, ff_cmd, p.root_acc, qdd_fd, acc);
   const double e_fd = relErr(qdd_fd, ours.qdd());
-  ck.check(e_fd <= 1e-9, tag + ": KDL FD with command torques rel err " + str(e_fd));
+  CHECK_MESSAGE(e_fd <= 1e-9, tag << ": KDL FD with command torques rel err " << str(e_fd));
   // What passes through: alfa_c^T Xdd = beta_c + p_f a_fext + p_t a_ff.
   Eigen::VectorXd achieved(M);
   for (int c = 0; c < M; ++c) achieved(c) = p.alfa.col(c).dot(ours.linkAccelerations().col(p.segs(c) + 1));
   const Eigen::VectorXd expect = p.beta + p.p_f.cwiseProduct(ref.a_fext) + p.p_t.cwiseProduct(ref.a_ff);
   const double e_acc = relErr(achieved, expect);
-  ck.check(e_acc <= 1e-9, tag + ": alfa^T Xdd vs beta + passed drivers rel err " + str(e_acc));
+  CHECK_MESSAGE(e_acc <= 1e-9, tag << ": alfa^T Xdd vs beta + passed drivers rel err " << str(e_acc));
   w.qdd = std::max(w.qdd, e_qdd), w.nu = std::max(w.nu, e_nu), w.tau_fd = std::max(w.tau_fd, e_fd);
   w.acc = std::max(w.acc, e_acc), w.sum = std::max(w.sum, ref.sum_err);
   ++w.compared;
@@ -206,16 +207,18 @@ void oracleCase(testutil::Checker& ck, testutil::RandomGen& g, bool general, int
   // All-zero weights: bit for bit the solve without weights.
   vereshchagin::ChainHdSolver plain(p.chain, p.root_acc), zeroed(p.chain, p.root_acc);
   const Eigen::VectorXd z = Eigen::VectorXd::Zero(M);
-  ck.check(zeroed.setPassThrough(z, z) == 0 && zeroed.passThroughColumns() == M, tag + ": zero weights accepted");
-  ck.check(solveWith(plain, p, general) == 0 && solveWith(zeroed, p, general) == 0, tag + ": zero-weight solves");
-  ck.check(plain.qdd() == zeroed.qdd() && Eigen::VectorXd(plain.nu()) == Eigen::VectorXd(zeroed.nu()) &&
-               plain.commandTorques() == zeroed.commandTorques(),
-           tag + ": zero weights not bit-identical to no weights");
+  CHECK_MESSAGE((zeroed.setPassThrough(z, z) == 0 && zeroed.passThroughColumns() == M),
+                tag << ": zero weights accepted");
+  CHECK_MESSAGE((solveWith(plain, p, general) == 0 && solveWith(zeroed, p, general) == 0),
+                tag << ": zero-weight solves");
+  CHECK_MESSAGE((plain.qdd() == zeroed.qdd() && Eigen::VectorXd(plain.nu()) == Eigen::VectorXd(zeroed.nu()) &&
+                 plain.commandTorques() == zeroed.commandTorques()),
+                tag << ": zero weights not bit-identical to no weights");
 }
 
 // Static friction with pass-through: the friction torques returned are compensated torques in the
 // dense formula, and stick / slip complementarity holds.
-void frictionCase(testutil::Checker& ck, testutil::RandomGen& g, int sample, double& worst) {
+void frictionCase(testutil::RandomGen& g, int sample, double& worst) {
   Problem p = randomProblem(g, g.coin(0.5));
   const int n = static_cast<int>(p.chain.getNrOfJoints()), M = static_cast<int>(p.alfa.cols());
   const std::string tag = "friction sample " + str(sample) + " (n=" + str(n) + ", M=" + str(M) + ")";
@@ -231,13 +234,13 @@ void frictionCase(testutil::Checker& ck, testutil::RandomGen& g, int sample, dou
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (K + K.transpose()), Eigen::EigenvaluesOnly);
   if (!testutil::wellConditioned(es.eigenvalues())) return;
   vereshchagin::FrictionSolver fs(p.chain, p.root_acc);
-  ck.check(fs.setPassThrough(p.p_f, p.p_t) == 0, tag + ": setPassThrough");
+  CHECK_MESSAGE(fs.setPassThrough(p.p_f, p.p_t) == 0, tag << ": setPassThrough");
   const Matrix6X fe = testutil::toMatrix(p.fext);
   const int rc = fs.solve(p.q.data, p.qd.data, p.alfa, p.beta, p.segs, fe, p.ff.data, fm);
-  if (!ck.check(rc == 0, tag + ": solve " + str(rc) + " " + fs.errorMessage())) return;
+  if (!CHECK_MESSAGE(rc == 0, tag << ": solve " << str(rc) << " " << fs.errorMessage())) return;
   const Dense ref = denseFormula(p, fs.frictionTorques() + fs.limitTorques());
   const double e = std::max(relErr(fs.qdd(), ref.qdd), relErr(fs.nu(), ref.nu));
-  ck.check(e <= 1e-8, tag + ": qdd / nu vs dense formula with the friction torques, rel err " + str(e));
+  CHECK_MESSAGE(e <= 1e-8, tag << ": qdd / nu vs dense formula with the friction torques, rel err " << str(e));
   worst = std::max(worst, e);
   const double scale = std::max(1.0, fs.qdd().cwiseAbs().maxCoeff());
   for (int j = 0; j < n; ++j) {
@@ -245,12 +248,35 @@ void frictionCase(testutil::Checker& ck, testutil::RandomGen& g, int sample, dou
     const double f = fs.frictionTorques()(j), a = fs.qdd()(j), fj = fm.static_friction(j);
     const bool stick = std::abs(a) <= 1e-8 * scale && std::abs(f) <= fj * (1 + 1e-12);
     const bool slip = std::abs(std::abs(f) - fj) <= 1e-10 * std::max(1.0, fj) && f * a <= 0.0;
-    ck.check(stick || slip, tag + ": joint " + str(j) + " neither sticks nor slips (friction " + str(f) + ", qdd " +
-                                str(a) + ", f " + str(fj) + ")");
+    CHECK_MESSAGE((stick || slip), tag << ": joint " << str(j) << " neither sticks nor slips (friction " << str(f)
+                                       << ", qdd " << str(a) << ", f " << str(fj) << ")");
   }
 }
 
-void badWeights(testutil::Checker& ck) {
+}  // namespace
+
+TEST_CASE("300 random tasks on the last segment or any segments against the dense pass-through formula") {
+  Worst w;
+  for (int s = 0; s < 300; ++s) {
+    testutil::RandomGen g(1000003ULL * static_cast<unsigned long long>(s) + 17ULL);
+    oracleCase(g, s % 2 == 1, s, w);
+  }
+  CHECK_MESSAGE(w.compared >= 200, "too few well-conditioned samples: " << str(w.compared));
+  MESSAGE(str(w.compared) << " compared, " << str(w.skipped) << " ill-conditioned skipped; worst rel err qdd "
+                          << str(w.qdd) << ", nu " << str(w.nu) << ", FD " << str(w.tau_fd) << ", alfa^T Xdd "
+                          << str(w.acc) << ", driver sum " << str(w.sum));
+}
+
+TEST_CASE("150 random tasks with static friction and pass-through: dense formula and complementarity") {
+  double worst_friction = 0.0;
+  for (int s = 0; s < 150; ++s) {
+    testutil::RandomGen g(7777ULL * static_cast<unsigned long long>(s) + 3ULL);
+    frictionCase(g, s, worst_friction);
+  }
+  MESSAGE("worst rel err with friction " << str(worst_friction));
+}
+
+TEST_CASE("bad pass-through weights are refused and leave none set") {
   testutil::RandomGen g(11);
   const KDL::Chain chain = g.chain(4);
   vereshchagin::ChainHdSolver s(chain, KDL::Twist::Zero());
@@ -258,41 +284,20 @@ void badWeights(testutil::Checker& ck) {
   const Eigen::VectorXd good = Eigen::VectorXd::Constant(2, 0.5);
   Eigen::VectorXd bad = good;
   bad(1) = 1.5;
-  ck.check(s.setPassThrough(bad, good) == Solver::E_OUT_OF_RANGE, "weight 1.5 refused");
+  CHECK_MESSAGE(s.setPassThrough(bad, good) == Solver::E_OUT_OF_RANGE, "weight 1.5 refused");
   bad(1) = NAN;
-  ck.check(s.setPassThrough(good, bad) == Solver::E_OUT_OF_RANGE, "NaN weight refused");
-  ck.check(s.setPassThrough(good, Eigen::VectorXd::Zero(3)) == Solver::E_SIZE_MISMATCH,
-           "weights of different sizes refused");
-  ck.check(s.passThroughColumns() == -1, "refused weights leave none set");
-  ck.check(s.setPassThrough(good, Eigen::VectorXd()) == 0 && s.passThroughColumns() == 2, "p_f alone accepted");
+  CHECK_MESSAGE(s.setPassThrough(good, bad) == Solver::E_OUT_OF_RANGE, "NaN weight refused");
+  CHECK_MESSAGE(s.setPassThrough(good, Eigen::VectorXd::Zero(3)) == Solver::E_SIZE_MISMATCH,
+                "weights of different sizes refused");
+  CHECK_MESSAGE(s.passThroughColumns() == -1, "refused weights leave none set");
+  CHECK_MESSAGE((s.setPassThrough(good, Eigen::VectorXd()) == 0 && s.passThroughColumns() == 2), "p_f alone accepted");
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(4);
   const Matrix6X alfa = g.alfa(3).data;
   const int rc = s.solve(q, q, alfa, Eigen::VectorXd::Zero(3), Matrix6X(6, 0), q);
-  ck.check(rc == Solver::E_SIZE_MISMATCH && std::string(s.errorMessage()).find("pass-through") != std::string::npos,
-           "weights for 2 columns, alfa with 3: E_SIZE_MISMATCH naming the pass-through (" +
-               std::string(s.errorMessage()) + ")");
+  CHECK_MESSAGE(
+      (rc == Solver::E_SIZE_MISMATCH && std::string(s.errorMessage()).find("pass-through") != std::string::npos),
+      "weights for 2 columns, alfa with 3: E_SIZE_MISMATCH naming the pass-through (" << std::string(s.errorMessage())
+                                                                                      << ")");
   s.clearPassThrough();
-  ck.check(s.solve(q, q, alfa, Eigen::VectorXd::Zero(3), Matrix6X(6, 0), q) == 0, "cleared weights: solve works");
-}
-
-}  // namespace
-
-int main() {
-  testutil::Checker ck("test_pass_through");
-  Worst w;
-  double worst_friction = 0.0;
-  for (int s = 0; s < 300; ++s) {
-    testutil::RandomGen g(1000003ULL * static_cast<unsigned long long>(s) + 17ULL);
-    oracleCase(ck, g, s % 2 == 1, s, w);
-  }
-  for (int s = 0; s < 150; ++s) {
-    testutil::RandomGen g(7777ULL * static_cast<unsigned long long>(s) + 3ULL);
-    frictionCase(ck, g, s, worst_friction);
-  }
-  badWeights(ck);
-  ck.check(w.compared >= 200, "too few well-conditioned samples: " + str(w.compared));
-  return ck.finish("(" + str(w.compared) + " compared, " + str(w.skipped) +
-                   " ill-conditioned skipped; worst rel err qdd " + str(w.qdd) + ", nu " + str(w.nu) + ", FD " +
-                   str(w.tau_fd) + ", alfa^T Xdd " + str(w.acc) + ", driver sum " + str(w.sum) + ", friction " +
-                   str(worst_friction) + ")");
+  CHECK_MESSAGE(s.solve(q, q, alfa, Eigen::VectorXd::Zero(3), Matrix6X(6, 0), q) == 0, "cleared weights: solve works");
 }

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <doctest/doctest.h>
 #include <Eigen/LU>
 #include <kdl/chaindynparam.hpp>
 #include <kdl/chainfksolvervel_recursive.hpp>
@@ -119,10 +120,10 @@ Matrix6X accelerationsByDifferences(const std::vector<PathChain>& paths, const E
   return acc;
 }
 
-void maxConstraintChecks(testutil::Checker& ck, HdSolver& s, testutil::RandomGen& g, const std::string& tag) {
+void maxConstraintChecks(HdSolver& s, testutil::RandomGen& g, const std::string& tag) {
   const unsigned int n = s.nrOfJoints(), ns = s.nrOfSegments();
   const int expected = std::min(static_cast<int>(6 * ns), vereshchagin::SolverOptions::kDefaultConstraintCapacity);
-  ck.check(s.maxConstraints() == expected, tag + ": maxConstraints " + str(s.maxConstraints()));
+  CHECK_MESSAGE(s.maxConstraints() == expected, tag << ": maxConstraints " << str(s.maxConstraints()));
   const int m = s.maxConstraints();
   Matrix6X alfa = g.alfa(m + 1).data;
   Eigen::VectorXd beta = g.beta(m + 1).data;
@@ -130,17 +131,17 @@ void maxConstraintChecks(testutil::Checker& ck, HdSolver& s, testutil::RandomGen
   for (int c = 0; c <= m; ++c) seg(c) = c % static_cast<int>(ns);
   const Eigen::VectorXd q = g.q(n).data, qd = g.qdot(n).data;
   int rc = s.solve(q, qd, alfa.leftCols(m), beta.head(m), seg.head(m), Matrix6X(6, 0), Eigen::VectorXd());
-  ck.check(rc == 0 && s.constraintCount() == m,
-           tag + ": " + str(m) + " columns: rc " + str(rc) + " " + s.errorMessage());
+  CHECK_MESSAGE((rc == 0 && s.constraintCount() == m),
+                tag << ": " << str(m) << " columns: rc " << str(rc) << " " << s.errorMessage());
   rc = s.solve(q, qd, alfa, beta, seg, Matrix6X(6, 0), Eigen::VectorXd());
-  ck.check(rc == HdSolver::E_TOO_MANY_CONSTRAINTS, tag + ": " + str(m + 1) + " columns: rc " + str(rc));
+  CHECK_MESSAGE(rc == HdSolver::E_TOO_MANY_CONSTRAINTS, tag << ": " << str(m + 1) << " columns: rc " << str(rc));
 }
 
 // SolverOptions::max_constraints: the capacity it sets (capped at 6 per segment), a solve within
 // it equal to the default solver's bit for bit, one column more refused naming the option,
 // negative values refused; and a 2,000-segment chain (12,000 columns by the old rule: its
 // coupling workspace alone was 4 x 12,000^2 doubles, 4.6 GB) builds and solves.
-void capacityChecks(testutil::Checker& ck) {
+TEST_CASE("SolverOptions::max_constraints sets the capacity and a 2000-segment chain solves") {
   testutil::RandomGen g(37);
   testutil::ChainSpec spec;
   spec.n_joints = 9;
@@ -149,8 +150,8 @@ void capacityChecks(testutil::Checker& ck) {
   vereshchagin::SolverOptions small;
   small.max_constraints = 8;
   vereshchagin::ChainHdSolver capped(chain, kGrav, small), full(chain, kGrav);
-  ck.check(capped.maxConstraints() == 8 && full.maxConstraints() == static_cast<int>(6 * ns),
-           "capacity: maxConstraints " + str(capped.maxConstraints()) + " / " + str(full.maxConstraints()));
+  CHECK_MESSAGE((capped.maxConstraints() == 8 && full.maxConstraints() == static_cast<int>(6 * ns)),
+                "capacity: maxConstraints " << str(capped.maxConstraints()) << " / " << str(full.maxConstraints()));
   const Eigen::VectorXd q = g.q(n).data, qd = g.qdot(n).data;
   const Matrix6X alfa = g.alfa(9).data;
   const Eigen::VectorXd beta = g.beta(9).data;
@@ -158,18 +159,18 @@ void capacityChecks(testutil::Checker& ck) {
   for (int c = 0; c < 9; ++c) seg(c) = (c * 5) % static_cast<int>(ns);
   int rc = capped.solve(q, qd, alfa.leftCols(8), beta.head(8), seg.head(8), Matrix6X(6, 0), Eigen::VectorXd());
   const int rc_full = full.solve(q, qd, alfa.leftCols(8), beta.head(8), seg.head(8), Matrix6X(6, 0), Eigen::VectorXd());
-  ck.check(rc == 0 && rc_full == 0 && capped.qdd() == full.qdd() && capped.nu() == full.nu(),
-           "capacity: 8 columns within the capacity equal the default solver's");
+  CHECK_MESSAGE((rc == 0 && rc_full == 0 && capped.qdd() == full.qdd() && capped.nu() == full.nu()),
+                "capacity: 8 columns within the capacity equal the default solver's");
   rc = capped.solve(q, qd, alfa, beta, seg, Matrix6X(6, 0), Eigen::VectorXd());
-  ck.check(rc == HdSolver::E_TOO_MANY_CONSTRAINTS &&
-               std::string(capped.errorMessage()).find("max_constraints") != std::string::npos,
-           "capacity: 9 columns refused naming max_constraints: " + std::string(capped.errorMessage()));
+  CHECK_MESSAGE((rc == HdSolver::E_TOO_MANY_CONSTRAINTS &&
+                 std::string(capped.errorMessage()).find("max_constraints") != std::string::npos),
+                "capacity: 9 columns refused naming max_constraints: " << std::string(capped.errorMessage()));
   vereshchagin::SolverOptions bad;
   bad.max_constraints = -1;
-  ck.check(full.setOptions(bad) == HdSolver::E_INVALID_OPTIONS, "capacity: max_constraints = -1 refused");
+  CHECK_MESSAGE(full.setOptions(bad) == HdSolver::E_INVALID_OPTIONS, "capacity: max_constraints = -1 refused");
   small.max_constraints = 1000;  // beyond 6 per segment: capped there
-  ck.check(full.setOptions(small) == 0 && full.maxConstraints() == static_cast<int>(6 * ns),
-           "capacity: 1000 capped at 6 per segment");
+  CHECK_MESSAGE((full.setOptions(small) == 0 && full.maxConstraints() == static_cast<int>(6 * ns)),
+                "capacity: 1000 capped at 6 per segment");
   KDL::Chain long_chain;
   for (int i = 0; i < 2000; ++i)
     long_chain.addSegment(KDL::Segment(
@@ -178,14 +179,15 @@ void capacityChecks(testutil::Checker& ck) {
   vereshchagin::ChainHdSolver big(long_chain, kGrav);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(2000);
   rc = big.solve(zero, zero, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), Eigen::VectorXd());
-  ck.check(big.modelError() == 0 && rc == 0 &&
-               big.maxConstraints() == vereshchagin::SolverOptions::kDefaultConstraintCapacity && big.qdd().allFinite(),
-           "capacity: a 2,000-segment chain builds and solves: rc " + str(rc) + " " + big.errorMessage());
+  CHECK_MESSAGE(
+      (big.modelError() == 0 && rc == 0 &&
+       big.maxConstraints() == vereshchagin::SolverOptions::kDefaultConstraintCapacity && big.qdd().allFinite()),
+      "capacity: a 2,000-segment chain builds and solves: rc " << str(rc) << " " << big.errorMessage());
 }
 
 // D_j against the Schur complement of H on the joints j moves (sub: their indices, j first).
-void articulatedChecks(testutil::Checker& ck, const HdSolver& s, const Eigen::MatrixXd& H,
-                       const std::vector<std::vector<int>>& moved, const std::string& tag) {
+void articulatedChecks(const HdSolver& s, const Eigen::MatrixXd& H, const std::vector<std::vector<int>>& moved,
+                       const std::string& tag) {
   double worst = 0.0;
   for (std::size_t j = 0; j < moved.size(); ++j) {
     const std::vector<int>& sub = moved[j];
@@ -196,10 +198,10 @@ void articulatedChecks(testutil::Checker& ck, const HdSolver& s, const Eigen::Ma
     const double got = s.articulatedInertia(static_cast<unsigned int>(j));
     worst = std::max(worst, std::abs(got - expected) / std::abs(expected));
   }
-  ck.check(worst <= 1e-9, tag + ": articulatedInertia vs Schur complement of H rel err " + str(worst));
+  CHECK_MESSAGE(worst <= 1e-9, tag << ": articulatedInertia vs Schur complement of H rel err " << str(worst));
 }
 
-void chainChecks(testutil::Checker& ck) {
+TEST_CASE("chain: maxConstraints, setJointAccelerations and articulatedInertia") {
   testutil::RandomGen g(31);
   testutil::ChainSpec spec;
   spec.n_joints = 7;
@@ -208,37 +210,37 @@ void chainChecks(testutil::Checker& ck) {
   const KDL::Chain chain = g.chain(spec);
   const unsigned int n = chain.getNrOfJoints(), ns = chain.getNrOfSegments();
   vereshchagin::ChainHdSolver s(chain, kGrav);
-  maxConstraintChecks(ck, s, g, "chain");
+  maxConstraintChecks(s, g, "chain");
   vereshchagin::ChainHdSolver fresh(chain, kGrav);
   const Eigen::VectorXd q = g.q(n).data, qd = g.qdot(n).data, qdd = g.torques(n).data;
   int rc = fresh.setJointAccelerations(qdd);
-  ck.check(rc == HdSolver::E_NO_SOLUTION, "chain: setJointAccelerations before a solve: rc " + str(rc));
+  CHECK_MESSAGE(rc == HdSolver::E_NO_SOLUTION, "chain: setJointAccelerations before a solve: rc " << str(rc));
   rc = fresh.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), Eigen::VectorXd());
-  ck.check(rc == 0, "chain: solve");
+  CHECK_MESSAGE(rc == 0, "chain: solve");
   rc = fresh.setJointAccelerations(qdd.head(n - 1));
-  ck.check(rc == HdSolver::E_SIZE_MISMATCH, "chain: setJointAccelerations wrong size: rc " + str(rc));
-  ck.check(fresh.setJointAccelerations(qdd) == 0, "chain: setJointAccelerations");
+  CHECK_MESSAGE(rc == HdSolver::E_SIZE_MISMATCH, "chain: setJointAccelerations wrong size: rc " << str(rc));
+  CHECK_MESSAGE(fresh.setJointAccelerations(qdd) == 0, "chain: setJointAccelerations");
   std::vector<PathChain> paths;
   for (unsigned int i = 1; i <= ns; ++i) paths.push_back(chainPrefix(chain, i));
   const Matrix6X expected = accelerationsByDifferences(paths, q, qd, qdd, testutil::toVector(kGrav));
   const double e = relErrCols(fresh.linkAccelerations().rightCols(ns), expected);
-  ck.check(e <= 1e-7, "chain: setJointAccelerations link accelerations vs KDL differences rel err " + str(e));
-  ck.check(fresh.linkAccelerations().col(0) == testutil::toVector(kGrav), "chain: column 0 is root_acc");
+  CHECK_MESSAGE(e <= 1e-7, "chain: setJointAccelerations link accelerations vs KDL differences rel err " << str(e));
+  CHECK_MESSAGE(fresh.linkAccelerations().col(0) == testutil::toVector(kGrav), "chain: column 0 is root_acc");
   // A failed solve withdraws the state.
   rc = fresh.solve(q.head(1), qd, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), Eigen::VectorXd());
-  ck.check(rc != 0 && fresh.setJointAccelerations(qdd) == HdSolver::E_NO_SOLUTION,
-           "chain: setJointAccelerations after a failed solve");
+  CHECK_MESSAGE((rc != 0 && fresh.setJointAccelerations(qdd) == HdSolver::E_NO_SOLUTION),
+                "chain: setJointAccelerations after a failed solve");
 
   KDL::ChainDynParam dyn(chain, KDL::Vector::Zero());
   KDL::JntArray jq(n);
   jq.data = q;
   KDL::JntSpaceInertiaMatrix H(n);
   dyn.JntToMass(jq, H);
-  ck.check(fresh.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), Eigen::VectorXd()) == 0, "solve");
+  CHECK_MESSAGE(fresh.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), Eigen::VectorXd()) == 0, "solve");
   std::vector<std::vector<int>> moved(n);
   for (unsigned int j = 0; j < n; ++j)
     for (unsigned int k = j; k < n; ++k) moved[j].push_back(static_cast<int>(k));
-  articulatedChecks(ck, fresh, H.data, moved, "chain");
+  articulatedChecks(fresh, H.data, moved, "chain");
 }
 
 Eigen::Matrix3d relative(const KDL::Frame& parent, const KDL::Frame& child, Eigen::Vector3d& p) {
@@ -247,8 +249,8 @@ Eigen::Matrix3d relative(const KDL::Frame& parent, const KDL::Frame& child, Eige
   return mat3(X.M);
 }
 
-void treeGetterChecks(testutil::Checker& ck, const KDL::Tree& tree, vereshchagin::TreeHdSolver& s,
-                      const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+void treeGetterChecks(const KDL::Tree& tree, vereshchagin::TreeHdSolver& s, const Eigen::VectorXd& q,
+                      const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
   const unsigned int ns = s.nrOfSegments(), n = s.nrOfJoints();
   KDL::TreeFkSolverPos_recursive fk(tree);
   KDL::JntArray jq(n);
@@ -274,31 +276,31 @@ void treeGetterChecks(testutil::Checker& ck, const KDL::Tree& tree, vereshchagin
     acc_err = std::max(acc_err, relErr(twist6(s.linkLocalAcceleration(i)), a_exp));
     base_err = std::max(base_err, relErr(s.linkAccelerations().col(i + 1), acc.col(i)));
   }
-  ck.check(pose_err <= 1e-12, "tree: linkLocalPose vs KDL TreeFkSolverPos_recursive err " + str(pose_err));
-  ck.check(vel_err <= 1e-12, "tree: linkLocalVelocity vs KDL ChainFkSolverVel_recursive rel err " + str(vel_err));
-  ck.check(acc_err <= 1e-7, "tree: linkLocalAcceleration vs KDL velocity differences rel err " + str(acc_err));
-  ck.check(base_err <= 1e-7, "tree: linkAccelerations vs KDL velocity differences rel err " + str(base_err));
+  CHECK_MESSAGE(pose_err <= 1e-12, "tree: linkLocalPose vs KDL TreeFkSolverPos_recursive err " << str(pose_err));
+  CHECK_MESSAGE(vel_err <= 1e-12, "tree: linkLocalVelocity vs KDL ChainFkSolverVel_recursive rel err " << str(vel_err));
+  CHECK_MESSAGE(acc_err <= 1e-7, "tree: linkLocalAcceleration vs KDL velocity differences rel err " << str(acc_err));
+  CHECK_MESSAGE(base_err <= 1e-7, "tree: linkAccelerations vs KDL velocity differences rel err " << str(base_err));
 }
 
-void treeChecks(testutil::Checker& ck) {
+TEST_CASE("tree: maxConstraints, link getters, setJointAccelerations and articulatedInertia") {
   testutil::RandomGen g(47);
   testutil::TreeSpec spec;
   spec.n_joints = 9;
   spec.rotor_inertia = false;  // KDL's TreeIdSolver_RNE has no rotors
   const KDL::Tree tree = testutil::randomTree(g, spec);
   vereshchagin::TreeHdSolver s(tree, kGrav);
-  ck.check(s.modelError() == 0, "tree: model " + std::string(s.errorMessage()));
+  CHECK_MESSAGE(s.modelError() == 0, "tree: model " << std::string(s.errorMessage()));
   const unsigned int n = s.nrOfJoints(), ns = s.nrOfSegments();
-  maxConstraintChecks(ck, s, g, "tree");
+  maxConstraintChecks(s, g, "tree");
   const Eigen::VectorXd q = g.q(n).data, qd = g.qdot(n).data, ff = g.torques(n).data;
   // The solve's own accelerations, then those of arbitrary qdd by setJointAccelerations().
   int rc = s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), ff);
-  ck.check(rc == 0, "tree: solve " + std::string(s.errorMessage()));
-  treeGetterChecks(ck, tree, s, q, qd, s.qdd());
+  CHECK_MESSAGE(rc == 0, "tree: solve " << std::string(s.errorMessage()));
+  treeGetterChecks(tree, s, q, qd, s.qdd());
   const Eigen::VectorXd qdd = g.torques(n).data;
-  ck.check(s.setJointAccelerations(qdd.head(n - 1)) == HdSolver::E_SIZE_MISMATCH, "tree: wrong size accepted");
-  ck.check(s.setJointAccelerations(qdd) == 0, "tree: setJointAccelerations");
-  treeGetterChecks(ck, tree, s, q, qd, qdd);
+  CHECK_MESSAGE(s.setJointAccelerations(qdd.head(n - 1)) == HdSolver::E_SIZE_MISMATCH, "tree: wrong size accepted");
+  CHECK_MESSAGE(s.setJointAccelerations(qdd) == 0, "tree: setJointAccelerations");
+  treeGetterChecks(tree, s, q, qd, qdd);
 
   // H by columns of KDL's tree RNE (no gravity, no velocity): H e_k. TreeIdSolver_RNE keeps a
   // reference to its tree and uses its q_nr: a copy's are depth-first, the solver's joint order.
@@ -313,7 +315,7 @@ void treeChecks(testutil::Checker& ck) {
     rne.CartToJnt(jq, zero, unit, KDL::WrenchMap(), tau);
     H.col(k) = tau.data;
   }
-  ck.check(s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), ff) == 0, "tree: solve again");
+  CHECK_MESSAGE(s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(), Matrix6X(6, 0), ff) == 0, "tree: solve again");
   std::vector<int> joint_of(ns, -1);
   for (unsigned int i = 0, j = 0; i < ns; ++i) {
     const std::string& jn = tree.getSegment(s.segmentNames()[i])->second.segment.getJoint().getName();
@@ -332,15 +334,7 @@ void treeChecks(testutil::Checker& ck) {
     for (unsigned int k = i; k < end; ++k)
       if (joint_of[k] >= 0) moved[joint_of[i]].push_back(joint_of[k]);
   }
-  articulatedChecks(ck, s, H, moved, "tree");
+  articulatedChecks(s, H, moved, "tree");
 }
 
 }  // namespace
-
-int main() {
-  testutil::Checker ck("test_public_contracts");
-  chainChecks(ck);
-  treeChecks(ck);
-  capacityChecks(ck);
-  return ck.finish("");
-}

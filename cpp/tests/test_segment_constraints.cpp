@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include <doctest/doctest.h>
 #include <Eigen/LU>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
@@ -56,10 +57,9 @@ Eigen::MatrixXd segmentJacobian(const KDL::Chain& chain, const KDL::JntArray& q,
 
 }  // namespace
 
-int main() {
-  testutil::Checker ck("test_segment_constraints");
+TEST_CASE("600 random tasks on any segments against KDL's pieces: KKT, FD, column order, response columns") {
   int compared = 0, skipped = 0;
-  double worst_qdd = 0.0, worst_nu = 0.0, worst_tau = 0.0, worst_fd = 0.0, worst_path = 0.0, worst_cols = 0.0;
+  double worst_qdd = 0.0, worst_nu = 0.0, worst_tau = 0.0, worst_fd = 0.0, worst_cols = 0.0;
   for (int s = 0; s < 600; ++s) {
     const unsigned long long seed = 7919ULL * static_cast<unsigned long long>(s) + 5ULL;
     testutil::RandomGen g(seed);
@@ -103,9 +103,9 @@ int main() {
 
     vereshchagin::ChainHdSolver ours(chain, root_acc);
     int rc = ours.solve(q.data, qd.data, alfa, beta, segs, fe, ff.data);
-    if (!ck.check(rc == 0, tag + ": solve returned " + str(rc) + " " + ours.errorMessage())) continue;
+    if (!CHECK_MESSAGE(rc == 0, tag << ": solve returned " << str(rc) << " " << ours.errorMessage())) continue;
     const Eigen::VectorXd qdd = ours.qdd(), nu = ours.nu(), tau = ours.commandTorques();
-    ck.check(qdd.allFinite() && nu.allFinite() && tau.allFinite() && nu.size() == M, tag + ": outputs");
+    CHECK_MESSAGE((qdd.allFinite() && nu.allFinite() && tau.allFinite() && nu.size() == M), tag << ": outputs");
 
     // Dense KKT oracle.
     const testutil::DenseModel d = testutil::denseModel(chain, q);
@@ -122,8 +122,8 @@ int main() {
     const Eigen::MatrixXd HinvAt = Hlu.solve(A.transpose());
     const Eigen::MatrixXd K = A * HinvAt;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (K + K.transpose()), Eigen::EigenvaluesOnly);
-    ck.check(ours.constraintRank() == M || !testutil::wellConditioned(es.eigenvalues(), 1e-9),
-             tag + ": rank " + str(ours.constraintRank()) + " of a well-posed task");
+    CHECK_MESSAGE((ours.constraintRank() == M || !testutil::wellConditioned(es.eigenvalues(), 1e-9)),
+                  tag << ": rank " << str(ours.constraintRank()) << " of a well-posed task");
     if (!testutil::wellConditioned(es.eigenvalues())) {
       ++skipped;
       continue;
@@ -131,9 +131,9 @@ int main() {
     const Eigen::VectorXd lambda = K.ldlt().solve(rhs);
     const Eigen::VectorXd qdd_ref = fr.qdd + HinvAt * lambda;
     const double e_qdd = relErr(qdd, qdd_ref), e_nu = relErr(nu, -lambda), e_tau = relErr(tau, A.transpose() * lambda);
-    ck.check(e_qdd <= 1e-9, tag + ": qdd vs KKT rel err " + str(e_qdd));
-    ck.check(e_nu <= 1e-9, tag + ": nu vs KKT rel err " + str(e_nu));
-    ck.check(e_tau <= 1e-9, tag + ": tau_cmd vs KKT rel err " + str(e_tau));
+    CHECK_MESSAGE(e_qdd <= 1e-9, tag << ": qdd vs KKT rel err " << str(e_qdd));
+    CHECK_MESSAGE(e_nu <= 1e-9, tag << ": nu vs KKT rel err " << str(e_nu));
+    CHECK_MESSAGE(e_tau <= 1e-9, tag << ": tau_cmd vs KKT rel err " << str(e_tau));
     worst_qdd = std::max(worst_qdd, e_qdd);
     worst_nu = std::max(worst_nu, e_nu);
     worst_tau = std::max(worst_tau, e_tau);
@@ -143,7 +143,7 @@ int main() {
     KDL::JntArray ff_cmd(n);
     ff_cmd.data = ff.data + tau;
     const double e_fd = relErr(kdlFree(chain, root_acc, q, qd, fext, ff_cmd).qdd, qdd);
-    ck.check(e_fd <= 1e-9, tag + ": KDL FD with command torques rel err " + str(e_fd));
+    CHECK_MESSAGE(e_fd <= 1e-9, tag << ": KDL FD with command torques rel err " << str(e_fd));
     worst_fd = std::max(worst_fd, e_fd);
 
     // Response columns equal exact differences (the solution is affine in ff).
@@ -151,10 +151,10 @@ int main() {
     for (int j = 0; j < n; ++j) joints(j) = j;
     Eigen::MatrixXd dq(n, n), dt(n, n), dn(M, n);
     rc = ours.responseColumns(joints, dq, dt, dn);
-    ck.check(rc == 0, tag + ": responseColumns " + str(rc));
+    CHECK_MESSAGE(rc == 0, tag << ": responseColumns " << str(rc));
     Eigen::VectorXd tau_of(n);
-    ck.check(ours.commandTorquesOf(nu, tau_of) == 0 && tau_of == tau,
-             tag + ": commandTorquesOf(nu()) != commandTorques()");
+    CHECK_MESSAGE((ours.commandTorquesOf(nu, tau_of) == 0 && tau_of == tau),
+                  tag << ": commandTorquesOf(nu()) != commandTorques()");
     vereshchagin::ChainHdSolver other(chain, root_acc);
     for (int j = 0; j < n; j += 3) {
       Eigen::VectorXd ff2 = ff.data;
@@ -167,7 +167,7 @@ int main() {
       };
       const double e = std::max({err(dq.col(j), other.qdd(), qdd), err(dt.col(j), other.commandTorques(), tau),
                                  err(dn.col(j), other.nu(), nu)});
-      ck.check(e <= 1e-9, tag + ": response column " + str(j) + " rel err " + str(e));
+      CHECK_MESSAGE(e <= 1e-9, tag << ": response column " << str(j) << " rel err " << str(e));
       worst_cols = std::max(worst_cols, e);
     }
 
@@ -181,10 +181,16 @@ int main() {
       segs_rev(c) = segs(M - 1 - c);
     }
     other.solve(q.data, qd.data, alfa_rev, beta_rev, segs_rev, fe, ff.data);
-    ck.check(relErr(other.qdd(), qdd) <= 1e-10 && relErr(other.nu().reverse(), nu) <= 1e-10,
-             tag + ": column order changes the solution");
+    CHECK_MESSAGE((relErr(other.qdd(), qdd) <= 1e-10 && relErr(other.nu().reverse(), nu) <= 1e-10),
+                  tag << ": column order changes the solution");
   }
+  MESSAGE("compared " << str(compared) << " (skipped ill-conditioned " << str(skipped) << "); worst rel err qdd "
+                      << str(worst_qdd) << ", nu " << str(worst_nu) << ", tau_cmd " << str(worst_tau) << ", KDL FD "
+                      << str(worst_fd) << ", response columns " << str(worst_cols));
+}
 
+TEST_CASE("the general path equals the end-segment path with a zero column on another segment") {
+  double worst_path = 0.0;
   // The general path equals the end-segment path: last-segment constraints plus a zero column on
   // another segment (which forces the general path and is truncated away).
   for (int s = 0; s < 200; ++s) {
@@ -208,19 +214,22 @@ int main() {
     segs(m) = g.integer(0, ns - 2);
     const std::string tag = "path sample " + str(s);
     const int rc = gen.solve(q.data, qd.data, alfa2, beta2, segs, fe, ff.data);
-    if (!ck.check(rc == 0, tag + ": general solve " + str(rc))) continue;
+    if (!CHECK_MESSAGE(rc == 0, tag << ": general solve " << str(rc))) continue;
     const double e = std::max({relErr(gen.qdd(), end.qdd()), relErr(gen.commandTorques(), end.commandTorques()),
                                relErr(gen.nu().head(m), end.nu()), std::abs(gen.nu()(m))});
-    ck.check(gen.constraintRank() == end.constraintRank(),
-             tag + ": rank " + str(gen.constraintRank()) + " vs " + str(end.constraintRank()));
+    CHECK_MESSAGE(gen.constraintRank() == end.constraintRank(),
+                  tag << ": rank " << str(gen.constraintRank()) << " vs " << str(end.constraintRank()));
     if (end.constraintRank() == m) {
-      ck.check(e <= 1e-10, tag + ": general vs end-segment path rel err " + str(e));
+      CHECK_MESSAGE(e <= 1e-10, tag << ": general vs end-segment path rel err " << str(e));
       worst_path = std::max(worst_path, e);
     }
-    ck.check(relErr(gen.linkAccelerations(), end.linkAccelerations()) <= 1e-9 || end.constraintRank() < m,
-             tag + ": link accelerations differ");
+    CHECK_MESSAGE((relErr(gen.linkAccelerations(), end.linkAccelerations()) <= 1e-9 || end.constraintRank() < m),
+                  tag << ": link accelerations differ");
   }
+  MESSAGE("worst rel err general vs end path " << str(worst_path));
+}
 
+TEST_CASE("conflicting constraints give finite outputs and the rank, and bad segment lists are refused") {
   // Conflicting constraints: the same wrench twice on one segment with different set-points, and
   // more columns than joints: finite outputs, reported rank.
   {
@@ -242,31 +251,26 @@ int main() {
       if (policy == 1) opt.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
       vereshchagin::ChainHdSolver solver(chain, root_acc, opt);
       const int rc = solver.solve(q.data, qd.data, alfa, beta, segs, Matrix6X(6, 0), Eigen::VectorXd(0));
-      ck.check(rc == 0, "conflicting constraints: rc " + str(rc));
-      ck.check(solver.qdd().allFinite() && solver.nu().allFinite() && solver.commandTorques().allFinite(),
-               "conflicting constraints: non-finite output");
+      CHECK_MESSAGE(rc == 0, "conflicting constraints: rc " << str(rc));
+      CHECK_MESSAGE((solver.qdd().allFinite() && solver.nu().allFinite() && solver.commandTorques().allFinite()),
+                    "conflicting constraints: non-finite output");
       if (policy == 0)
-        ck.check(solver.constraintRank() == 5,
-                 "conflicting constraints: rank " + str(solver.constraintRank()) + ", expected 5 (5 joints)");
+        CHECK_MESSAGE(solver.constraintRank() == 5,
+                      "conflicting constraints: rank " << str(solver.constraintRank()) << ", expected 5 (5 joints)");
     }
     // Errors: segment out of range, more than 6 columns on one segment, size mismatch.
     vereshchagin::ChainHdSolver solver(chain, root_acc);
     Eigen::VectorXi bad = segs;
     bad(0) = 7;
-    ck.check(solver.solve(q.data, qd.data, alfa, beta, bad, Matrix6X(6, 0), Eigen::VectorXd(0)) ==
-                 vereshchagin::ChainHdSolver::E_OUT_OF_RANGE,
-             "segment index out of range not reported");
+    CHECK_MESSAGE(solver.solve(q.data, qd.data, alfa, beta, bad, Matrix6X(6, 0), Eigen::VectorXd(0)) ==
+                      vereshchagin::ChainHdSolver::E_OUT_OF_RANGE,
+                  "segment index out of range not reported");
     Eigen::VectorXi seven = Eigen::VectorXi::Constant(9, 1);
-    ck.check(solver.solve(q.data, qd.data, alfa, beta, seven, Matrix6X(6, 0), Eigen::VectorXd(0)) ==
-                 vereshchagin::ChainHdSolver::E_TOO_MANY_CONSTRAINTS,
-             "7 columns on one segment not reported");
-    ck.check(solver.solve(q.data, qd.data, alfa, beta, segs.head(8), Matrix6X(6, 0), Eigen::VectorXd(0)) ==
-                 vereshchagin::ChainHdSolver::E_SIZE_MISMATCH,
-             "segments/alfa size mismatch not reported");
+    CHECK_MESSAGE(solver.solve(q.data, qd.data, alfa, beta, seven, Matrix6X(6, 0), Eigen::VectorXd(0)) ==
+                      vereshchagin::ChainHdSolver::E_TOO_MANY_CONSTRAINTS,
+                  "7 columns on one segment not reported");
+    CHECK_MESSAGE(solver.solve(q.data, qd.data, alfa, beta, segs.head(8), Matrix6X(6, 0), Eigen::VectorXd(0)) ==
+                      vereshchagin::ChainHdSolver::E_SIZE_MISMATCH,
+                  "segments/alfa size mismatch not reported");
   }
-
-  return ck.finish("compared " + str(compared) + " (skipped ill-conditioned " + str(skipped) + "); worst rel err qdd " +
-                   str(worst_qdd) + ", nu " + str(worst_nu) + ", tau_cmd " + str(worst_tau) + ", KDL FD " +
-                   str(worst_fd) + ", response columns " + str(worst_cols) + ", general vs end path " +
-                   str(worst_path));
 }

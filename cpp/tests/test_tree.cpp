@@ -10,6 +10,7 @@
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
 #include <kdl/treejnttojacsolver.hpp>
 
+#include <doctest/doctest.h>
 #include <Eigen/Dense>
 
 #include "random_tree.hpp"
@@ -197,7 +198,7 @@ struct TreeCase {
   int nj, ns;
 };
 
-void testForwardDynamics(testutil::Checker& ck) {
+TEST_CASE("forward dynamics (no constraint) replayed through TreeIdSolver_RNE") {
   double worst = 0.0;
   for (int seed = 0; seed < 60; ++seed) {
     TreeCase c(500 + seed, 40);
@@ -205,17 +206,18 @@ void testForwardDynamics(testutil::Checker& ck) {
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, ff = g.torques(nj).data;
     const Matrix6X f_ext = testutil::toMatrix(g.fext(ns));
     const int rc = s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), f_ext, ff);
-    if (!ck.check(rc == 0, "seed " + str(seed) + ": solve failed: " + s.errorMessage())) continue;
+    if (!CHECK_MESSAGE(rc == 0, "seed " << str(seed) << ": solve failed: " << s.errorMessage())) continue;
     const double e = relErr(o.rne(q, qd, s.qdd(), f_ext, true), ff);
     worst = std::max(worst, e);
-    ck.check(e < kTol, "seed " + str(seed) + ": m = 0 qdd replayed through TreeIdSolver_RNE misses ff by " + str(e));
+    CHECK_MESSAGE(e < kTol,
+                  "seed " << str(seed) << ": m = 0 qdd replayed through TreeIdSolver_RNE misses ff by " << str(e));
   }
-  std::printf("  m = 0 forward dynamics vs TreeIdSolver_RNE: worst %.2e\n", worst);
+  MESSAGE(testutil::format("m = 0 forward dynamics vs TreeIdSolver_RNE: worst %.2e", worst));
 }
 
 // inverseInertiaTimes after a solve (with and without constraints) against H from RNE columns:
 // H out = tau; and its error codes.
-void testInverseInertia(testutil::Checker& ck) {
+TEST_CASE("inverseInertiaTimes against H from TreeIdSolver_RNE") {
   double worst = 0.0;
   for (int seed = 0; seed < 30; ++seed) {
     TreeCase c(900 + seed, 30);
@@ -223,30 +225,30 @@ void testInverseInertia(testutil::Checker& ck) {
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, tau = g.torques(nj).data;
     Eigen::VectorXd out(nj);
     if (seed == 0) {
-      ck.check(s.inverseInertiaTimes(tau, out) == vereshchagin::HdSolver::E_NO_SOLUTION,
-               "inverseInertiaTimes before a solve");
-      ck.check(std::string(s.errorMessage()).find("needs a successful solve") != std::string::npos,
-               std::string("its message: ") + s.errorMessage());
+      CHECK_MESSAGE(s.inverseInertiaTimes(tau, out) == vereshchagin::HdSolver::E_NO_SOLUTION,
+                    "inverseInertiaTimes before a solve");
+      CHECK_MESSAGE(std::string(s.errorMessage()).find("needs a successful solve") != std::string::npos,
+                    std::string("its message: ") << s.errorMessage());
     }
     const Task t = randomTask(g, s, tree, seed % 4);
     const Matrix6X none(6, 0);
     const int rc = seed % 2 ? s.solve(q, qd, t.alfa, t.beta, t.segments, none, Eigen::VectorXd(0))
                             : s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), none, Eigen::VectorXd(0));
-    if (!ck.check(rc == 0, "seed " + str(seed) + ": solve failed: " + s.errorMessage())) continue;
-    if (!ck.check(s.inverseInertiaTimes(tau, out) == 0, "inverseInertiaTimes failed")) continue;
+    if (!CHECK_MESSAGE(rc == 0, "seed " << str(seed) << ": solve failed: " << s.errorMessage())) continue;
+    if (!CHECK_MESSAGE(s.inverseInertiaTimes(tau, out) == 0, "inverseInertiaTimes failed")) continue;
     const double e = relErr(o.massMatrix(q) * out, tau);
     worst = std::max(worst, e);
-    ck.check(e < kTol, "seed " + str(seed) + ": H (H^-1 tau) misses tau by " + str(e));
+    CHECK_MESSAGE(e < kTol, "seed " << str(seed) << ": H (H^-1 tau) misses tau by " << str(e));
     Eigen::VectorXd short_out(std::max(nj - 1, 0));
-    ck.check(s.inverseInertiaTimes(tau, short_out) == vereshchagin::HdSolver::E_SIZE_MISMATCH,
-             "wrong out size is refused");
+    CHECK_MESSAGE(s.inverseInertiaTimes(tau, short_out) == vereshchagin::HdSolver::E_SIZE_MISMATCH,
+                  "wrong out size is refused");
   }
-  std::printf("  inverseInertiaTimes vs H from TreeIdSolver_RNE: worst %.2e\n", worst);
+  MESSAGE(testutil::format("inverseInertiaTimes vs H from TreeIdSolver_RNE: worst %.2e", worst));
 }
 
 // Constrained solves at q_dot = 0 against the KKT solution; command torques replayed through
 // RNE and beta checked from the link accelerations (q_dot = 0 and q_dot != 0).
-void testConstraints(testutil::Checker& ck) {
+TEST_CASE("constraints on several branches against the KKT system") {
   double worst_kkt = 0.0, worst_tau = 0.0, worst_beta = 0.0, worst_sigma = 0.0;
   int tested = 0;
   for (int seed = 0; seed < 120; ++seed) {
@@ -262,41 +264,42 @@ void testConstraints(testutil::Checker& ck) {
     ++tested;
     const std::string tag = "seed " + str(seed) + " (m = " + str(t.segments.size()) + ")";
     int rc = s.solve(q, zero, t.alfa, t.beta, t.segments, f_ext, ff);
-    if (!ck.check(rc == 0, tag + ": solve failed: " + s.errorMessage())) continue;
+    if (!CHECK_MESSAGE(rc == 0, tag << ": solve failed: " << s.errorMessage())) continue;
     const Eigen::VectorXd C = o.rne(q, zero, zero, f_ext, true);
     const Eigen::VectorXd qdd_kkt = kkt(o.massMatrix(q), ff - C, A, b);
     const double e_kkt = relErr(s.qdd(), qdd_kkt);
-    ck.check(e_kkt < kTol, tag + ": qdd differs from the KKT solution by " + str(e_kkt));
+    CHECK_MESSAGE(e_kkt < kTol, tag << ": qdd differs from the KKT solution by " << str(e_kkt));
     worst_kkt = std::max(worst_kkt, e_kkt);
     // K = A H^-1 A^T: its smallest eigenvalue against Eigen's dense eigen-solver.
     const Eigen::MatrixXd K = A * o.massMatrix(q).ldlt().solve(A.transpose());
     const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K, Eigen::EigenvaluesOnly).eigenvalues();
     const double e_sigma = std::abs(s.smallestSingularValue() - ev(0)) / ev(ev.size() - 1);
-    ck.check(e_sigma < kTol, tag + ": smallestSingularValue " + str(s.smallestSingularValue()) + " vs " + str(ev(0)));
+    CHECK_MESSAGE(e_sigma < kTol,
+                  tag << ": smallestSingularValue " << str(s.smallestSingularValue()) << " vs " << str(ev(0)));
     worst_sigma = std::max(worst_sigma, e_sigma);
     for (int pass = 0; pass < 2; ++pass) {  // q_dot = 0, then q_dot != 0
       const Eigen::VectorXd qd = pass ? g.qdot(nj).data : zero;
       rc = s.solve(q, qd, t.alfa, t.beta, t.segments, f_ext, ff);
-      if (!ck.check(rc == 0, tag + ": solve failed: " + s.errorMessage())) continue;
+      if (!CHECK_MESSAGE(rc == 0, tag << ": solve failed: " << s.errorMessage())) continue;
       const double e_tau = relErr(o.rne(q, qd, s.qdd(), f_ext, true), ff + s.commandTorques());
-      ck.check(e_tau < kTol, tag + ": command torques replayed through RNE miss by " + str(e_tau));
+      CHECK_MESSAGE(e_tau < kTol, tag << ": command torques replayed through RNE miss by " << str(e_tau));
       Eigen::VectorXd achieved(t.segments.size());
       for (int c = 0; c < t.segments.size(); ++c)
         achieved(c) = t.alfa.col(c).dot(s.linkAccelerations().col(t.segments(c) + 1));
       const double e_beta = relErr(achieved, t.beta);
-      ck.check(e_beta < kTol, tag + ": beta not met, by " + str(e_beta));
+      CHECK_MESSAGE(e_beta < kTol, tag << ": beta not met, by " << str(e_beta));
       worst_tau = std::max(worst_tau, e_tau);
       worst_beta = std::max(worst_beta, e_beta);
     }
   }
-  ck.check(tested >= 50, "only " + str(tested) + " constraint layouts of full rank");
-  std::printf("  constraints on branches (%d layouts): KKT %.2e, tau replay %.2e, beta %.2e, sigma_min %.2e\n", tested,
-              worst_kkt, worst_tau, worst_beta, worst_sigma);
+  CHECK_MESSAGE(tested >= 50, "only " << str(tested) << " constraint layouts of full rank");
+  MESSAGE(testutil::format("constraints on branches (%d layouts): KKT %.2e, tau replay %.2e, beta %.2e, sigma_min %.2e",
+                           tested, worst_kkt, worst_tau, worst_beta, worst_sigma));
 }
 
 // Link accelerations against d/dt of the segment twists J(q) q_dot: the spatial acceleration
 // (base axes, tip origin) is [d/dt v - w x v; d/dt w] plus the base's.
-void testLinkAccelerations(testutil::Checker& ck) {
+TEST_CASE("link accelerations against finite differences of J(q) q_dot") {
   double worst = 0.0;
   for (int seed = 0; seed < 30; ++seed) {
     TreeCase c(7000 + seed, 25);
@@ -318,14 +321,15 @@ void testLinkAccelerations(testutil::Checker& ck) {
       expect.head(3) -= Eigen::Vector3d(V.tail(3)).cross(Eigen::Vector3d(V.head(3)));
       const double e = relErr(s.linkAccelerations().col(i + 1), expect);
       worst = std::max(worst, e);
-      ck.check(e < 1e-6, "seed " + str(seed) + " segment " + str(i) + ": link acceleration vs d/dt twist " + str(e));
+      CHECK_MESSAGE(e < 1e-6,
+                    "seed " << str(seed) << " segment " << str(i) << ": link acceleration vs d/dt twist " << str(e));
     }
   }
-  std::printf("  link accelerations vs finite differences of J(q) q_dot: worst %.2e\n", worst);
+  MESSAGE(testutil::format("link accelerations vs finite differences of J(q) q_dot: worst %.2e", worst));
 }
 
 // Response columns against central differences in ff (exact: qdd, tau_cmd and nu are affine).
-void testResponseColumns(testutil::Checker& ck) {
+TEST_CASE("response columns against differences in ff_torques") {
   double worst = 0.0;
   for (int seed = 0; seed < 40; ++seed) {
     TreeCase c(9000 + seed, 30);
@@ -339,7 +343,8 @@ void testResponseColumns(testutil::Checker& ck) {
     Eigen::MatrixXd dqdd(nj, nj), dtau(nj, nj), dnu(m, nj);
     int rc = s.solve(q, qd, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff);
     if (rc == 0) rc = s.responseColumns(joints, dqdd, dtau, dnu);
-    if (!ck.check(rc == 0, "seed " + str(seed) + ": response columns rc " + str(rc) + " " + s.errorMessage())) continue;
+    if (!CHECK_MESSAGE(rc == 0, "seed " << str(seed) << ": response columns rc " << str(rc) << " " << s.errorMessage()))
+      continue;
     Eigen::MatrixXd fq(nj, nj), ft(nj, nj), fn(m, nj);
     for (int c = 0; c < nj; ++c) {
       const Eigen::VectorXd e = Eigen::VectorXd::Unit(nj, joints(c));
@@ -352,22 +357,22 @@ void testResponseColumns(testutil::Checker& ck) {
     }
     const double e = std::max({relErr(dqdd, fq), relErr(dtau, ft), m ? relErr(dnu, fn) : 0.0});
     worst = std::max(worst, e);
-    ck.check(e < kTol, "seed " + str(seed) + ": response columns vs differences " + str(e));
+    CHECK_MESSAGE(e < kTol, "seed " << str(seed) << ": response columns vs differences " << str(e));
     // More columns than joints (processed in chunks of n_joints): every joint twice.
     Eigen::VectorXi twice(2 * nj);
     twice << joints, joints;
     Eigen::MatrixXd dq2(nj, 2 * nj), dt2(nj, 2 * nj);
     s.solve(q, qd, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff);
     rc = s.responseColumns(twice, dq2, dt2);
-    ck.check(rc == 0 && relErr(dq2.leftCols(nj), dqdd) < kTol && relErr(dq2.rightCols(nj), dqdd) < kTol &&
-                 relErr(dt2.rightCols(nj), dtau) < kTol,
-             "seed " + str(seed) + ": response columns in two chunks differ");
+    CHECK_MESSAGE((rc == 0 && relErr(dq2.leftCols(nj), dqdd) < kTol && relErr(dq2.rightCols(nj), dqdd) < kTol &&
+                   relErr(dt2.rightCols(nj), dtau) < kTol),
+                  "seed " << str(seed) << ": response columns in two chunks differ");
   }
-  std::printf("  response columns vs differences in ff: worst %.2e\n", worst);
+  MESSAGE(testutil::format("response columns vs differences in ff: worst %.2e", worst));
 }
 
 // A chain given as a KDL::Tree gives ChainHdSolver's outputs (both solve() overloads, friction).
-void testChainAsTree(testutil::Checker& ck) {
+TEST_CASE("a chain given as a tree equals ChainHdSolver") {
   double worst = 0.0;
   for (int seed = 0; seed < 40; ++seed) {
     testutil::RandomGen g(300 + seed);
@@ -398,15 +403,17 @@ void testChainAsTree(testutil::Checker& ck) {
     for (int overload = 0; overload < 2; ++overload) {
       const int rc1 = overload ? cs.solve(q, qd, alfa, beta, segs, f_ext, ff) : cs.solve(q, qd, alfa, beta, f_ext, ff);
       const int rc2 = overload ? ts.solve(q, qd, alfa, beta, segs, f_ext, ff) : ts.solve(q, qd, alfa, beta, f_ext, ff);
-      if (!ck.check(rc1 == 0 && rc2 == 0, "seed " + str(seed) + ": " + cs.errorMessage() + ts.errorMessage())) continue;
+      if (!CHECK_MESSAGE((rc1 == 0 && rc2 == 0),
+                         "seed " << str(seed) << ": " << cs.errorMessage() << ts.errorMessage()))
+        continue;
       cs.responseColumns(joints, dq1, dt1);
       ts.responseColumns(joints, dq2, dt2);
       const double e =
           std::max({relErr(ts.qdd(), cs.qdd()), relErr(ts.commandTorques(), cs.commandTorques()),
                     m ? relErr(ts.nu(), cs.nu()) : 0.0, relErr(ts.linkAccelerations(), cs.linkAccelerations()),
                     relErr(dq2, dq1), relErr(dt2, dt1)});
-      ck.check(ts.constraintRank() == cs.constraintRank(), "seed " + str(seed) + ": ranks differ");
-      ck.check(e < kTol, "seed " + str(seed) + ": chain as tree differs from the chain by " + str(e));
+      CHECK_MESSAGE(ts.constraintRank() == cs.constraintRank(), "seed " << str(seed) << ": ranks differ");
+      CHECK_MESSAGE(e < kTol, "seed " << str(seed) << ": chain as tree differs from the chain by " << str(e));
       worst = std::max(worst, e);
     }
     vereshchagin::FrictionSolver fc(chain, kGravityUp), ft(tree, kGravityUp);
@@ -416,19 +423,20 @@ void testChainAsTree(testutil::Checker& ck) {
     const int mf = std::min(m, nj);
     const int rc1 = fc.solve(q, rest, alfa.leftCols(mf), beta.head(mf), f_ext, ff, fm);
     const int rc2 = ft.solve(q, rest, alfa.leftCols(mf), beta.head(mf), f_ext, ff, fm);
-    if (!ck.check(rc1 == 0 && rc2 == 0, "seed " + str(seed) + ": friction " + fc.errorMessage() + ft.errorMessage()))
+    if (!CHECK_MESSAGE((rc1 == 0 && rc2 == 0),
+                       "seed " << str(seed) << ": friction " << fc.errorMessage() << ft.errorMessage()))
       continue;
     const double e = std::max(relErr(ft.qdd(), fc.qdd()), relErr(ft.frictionTorques(), fc.frictionTorques()));
-    ck.check(e < kTol, "seed " + str(seed) + ": friction on the chain as tree differs by " + str(e));
+    CHECK_MESSAGE(e < kTol, "seed " << str(seed) << ": friction on the chain as tree differs by " << str(e));
     worst = std::max(worst, e);
   }
-  std::printf("  chain as tree vs ChainHdSolver: worst %.2e\n", worst);
+  MESSAGE(testutil::format("chain as tree vs ChainHdSolver: worst %.2e", worst));
 }
 
 // Static friction on trees: stick joints do not move and hold at most f; slipping joints get
 // -f sign(qdd); the sticking set solved as a constrained problem (KKT with qdd_stick = 0 and the
 // slipping joints' friction as torques) gives the same qdd; the solution replays through RNE.
-void testFriction(testutil::Checker& ck) {
+TEST_CASE("friction on trees against stick/slip enumeration") {
   double worst = 0.0;
   int sticks = 0, slips = 0;
   for (int seed = 0; seed < 60; ++seed) {
@@ -449,8 +457,8 @@ void testFriction(testutil::Checker& ck) {
     vereshchagin::FrictionModel fm;
     fm.static_friction = Eigen::VectorXd::Constant(nj, g.uniform(0.2, 6.0));
     const std::string tag = "seed " + str(seed);
-    if (!ck.check(fs.solve(q, zero, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff, fm) == 0,
-                  tag + ": " + fs.errorMessage()))
+    if (!CHECK_MESSAGE(fs.solve(q, zero, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff, fm) == 0,
+                       tag << ": " << fs.errorMessage()))
       continue;
     const Eigen::VectorXd qdd = fs.qdd(), fr = fs.frictionTorques();
     const double qscale = std::max(1.0, qdd.cwiseAbs().maxCoeff());
@@ -461,12 +469,12 @@ void testFriction(testutil::Checker& ck) {
       if (fs.status()[j] == vereshchagin::FrictionSolver::Stick) {
         stick.push_back(j);
         ++sticks;
-        ck.check(std::abs(qdd(j)) < kTol * qscale, tag + ": a sticking joint moves, qdd " + str(qdd(j)));
-        ck.check(std::abs(fr(j)) <= f * (1 + kTol), tag + ": stick friction beyond f");
+        CHECK_MESSAGE(std::abs(qdd(j)) < kTol * qscale, tag << ": a sticking joint moves, qdd " << str(qdd(j)));
+        CHECK_MESSAGE(std::abs(fr(j)) <= f * (1 + kTol), tag << ": stick friction beyond f");
       } else {
         ++slips;
-        ck.check(std::abs(fr(j) + f * (qdd(j) > 0 ? 1.0 : -1.0)) < kTol * f,
-                 tag + ": slip friction is not -f sgn(qdd)");
+        CHECK_MESSAGE(std::abs(fr(j) + f * (qdd(j) > 0 ? 1.0 : -1.0)) < kTol * f,
+                      tag << ": slip friction is not -f sgn(qdd)");
         tau(j) += fr(j);
       }
     }
@@ -482,17 +490,18 @@ void testFriction(testutil::Checker& ck) {
     const Eigen::VectorXd C = o.rne(q, zero, zero, Matrix6X(6, 0), true);
     const double e_kkt = relErr(qdd, kkt(o.massMatrix(q), tau - C, Aall, ball));
     const double e_rne = relErr(o.rne(q, zero, qdd, Matrix6X(6, 0), true), ff + fs.commandTorques() + fr);
-    ck.check(e_kkt < kTol, tag + ": stick/slip enumeration differs by " + str(e_kkt));
-    ck.check(e_rne < kTol, tag + ": friction solution replayed through RNE misses by " + str(e_rne));
+    CHECK_MESSAGE(e_kkt < kTol, tag << ": stick/slip enumeration differs by " << str(e_kkt));
+    CHECK_MESSAGE(e_rne < kTol, tag << ": friction solution replayed through RNE misses by " << str(e_rne));
     worst = std::max({worst, e_kkt, e_rne});
   }
-  ck.check(sticks > 20 && slips > 20, "too few stick (" + str(sticks) + ") or slip (" + str(slips) + ") joints");
-  std::printf("  friction on trees (%d stick, %d slip joints): worst %.2e\n", sticks, slips, worst);
+  CHECK_MESSAGE((sticks > 20 && slips > 20),
+                "too few stick (" << str(sticks) << ") or slip (" << str(slips) << ") joints");
+  MESSAGE(testutil::format("friction on trees (%d stick, %d slip joints): worst %.2e", sticks, slips, worst));
 }
 
 // Pass-through on trees: with f_ext weights 1, alfa_c^T Xdd = beta_c + a_fext,c, where a_fext is
 // what f_ext alone gives the unconstrained tree at rest without gravity.
-void testPassThrough(testutil::Checker& ck) {
+TEST_CASE("pass-through set-points on trees") {
   double worst = 0.0;
   for (int seed = 0; seed < 30; ++seed) {
     testutil::RandomGen g(13000 + seed);
@@ -510,18 +519,18 @@ void testPassThrough(testutil::Checker& ck) {
     Eigen::VectorXd a_fext(m), achieved(m);
     for (int c = 0; c < m; ++c) a_fext(c) = t.alfa.col(c).dot(alone.linkAccelerations().col(t.segments(c) + 1));
     s.setPassThrough(Eigen::VectorXd::Ones(m), Eigen::VectorXd(0));
-    if (!ck.check(s.solve(q, qd, t.alfa, t.beta, t.segments, f_ext, ff) == 0, s.errorMessage())) continue;
+    if (!CHECK_MESSAGE(s.solve(q, qd, t.alfa, t.beta, t.segments, f_ext, ff) == 0, s.errorMessage())) continue;
     if (s.constraintRank() < m) continue;  // a redundant layout cannot meet every set-point
     for (int c = 0; c < m; ++c) achieved(c) = t.alfa.col(c).dot(s.linkAccelerations().col(t.segments(c) + 1));
     const double e = relErr(achieved, t.beta + a_fext);
     worst = std::max(worst, e);
-    ck.check(e < kTol, "seed " + str(seed) + ": pass-through set-points missed by " + str(e));
+    CHECK_MESSAGE(e < kTol, "seed " << str(seed) << ": pass-through set-points missed by " << str(e));
   }
-  std::printf("  pass-through on trees: worst %.2e\n", worst);
+  MESSAGE(testutil::format("pass-through on trees: worst %.2e", worst));
 }
 
 // Names, order and error paths.
-void testModelAndErrors(testutil::Checker& ck) {
+TEST_CASE("segment order, names, sub-trees and errors") {
   testutil::RandomGen g(42);
   testutil::TreeSpec spec;
   spec.n_joints = 12;
@@ -529,75 +538,64 @@ void testModelAndErrors(testutil::Checker& ck) {
   TreeHdSolver s(tree, kGravityUp);
   const KDL::Tree copy(tree);
   const int ns = static_cast<int>(s.nrOfSegments());
-  ck.check(s.modelError() == 0 && s.nrOfJoints() == tree.getNrOfJoints() && ns == (int)tree.getNrOfSegments(),
-           "tree sizes");
+  CHECK_MESSAGE((s.modelError() == 0 && s.nrOfJoints() == tree.getNrOfJoints() && ns == (int)tree.getNrOfSegments()),
+                "tree sizes");
   for (int i = 0; i < ns; ++i) {
-    ck.check(s.parent()[i] < i, "parent after child in the segment order");
-    ck.check(s.segmentIndex(s.segmentNames()[i]) == i, "segmentIndex");
+    CHECK_MESSAGE(s.parent()[i] < i, "parent after child in the segment order");
+    CHECK_MESSAGE(s.segmentIndex(s.segmentNames()[i]) == i, "segmentIndex");
     const auto& el = tree.getSegment(s.segmentNames()[i])->second;
     const std::string pname = el.parent->first;
-    ck.check(s.parent()[i] == s.segmentIndex(pname), "parent index does not name the KDL parent");
+    CHECK_MESSAGE(s.parent()[i] == s.segmentIndex(pname), "parent index does not name the KDL parent");
     const auto& el_copy = copy.getSegment(s.segmentNames()[i])->second;
     if (el.segment.getJoint().getType() != KDL::Joint::Fixed)
-      ck.check(s.jointNames()[el_copy.q_nr] == el.segment.getJoint().getName(), "joint order is not q_nr of a copy");
+      CHECK_MESSAGE(s.jointNames()[el_copy.q_nr] == el.segment.getJoint().getName(),
+                    "joint order is not q_nr of a copy");
   }
-  ck.check(s.segmentIndex("no such segment") == -1, "segmentIndex of an unknown name");
+  CHECK_MESSAGE(s.segmentIndex("no such segment") == -1, "segmentIndex of an unknown name");
   const int nj = static_cast<int>(s.nrOfJoints());
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(nj);
   Eigen::VectorXi segs(1);
   segs << ns;
   Matrix6X alfa = g.alfa(7).data;
   int rc = s.solve(q, q, alfa.leftCols(1), Eigen::VectorXd::Zero(1), segs, Matrix6X(6, 0), Eigen::VectorXd(0));
-  ck.check(rc == KDL::SolverI::E_OUT_OF_RANGE && std::string(s.errorMessage()).find("segments(0)") != std::string::npos,
-           "segment index out of range: " + str(rc) + " " + s.errorMessage());
+  CHECK_MESSAGE(
+      (rc == KDL::SolverI::E_OUT_OF_RANGE && std::string(s.errorMessage()).find("segments(0)") != std::string::npos),
+      "segment index out of range: " << str(rc) << " " << s.errorMessage());
   Eigen::VectorXi seven = Eigen::VectorXi::Constant(7, ns - 1);
   rc = s.solve(q, q, alfa, Eigen::VectorXd::Zero(7), seven, Matrix6X(6, 0), Eigen::VectorXd(0));
-  ck.check(rc == TreeHdSolver::E_TOO_MANY_CONSTRAINTS, "7 columns on one segment: " + str(rc));
+  CHECK_MESSAGE(rc == TreeHdSolver::E_TOO_MANY_CONSTRAINTS, "7 columns on one segment: " << str(rc));
   rc = s.solve(q, q, Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X::Zero(6, ns + 1), Eigen::VectorXd(0));
-  ck.check(rc == KDL::SolverI::E_SIZE_MISMATCH, "f_ext with a column too many: " + str(rc));
+  CHECK_MESSAGE(rc == KDL::SolverI::E_SIZE_MISMATCH, "f_ext with a column too many: " << str(rc));
 
   TreeHdSolver unknown(tree, kGravityUp, vereshchagin::SolverOptions(), "nowhere");
   rc = unknown.solve(Eigen::VectorXd(0), Eigen::VectorXd(0), Matrix6X(6, 0), Eigen::VectorXd(0), Matrix6X(6, 0),
                      Eigen::VectorXd(0));
-  ck.check(unknown.modelError() == TreeHdSolver::E_INVALID_MODEL && rc == TreeHdSolver::E_INVALID_MODEL &&
-               std::string(unknown.errorMessage()).find("nowhere") != std::string::npos,
-           std::string("unknown root: ") + unknown.errorMessage());
+  CHECK_MESSAGE((unknown.modelError() == TreeHdSolver::E_INVALID_MODEL && rc == TreeHdSolver::E_INVALID_MODEL &&
+                 std::string(unknown.errorMessage()).find("nowhere") != std::string::npos),
+                std::string("unknown root: ") << unknown.errorMessage());
   TreeHdSolver empty(KDL::Tree("root"), kGravityUp);
-  ck.check(empty.modelError() == TreeHdSolver::E_INVALID_MODEL &&
-               std::string(empty.errorMessage()).find("no segments") != std::string::npos,
-           std::string("empty tree: ") + empty.errorMessage());
+  CHECK_MESSAGE((empty.modelError() == TreeHdSolver::E_INVALID_MODEL &&
+                 std::string(empty.errorMessage()).find("no segments") != std::string::npos),
+                std::string("empty tree: ") << empty.errorMessage());
   KDL::Tree bad = tree;
   bad.addSegment(KDL::Segment("heavy", KDL::Joint("jb", KDL::Joint::RotZ), KDL::Frame(),
                               KDL::RigidBodyInertia(-1.0, KDL::Vector::Zero(), KDL::RotationalInertia(1, 1, 1))),
                  "root");
   TreeHdSolver negative(bad, kGravityUp);
-  ck.check(negative.modelError() == TreeHdSolver::E_INVALID_MODEL &&
-               std::string(negative.errorMessage()).find("heavy") != std::string::npos,
-           std::string("negative mass: ") + negative.errorMessage());
+  CHECK_MESSAGE((negative.modelError() == TreeHdSolver::E_INVALID_MODEL &&
+                 std::string(negative.errorMessage()).find("heavy") != std::string::npos),
+                std::string("negative mass: ") << negative.errorMessage());
 
   // A sub-tree root: the segments below it only, in the same order, its joints renumbered from 0.
   const std::string sub = s.segmentNames()[0];
   TreeHdSolver part(tree, kGravityUp, vereshchagin::SolverOptions(), sub);
   int end = 1;  // segment 0's subtree is [0, end) in s
   while (end < ns && s.parent()[end] >= 0) ++end;
-  ck.check(part.modelError() == 0 && part.rootName() == sub, std::string("sub-tree root: ") + part.errorMessage());
-  ck.check(static_cast<int>(part.nrOfSegments()) == end - 1, "sub-tree segment count");
+  CHECK_MESSAGE((part.modelError() == 0 && part.rootName() == sub), std::string("sub-tree root: ")
+                                                                        << part.errorMessage());
+  CHECK_MESSAGE(static_cast<int>(part.nrOfSegments()) == end - 1, "sub-tree segment count");
   for (int k = 0; k + 1 < end && k < static_cast<int>(part.nrOfSegments()); ++k)
-    ck.check(part.segmentNames()[k] == s.segmentNames()[k + 1], "sub-tree segment order");
+    CHECK_MESSAGE(part.segmentNames()[k] == s.segmentNames()[k + 1], "sub-tree segment order");
 }
 
 }  // namespace
-
-int main() {
-  testutil::Checker ck("test_tree");
-  testChainAsTree(ck);
-  testForwardDynamics(ck);
-  testInverseInertia(ck);
-  testConstraints(ck);
-  testLinkAccelerations(ck);
-  testResponseColumns(ck);
-  testFriction(ck);
-  testPassThrough(ck);
-  testModelAndErrors(ck);
-  return ck.finish("");
-}

@@ -6,16 +6,12 @@
 
 #include <kdl/chainfksolverpos_recursive.hpp>
 
+#include <doctest/doctest.h>
+
 #include "test_common.hpp"
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace {
-
-testutil::Checker checker("test_urdf");
-
-void check(bool ok, const std::string& what) {
-  checker.check(ok, what);
-}
 
 using testutil::near;
 using testutil::nearFrame;
@@ -59,20 +55,19 @@ KDL::RigidBodyInertia diagInertia(double m, const KDL::Vector& c, double ixx, do
   return KDL::RigidBodyInertia(m, c, KDL::RotationalInertia(ixx, iyy, izz, 0, 0, 0));
 }
 
-void testStructure() {
+TEST_CASE("arm URDF: segments, joint metadata, forward kinematics and merged inertias") {
   const vereshchagin::UrdfResult r = vereshchagin::chainFromUrdfString(kArm);
-  check(r.ok, "arm loads: " + r.message);
-  if (!r.ok) return;
+  REQUIRE_MESSAGE(r.ok, "arm loads: " << r.message);
   const KDL::Chain& ch = r.robot.chain;
-  check(ch.getNrOfSegments() == 2 && ch.getNrOfJoints() == 2, "two moving joints -> two segments");
-  check(ch.getSegment(0).getName() == "l1b" && ch.getSegment(1).getName() == "tool",
-        "segments are named after their tip links");
-  check(r.robot.joints.size() == 2 && r.robot.joints[0].name == "j1" && r.robot.joints[1].type == "prismatic",
-        "joint metadata");
-  check(near(r.robot.joints[0].lower, -2) && near(r.robot.joints[0].upper, 2.5) &&
-            near(r.robot.joints[0].effort_limit, 40) && near(r.robot.joints[0].velocity_limit, 1.5) &&
-            near(r.robot.joints[0].friction, 1.2) && near(r.robot.joints[0].damping, 0.3),
-        "limits, friction and damping of j1");
+  CHECK_MESSAGE((ch.getNrOfSegments() == 2 && ch.getNrOfJoints() == 2), "two moving joints -> two segments");
+  CHECK_MESSAGE((ch.getSegment(0).getName() == "l1b" && ch.getSegment(1).getName() == "tool"),
+                "segments are named after their tip links");
+  CHECK_MESSAGE((r.robot.joints.size() == 2 && r.robot.joints[0].name == "j1" && r.robot.joints[1].type == "prismatic"),
+                "joint metadata");
+  CHECK_MESSAGE((near(r.robot.joints[0].lower, -2) && near(r.robot.joints[0].upper, 2.5) &&
+                 near(r.robot.joints[0].effort_limit, 40) && near(r.robot.joints[0].velocity_limit, 1.5) &&
+                 near(r.robot.joints[0].friction, 1.2) && near(r.robot.joints[0].damping, 0.3)),
+                "limits, friction and damping of j1");
 
   // Forward kinematics at q = (0.7, 0.2) against hand composition of the URDF transforms.
   const double q1 = 0.7, q2 = 0.2;
@@ -90,8 +85,8 @@ void testStructure() {
   KDL::Frame got0, got1;
   fk.JntToCart(q, got0, 1);
   fk.JntToCart(q, got1, 2);
-  check(nearFrame(got0, l1b), "segment 0 tip is link l1b");
-  check(nearFrame(got1, tool), "segment 1 tip is the tool link");
+  CHECK_MESSAGE(nearFrame(got0, l1b), "segment 0 tip is link l1b");
+  CHECK_MESSAGE(nearFrame(got1, tool), "segment 1 tip is the tool link");
 
   // Merged inertias, expressed in each segment's tip frame.
   const KDL::Frame in1(KDL::Rotation::RPY(0.1, 0, 0), KDL::Vector(0, 0, 0.1));
@@ -103,7 +98,7 @@ void testStructure() {
   for (int k = 0; k < 3; ++k) same0 = same0 && near(got_seg0.getCOG()(k), seg0.getCOG()(k));
   for (int k = 0; k < 9; ++k)
     same0 = same0 && near(got_seg0.getRotationalInertia().data[k], seg0.getRotationalInertia().data[k]);
-  check(same0, "segment 0 inertia = l1 (moved into l1b's frame) + l1b");
+  CHECK_MESSAGE(same0, "segment 0 inertia = l1 (moved into l1b's frame) + l1b");
   const KDL::RigidBodyInertia seg1 = tool_in_l2.Inverse() * diagInertia(1, KDL::Vector::Zero(), 0.01, 0.01, 0.01) +
                                      diagInertia(0.25, KDL::Vector::Zero(), 1e-4, 1e-4, 1e-4);
   const KDL::RigidBodyInertia got_seg1 = ch.getSegment(1).getInertia();
@@ -111,14 +106,14 @@ void testStructure() {
   for (int k = 0; k < 3; ++k) same1 = same1 && near(got_seg1.getCOG()(k), seg1.getCOG()(k));
   for (int k = 0; k < 9; ++k)
     same1 = same1 && near(got_seg1.getRotationalInertia().data[k], seg1.getRotationalInertia().data[k]);
-  check(same1, "segment 1 inertia = l2 (moved into the tool frame) + tool");
+  CHECK_MESSAGE(same1, "segment 1 inertia = l2 (moved into the tool frame) + tool");
 }
 
 void expectError(const std::string& xml, const std::string& root, const std::string& tip, const std::string& fragment,
                  const std::string& what) {
   const vereshchagin::UrdfResult r = vereshchagin::chainFromUrdfString(xml, root, tip);
-  check(!r.ok && r.message.find(fragment) != std::string::npos,
-        what + " (message: '" + r.message + "', expected to contain '" + fragment + "')");
+  CHECK_MESSAGE((!r.ok && r.message.find(fragment) != std::string::npos),
+                what << " (message: '" << r.message << "', expected to contain '" << fragment << "')");
 }
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {
@@ -127,7 +122,7 @@ std::string replaced(std::string s, const std::string& from, const std::string& 
   return s;
 }
 
-void testErrors() {
+TEST_CASE("malformed or unusable URDFs and missing files are refused with a message") {
   expectError("<robot name='x'><link name='a'>", "", "", "malformed URDF", "malformed XML");
   expectError(kArm, "nowhere", "", "root link 'nowhere' not found", "missing root");
   expectError(kArm, "", "nowhere", "tip link 'nowhere' not found", "missing tip");
@@ -141,10 +136,11 @@ void testErrors() {
   expectError(replaced(kArm, "<mass value=\"1\"/>", "<mass value=\"abc\"/>"), "", "", "malformed URDF",
               "unparsable number (urdfdom would silently use 0)");
   const vereshchagin::UrdfResult missing = vereshchagin::chainFromUrdfFile("/nonexistent/robot.urdf");
-  check(!missing.ok && missing.message.find("'/nonexistent/robot.urdf' does not exist") != std::string::npos,
-        "missing file: " + missing.message);
+  CHECK_MESSAGE((!missing.ok && missing.message.find("'/nonexistent/robot.urdf' does not exist") != std::string::npos),
+                "missing file: " << missing.message);
   const vereshchagin::UrdfResult dir = vereshchagin::chainFromUrdfFile("/");
-  check(!dir.ok && dir.message.find("'/' is a directory") != std::string::npos, "a directory: " + dir.message);
+  CHECK_MESSAGE((!dir.ok && dir.message.find("'/' is a directory") != std::string::npos),
+                "a directory: " << dir.message);
 }
 
 // base -j1- l1 -j2- ... -jn- ln: revolute joints about z, 0.1 m apart along z, 1 kg per link.
@@ -180,31 +176,32 @@ std::string sideBranchXml(int n) {
 }
 
 // Deep documents used to overflow the stack in the recursive walks (leaves, side branches).
-void testDeep() {
+TEST_CASE("30000-deep chain and fixed side branch load (no stack overflow)") {
   const int n = 30000;
   const vereshchagin::UrdfResult serial = vereshchagin::chainFromUrdfString(serialXml(n));
-  check(serial.ok && serial.robot.chain.getNrOfJoints() == static_cast<unsigned>(n), "deep chain: " + serial.message);
+  CHECK_MESSAGE((serial.ok && serial.robot.chain.getNrOfJoints() == static_cast<unsigned>(n)),
+                "deep chain: " << serial.message);
   if (serial.ok) {
     KDL::ChainFkSolverPos_recursive fk(serial.robot.chain);
     KDL::JntArray q(static_cast<unsigned>(n));
     KDL::Frame tip;
     fk.JntToCart(q, tip);
-    check(near(tip.p.z(), 0.1 * n) && near(tip.p.x(), 0.0), "deep chain: the tip is n * 0.1 m up");
+    CHECK_MESSAGE((near(tip.p.z(), 0.1 * n) && near(tip.p.x(), 0.0)), "deep chain: the tip is n * 0.1 m up");
   }
   const vereshchagin::UrdfResult branch = vereshchagin::chainFromUrdfString(sideBranchXml(n), "", "b");
-  check(branch.ok && branch.robot.chain.getNrOfSegments() == 2, "deep fixed side branch: " + branch.message);
+  CHECK_MESSAGE((branch.ok && branch.robot.chain.getNrOfSegments() == 2), "deep fixed side branch: " << branch.message);
   if (branch.ok) {
     const KDL::RigidBodyInertia& body = branch.robot.chain.getSegment(0).getInertia();
-    check(near(body.getMass(), 1.0 + 0.01 * n), "the side branch's mass is lumped into segment 0");
+    CHECK_MESSAGE(near(body.getMass(), 1.0 + 0.01 * n), "the side branch's mass is lumped into segment 0");
     // Centre of mass: s_k sits k mm along x, so sum(0.01 * k mm) / total mass.
     const double cx = 0.01 * 0.001 * 0.5 * n * (n + 1.0) / (1.0 + 0.01 * n);
-    check(std::abs(body.getCOG().x() - cx) <= 1e-9 * cx, "the side branch's centre of mass");
-    check(branch.robot.links.size() == static_cast<std::size_t>(n) + 3, "every branch link is placed");
+    CHECK_MESSAGE(std::abs(body.getCOG().x() - cx) <= 1e-9 * cx, "the side branch's centre of mass");
+    CHECK_MESSAGE(branch.robot.links.size() == static_cast<std::size_t>(n) + 3, "every branch link is placed");
   }
 }
 
 // Documents refused before urdfdom reads them (its reader recurses per nesting level).
-void testLimits() {
+TEST_CASE("nesting depth and link count limits refuse documents before urdfdom reads them") {
   const std::string body =
       "<link name='a'/><link name='b'/><joint name='j' type='continuous'><parent "
       "link='a'/><child link='b'/><axis xyz='0 0 1'/></joint>";
@@ -214,7 +211,7 @@ void testLimits() {
     for (int k = 0; k < levels; ++k) xml += "</x>";
     return xml + "<!-- <y><y> --><![CDATA[<z>]]></robot>";
   };
-  check(vereshchagin::chainFromUrdfString(nested(999)).ok, "1000 nesting levels load");
+  CHECK_MESSAGE(vereshchagin::chainFromUrdfString(nested(999)).ok, "1000 nesting levels load");
   expectError(nested(1000), "", "", "nested more than 1000 levels", "1001 nesting levels are refused");
   expectError(nested(200000), "", "", "nested more than 1000 levels", "200000 nesting levels are refused");
   std::string many = "<robot name='r'>";
@@ -223,28 +220,19 @@ void testLimits() {
 }
 
 // The fixed base leaves the root link's mass out: a note says so, with the mass and the link.
-void testBaseMassNote() {
+TEST_CASE("a heavy root link is noted: the fixed base leaves its mass out") {
   const vereshchagin::UrdfResult bare = vereshchagin::chainFromUrdfString(kArm);
-  check(bare.ok && bare.robot.notes.empty(), "a massless root link gives no note");
+  CHECK_MESSAGE((bare.ok && bare.robot.notes.empty()), "a massless root link gives no note");
   const std::string heavy =
       replaced(kArm, "<link name=\"base\"/>",
                "<link name=\"base\"><inertial><mass value=\"7.5\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" "
                "iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>");
   const vereshchagin::UrdfResult r = vereshchagin::chainFromUrdfString(heavy);
-  check(r.ok && r.robot.notes.size() == 1 &&
-            r.robot.notes[0].find("root link 'base' carries 7.5 kg: ") != std::string::npos &&
-            r.robot.notes[0].find("welded to the world") != std::string::npos &&
-            r.robot.notes[0].find("a floating base (base=\"free\") is not supported yet") != std::string::npos,
-        "the root link's mass is noted: " + (r.robot.notes.empty() ? std::string() : r.robot.notes[0]));
+  CHECK_MESSAGE((r.ok && r.robot.notes.size() == 1 &&
+                 r.robot.notes[0].find("root link 'base' carries 7.5 kg: ") != std::string::npos &&
+                 r.robot.notes[0].find("welded to the world") != std::string::npos &&
+                 r.robot.notes[0].find("a floating base (base=\"free\") is not supported yet") != std::string::npos),
+                "the root link's mass is noted: " << (r.robot.notes.empty() ? std::string() : r.robot.notes[0]));
 }
 
 }  // namespace
-
-int main() {
-  testStructure();
-  testErrors();
-  testDeep();
-  testLimits();
-  testBaseMassNote();
-  return checker.finish("");
-}

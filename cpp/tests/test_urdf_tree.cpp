@@ -10,16 +10,12 @@
 
 #include <kdl/treefksolverpos_recursive.hpp>
 
+#include <doctest/doctest.h>
+
 #include "test_common.hpp"
 #include "vereshchagin/urdf_loader.hpp"
 
 namespace {
-
-testutil::Checker checker("test_urdf_tree");
-
-void check(bool ok, const std::string& what) {
-  checker.check(ok, what);
-}
 
 using testutil::near;
 using testutil::nearFrame;
@@ -124,26 +120,36 @@ std::map<std::string, KDL::Frame> treeFk(const KDL::Tree& tree, const KDL::JntAr
   return out;
 }
 
-void testOrderAndJoints(const vereshchagin::RobotTree& t) {
+TEST_CASE("the branched tree loads without a message") {
+  const vereshchagin::UrdfTreeResult r = vereshchagin::treeFromUrdfString(treeXml());
+  CHECK_MESSAGE((r.ok && r.message.empty()), "branched tree loads: " << r.message);
+}
+
+TEST_CASE("branched tree: segments in preorder, joint metadata and treeSegmentOrder") {
+  const vereshchagin::UrdfTreeResult r = vereshchagin::treeFromUrdfString(treeXml());
+  REQUIRE_MESSAGE(r.ok, "branched tree loads: " << r.message);
+  const vereshchagin::RobotTree& t = r.robot;
   const std::vector<std::string> names = {"torso", "left1", "left_tool", "head", "hand"};
-  check(t.segment_names == names, "segments in preorder, children by joint name, named after their tip links");
-  check(t.parent == std::vector<int>({-1, 0, 1, 0, 0}), "parent array");
-  check(t.root_link == "base" && t.tree.getRootSegment()->first == "base", "root link");
-  check(t.tree.getNrOfJoints() == 5 && t.tree.getNrOfSegments() == 5 && t.joints.size() == 5, "five moving joints");
+  CHECK_MESSAGE(t.segment_names == names, "segments in preorder, children by joint name, named after their tip links");
+  CHECK_MESSAGE(t.parent == std::vector<int>({-1, 0, 1, 0, 0}), "parent array");
+  CHECK_MESSAGE((t.root_link == "base" && t.tree.getRootSegment()->first == "base"), "root link");
+  CHECK_MESSAGE((t.tree.getNrOfJoints() == 5 && t.tree.getNrOfSegments() == 5 && t.joints.size() == 5),
+                "five moving joints");
   const std::vector<std::string> joints = {"a_torso", "b_left", "b_left2", "d_head", "c_right"};
   for (std::size_t k = 0; k < t.joints.size(); ++k) {
     const auto& j = t.joints[k];
-    check(j.name == joints[k] && j.segment == k, "joint " + std::to_string(k) + " is " + joints[k]);
-    check(GetTreeElementQNr(t.tree.getSegments().find(names[k])->second) == k, "q_nr of segment " + names[k]);
+    CHECK_MESSAGE((j.name == joints[k] && j.segment == k), "joint " << std::to_string(k) << " is " << joints[k]);
+    CHECK_MESSAGE(GetTreeElementQNr(t.tree.getSegments().find(names[k])->second) == k, "q_nr of segment " << names[k]);
     for (const LinkSpec& s : kLinks) {
       if (j.name != s.joint) continue;
-      check(j.type == s.type, "type of " + j.name);
+      CHECK_MESSAGE(j.type == s.type, "type of " << j.name);
       const bool limited = j.type != "continuous";
-      check(near(j.friction, 0.5 * s.mass) && near(j.damping, 0.1 * s.mass), "friction and damping of " + j.name);
-      check(limited ? near(j.lower, -1.5) && near(j.upper, 1.0 + s.mass) && near(j.effort_limit, 10 * s.mass) &&
-                          near(j.velocity_limit, 2 * s.mass)
-                    : std::isinf(j.lower) && std::isinf(j.upper),
-            "limits of " + j.name);
+      CHECK_MESSAGE((near(j.friction, 0.5 * s.mass) && near(j.damping, 0.1 * s.mass)),
+                    "friction and damping of " << j.name);
+      CHECK_MESSAGE((limited ? near(j.lower, -1.5) && near(j.upper, 1.0 + s.mass) &&
+                                   near(j.effort_limit, 10 * s.mass) && near(j.velocity_limit, 2 * s.mass)
+                             : std::isinf(j.lower) && std::isinf(j.upper)),
+                    "limits of " << j.name);
     }
   }
   std::vector<KDL::SegmentMap::const_iterator> order;
@@ -151,23 +157,26 @@ void testOrderAndJoints(const vereshchagin::RobotTree& t) {
   vereshchagin::treeSegmentOrder(t.tree, order, parent);
   bool same = order.size() == names.size() && parent == t.parent;
   for (std::size_t i = 0; same && i < order.size(); ++i) same = order[i]->first == names[i];
-  check(same, "treeSegmentOrder gives the loader's order");
+  CHECK_MESSAGE(same, "treeSegmentOrder gives the loader's order");
 }
 
 // Placements: every link's pose = fk(its segment) * in_segment_tip, at q = 0 (hand-composed
 // URDF poses) and in mass: total spatial inertia in the base frame conserved.
-void testPlacementsAndInertia(const vereshchagin::RobotTree& t) {
+TEST_CASE("branched tree: link placements and merged inertias") {
+  const vereshchagin::UrdfTreeResult r = vereshchagin::treeFromUrdfString(treeXml());
+  REQUIRE_MESSAGE(r.ok, "branched tree loads: " << r.message);
+  const vereshchagin::RobotTree& t = r.robot;
   const std::map<std::string, KDL::Frame> expected = linkPosesAtZero();
   KDL::JntArray q0(t.tree.getNrOfJoints());
   const std::map<std::string, KDL::Frame> fk = treeFk(t.tree, q0, t.segment_names);
-  check(t.links.size() == sizeof kLinks / sizeof kLinks[0], "every link placed once");
+  CHECK_MESSAGE(t.links.size() == sizeof kLinks / sizeof kLinks[0], "every link placed once");
   std::map<std::string, int> expected_segment = {
       {"base", -1},    {"pedestal", -1}, {"torso", 0}, {"plate", 0}, {"chest", 0},     {"right1", 4}, {"hand", 4},
       {"finger_a", 4}, {"finger_b", 4},  {"left1", 1}, {"left2", 2}, {"left_tool", 2}, {"head", 3}};
   for (const auto& l : t.links) {
     const KDL::Frame seg = l.segment < 0 ? KDL::Frame::Identity() : fk.at(t.segment_names[l.segment]);
-    check(nearFrame(seg * l.in_segment_tip, expected.at(l.link)), "placement of link " + l.link);
-    check(l.segment == expected_segment.at(l.link), "segment of link " + l.link);
+    CHECK_MESSAGE(nearFrame(seg * l.in_segment_tip, expected.at(l.link)), "placement of link " << l.link);
+    CHECK_MESSAGE(l.segment == expected_segment.at(l.link), "segment of link " << l.link);
   }
   KDL::RigidBodyInertia want = KDL::RigidBodyInertia::Zero(), got = KDL::RigidBodyInertia::Zero();
   double mass = 0.0;
@@ -178,14 +187,16 @@ void testPlacementsAndInertia(const vereshchagin::RobotTree& t) {
   }
   for (const std::string& n : t.segment_names)
     got = got + fk.at(n) * t.tree.getSegments().find(n)->second.segment.getInertia();
-  check(near(got.getMass(), mass) && nearInertia(got, want), "total spatial inertia below the base conserved");
+  CHECK_MESSAGE((near(got.getMass(), mass) && nearInertia(got, want)),
+                "total spatial inertia below the base conserved");
   const KDL::RigidBodyInertia hand = t.tree.getSegments().find("hand")->second.segment.getInertia();
   KDL::RigidBodyInertia hand_want = KDL::RigidBodyInertia::Zero();
   for (const char* n : {"right1", "hand", "finger_a", "finger_b"})
     for (const LinkSpec& s : kLinks)
       if (std::string(s.link) == n)
         hand_want = hand_want + (expected.at("hand").Inverse() * expected.at(n)) * ownInertia(s);
-  check(nearInertia(hand, hand_want), "right arm segment: right1, hand and both fingers merged in the hand frame");
+  CHECK_MESSAGE(nearInertia(hand, hand_want),
+                "right arm segment: right1, hand and both fingers merged in the hand frame");
 }
 
 bool sameSegment(const KDL::Segment& a, const KDL::Segment& b) {
@@ -200,7 +211,7 @@ bool sameSegment(const KDL::Segment& a, const KDL::Segment& b) {
 }
 
 // Root-to-leaf paths without other branches equal the chain loader's chains, bit for bit.
-void testPathsAgainstChains() {
+TEST_CASE("root-to-leaf paths equal the chain loader's chains bit for bit") {
   const std::string xml = treeXml();
   const struct {
     const char *root, *leaf;
@@ -214,19 +225,21 @@ void testPathsAgainstChains() {
     const auto chain = vereshchagin::chainFromUrdfString(xml, p.root, p.leaf);
     for (const std::string& root : {std::string(p.from_base ? "base" : p.root), std::string(p.root)}) {
       const auto tree = vereshchagin::treeFromUrdfString(xml, root);
-      check(chain.ok && tree.ok, std::string("path ") + p.root + " -> " + p.leaf + " loads");
+      CHECK_MESSAGE((chain.ok && tree.ok), std::string("path ") << p.root << " -> " << p.leaf << " loads");
       if (!chain.ok || !tree.ok) continue;
       bool same = chain.robot.chain.getNrOfSegments() == p.segments.size();
       for (std::size_t i = 0; same && i < p.segments.size(); ++i)
         same = sameSegment(chain.robot.chain.getSegment(static_cast<unsigned int>(i)),
                            tree.robot.tree.getSegments().find(p.segments[i])->second.segment);
-      check(same, std::string("tree (root ") + root + ") path " + p.root + " -> " + p.leaf + " equals the chain");
+      CHECK_MESSAGE(same, std::string("tree (root ")
+                              << root << ") path " << p.root << " -> " << p.leaf << " equals the chain");
     }
   }
   // chest -> hand: the chain's tip is `hand` only because its fingers are no path; to finger_a it
   // ends at the finger, the tree's segment at the hand (the fingers' common parent).
   const auto to_finger = vereshchagin::chainFromUrdfString(xml, "chest", "finger_a");
-  check(to_finger.ok && to_finger.robot.chain.getSegment(0).getName() == "finger_a", "chain to a finger ends there");
+  CHECK_MESSAGE((to_finger.ok && to_finger.robot.chain.getSegment(0).getName() == "finger_a"),
+                "chain to a finger ends there");
 }
 
 void expectTreeError(const std::string& xml, const std::string& root, const std::vector<std::string>& fragments,
@@ -234,41 +247,47 @@ void expectTreeError(const std::string& xml, const std::string& root, const std:
   const auto r = vereshchagin::treeFromUrdfString(xml, root);
   bool has = !r.ok;
   for (const auto& f : fragments) has = has && r.message.find(f) != std::string::npos;
-  check(has, what + " (message: '" + r.message + "')");
+  CHECK_MESSAGE(has, what << " (message: '" << r.message << "')");
 }
 
-void testErrors() {
+TEST_CASE("floating and planar joints, mimic joints, bad roots and missing files") {
   for (const char* type : {"floating", "planar"}) {
     const std::string xml = treeXml({{"b_left", type}});
     expectTreeError(xml, "", {"joint 'b_left'", type, "root='left1'"}, std::string(type) + " joint in the tree");
     const auto below = vereshchagin::treeFromUrdfString(xml, "left1");
-    check(below.ok && below.robot.segment_names == std::vector<std::string>({"left_tool"}),
-          std::string("the sub-tree below the ") + type + " joint loads: " + below.message);
+    CHECK_MESSAGE((below.ok && below.robot.segment_names == std::vector<std::string>({"left_tool"})),
+                  std::string("the sub-tree below the ") << type << " joint loads: " << below.message);
   }
   std::string mimic = treeXml();
   mimic.insert(mimic.find("</joint>", mimic.find("name='d_head'")), "<mimic joint='a_torso'/>");
   const auto mimicked = vereshchagin::treeFromUrdfString(mimic);
-  check(mimicked.ok && mimicked.robot.joints.size() == 5 && mimicked.robot.notes.size() == 2 &&
-            mimicked.robot.notes[1].find("'d_head' mimics joint 'a_torso'") != std::string::npos,
-        "a mimic joint becomes an independent joint, with a note");
+  CHECK_MESSAGE((mimicked.ok && mimicked.robot.joints.size() == 5 && mimicked.robot.notes.size() == 2 &&
+                 mimicked.robot.notes[1].find("'d_head' mimics joint 'a_torso'") != std::string::npos),
+                "a mimic joint becomes an independent joint, with a note");
   expectTreeError(treeXml(), "nowhere", {"root link 'nowhere' not found"}, "unknown root");
   expectTreeError(treeXml(), "finger_a", {"no moving joint below root link 'finger_a'"}, "a leaf as root");
   expectTreeError("<robot name='x'><link name='a'>", "", {"malformed URDF"}, "malformed XML");
   const auto missing = vereshchagin::treeFromUrdfFile("/nonexistent/robot.urdf");
-  check(!missing.ok && missing.message.find("'/nonexistent/robot.urdf' does not exist") != std::string::npos,
-        "missing file: " + missing.message);
+  CHECK_MESSAGE((!missing.ok && missing.message.find("'/nonexistent/robot.urdf' does not exist") != std::string::npos),
+                "missing file: " << missing.message);
   const auto dir = vereshchagin::treeFromUrdfFile("/");
-  check(!dir.ok && dir.message.find("'/' is a directory") != std::string::npos, "a directory: " + dir.message);
+  CHECK_MESSAGE((!dir.ok && dir.message.find("'/' is a directory") != std::string::npos),
+                "a directory: " << dir.message);
 }
 
 // The base (base 3 kg, pedestal 5 kg fixed to it) is welded to the world: a note gives its mass.
-void testBaseMassNote(const vereshchagin::RobotTree& t) {
-  check(!t.notes.empty() && t.notes[0].find("root link 'base' carries 8 kg (with the links fixed to it): ") == 0 &&
-            t.notes[0].find("a floating base (base=\"free\") is not supported yet") != std::string::npos,
-        "the base's mass is noted: " + (t.notes.empty() ? std::string() : t.notes[0]));
+TEST_CASE("branched tree: the base's mass and a sub-tree root's mass are noted") {
+  const vereshchagin::UrdfTreeResult r = vereshchagin::treeFromUrdfString(treeXml());
+  REQUIRE_MESSAGE(r.ok, "branched tree loads: " << r.message);
+  const vereshchagin::RobotTree& t = r.robot;
+  CHECK_MESSAGE(
+      (!t.notes.empty() && t.notes[0].find("root link 'base' carries 8 kg (with the links fixed to it): ") == 0 &&
+       t.notes[0].find("a floating base (base=\"free\") is not supported yet") != std::string::npos),
+      "the base's mass is noted: " << (t.notes.empty() ? std::string() : t.notes[0]));
   const auto sub = vereshchagin::treeFromUrdfString(treeXml(), "left1");  // left1 carries 1.1 kg
-  check(sub.ok && sub.robot.notes.size() == 1 && sub.robot.notes[0].find("root link 'left1' carries 1.1 kg: ") == 0,
-        "a sub-tree root's mass is noted");
+  CHECK_MESSAGE(
+      (sub.ok && sub.robot.notes.size() == 1 && sub.robot.notes[0].find("root link 'left1' carries 1.1 kg: ") == 0),
+      "a sub-tree root's mass is noted");
 }
 
 // base -j1- l1 -j2- ... -jn- ln: revolute joints about z, 0.1 m apart along z, 1 kg per link;
@@ -290,39 +309,40 @@ std::string deepXml(int n, bool branch) {
 
 // Deep trees used to overflow the stack: the loader's walks, treeSegmentOrder, and copies of a
 // RobotTree (KDL::Tree's own copy recurses per level).
-void testDeep() {
+TEST_CASE("30000-deep tree and fixed side branch: loader, treeSegmentOrder and copies") {
   const int n = 30000;
   const auto serial = vereshchagin::treeFromUrdfString(deepXml(n, false));
-  check(serial.ok && serial.robot.segment_names.size() == static_cast<std::size_t>(n), "deep tree: " + serial.message);
+  CHECK_MESSAGE((serial.ok && serial.robot.segment_names.size() == static_cast<std::size_t>(n)),
+                "deep tree: " << serial.message);
   if (!serial.ok) return;
   bool chain = true;
   for (int i = 0; i < n; ++i) chain = chain && serial.robot.parent[static_cast<std::size_t>(i)] == i - 1;
-  check(chain, "deep tree: parent[i] = i - 1");
+  CHECK_MESSAGE(chain, "deep tree: parent[i] = i - 1");
   std::vector<KDL::SegmentMap::const_iterator> order;
   std::vector<int> parent;
   vereshchagin::treeSegmentOrder(serial.robot.tree, order, parent);
-  check(parent == serial.robot.parent && order.back()->first == "l30000", "deep tree: treeSegmentOrder");
+  CHECK_MESSAGE((parent == serial.robot.parent && order.back()->first == "l30000"), "deep tree: treeSegmentOrder");
   const vereshchagin::RobotTree copy = serial.robot;
   vereshchagin::RobotTree assigned;
   assigned = copy;
   for (const vereshchagin::RobotTree* t : {&copy, static_cast<const vereshchagin::RobotTree*>(&assigned)}) {
     const auto last = t->tree.getSegments().find("l30000");
-    check(t->tree.getNrOfJoints() == static_cast<unsigned>(n) && last != t->tree.getSegments().end() &&
-              GetTreeElementQNr(last->second) == static_cast<unsigned>(n - 1) &&
-              t->segment_names == serial.robot.segment_names,
-          "deep tree: copies keep every segment and q_nr");
+    CHECK_MESSAGE((t->tree.getNrOfJoints() == static_cast<unsigned>(n) && last != t->tree.getSegments().end() &&
+                   GetTreeElementQNr(last->second) == static_cast<unsigned>(n - 1) &&
+                   t->segment_names == serial.robot.segment_names),
+                  "deep tree: copies keep every segment and q_nr");
   }
   const auto branch = vereshchagin::treeFromUrdfString(deepXml(n, true));
-  check(branch.ok && branch.robot.segment_names == std::vector<std::string>({"l1", "l2"}),
-        "deep fixed side branch: " + branch.message);
+  CHECK_MESSAGE((branch.ok && branch.robot.segment_names == std::vector<std::string>({"l1", "l2"})),
+                "deep fixed side branch: " << branch.message);
   if (branch.ok) {
     const KDL::Segment& s = branch.robot.tree.getSegments().find("l1")->second.segment;
-    check(near(s.getInertia().getMass(), 1.0 + 0.01 * n), "the side branch's mass is lumped into l1");
+    CHECK_MESSAGE(near(s.getInertia().getMass(), 1.0 + 0.01 * n), "the side branch's mass is lumped into l1");
   }
 }
 
 // copyTree on a KDL tree deeper than KDL's own (recursive) copy survives with an 8 MB stack.
-void testCopyTree() {
+TEST_CASE("copyTree of a 400000-deep KDL tree") {
   const int n = 400000;
   KDL::Tree deep("root");
   std::string previous = "root";
@@ -334,26 +354,11 @@ void testCopyTree() {
   KDL::Tree copy;
   vereshchagin::copyTree(deep, copy);
   const auto last = copy.getSegments().find(previous);
-  check(copy.getNrOfSegments() == static_cast<unsigned>(n) && copy.getNrOfJoints() == deep.getNrOfJoints() &&
-            last != copy.getSegments().end() &&
-            GetTreeElementQNr(last->second) == GetTreeElementQNr(deep.getSegments().find(previous)->second) &&
-            GetTreeElementParent(last->second)->first == "s" + std::to_string(n - 2),
-        "copyTree of a 400000-deep tree");
+  CHECK_MESSAGE((copy.getNrOfSegments() == static_cast<unsigned>(n) && copy.getNrOfJoints() == deep.getNrOfJoints() &&
+                 last != copy.getSegments().end() &&
+                 GetTreeElementQNr(last->second) == GetTreeElementQNr(deep.getSegments().find(previous)->second) &&
+                 GetTreeElementParent(last->second)->first == "s" + std::to_string(n - 2)),
+                "copyTree of a 400000-deep tree");
 }
 
 }  // namespace
-
-int main() {
-  const auto r = vereshchagin::treeFromUrdfString(treeXml());
-  check(r.ok && r.message.empty(), "branched tree loads: " + r.message);
-  if (r.ok) {
-    testOrderAndJoints(r.robot);
-    testPlacementsAndInertia(r.robot);
-    testBaseMassNote(r.robot);
-  }
-  testPathsAgainstChains();
-  testErrors();
-  testDeep();
-  testCopyTree();
-  return checker.finish("");
-}
