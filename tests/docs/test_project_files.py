@@ -26,10 +26,14 @@ def test_version_is_written_once():
     assert f"## [{version}]" in (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
 
 
+PY_DIRS = ("python", "experiments", "tests", "benchmarks", "examples", "docs", "tools")
+"""The folders with Python files (as tools/check_format.sh checks them)."""
+
+
 def test_ruff_lint_clean():
     """The lint rules of pyproject.toml's [tool.ruff.lint] hold on every Python file of the repository."""
     proc = subprocess.run(
-        [sys.executable, "-m", "ruff", "check", "python", "experiments", "tests", "benchmarks", "examples", "docs"],
+        [sys.executable, "-m", "ruff", "check", *PY_DIRS],
         cwd=ROOT,
         capture_output=True,
         text=True,
