@@ -44,18 +44,48 @@ def test_code_blocks_run(page, tmp_path):
     assert proc.returncode == 0, f"{page.name}:\n{proc.stdout[-2000:]}\n{proc.stderr[-4000:]}"
 
 
-def test_sphinx_builds_without_warnings(tmp_path):
-    """``sphinx-build -W``: any warning (a broken reference, a bad docstring) fails."""
+@pytest.fixture(scope="module")
+def sphinx_html(tmp_path_factory):
+    """One ``sphinx-build -W`` of the site for this module: the process and its output folder."""
+    html = tmp_path_factory.mktemp("docs") / "html"
     proc = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html", str(DOCS), str(tmp_path / "html")],
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html", str(DOCS), str(html)],
         cwd=ROOT,
         capture_output=True,
         text=True,
         timeout=600,
         env=dict(os.environ, MPLBACKEND="Agg"),
     )
+    return proc, html
+
+
+def test_sphinx_builds_without_warnings(sphinx_html):
+    """``sphinx-build -W``: any warning (a broken reference, a bad docstring, an undocumented public
+    C++ member reported by Doxygen) fails."""
+    proc, html = sphinx_html
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-6000:]
-    index = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
+    index = (html / "index.html").read_text(encoding="utf-8")
     assert "vereshchagin" in index
     for page in ("conventions", "friction", "api/python", "api/cpp"):
-        assert (tmp_path / "html" / f"{page}.html").is_file(), page
+        assert (html / f"{page}.html").is_file(), page
+
+
+CLASS = re.compile(r"^\s*(?:class|struct)\s+(?:\[\[.*?\]\]\s+)?(\w+)\s*(?::[^:]|\{)", re.M)
+
+
+def test_cpp_reference_has_every_public_header(sphinx_html):
+    """api/cpp has a section per header of cpp/include/vereshchagin (found by a glob at build time,
+    so a new header appears without editing the page), with the header's file documentation and
+    every class or struct it defines, rendered from Doxygen's XML by breathe."""
+    proc, html = sphinx_html
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-6000:]
+    page = (html / "api" / "cpp.html").read_text(encoding="utf-8")
+    headers = sorted((ROOT / "cpp" / "include" / "vereshchagin").glob("*.hpp"))
+    assert len(headers) >= 12
+    for header in headers:
+        anchor = '<section id="' + header.name.replace("_", "-").replace(".", "-") + '">'
+        assert anchor in page, f"api/cpp has no section for {header.name}"
+        section = page.split(anchor, 1)[1].split("<section id=", 1)[0]
+        assert "<p>" in section, f"{header.name}: no file documentation rendered"
+        for name in CLASS.findall(header.read_text(encoding="utf-8")):
+            assert f'<span class="n"><span class="pre">{name}</span></span>' in section, f"{header.name}: {name}"
