@@ -4,7 +4,7 @@
 Chains: the Kinova Gen3 7-DoF arm of bench_solver.cpp (same joint origins and inertias) and seeded
 random chains with n = 7, 15, 30, 60 revolute joints built with bench_solver.cpp's recipe (numpy's
 generator, so not the same numbers as the C++ random chains). Each chain is built twice, as a
-vereshchagin.Chain and as a pinocchio.Model, with the correspondence of tests/chains.py (the KDL tip
+vereshchagin.Chain and as a pinocchio.Model, with the correspondence of tests/support/chains.py (the KDL tip
 frame of the last segment is a Pinocchio OP_FRAME). 64 seeded states per chain; m = 0, 1, 6
 orthonormal constraint columns on the last segment, beta = alpha^T (0, 0, 9.81, 0, 0, 0) + U(-1, 1).
 
@@ -18,7 +18,7 @@ Timed per call, from Python:
                     getFrameJacobian(LWA), gamma = alpha^T (getFrameAcceleration(LWA) + [-g; 0]) - beta,
                     then pin.forwardDynamics(tau, J, gamma). m = 0: pin.aba (same as pin FD).
 Our constraint alpha^T a_tip = beta is Pinocchio's J qdd + gamma = 0 with the J and gamma above
-(see tests/test_pinocchio_oracle.py); every case is checked once for equal joint accelerations.
+(see tests/oracles/test_pinocchio_oracle.py); every case is checked once for equal joint accelerations.
 
 Usage: python benchmarks/bench_pinocchio.py [--out FILE] [--batches N] [--batch-ms MS]
 The Markdown section goes to stdout (and FILE); progress to stderr. Exit code 2 if a check failed.
@@ -192,7 +192,7 @@ def make_states(n, seed):
 
 
 def pinocchio_task(model, data, fid, q, qd, alpha, beta):
-    """J and gamma of Pinocchio's J qdd + gamma = 0, the way tests/test_pinocchio_oracle.py builds them."""
+    """J and gamma of Pinocchio's J qdd + gamma = 0, the way tests/oracles/test_pinocchio_oracle.py builds them."""
     pin.forwardKinematics(model, data, q, qd, np.zeros(model.nv))
     pin.updateFramePlacements(model, data)
     drift = pin.getFrameAcceleration(model, data, fid, LWA).vector

@@ -4,7 +4,7 @@
 Robots: the Kinova Gen3 7-DoF with the rigid Robotiq 2F-85 (``vereshchagin.robots.gen3(True)`` and
 ``pin.buildModelFromXML(gen3_urdf(True))``; continuous joints are (cos, sin) pairs in Pinocchio) and the
 Franka Panda of example-robot-data up to ``panda_hand`` (Pinocchio's finger joints locked at 0, as in
-tests/test_urdf_pinocchio.py). Gravity (0, 0, -9.81) in both, no rotor inertia.
+tests/oracles/test_urdf_pinocchio.py). Gravity (0, 0, -9.81) in both, no rotor inertia.
 
 Constraint sets (segment: m_i), in the order of the table: tool: 6; elbow: 3; elbow: 3 + tool: 3;
 upper arm: 1 + elbow: 2 + tool: 3. Elbow = the segment whose tip origin is the elbow joint (Gen3
@@ -28,7 +28,7 @@ Timed per call, from Python (interleaved batches and medians, the timer of bench
   pin KKT only      pin.forwardDynamics(q, v, tau, A, gamma) with A and gamma precomputed
   ours alpha=       tool-only rows: the same task as Solver.solve(q, qd, alpha, beta, None, tau) (end-segment
                     arguments, no dict), for the cost of the constraints= entry point
-Our rows alpha_i^T a_i = beta_i are Pinocchio's A qdd + gamma = 0 (tests/test_segment_constraints.py);
+Our rows alpha_i^T a_i = beta_i are Pinocchio's A qdd + gamma = 0 (tests/oracles/test_segment_constraints.py);
 nu = -lambda. Before timing every state is checked: qdd of all three and nu against -lambda agree to
 1e-8 relative, and our constraint rank is the total m.
 

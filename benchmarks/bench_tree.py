@@ -3,7 +3,7 @@
 
 Robots: Baxter (example-robot-data: head, two 7-joint arms, two-finger grippers, 19 joints) with
 6-D constraints on one hand (m = 6) or on both hands (m = 12), and m = 0 (plain forward dynamics);
-seeded random trees of 15, 30 and 60 moving joints (revolute, continuous, prismatic; tests/trees.py, written as URDF text and
+seeded random trees of 15, 30 and 60 moving joints (revolute, continuous, prismatic; tests/support/trees.py, written as URDF text and
 loaded by both libraries) with 3-D constraints on two leaves of different branches (m = 6; random trees are shallow, so
 each leaf has 3 joints of its own, not 6), for the scaling in n at fixed m.
 
@@ -38,7 +38,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests"))
 from bench_pinocchio import LWA, N_STATES, UP, paired_ratio, rel_diff, time_group  # noqa: E402
-from trees import pin_q, pin_v_index, random_solvable_tree  # noqa: E402  (tests/trees.py)
+from support.trees import pin_q, pin_v_index, random_solvable_tree  # noqa: E402  (tests/support/trees.py)
 
 G = -UP[:3]
 RTOL = 1e-8

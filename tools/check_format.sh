@@ -6,10 +6,10 @@
 #
 # The test command (.ci/test) runs --all: the tree is formatted (the one formatting commit is listed
 # in .git-blame-ignore-revs), so unformatted code fails the tests. ruff is pinned in .ci/setup.
-# To format: clang-format-14 -i <files>  and  ruff format python experiments tests benchmarks examples docs.
+# To format: clang-format-14 -i <files>  and  ruff format python experiments tests benchmarks examples docs tools.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-PY_DIRS="python experiments tests benchmarks examples docs"
+PY_DIRS="python experiments tests benchmarks examples docs tools"
 echo "[format] ruff check $PY_DIRS"
 python3 -m ruff check $PY_DIRS
 if [ "${1:-}" = "--all" ]; then

@@ -1,19 +1,20 @@
-// The per-thread side of a solve: Data holds the workspace and the results, sized once for a
-// Model; solve(model, data, input) runs the Popov-Vereshchagin sweeps (with static friction when
-// the input has it) on them. Math, frames, signs and units: hd_solver.hpp; friction:
-// friction_solver.hpp.
-//
-//     Model model(chain);                       // once; shared by threads
-//     Data data(model);                         // once per thread
-//     SolveInput in(model);                     // once; rewritten every cycle
-//     in.setState(JointPositions(q), JointVelocities(qd));
-//     in.addConstraint(model.segmentOfJoint().back(), alfa, beta);
-//     if (const Status s = solve(model, data, in); !s) handle(s.message());
-//     use(data.qdd(), data.commandTorques());
-//
-// Real-time use: constructing a Data allocates everything; solve() and every accessor below
-// allocate nothing. One Data per thread: a call entering a Data while another thread is inside
-// one returns Error::ConcurrentCall and leaves it untouched.
+/// @file
+/// The per-thread side of a solve: Data holds the workspace and the results, sized once for a
+/// Model; solve(model, data, input) runs the Popov-Vereshchagin sweeps (with static friction when
+/// the input has it) on them. Math, frames, signs and units: hd_solver.hpp; friction:
+/// friction_solver.hpp.
+///
+///     Model model(chain);                       // once; shared by threads
+///     Data data(model);                         // once per thread
+///     SolveInput in(model);                     // once; rewritten every cycle
+///     in.setState(JointPositions(q), JointVelocities(qd));
+///     in.addConstraint(model.segmentOfJoint().back(), alfa, beta);
+///     if (const Status s = solve(model, data, in); !s) handle(s.message());
+///     use(data.qdd(), data.commandTorques());
+///
+/// Real-time use: constructing a Data allocates everything; solve() and every accessor below
+/// allocate nothing. One Data per thread: a call entering a Data while another thread is inside
+/// one returns Error::ConcurrentCall and leaves it untouched.
 #pragma once
 
 #include <memory>
@@ -33,71 +34,72 @@ namespace detail {
 struct DataImpl;
 }  // namespace detail
 
-// Per joint after a solve with friction (friction_solver.hpp).
+/// Per joint after a solve with friction (friction_solver.hpp).
 enum class JointStatus : signed char { Moving = 0, Stick = 1, SlipPositive = 2, SlipNegative = 3 };
 
+/// Workspace and results of solves on one Model, one per thread (see the top of this file).
 class Data {
  public:
-  // Workspace for `model` with `options` (policy, rcond, damping, max_constraints; its
-  // inertia_check is the model's and is ignored here). status() reports invalid options or an
-  // invalid model.
+  /// Workspace for `model` with `options` (policy, rcond, damping, max_constraints; its
+  /// inertia_check is the model's and is ignored here). status() reports invalid options or an
+  /// invalid model.
   explicit Data(const Model& model, const SolverOptions& options = SolverOptions());
   ~Data();
-  Data(Data&&) noexcept;
-  Data& operator=(Data&&) noexcept;
+  Data(Data&&) noexcept;             ///< moves the workspace and results
+  Data& operator=(Data&&) noexcept;  ///< moves the workspace and results
   Data(const Data&) = delete;
   Data& operator=(const Data&) = delete;
 
-  Status status() const noexcept;
-  const SolverOptions& options() const noexcept;
-  // The workspace of the friction stage (n_joints^2 doubles, a few times over) is allocated at
-  // the first solve with input.friction set, so a frictionless Data stays O(n + m^2); call this
-  // once beforehand to keep that first friction solve allocation-free too.
+  Status status() const noexcept;                 ///< invalid options or model, else Error::None
+  const SolverOptions& options() const noexcept;  ///< the options given to the constructor
+  /// The workspace of the friction stage (n_joints^2 doubles, a few times over) is allocated at
+  /// the first solve with input.friction set, so a frictionless Data stays O(n + m^2); call this
+  /// once beforehand to keep that first friction solve allocation-free too.
   void reserveFriction();
-  // The model this Data was built for (solve() with another one: Error::NotUpToDate).
+  /// The model this Data was built for (solve() with another one: Error::NotUpToDate).
   const Model& model() const noexcept;
 
-  // Results of the last successful solve (unspecified before one).
+  /// Results of the last successful solve (unspecified before one).
   const Eigen::VectorXd& qdd() const noexcept;
-  const Eigen::VectorXd& commandTorques() const noexcept;
-  Eigen::Map<const Eigen::VectorXd> nu() const noexcept;  // input.columns(), the input's column order
-  int constraintRank() const noexcept;
-  double smallestSingularValue() const;  // computed on first request
-  // 6 x (n_segments + 1): column 0 the root acceleration, column i + 1 segment i's tip (base axes,
-  // tip origin, root acceleration included). Computed on first request.
+  const Eigen::VectorXd& commandTorques() const noexcept;  ///< tau_cmd (n_joints), hd_solver.hpp
+  Eigen::Map<const Eigen::VectorXd> nu() const noexcept;   ///< input.columns(), the input's column order
+  int constraintRank() const noexcept;                     ///< rank of the coupling matrix K, hd_solver.hpp
+  double smallestSingularValue() const;                    ///< computed on first request
+  /// 6 x (n_segments + 1): column 0 the root acceleration, column i + 1 segment i's tip (base axes,
+  /// tip origin, root acceleration included). Computed on first request.
   const Matrix6X& linkAccelerations() const;
-  // With friction (zero / Moving without): friction and limit torques, joint status, Gauss value.
+  /// With friction (zero / Moving without): friction and limit torques, joint status, Gauss value.
   const Eigen::VectorXd& frictionTorques() const noexcept;
-  const Eigen::VectorXd& limitTorques() const noexcept;
-  const std::vector<JointStatus>& jointStatus() const noexcept;
-  double gaussValue() const;  // NaN without a friction solve
-  int iterations() const noexcept;
+  const Eigen::VectorXd& limitTorques() const noexcept;          ///< joint limit reactions (n_joints)
+  const std::vector<JointStatus>& jointStatus() const noexcept;  ///< JointStatus of each joint
+  double gaussValue() const;                                     ///< NaN without a friction solve
+  int iterations() const noexcept;                               ///< active-set iterations of the friction solve
 
-  // Kinematics at the last solve's state, base axes (allocation-free, O(depth) per call):
-  // the pose of a frame in the base frame, its twist [linear velocity of its origin; angular],
-  // and its Jacobian (6 x n_joints, columns in joint order; twist = J q_dot).
+  /// Kinematics at the last solve's state, base axes (allocation-free, O(depth) per call):
+  /// the pose of a frame in the base frame, its twist [linear velocity of its origin; angular],
+  /// and its Jacobian (6 x n_joints, columns in joint order; twist = J q_dot).
   KDL::Frame framePose(const FrameRef& frame) const;
-  KDL::Twist frameTwist(const FrameRef& frame) const;
-  Status frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const;
+  KDL::Twist frameTwist(const FrameRef& frame) const;                                       ///< see framePose()
+  Status frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const;  ///< see framePose()
 
-  // Affine response to unit joint torques (hd_solver.hpp, "Affine structure"), after a solve.
+  /// Affine response to unit joint torques (hd_solver.hpp, "Affine structure"), after a solve.
   Status responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                          Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
-  // tau_cmd of given constraint magnitudes at the last solve's state.
+  /// tau_cmd of given constraint magnitudes at the last solve's state.
   Status commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
-  // out = H(q)^-1 tau at the last solve's q.
+  /// out = H(q)^-1 tau at the last solve's q.
   Status inverseInertiaTimes(const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> out);
 
-  detail::DataImpl& impl() noexcept { return *impl_; }
-  const detail::DataImpl& impl() const noexcept { return *impl_; }
+  detail::DataImpl& impl() noexcept { return *impl_; }              ///< the implementation (internal)
+  const detail::DataImpl& impl() const noexcept { return *impl_; }  ///< the implementation (internal)
 
  private:
   std::unique_ptr<detail::DataImpl> impl_;
 };
 
-// One solve: validates the input against the model (sizes, finite values, constraint and
-// friction ranges, with the messages of HdSolver and FrictionSolver), then runs the sweeps.
-// Results in data. Nothing of the input outlives the call.
+/// One solve: validates the input against the model (sizes, finite values, constraint and
+/// friction ranges, with the messages of HdSolver and FrictionSolver), then runs the sweeps.
+/// Results in data. Nothing of the input outlives the call.
 Status solve(const Model& model, Data& data, const SolveInput& input);
 
 }  // namespace vereshchagin

@@ -1,32 +1,33 @@
-// Rigid-body dynamics companions of the hybrid solver on a Model (model.hpp), for chains and trees
-// alike: inverse dynamics (recursive Newton-Euler), the joint-space mass matrix (composite rigid
-// bodies), gravity torques and Coriolis/centrifugal torques.
-//
-//     Model model(chain);
-//     DynamicsData dd(model);                       // once: allocates everything
-//     Eigen::VectorXd tau(model.nrOfJoints());
-//     gravityTorques(model, dd, JointPositions(q), KDL::Vector(0, 0, -9.81), tau);  // no allocation
-//
-// The equation of motion these functions split up is
-//     H(q) q_ddot + C(q, q_dot) q_dot + g(q) = tau + sum_i J_i(q)^T f_ext_i,
-// with, for every argument and result:
-//  * q, q_dot, q_ddot, tau: n_joints entries in the model's joint order (rad, rad/s, rad/s^2, N m;
-//    m, m/s, m/s^2, N for prismatic joints); tau is what the joint motors apply;
-//  * H (n_joints x n_joints, kg m^2 or kg): symmetric, rotor inertias KDL::Joint::getInertia() on
-//    the diagonal; entries of two joints on different branches (neither on the other's path to
-//    the base) are zero;
-//  * gravity: PHYSICAL gravity in base-frame axes, m/s^2 (Earth with z up: (0, 0, -9.81)),
-//    the convention of SolveInput::gravity; g(q) is the torque that holds the robot still
-//    against it (the base is treated as accelerating by -gravity);
-//  * f_ext: 6 x n_segments (or 6 x 0 for none), column i the wrench [force (N); moment (N m)] ON
-//    segment i BY the environment, base-frame axes, the moment about segment i's TIP ORIGIN (as
-//    SolveInput::f_ext); J_i is the Jacobian of segment i's tip origin (kinematics.hpp).
-//
-// After a call, dd.kinematics() holds the forward kinematics at q (and at q_dot for
-// inverseDynamics and coriolisTorques): framePose() etc. of kinematics.hpp can be asked of it.
-// Errors: NotUpToDate (dd built for another model), SizeMismatch (a vector, f_ext or the output
-// of the wrong size), NonfiniteInput (NaN or Inf in an input); the message lives in dd. Any Model
-// works, also one whose status() reports an inertia problem (the numbers are used as given).
+/// @file
+/// Rigid-body dynamics companions of the hybrid solver on a Model (model.hpp), for chains and trees
+/// alike: inverse dynamics (recursive Newton-Euler), the joint-space mass matrix (composite rigid
+/// bodies), gravity torques and Coriolis/centrifugal torques.
+///
+///     Model model(chain);
+///     DynamicsData dd(model);                       // once: allocates everything
+///     Eigen::VectorXd tau(model.nrOfJoints());
+///     gravityTorques(model, dd, JointPositions(q), KDL::Vector(0, 0, -9.81), tau);  // no allocation
+///
+/// The equation of motion these functions split up is
+///     H(q) q_ddot + C(q, q_dot) q_dot + g(q) = tau + sum_i J_i(q)^T f_ext_i,
+/// with, for every argument and result:
+///  * q, q_dot, q_ddot, tau: n_joints entries in the model's joint order (rad, rad/s, rad/s^2, N m;
+///    m, m/s, m/s^2, N for prismatic joints); tau is what the joint motors apply;
+///  * H (n_joints x n_joints, kg m^2 or kg): symmetric, rotor inertias KDL::Joint::getInertia() on
+///    the diagonal; entries of two joints on different branches (neither on the other's path to
+///    the base) are zero;
+///  * gravity: PHYSICAL gravity in base-frame axes, m/s^2 (Earth with z up: (0, 0, -9.81)),
+///    the convention of SolveInput::gravity; g(q) is the torque that holds the robot still
+///    against it (the base is treated as accelerating by -gravity);
+///  * f_ext: 6 x n_segments (or 6 x 0 for none), column i the wrench [force (N); moment (N m)] ON
+///    segment i BY the environment, base-frame axes, the moment about segment i's TIP ORIGIN (as
+///    SolveInput::f_ext); J_i is the Jacobian of segment i's tip origin (kinematics.hpp).
+///
+/// After a call, dd.kinematics() holds the forward kinematics at q (and at q_dot for
+/// inverseDynamics and coriolisTorques): framePose() etc. of kinematics.hpp can be asked of it.
+/// Errors: NotUpToDate (dd built for another model), SizeMismatch (a vector, f_ext or the output
+/// of the wrong size), NonfiniteInput (NaN or Inf in an input); the message lives in dd. Any Model
+/// works, also one whose status() reports an inertia problem (the numbers are used as given).
 #pragma once
 
 #include <memory>
@@ -42,48 +43,49 @@
 
 namespace vereshchagin {
 
-// q_ddot: rad/s^2 or m/s^2, n_joints (input.hpp's typed joint vectors).
+/// q_ddot: rad/s^2 or m/s^2, n_joints (input.hpp's typed joint vectors).
 using JointAccelerations = JointVector<struct JointAccelerationsTag>;
 
 namespace detail {
 struct DynamicsImpl;
 }  // namespace detail
 
+/// Workspace of the dynamics functions below on one Model, one per thread.
 class DynamicsData {
  public:
-  // Sized for `model` (allocates); every call below is allocation-free.
+  /// Sized for `model` (allocates); every call below is allocation-free.
   explicit DynamicsData(const Model& model);
   ~DynamicsData();
-  DynamicsData(DynamicsData&&) noexcept;
-  DynamicsData& operator=(DynamicsData&&) noexcept;
+  DynamicsData(DynamicsData&&) noexcept;             ///< moves the workspace
+  DynamicsData& operator=(DynamicsData&&) noexcept;  ///< moves the workspace
   DynamicsData(const DynamicsData&) = delete;
   DynamicsData& operator=(const DynamicsData&) = delete;
 
-  const Model& model() const noexcept;
-  // The kinematics of the last call's state (kinematics.hpp).
+  const Model& model() const noexcept;  ///< the model it was built for
+  /// The kinematics of the last call's state (kinematics.hpp).
   KinematicsData& kinematics() noexcept;
-  const KinematicsData& kinematics() const noexcept;
+  const KinematicsData& kinematics() const noexcept;  ///< see kinematics()
 
-  detail::DynamicsImpl& impl() noexcept { return *impl_; }
+  detail::DynamicsImpl& impl() noexcept { return *impl_; }  ///< the implementation (internal)
 
  private:
   std::unique_ptr<detail::DynamicsImpl> impl_;
 };
 
-// tau = H q_ddot + C q_dot + g - sum_i J_i^T f_ext_i (recursive Newton-Euler). f_ext: 6 x n_segments
-// or 6 x 0; tau: n_joints (written).
+/// tau = H q_ddot + C q_dot + g - sum_i J_i^T f_ext_i (recursive Newton-Euler). f_ext: 6 x n_segments
+/// or 6 x 0; tau: n_joints (written).
 Status inverseDynamics(const Model& model, DynamicsData& ddata, const JointPositions& q, const JointVelocities& q_dot,
                        const JointAccelerations& q_ddot, const Eigen::Ref<const Matrix6X>& f_ext,
                        const KDL::Vector& gravity, Eigen::Ref<Eigen::VectorXd> tau);
 
-// H(q), n_joints x n_joints (written in full, both triangles).
+/// H(q), n_joints x n_joints (written in full, both triangles).
 Status massMatrix(const Model& model, DynamicsData& ddata, const JointPositions& q, Eigen::Ref<Eigen::MatrixXd> H);
 
-// g(q) for physical gravity `gravity` (base axes, m/s^2): tau = g(q) holds the robot still.
+/// g(q) for physical gravity `gravity` (base axes, m/s^2): tau = g(q) holds the robot still.
 Status gravityTorques(const Model& model, DynamicsData& ddata, const JointPositions& q, const KDL::Vector& gravity,
                       Eigen::Ref<Eigen::VectorXd> tau);
 
-// C(q, q_dot) q_dot: the Coriolis and centrifugal torques (no gravity, q_ddot = 0).
+/// C(q, q_dot) q_dot: the Coriolis and centrifugal torques (no gravity, q_ddot = 0).
 Status coriolisTorques(const Model& model, DynamicsData& ddata, const JointPositions& q, const JointVelocities& q_dot,
                        Eigen::Ref<Eigen::VectorXd> tau);
 

@@ -1,21 +1,23 @@
-// Joint friction and limits of a solve with static friction (friction_solver.hpp has the
-// problem, the method and the outputs; docs/friction.md the math). Units: N m or N, rad or m.
+/// @file
+/// Joint friction and limits of a solve with static friction (friction_solver.hpp has the
+/// problem, the method and the outputs; docs/friction.md the math). Units: N m or N, rad or m.
 #pragma once
 
 #include <Eigen/Core>
 
 namespace vereshchagin {
 
+/// Friction (and joint limit) parameters of one FrictionSolver::solve() call.
 struct FrictionModel {
-  Eigen::VectorXd static_friction;   // f_j >= 0 per joint (N m or N)
-  Eigen::VectorXd kinetic_friction;  // 0 <= fk_j <= f_j per joint; empty: equal to static_friction
-  double velocity_tolerance = 1e-6;  // |qd_j| at or below this: the joint is at rest
-  // Joint position limits (Vukcevic 2018, sec. 5.2: a second dissipative force). A joint at rest
-  // with q_j <= lower_j + limit_tolerance (or >= upper_j - limit_tolerance) gets, in the same
-  // optimisation, a one-sided reaction that stops it from moving further into the limit (no
-  // bound on its size). Empty vectors: no limits; +-infinity entries: no limit on that side.
-  Eigen::VectorXd lower, upper;
-  double limit_tolerance = 1e-9;
+  Eigen::VectorXd static_friction;   ///< f_j >= 0 per joint (N m or N)
+  Eigen::VectorXd kinetic_friction;  ///< 0 <= fk_j <= f_j per joint; empty: equal to static_friction
+  double velocity_tolerance = 1e-6;  ///< |qd_j| at or below this: the joint is at rest
+  /// Joint position limits (Vukcevic 2018, sec. 5.2: a second dissipative force). A joint at rest
+  /// with q_j <= lower_j + limit_tolerance (or >= upper_j - limit_tolerance) gets, in the same
+  /// optimisation, a one-sided reaction that stops it from moving further into the limit (no
+  /// bound on its size). Empty vectors: no limits; +-infinity entries: no limit on that side.
+  Eigen::VectorXd lower, upper;   ///< lower and upper joint position limits (rad or m)
+  double limit_tolerance = 1e-9;  ///< distance (rad or m) from a limit at which a joint counts as on it
 };
 
 }  // namespace vereshchagin

@@ -1,11 +1,12 @@
-// Everything one solve reads (solve() in data.hpp), as one plain value: the joint state, the
-// constraints, the wrenches, the feed-forward torques, friction and gravity. Frames, signs and
-// units are those of hd_solver.hpp unless stated here.
-//
-// A SolveInput is sized for its model once (construction allocates; reserve() more constraint
-// blocks or link wrenches up front); filling it afterwards allocates nothing, so a control loop
-// keeps one and rewrites it. clear() resets everything but the state and gravity. Nothing in it
-// is kept by the solve: the next solve reads only the input it is given.
+/// @file
+/// Everything one solve reads (solve() in data.hpp), as one plain value: the joint state, the
+/// constraints, the wrenches, the feed-forward torques, friction and gravity. Frames, signs and
+/// units are those of hd_solver.hpp unless stated here.
+///
+/// A SolveInput is sized for its model once (construction allocates; reserve() more constraint
+/// blocks or link wrenches up front); filling it afterwards allocates nothing, so a control loop
+/// keeps one and rewrites it. clear() resets everything but the state and gravity. Nothing in it
+/// is kept by the solve: the next solve reads only the input it is given.
 #pragma once
 
 #include <vector>
@@ -19,83 +20,89 @@
 
 namespace vereshchagin {
 
-// Typed joint vectors: a function that takes (JointPositions, JointVelocities) does not compile
-// with the two swapped. Each wraps a reference to the caller's vector (no copy).
+/// Typed joint vectors: a function that takes (JointPositions, JointVelocities) does not compile
+/// with the two swapped. Each wraps a reference to the caller's vector (no copy).
 template <typename Tag>
 class JointVector {
  public:
+  /// Wraps a reference to v (which must outlive this object).
   explicit JointVector(const Eigen::Ref<const Eigen::VectorXd>& v) : v_(v) {}
-  const Eigen::Ref<const Eigen::VectorXd>& operator*() const { return v_; }
-  const Eigen::Ref<const Eigen::VectorXd>& value() const { return v_; }
+  const Eigen::Ref<const Eigen::VectorXd>& operator*() const { return v_; }  ///< the wrapped vector
+  const Eigen::Ref<const Eigen::VectorXd>& value() const { return v_; }      ///< the wrapped vector
 
  private:
   Eigen::Ref<const Eigen::VectorXd> v_;
 };
-using JointPositions = JointVector<struct JointPositionsTag>;    // q: rad or m, n_joints
-using JointVelocities = JointVector<struct JointVelocitiesTag>;  // q_dot: rad/s or m/s, n_joints
-using JointTorques = JointVector<struct JointTorquesTag>;        // N m or N, n_joints
+using JointPositions = JointVector<struct JointPositionsTag>;    ///< q: rad or m, n_joints
+using JointVelocities = JointVector<struct JointVelocitiesTag>;  ///< q_dot: rad/s or m/s, n_joints
+using JointTorques = JointVector<struct JointTorquesTag>;        ///< N m or N, n_joints
 
-// Up to 6 constraint columns on one frame moving with a segment.
+/// Up to 6 constraint columns on one frame moving with a segment.
 struct ConstraintBlock {
-  int segment = -1;  // the segment the columns act on (segment order)
-  int columns = 0;   // 0..6: how many of the columns below are used
-  // Column c < columns: a unit constraint wrench [force; moment], base axes, the moment about
-  // `point`; beta(c) = alfa.col(c)^T Xdd_point (Xdd: the frame's spatial acceleration in base
-  // axes about `point`, root acceleration -gravity included, as hd_solver.hpp).
+  int segment = -1;  ///< the segment the columns act on (segment order)
+  int columns = 0;   ///< 0..6: how many of the columns below are used
+  /// Column c < columns: a unit constraint wrench [force; moment], base axes, the moment about
+  /// `point`; beta(c) = alfa.col(c)^T Xdd_point (Xdd: the frame's spatial acceleration in base
+  /// axes about `point`, root acceleration -gravity included, as hd_solver.hpp).
   Eigen::Matrix<double, 6, 6> alfa = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> beta = Eigen::Matrix<double, 6, 1>::Zero();
-  // The frame's origin in the segment's tip frame (a merged link or a tool frame; zero: the tip).
+  Eigen::Matrix<double, 6, 1> beta = Eigen::Matrix<double, 6, 1>::Zero();  ///< beta(c) of column c (see alfa)
+  /// The frame's origin in the segment's tip frame (a merged link or a tool frame; zero: the tip).
   Vector3 point = Vector3::Zero();
-  // Driver pass-through per column (hd_solver.hpp, "Driver pass-through"), each in [0, 1].
+  /// Driver pass-through per column (hd_solver.hpp, "Driver pass-through"), each in [0, 1].
   Eigen::Matrix<double, 6, 1> f_ext_pass_through = Eigen::Matrix<double, 6, 1>::Zero();
-  Eigen::Matrix<double, 6, 1> ff_pass_through = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> ff_pass_through = Eigen::Matrix<double, 6, 1>::Zero();  ///< see f_ext_pass_through
 };
 
-// A wrench on a frame moving with a segment, added to f_ext.
+/// A wrench on a frame moving with a segment, added to f_ext.
 struct FrameWrench {
-  int segment = -1;
-  Vector6 wrench = Vector6::Zero();  // [force; moment] ON the body BY the environment, base axes, moment about `point`
-  Vector3 point = Vector3::Zero();   // the frame's origin in the segment's tip frame
+  int segment = -1;  ///< the segment the frame moves with (segment order)
+  Vector6 wrench =
+      Vector6::Zero();              ///< [force; moment] ON the body BY the environment, base axes, moment about `point`
+  Vector3 point = Vector3::Zero();  ///< the frame's origin in the segment's tip frame
 };
 
+/// Everything one solve reads (see the top of this file).
 struct SolveInput {
-  // Sized for `model`: q, q_dot, ff_torques zero (n_joints), f_ext zero (6 x n_segments), room
-  // for `blocks` constraint blocks and `wrenches` frame wrenches without allocating.
+  /// Sized for `model`: q, q_dot, ff_torques zero (n_joints), f_ext zero (6 x n_segments), room
+  /// for `blocks` constraint blocks and `wrenches` frame wrenches without allocating.
   explicit SolveInput(const Model& model, int blocks = 8, int wrenches = 8);
 
-  Eigen::VectorXd q, q_dot;  // n_joints
-  // Wrench on each segment BY the environment (6 x n_segments): base axes, moment about the
-  // segment's tip origin. Gravity does not go here.
+  /// Joint positions q (rad or m) and velocities q_dot (rad/s or m/s).
+  Eigen::VectorXd q, q_dot;  ///< n_joints
+  /// Wrench on each segment BY the environment (6 x n_segments): base axes, moment about the
+  /// segment's tip origin. Gravity does not go here.
   Matrix6X f_ext;
-  std::vector<FrameWrench> wrenches;         // more wrenches, on any frame (added to f_ext)
-  Eigen::VectorXd ff_torques;                // n_joints, added as-is
-  std::vector<ConstraintBlock> constraints;  // the columns of nu, in this order
-  // Static friction, kinetic friction and joint limits (friction_solver.hpp); nullptr: none.
-  // Not owned: it must outlive the solve.
+  std::vector<FrameWrench> wrenches;         ///< more wrenches, on any frame (added to f_ext)
+  Eigen::VectorXd ff_torques;                ///< n_joints, added as-is
+  std::vector<ConstraintBlock> constraints;  ///< the columns of nu, in this order
+  /// Static friction, kinetic friction and joint limits (friction_solver.hpp); nullptr: none.
+  /// Not owned: it must outlive the solve.
   const FrictionModel* friction = nullptr;
-  // Physical gravity, base axes, m/s^2 (Earth with z up: (0, 0, -9.81)), and the base's own
-  // commanded spatial acceleration [linear; angular] (base axes, base origin; zero: a fixed
-  // base). The solver's root acceleration is base_acceleration - [gravity; 0].
+  /// Physical gravity, base axes, m/s^2 (Earth with z up: (0, 0, -9.81)), and the base's own
+  /// commanded spatial acceleration [linear; angular] (base axes, base origin; zero: a fixed
+  /// base). The solver's root acceleration is base_acceleration - [gravity; 0].
   KDL::Vector gravity = KDL::Vector(0.0, 0.0, -9.81);
-  KDL::Twist base_acceleration = KDL::Twist::Zero();
+  KDL::Twist base_acceleration = KDL::Twist::Zero();  ///< see gravity
 
+  /// q = q_in, q_dot = q_dot_in.
   void setState(const JointPositions& q_in, const JointVelocities& q_dot_in);
-  // Appends a block (no allocation within reserve()); Error::SizeMismatch for more than 6 columns
-  // or a beta of another length, Error::OutOfRange for a segment outside the model.
+  /// Appends a block (no allocation within reserve()); Error::SizeMismatch for more than 6 columns
+  /// or a beta of another length, Error::OutOfRange for a segment outside the model.
   Status addConstraint(int segment, const Eigen::Ref<const Eigen::MatrixXd>& alfa,
                        const Eigen::Ref<const Eigen::VectorXd>& beta, const Vector3& point = Vector3::Zero());
-  // The same on a frame resolved by Model::findFrame (its offset gives `point`; its orientation
-  // does not matter: alfa is in base axes).
+  /// The same on a frame resolved by Model::findFrame (its offset gives `point`; its orientation
+  /// does not matter: alfa is in base axes).
   Status addConstraint(const FrameRef& frame, const Eigen::Ref<const Eigen::MatrixXd>& alfa,
                        const Eigen::Ref<const Eigen::VectorXd>& beta);
-  // Adds a wrench on a frame (its offset gives `point`); Error::OutOfRange for the base
-  // (segment -1: nothing moves it) or a segment outside the model.
+  /// Adds a wrench on a frame (its offset gives `point`); Error::OutOfRange for the base
+  /// (segment -1: nothing moves it) or a segment outside the model.
   Status addWrench(const FrameRef& frame, const Vector6& wrench);
-  // Constraint columns in all (the size of nu).
+  /// Constraint columns in all (the size of nu).
   int columns() const;
-  // Zero f_ext and ff_torques, no constraints, frame wrenches or friction; keeps q, q_dot,
-  // gravity, base_acceleration and all capacity.
+  /// Zero f_ext and ff_torques, no constraints, frame wrenches or friction; keeps q, q_dot,
+  /// gravity, base_acceleration and all capacity.
   void clear();
+  /// Room for `blocks` constraint blocks and `wrenches` frame wrenches (allocates now, not later).
   void reserve(int blocks, int wrenches);
 
  private:

@@ -1,9 +1,10 @@
-// Small spatial-vector algebra on fixed-size Eigen types, used by the solver's sweeps.
-//
-// Conventions (same as KDL): a motion vector (twist, spatial acceleration) is [linear; angular],
-// a force vector (wrench) is [force; moment]; both are expressed in some frame and refer to that
-// frame's origin. A `Pose` {R, p} is the pose of a child frame in its parent frame: R has the
-// child's axes as columns (parent coordinates), p is the child's origin in parent coordinates.
+/// @file
+/// Small spatial-vector algebra on fixed-size Eigen types, used by the solver's sweeps.
+///
+/// Conventions (same as KDL): a motion vector (twist, spatial acceleration) is [linear; angular],
+/// a force vector (wrench) is [force; moment]; both are expressed in some frame and refer to that
+/// frame's origin. A `Pose` {R, p} is the pose of a child frame in its parent frame: R has the
+/// child's axes as columns (parent coordinates), p is the child's origin in parent coordinates.
 #pragma once
 
 #include <Eigen/Core>
@@ -11,25 +12,27 @@
 
 namespace vereshchagin {
 
-using Vector3 = Eigen::Matrix<double, 3, 1>;
-using Vector6 = Eigen::Matrix<double, 6, 1>;
-using Matrix3 = Eigen::Matrix<double, 3, 3>;
-using Matrix6 = Eigen::Matrix<double, 6, 6>;
-using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // one spatial vector per column
+using Vector3 = Eigen::Matrix<double, 3, 1>;                ///< a 3-vector
+using Vector6 = Eigen::Matrix<double, 6, 1>;                ///< a spatial vector
+using Matrix3 = Eigen::Matrix<double, 3, 3>;                ///< a 3x3 matrix
+using Matrix6 = Eigen::Matrix<double, 6, 6>;                ///< a spatial (6x6) matrix
+using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;  ///< one spatial vector per column
 
+/// The pose {R, p} of a child frame in its parent frame (see the top of this file).
 struct Pose {
-  Matrix3 R = Matrix3::Identity();
-  Vector3 p = Vector3::Zero();
+  Matrix3 R = Matrix3::Identity();  ///< the child's axes as columns, parent coordinates
+  Vector3 p = Vector3::Zero();      ///< the child's origin, parent coordinates
 };
 
+/// The cross-product matrix [a]x: skew(a) b = a x b.
 inline Matrix3 skew(const Vector3& a) {
   Matrix3 s;
   s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
   return s;
 }
 
-// Motion vector given in the parent frame -> the same motion in the child frame.
-// w' = R^T w, v' = R^T (v - p x w).
+/// Motion vector given in the parent frame -> the same motion in the child frame.
+/// w' = R^T w, v' = R^T (v - p x w).
 template <typename In>
 inline Vector6 motionToChild(const Pose& X, const Eigen::MatrixBase<In>& m) {
   Vector6 out;
@@ -39,8 +42,8 @@ inline Vector6 motionToChild(const Pose& X, const Eigen::MatrixBase<In>& m) {
   return out;
 }
 
-// Force vector given in the child frame -> the same force in the parent frame, as its two
-// halves: f = R f', n = R n' + p x (R f').
+/// Force vector given in the child frame -> the same force in the parent frame, as its two
+/// halves: f = R f', n = R n' + p x (R f').
 template <typename In>
 inline void forceHalvesToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child, Vector3& f, Vector3& n) {
   f.noalias() = X.R * f_child.template head<3>();
@@ -48,6 +51,7 @@ inline void forceHalvesToParent(const Pose& X, const Eigen::MatrixBase<In>& f_ch
   n += X.p.cross(f);
 }
 
+/// Force vector given in the child frame -> the same force in the parent frame (forceHalvesToParent()).
 template <typename In>
 inline Vector6 forceToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child) {
   Vector3 f, n;
@@ -57,10 +61,10 @@ inline Vector6 forceToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child
   return out;
 }
 
-// The same transform written in place (f_io holds f' on entry, f on return), and added to an
-// accumulator (out += X^* f'). Both write the two 3-vector halves straight into their
-// destination: a returned 6-vector assembled from halves and read back as 2-wide packets makes
-// the processor wait on store forwarding, which cost half the time of the column loop.
+/// The same transform written in place (f_io holds f' on entry, f on return), and added to an
+/// accumulator (out += X^* f'). Both write the two 3-vector halves straight into their
+/// destination: a returned 6-vector assembled from halves and read back as 2-wide packets makes
+/// the processor wait on store forwarding, which cost half the time of the column loop.
 template <typename Io>
 inline void forceToParentInPlace(const Pose& X, Eigen::MatrixBase<Io>& f_io) {
   Vector3 f, n;
@@ -69,6 +73,7 @@ inline void forceToParentInPlace(const Pose& X, Eigen::MatrixBase<Io>& f_io) {
   f_io.template tail<3>() = n;
 }
 
+/// out += the force f_child (child frame) in the parent frame (see forceToParentInPlace()).
 template <typename In, typename Out>
 inline void addForceToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child, Eigen::MatrixBase<Out>& out) {
   Vector3 f, n;
@@ -77,7 +82,7 @@ inline void addForceToParent(const Pose& X, const Eigen::MatrixBase<In>& f_child
   out.template tail<3>() += n;
 }
 
-// Spatial cross product for motions: m1 x m2.
+/// Spatial cross product for motions: m1 x m2.
 inline Vector6 crossMotion(const Vector6& a, const Vector6& b) {
   Vector6 out;
   const Vector3 av = a.head<3>(), aw = a.tail<3>();
@@ -86,7 +91,7 @@ inline Vector6 crossMotion(const Vector6& a, const Vector6& b) {
   return out;
 }
 
-// Spatial cross product motion x* force.
+/// Spatial cross product motion x* force.
 inline Vector6 crossForce(const Vector6& a, const Vector6& f) {
   Vector6 out;
   const Vector3 av = a.head<3>(), aw = a.tail<3>();
@@ -95,10 +100,10 @@ inline Vector6 crossForce(const Vector6& a, const Vector6& f) {
   return out;
 }
 
-// Products with P = [p]x written as cross products: column j of P A is p x (column j of A), row
-// i of A P is (row i of A) x p. Each entry is then the same two products and one difference as
-// in the dense 3x3 product with P, whose third term is an exact zero (x + 0 = x), so the results
-// are bit for bit those of the dense product at a third fewer operations.
+/// Products with P = [p]x written as cross products: column j of P A is p x (column j of A), row
+/// i of A P is (row i of A) x p. Each entry is then the same two products and one difference as
+/// in the dense 3x3 product with P, whose third term is an exact zero (x + 0 = x), so the results
+/// are bit for bit those of the dense product at a third fewer operations.
 inline Matrix3 skewTimes(const Vector3& p, const Matrix3& A) {  // [p]x A
   Matrix3 out;
   for (int j = 0; j < 3; ++j) {
@@ -109,6 +114,7 @@ inline Matrix3 skewTimes(const Vector3& p, const Matrix3& A) {  // [p]x A
   return out;
 }
 
+/// A [p]x, bit for bit the dense product (see skewTimes()).
 template <typename M>  // any 3x3 expression, e.g. a transpose, read in place
 inline Matrix3 timesSkew(const Eigen::MatrixBase<M>& A, const Vector3& p) {  // A [p]x
   Matrix3 out;
@@ -120,10 +126,10 @@ inline Matrix3 timesSkew(const Eigen::MatrixBase<M>& A, const Vector3& p) {  // 
   return out;
 }
 
-// A symmetric 6x6 inertia (rigid or articulated) given in the child frame, expressed in the
-// parent frame: X^* I X with X the parent-to-child motion transform. Block form with
-// I = [M H; H^T J]: rotate every block by R, then shift the reference point by p (P = [p]x):
-// M' = M, H' = H - M P, J' = J - H^T P + P H - P M P.
+/// A symmetric 6x6 inertia (rigid or articulated) given in the child frame, expressed in the
+/// parent frame: X^* I X with X the parent-to-child motion transform. Block form with
+/// I = [M H; H^T J]: rotate every block by R, then shift the reference point by p (P = [p]x):
+/// M' = M, H' = H - M P, J' = J - H^T P + P H - P M P.
 inline void addInertiaToParent(const Pose& X, const Matrix6& Ic, Matrix6& Ip) {
   const Matrix3& R = X.R;
   const Matrix3 M = R * Ic.topLeftCorner<3, 3>() * R.transpose();
@@ -139,8 +145,8 @@ inline void addInertiaToParent(const Pose& X, const Matrix6& Ic, Matrix6& Ip) {
   Ip.bottomRightCorner<3, 3>() += J2;
 }
 
-// Rigid-body inertia about a frame origin, from mass m, centre of mass c and rotational inertia
-// Io about the frame origin (all in that frame): [m 1, -m [c]x; m [c]x, Io].
+/// Rigid-body inertia about a frame origin, from mass m, centre of mass c and rotational inertia
+/// Io about the frame origin (all in that frame): [m 1, -m [c]x; m [c]x, Io].
 inline Matrix6 rigidInertia(double m, const Vector3& c, const Matrix3& Io) {
   Matrix6 I;
   const Matrix3 mc = m * skew(c);

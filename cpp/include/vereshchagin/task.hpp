@@ -1,13 +1,14 @@
-// Task-space helpers for stating constraints in the solver's terms: the solver constrains
-// alfa^T Xdd = beta with Xdd a frame's SPATIAL acceleration (base axes, about the frame's origin,
-// root acceleration -gravity included: hd_solver.hpp, input.hpp's ConstraintBlock), while
-// controllers think in the CLASSICAL acceleration of the frame's origin and in pose errors.
-//
-// Units and frames of every argument: base-frame axes; [linear; angular] 6-vectors; a twist is
-// [velocity of the frame's origin (m/s); angular velocity (rad/s)]; a classical acceleration is
-// [second time derivative of the origin's position (m/s^2); angular acceleration (rad/s^2)];
-// gravity is PHYSICAL gravity (m/s^2, Earth with z up: (0, 0, -9.81)), as SolveInput::gravity,
-// with a fixed base (SolveInput::base_acceleration zero).
+/// @file
+/// Task-space helpers for stating constraints in the solver's terms: the solver constrains
+/// alfa^T Xdd = beta with Xdd a frame's SPATIAL acceleration (base axes, about the frame's origin,
+/// root acceleration -gravity included: hd_solver.hpp, input.hpp's ConstraintBlock), while
+/// controllers think in the CLASSICAL acceleration of the frame's origin and in pose errors.
+///
+/// Units and frames of every argument: base-frame axes; [linear; angular] 6-vectors; a twist is
+/// [velocity of the frame's origin (m/s); angular velocity (rad/s)]; a classical acceleration is
+/// [second time derivative of the origin's position (m/s^2); angular acceleration (rad/s^2)];
+/// gravity is PHYSICAL gravity (m/s^2, Earth with z up: (0, 0, -9.81)), as SolveInput::gravity,
+/// with a fixed base (SolveInput::base_acceleration zero).
 #pragma once
 
 #include <Eigen/Core>
@@ -20,30 +21,30 @@
 
 namespace vereshchagin {
 
-// The spatial acceleration the solver sees for a desired classical one:
-//     [a_lin - omega x v - gravity; a_ang].
-// (The linear part of a spatial acceleration is that of the body point passing through the
-// origin at this instant, a_classical - omega x v; the solver's base accelerates by -gravity.)
+/// The spatial acceleration the solver sees for a desired classical one:
+///     [a_lin - omega x v - gravity; a_ang].
+/// (The linear part of a spatial acceleration is that of the body point passing through the
+/// origin at this instant, a_classical - omega x v; the solver's base accelerates by -gravity.)
 Vector6 spatialFromClassical(const Vector6& classical, const Vector6& twist, const KDL::Vector& gravity);
 
-// beta (m) = alfa^T spatialFromClassical(classical, twist, gravity) for alfa 6 x m (unit wrenches
-// [force; moment about the frame's origin], base axes). Holding a frame still needs
-// beta = alfa^T [-omega x v - gravity; 0], not zero.
+/// beta (m) = alfa^T spatialFromClassical(classical, twist, gravity) for alfa 6 x m (unit wrenches
+/// [force; moment about the frame's origin], base axes). Holding a frame still needs
+/// beta = alfa^T [-omega x v - gravity; 0], not zero.
 void betaFromClassical(const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Vector6& classical, const Vector6& twist,
                        const KDL::Vector& gravity, Eigen::Ref<Eigen::VectorXd> beta);
 
-// The same with the frame's twist from kdata (forwardKinematics with q_dot first). Errors: those
-// of frameTwist (kinematics.hpp), SizeMismatch for alfa not 6 x m or beta not m long.
+/// The same with the frame's twist from kdata (forwardKinematics with q_dot first). Errors: those
+/// of frameTwist (kinematics.hpp), SizeMismatch for alfa not 6 x m or beta not m long.
 Status betaForFrame(const Model& model, KinematicsData& kdata, const FrameRef& frame,
                     const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Vector6& classical, const KDL::Vector& gravity,
                     Eigen::Ref<Eigen::VectorXd> beta);
 
-// Pose error [p_d - p_c (m); axis * angle of R_d R_c^T (rad, angle in [0, pi])], base axes: the
-// rotation that turns the current orientation into the desired one (KDL's diff(current, desired)),
-// via a unit quaternion, accurate near 0 and pi.
+/// Pose error [p_d - p_c (m); axis * angle of R_d R_c^T (rad, angle in [0, pi])], base axes: the
+/// rotation that turns the current orientation into the desired one (KDL's diff(current, desired)),
+/// via a unit quaternion, accurate near 0 and pi.
 Vector6 poseError(const KDL::Frame& current, const KDL::Frame& desired);
 
-// Twist error desired - current (both [v; omega], base axes).
+/// Twist error desired - current (both [v; omega], base axes).
 inline Vector6 twistError(const Vector6& current, const Vector6& desired) {
   return desired - current;
 }
