@@ -45,6 +45,10 @@ Status Data::status() const noexcept {
 const SolverOptions& Data::options() const noexcept {
   return impl_->core.options;
 }
+
+int Data::maxConstraints() const noexcept {
+  return impl_->core.mcap;
+}
 void Data::reserveFriction() {
   impl_->friction();
 }

@@ -1,6 +1,6 @@
-// One solve's worth of C++ state for the Python Solver: a solver of the chain or tree (HdSolver),
-// a FrictionSolver and the buffers that turn numpy rows into their inputs. Solver.solve uses engine 0; solve_batch
-// gives each thread its own engine, so every row runs the same code as a single solve.
+// One solve's worth of C++ state for the Python Solver: a Data and a SolveInput on the solver's
+// Model. Solver.solve uses engine 0; solve_batch gives each thread its own engine, so every row
+// runs the same code as a single solve.
 #pragma once
 
 #include <memory>
@@ -13,8 +13,8 @@
 #include <kdl/tree.hpp>
 
 #include "vereshchagin/chain_hd_solver.hpp"
+#include "vereshchagin/data.hpp"
 #include "vereshchagin/friction_solver.hpp"
-#include "vereshchagin/tree_hd_solver.hpp"
 
 namespace vsbind {
 
@@ -59,67 +59,36 @@ struct RowInputs {
   const double* tau_ff_pass_through = nullptr;
 };
 
-// The robot of a solver: a chain, or the tree below its root segment (segment order: preorder,
-// robot_tree.hpp).
-struct EngineModel {
-  const KDL::Chain* chain = nullptr;
-  const KDL::Tree* tree = nullptr;
-  std::string root;  // the tree's root segment (the base)
-};
-
-// Pose of a segment's tip in the base frame from the segments and the parent array (for moving
-// moments from merged links to tips before a solve); no allocation per call.
-class SegmentKinematics {
- public:
-  // solver: the engine's solver of `model` (its segment order and parents).
-  SegmentKinematics(const EngineModel& model, const vereshchagin::HdSolver& solver);
-  KDL::Rotation tipRotation(int segment, const double* q) const;
-
- private:
-  std::vector<KDL::Segment> segments_;
-  std::vector<int> parent_, q_index_;  // q_index_: -1 for a fixed joint
-};
-
+// One row's solve on a Data of the solver's shared Model: RowInputs are copied into a SolveInput
+// (constraint blocks with their points and pass-through weights, frame wrenches, friction) and
+// solve(model, data, input) does the rest. No algorithm here.
 class Engine {
  public:
-  Engine(const EngineModel& model, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt);
+  Engine(const vereshchagin::Model& model, const KDL::Vector& gravity, const vereshchagin::SolverOptions& opt);
 
   // Solves one row; returns 0 or the C++ error code (message in errorMessage()).
   int run(const RowInputs& in);
-  // run() with the row's pass-through weights set for this solve only.
-  int runWeighted(const RowInputs& in);
-  const char* errorMessage() const;
-  void setGravity(const KDL::Vector& gravity);
+  const char* errorMessage() const { return message_; }
+  void setGravity(const KDL::Vector& gravity) { input_.gravity = gravity; }
 
   // Results of the last run(), in the numpy layouts of SolveResult.
   int columns() const { return columns_; }
   void writeCore(double* qdd, double* tau_cmd, double* nu, double* link_acc, int* rank, double* smin);
   void writeFriction(double* friction_torque, double* limit_torque, int* status, double* gauss, int* iterations);
   bool lastHadFriction() const { return last_friction_; }
-  vereshchagin::HdSolver& answered() { return last_friction_ ? friction_->hdSolver() : *hd_; }
-  vereshchagin::FrictionSolver& frictionSolver();  // built at first use
+  vereshchagin::Data& data() { return data_; }
 
   unsigned int nj, ns;
 
  private:
-  void assembleColumns(const RowInputs& in);
-  const double* assembleExternal(const RowInputs& in);
-  KDL::Vector tipOffsetInBase(int segment, const KDL::Vector& offset) const;
+  void fillInput(const RowInputs& in);
 
-  EngineModel model_;  // pointers into the PySolver's model, which outlives its engines
-  KDL::Vector gravity_;
-  vereshchagin::SolverOptions options_;
-  std::unique_ptr<vereshchagin::HdSolver> hd_;
-  std::unique_ptr<vereshchagin::FrictionSolver> friction_;  // nullptr until a friction-aware solve
-  SegmentKinematics kinematics_;
-  const double* q_ = nullptr;     // the row being solved
-  ChainHdSolver::Matrix6X alfa_;  // constraint columns of a solve (6 x maxConstraints())
-  Eigen::VectorXd beta_;
-  Eigen::VectorXi segs_;
-  ChainHdSolver::Matrix6X fext_;  // f_ext when wrenches on merged links must be added
+  vereshchagin::Model model_;  // shared with the solver's other engines
+  vereshchagin::Data data_;
+  vereshchagin::SolveInput input_;
+  const char* message_ = "";
   int columns_ = 0;
   bool last_friction_ = false;
-  bool last_general_ = false;
 };
 
 }  // namespace vsbind

@@ -133,7 +133,7 @@ class PySolver {
   std::unique_ptr<PyChain> chain_;  // the model: one of these two
   std::unique_ptr<PyTree> tree_;
   const Addressable* model_ = nullptr;
-  EngineModel engine_model_;
+  vereshchagin::Model cpp_model_;  // shared by the engines
   KDL::Vector gravity_;
   vereshchagin::SolverOptions options_;
   py::object damping_arg_;

@@ -19,12 +19,9 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
   if (py::isinstance<PyChain>(model)) {
     chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
     model_ = chain_.get();
-    engine_model_.chain = &chain_->robot.chain;
   } else if (py::isinstance<PyTree>(model)) {
     tree_ = std::make_unique<PyTree>(model.cast<const PyTree&>());
     model_ = tree_.get();
-    engine_model_.tree = &tree_->robot.tree;
-    engine_model_.root = tree_->robot.root_link;
   } else {
     throw py::type_error("Solver(model): model must be a vereshchagin.Chain or vereshchagin.Tree, got " +
                          std::string(Py_TYPE(model.ptr())->tp_name));
@@ -49,14 +46,17 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
     options_.max_constraints = static_cast<int>(*value);
   }
   gravity_ = vec3(gravity, "gravity");
-  auto probe = std::make_unique<Engine>(engine_model_, gravity_, options_);
-  const vereshchagin::HdSolver& hd = probe->answered();
-  if (hd.modelError() != ChainHdSolver::E_NOERROR)
-    raise(std::string(tree_ ? "invalid tree: " : "invalid chain: ") + hd.errorMessage());
+  const vereshchagin::ModelOptions model_options{options_.inertia_check};
+  cpp_model_ = tree_ ? vereshchagin::Model(tree_->robot.tree, tree_->robot.root_link, model_options)
+                     : vereshchagin::Model(chain_->robot.chain, model_options);
+  const char* invalid = tree_ ? "invalid tree: " : "invalid chain: ";
+  if (const vereshchagin::Status s = cpp_model_.status(); !s) raise(invalid + std::string(s.message()));
+  auto probe = std::make_unique<Engine>(cpp_model_, gravity_, options_);
+  if (const vereshchagin::Status s = probe->data().status(); !s) raise(invalid + std::string(s.message()));
+  max_columns_ = probe->data().maxConstraints();
   engines_.push_back(std::move(probe));
-  nj = hd.nrOfJoints();
-  ns = hd.nrOfSegments();
-  max_columns_ = hd.maxConstraints();
+  nj = cpp_model_.nrOfJoints();
+  ns = cpp_model_.nrOfSegments();
   const std::vector<vereshchagin::JointInfo>& joints = model_->jointInfos();
   const auto n = static_cast<Eigen::Index>(joints.size());
   chain_friction_.static_friction = chain_friction_.lower = chain_friction_.upper = Eigen::VectorXd::Zero(n);
@@ -85,7 +85,7 @@ PySolver::Lock::~Lock() {
 }
 
 Engine& PySolver::engine(std::size_t k) {
-  while (engines_.size() <= k) engines_.push_back(std::make_unique<Engine>(engine_model_, gravity_, options_));
+  while (engines_.size() <= k) engines_.push_back(std::make_unique<Engine>(cpp_model_, gravity_, options_));
   return *engines_[k];
 }
 
@@ -216,24 +216,24 @@ py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking
   Engine& e = *engines_[0];
   Eigen::VectorXi held(0);
   if (hold_sticking && e.lastHadFriction()) {
-    const auto& status = e.frictionSolver().status();
-    held.resize(
-        static_cast<Eigen::Index>(std::count(status.begin(), status.end(), vereshchagin::FrictionSolver::Stick)));
+    const auto& status = e.data().jointStatus();
+    const auto stick = vereshchagin::JointStatus::Stick;
+    held.resize(static_cast<Eigen::Index>(std::count(status.begin(), status.end(), stick)));
     Eigen::Index a = 0;
     for (unsigned int j = 0; j < nj; ++j)
-      if (status[j] == vereshchagin::FrictionSolver::Stick) held(a++) = static_cast<int>(j);
+      if (status[j] == stick) held(a++) = static_cast<int>(j);
   }
   const Eigen::Index k = requested.size();
   Eigen::VectorXi all(k + held.size());
   all << requested, held;
   Eigen::MatrixXd dq(nj, all.size()), dt(nj, all.size());
-  int rc;
+  vereshchagin::Status rc;
   {
     py::gil_scoped_release release;
-    rc = e.answered().responseColumns(all, dq, dt);
-    if (rc == ChainHdSolver::E_NOERROR && held.size() > 0) holdJoints(dq, dt, held, k);
+    rc = e.data().responseColumns(all, dq, dt);
+    if (rc && held.size() > 0) holdJoints(dq, dt, held, k);
   }
-  if (rc != ChainHdSolver::E_NOERROR) raise(e.answered().errorMessage());
+  if (!rc) raise(rc.message());
   auto toNumpy = [&](const Eigen::MatrixXd& M) {
     py::array a = newDoubles({static_cast<py::ssize_t>(nj), static_cast<py::ssize_t>(k)});
     Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(doubles(a), nj, k) = M;

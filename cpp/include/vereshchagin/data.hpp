@@ -52,6 +52,9 @@ class Data {
 
   Status status() const noexcept;                 ///< invalid options or model, else Error::None
   const SolverOptions& options() const noexcept;  ///< the options given to the constructor
+  /// Constraint columns one solve may have in all: 6 per segment (at least 6), capped by
+  /// options().max_constraints (0: SolverOptions::kDefaultConstraintCapacity).
+  int maxConstraints() const noexcept;
   /// The workspace of the friction stage (n_joints^2 doubles, a few times over) is allocated at
   /// the first solve with input.friction set, so a frictionless Data stays O(n + m^2); call this
   /// once beforehand to keep that first friction solve allocation-free too.
