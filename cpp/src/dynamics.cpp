@@ -16,6 +16,7 @@
 #include "vereshchagin/dynamics.hpp"
 
 #include "dynamics_impl.hpp"
+#include "kdl_convert.hpp"
 
 namespace vereshchagin {
 namespace detail {
@@ -100,10 +101,6 @@ namespace {
 
 const Eigen::Map<const Matrix6X> kNoWrenches(nullptr, 6, 0);
 
-Vector3 toEigen(const KDL::Vector& v) {
-  return Vector3(v.x(), v.y(), v.z());
-}
-
 Status checkGravity(detail::KinematicsImpl& k, const KDL::Vector& g) {
   if (!std::isfinite(g.x()) || !std::isfinite(g.y()) || !std::isfinite(g.z()))
     return k.fail(Error::NonfiniteInput, "gravity is not finite");
@@ -128,7 +125,7 @@ Status inverseDynamics(const Model& model, DynamicsData& ddata, const JointPosit
   if (const Status s = d.checkOut(tau.size(), 1, 1, "tau"); !s) return s;
   k.has_q = k.has_qd = false;
   k.place(*q);
-  d.rnea(q_dot.value().data(), q_ddot.value().data(), f_ext, toEigen(gravity), tau);
+  d.rnea(q_dot.value().data(), q_ddot.value().data(), f_ext, detail::toEigen(gravity), tau);
   k.has_q = k.has_qd = true;
   return Status();
 }

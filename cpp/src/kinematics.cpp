@@ -3,25 +3,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include "kdl_convert.hpp"
 #include "kinematics_impl.hpp"
 
 namespace vereshchagin {
 namespace detail {
 
 namespace {
-
-Vector3 toEigen(const KDL::Vector& v) {
-  return Vector3(v.x(), v.y(), v.z());
-}
-
-Pose toPose(const KDL::Frame& f) {
-  Pose X;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) X.R(r, c) = f.M(r, c);
-    X.p(r) = f.p(r);
-  }
-  return X;
-}
 
 // Segment i's constants. KDL::Segment::twist(0, 1) is the joint's twist per unit q_dot, root axes,
 // reference point the tip origin; moved to the root origin: v_r = v_tip - w x p_tip.

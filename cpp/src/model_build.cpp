@@ -10,21 +10,13 @@
 #include <utility>
 
 #include "hd_core.hpp"
+#include "kdl_convert.hpp"
 #include "model_validation.hpp"
 
 namespace vereshchagin {
 namespace detail {
 
 namespace {
-
-Pose toPose(const KDL::Frame& f) {
-  Pose X;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) X.R(r, c) = f.M(r, c);
-    X.p(r) = f.p(r);
-  }
-  return X;
-}
 
 // Fills one HdModel; every failing step writes its message and returns the code.
 class ModelBuilder {
