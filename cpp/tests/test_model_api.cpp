@@ -199,6 +199,23 @@ TEST_CASE("friction through solve equals FrictionSolver") {
     CHECK(same(data.linkAccelerations(), fs.linkAccelerations()));
     CHECK(data.gaussValue() == fs.gaussValue());
     for (int j = 0; j < n; ++j) CHECK(static_cast<int>(data.jointStatus()[j]) == fs.status()[j]);
+    // Held response: the sticking joints do not move (their rows vanish), and a torque on a
+    // sticking joint is absorbed by its friction (its column vanishes), when G[S, S] is regular.
+    Eigen::VectorXi all = Eigen::VectorXi::LinSpaced(n, 0, n - 1);
+    Eigen::MatrixXd dq(n, n), dt(n, n), dq_free(n, n), dt_free(n, n);
+    REQUIRE(data.responseColumnsHoldingSticking(all, dq, dt).ok());
+    REQUIRE(data.responseColumns(all, dq_free, dt_free).ok());
+    const double scale = std::max(1.0, dq_free.cwiseAbs().maxCoeff());
+    bool any_stick = false;
+    for (int j = 0; j < n; ++j) {
+      if (data.jointStatus()[j] != JointStatus::Stick) continue;
+      any_stick = true;
+      CHECK(dq.row(j).cwiseAbs().maxCoeff() <= 1e-9 * scale);
+    }
+    if (!any_stick) CHECK(same(dq, dq_free));
+    Eigen::MatrixXd wrong(n, n + 1);
+    CHECK(data.responseColumnsHoldingSticking(all, wrong, dt).code() ==
+          (any_stick ? Error::SizeMismatch : data.responseColumns(all, wrong, dt).code()));
     // The same Data without friction again: zero friction outputs, all Moving.
     input.friction = nullptr;
     REQUIRE(solve(model, data, input).ok());

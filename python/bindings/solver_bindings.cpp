@@ -188,22 +188,6 @@ Eigen::VectorXi jointList(const Addressable& chain, const py::object& joints) {
   return j;
 }
 
-// Response with the sticking joints S held (their friction absorbs the change): the columns of
-// G - G[:, S] G[S, S]^+ G[S, :], from the columns of G for the requested joints and for S.
-void holdJoints(Eigen::MatrixXd& dq, Eigen::MatrixXd& dt, const Eigen::VectorXi& held, Eigen::Index k) {
-  const Eigen::Index s = held.size();
-  Eigen::MatrixXd Gss(s, s), Gsj(s, k);
-  for (Eigen::Index a = 0; a < s; ++a) {
-    for (Eigen::Index b = 0; b < s; ++b) Gss(a, b) = dq(held(a), k + b);
-    for (Eigen::Index c = 0; c < k; ++c) Gsj(a, c) = dq(held(a), c);
-  }
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(Gss);
-  cod.setThreshold(1e-12);
-  const Eigen::MatrixXd X = -cod.solve(Gsj);  // the held joints' extra friction per unit torque
-  dq = dq.leftCols(k) + dq.rightCols(s) * X;
-  dt = dt.leftCols(k) + dt.rightCols(s) * X;
-}
-
 }  // namespace
 
 py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking) {
@@ -214,24 +198,13 @@ py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking
         "response_columns() linearises around the last successful solve() (or the last row of solve_batch()): "
         "call solve() at the state first");
   Engine& e = *engines_[0];
-  Eigen::VectorXi held(0);
-  if (hold_sticking && e.lastHadFriction()) {
-    const auto& status = e.data().jointStatus();
-    const auto stick = vereshchagin::JointStatus::Stick;
-    held.resize(static_cast<Eigen::Index>(std::count(status.begin(), status.end(), stick)));
-    Eigen::Index a = 0;
-    for (unsigned int j = 0; j < nj; ++j)
-      if (status[j] == stick) held(a++) = static_cast<int>(j);
-  }
   const Eigen::Index k = requested.size();
-  Eigen::VectorXi all(k + held.size());
-  all << requested, held;
-  Eigen::MatrixXd dq(nj, all.size()), dt(nj, all.size());
+  Eigen::MatrixXd dq(nj, k), dt(nj, k);
   vereshchagin::Status rc;
   {
     py::gil_scoped_release release;
-    rc = e.data().responseColumns(all, dq, dt);
-    if (rc && held.size() > 0) holdJoints(dq, dt, held, k);
+    rc = hold_sticking ? e.data().responseColumnsHoldingSticking(requested, dq, dt)
+                       : e.data().responseColumns(requested, dq, dt);
   }
   if (!rc) raise(rc.message());
   auto toNumpy = [&](const Eigen::MatrixXd& M) {

@@ -88,6 +88,16 @@ class Data {
   /// Affine response to unit joint torques (hd_solver.hpp, "Affine structure"), after a solve.
   Status responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                          Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
+  /// The same around a friction solve's sticking state: the joints that stuck in the last solve
+  /// (jointStatus() Stick) are held, their static friction (or limit reaction) absorbing a small
+  /// change of torque, so their qdd stays 0 and the others respond as in the robot with those
+  /// joints locked: the columns of G - G[:, S] G[S, S]^+ G[S, :] (S the sticking joints,
+  /// pseudo-inverse by complete orthogonal decomposition with threshold 1e-12). After a solve
+  /// without friction, or with no joint sticking, it equals responseColumns(). Valid while the
+  /// friction torques stay inside their bounds. Allocates its |S|-sized workspace (not for a
+  /// real-time loop). dqdd, dtau_cmd: n_joints x joints.size().
+  Status responseColumnsHoldingSticking(const Eigen::Ref<const Eigen::VectorXi>& joints,
+                                        Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
   /// tau_cmd of given constraint magnitudes at the last solve's state.
   Status commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
   /// out = H(q)^-1 tau at the last solve's q.

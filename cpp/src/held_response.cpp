@@ -1,0 +1,41 @@
+// Data::responseColumnsHoldingSticking (data.hpp): the affine response with the sticking joints of
+// the last friction solve held, from the response columns of the requested and the held joints.
+#include <algorithm>
+
+#include <Eigen/QR>  // CompleteOrthogonalDecomposition
+
+#include "vereshchagin/data.hpp"
+
+#include "data_impl.hpp"
+
+namespace vereshchagin {
+
+Status Data::responseColumnsHoldingSticking(const Eigen::Ref<const Eigen::VectorXi>& joints,
+                                            Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
+  const std::vector<JointStatus>& status = impl_->status_per_joint;
+  const auto held_count = std::count(status.begin(), status.end(), JointStatus::Stick);
+  if (!impl_->friction_last || held_count == 0) return responseColumns(joints, dqdd, dtau_cmd);
+  const Eigen::Index n = model().nrOfJoints(), k = joints.size(), s = held_count;
+  if (dqdd.rows() != n || dqdd.cols() != k || dtau_cmd.rows() != n || dtau_cmd.cols() != k)
+    return Status(Error::SizeMismatch, "dqdd and dtau_cmd must be n_joints x joints.size()");
+  Eigen::VectorXi all(k + s);
+  all.head(k) = joints;
+  for (Eigen::Index j = 0, a = k; j < n; ++j)
+    if (status[static_cast<std::size_t>(j)] == JointStatus::Stick) all(a++) = static_cast<int>(j);
+  Eigen::MatrixXd dq(n, k + s), dt(n, k + s);
+  if (const Status st = responseColumns(all, dq, dt); !st) return st;
+  // The held joints' extra friction per unit torque X = -G[S, S]^+ G[S, J]; then G[:, J] + G[:, S] X.
+  Eigen::MatrixXd g_ss(s, s), g_sj(s, k);
+  for (Eigen::Index a = 0; a < s; ++a) {
+    for (Eigen::Index b = 0; b < s; ++b) g_ss(a, b) = dq(all(k + a), k + b);
+    for (Eigen::Index c = 0; c < k; ++c) g_sj(a, c) = dq(all(k + a), c);
+  }
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(g_ss);
+  cod.setThreshold(1e-12);
+  const Eigen::MatrixXd x = -cod.solve(g_sj);
+  dqdd = dq.leftCols(k) + dq.rightCols(s) * x;
+  dtau_cmd = dt.leftCols(k) + dt.rightCols(s) * x;
+  return Status();
+}
+
+}  // namespace vereshchagin
