@@ -47,14 +47,13 @@ struct RowInputs {
   const double* qd = nullptr;
   const ConstraintBlock* blocks = nullptr;  // end-segment alpha first (if any), then constraints=
   int n_blocks = 0;
-  bool general = false;           // constraints= given: the segment-constraint entry point
   const double* f_ext = nullptr;  // (n_segments, 6) or nullptr
   const LinkWrench* link_wrenches = nullptr;
   int n_link_wrenches = 0;
   const double* tau_ff = nullptr;  // (n_joints,) or nullptr
   const vereshchagin::FrictionModel* friction = nullptr;
-  // Driver pass-through weights per constraint column in nu's order (nullptr: 0), see
-  // ChainHdSolver::setPassThrough.
+  // Driver pass-through weights per constraint column in nu's order (nullptr: 0), for this row
+  // only (ConstraintBlock's weights in input.hpp).
   const double* f_ext_pass_through = nullptr;
   const double* tau_ff_pass_through = nullptr;
 };

@@ -138,7 +138,7 @@ class PySolver {
   vereshchagin::SolverOptions options_;
   py::object damping_arg_;
   std::vector<std::unique_ptr<Engine>> engines_;
-  py::ssize_t max_columns_ = 0;                 // HdSolver::maxConstraints() of every engine
+  py::ssize_t max_columns_ = 0;                 // Data::maxConstraints() of every engine
   vereshchagin::FrictionModel chain_friction_;  // friction=True
   // The last vereshchagin.Friction parsed and its six attribute objects: reused only while every
   // attribute is the same object (the arrays cannot be written: friction.py).

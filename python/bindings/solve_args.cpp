@@ -115,7 +115,6 @@ void PySolver::parse(PyObject* const* a, ParsedSolve& p) {
   r.qd = p.qd.data;
   r.blocks = p.blocks.data();
   r.n_blocks = static_cast<int>(p.blocks.size());
-  r.general = given(constraints);
   r.f_ext = p.f_ext.data;
   if (!p.f_ext_dense.empty() && p.f_ext.data == nullptr) r.f_ext = p.f_ext_dense.data();
   r.link_wrenches = p.link_wrenches.data();

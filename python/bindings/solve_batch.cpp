@@ -109,7 +109,6 @@ struct BatchRunner {
   std::vector<LinkWrench> link_wrench_template;
   std::vector<double> f_ext_dense;  // dict f_ext without merged links: (B or 1, ns, 6)
   bool f_ext_dense_batched = false;
-  bool general = false;
   std::vector<vereshchagin::FrictionModel> friction;  // empty, one shared, or one per row
   std::vector<char> row_has_friction;
   bool any_friction = false;
@@ -178,7 +177,6 @@ struct BatchRunner {
 
   void parseConstraints(PyObject* obj) {
     if (!PyDict_Check(obj)) raise("constraints must be a dict {segment name or index: (alpha (6, m_i), beta (m_i,))}");
-    general = true;
     ConstraintKeys keys(*s.model_, static_cast<int>(s.ns), block_template.empty() ? 0 : block_template[0].cols);
     PyObject *key, *value;
     Py_ssize_t pos = 0;
@@ -243,7 +241,6 @@ struct BatchRunner {
     for (std::size_t k = 0; k < wrenches.size(); ++k) wrenches[k].wrench = link_wrench_rows[k].row(b);
     r.blocks = blocks.data();
     r.n_blocks = static_cast<int>(blocks.size());
-    r.general = general;
     r.f_ext = f_ext.row(b);
     r.link_wrenches = wrenches.data();
     r.n_link_wrenches = static_cast<int>(wrenches.size());
