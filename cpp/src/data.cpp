@@ -25,6 +25,7 @@ DataImpl::DataImpl(const Model& m, const SolverOptions& options)
   status_per_joint.assign(nj, JointStatus::Moving);
   loads.f_ext = &f_ext;
   loads.alfa = &alfa;
+  loads.beta = &beta;
 }
 
 DataImpl::~DataImpl() = default;

@@ -7,11 +7,34 @@
 namespace vereshchagin {
 namespace detail {
 
+// Blocks with a classical set-point (ConstraintBlock::classical): beta = alfa^T [a - w x v +
+// root_acc_lin; alpha] with the frame's twist [v; w] (base axes, at its point) from the sweep; the
+// root acceleration is -gravity (a base at rest). Before the moments of alfa move to the tip.
+void HdCore::classicalSetPoints() {
+  const SolveInput& in = *loads->input;
+  Eigen::VectorXd& beta = *loads->beta;
+  const Matrix6X& alfa = *loads->alfa;
+  int col = 0;
+  for (const ConstraintBlock& b : in.constraints) {
+    if (b.classical) {
+      const SegmentState& s = ws.seg[b.segment];
+      const Vector3 w = s.R_base * s.v.tail<3>();
+      const Vector3 v = s.R_base * s.v.head<3>() + w.cross(s.R_base * b.point);
+      Vector6 spatial;
+      spatial.head<3>() = b.classical_acceleration.head<3>() - w.cross(v) + root_acc.head<3>();
+      spatial.tail<3>() = b.classical_acceleration.tail<3>() + root_acc.tail<3>();
+      for (int c = 0; c < b.columns; ++c) beta(col + c) = alfa.col(col + c).dot(spatial);
+    }
+    col += b.columns;
+  }
+}
+
 // After outwardSweep(): the blocks' columns with a point get their moments moved to the tip; the
 // frame wrenches are added to the solve's f_ext (for the pass-through and the checks) and to the
 // bias forces the sweep formed from the input's f_ext alone.
 void HdCore::applyFrameLoads() {
   const SolveInput& in = *loads->input;
+  if (loads->classical) classicalSetPoints();
   if (loads->points) {
     Matrix6X& alfa = *loads->alfa;
     int col = 0;

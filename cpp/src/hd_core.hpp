@@ -198,7 +198,8 @@ struct FrameLoads {
   const SolveInput* input = nullptr;  // its frame wrenches and its constraint blocks with a point
   Matrix6X* f_ext = nullptr;          // the solve's f_ext: a copy of the input's, the wrenches added
   Matrix6X* alfa = nullptr;           // the solve's columns (the blocks in order)
-  bool wrenches = false, points = false;
+  Eigen::VectorXd* beta = nullptr;    // their set-points: written for classical blocks
+  bool wrenches = false, points = false, classical = false;
 };
 
 // Constraint columns a solve may have (SolverOptions::max_constraints, hd_solver.hpp): the
@@ -282,6 +283,7 @@ class HdCore {
 
   // Frame loads after the outward sweep (frame_loads.cpp).
   void applyFrameLoads();
+  void classicalSetPoints();  // beta of ConstraintBlock::classical blocks
 
   // Sweeps shared by both paths (hd_core.cpp, articulated_step.hpp).
   void screwPose(const SegmentModel& sm, SegmentState& s, double q) const;

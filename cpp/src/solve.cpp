@@ -27,6 +27,8 @@ int checkBlock(HdCore& c, std::size_t b, const ConstraintBlock& k, int first) {
   if (k.segment < 0 || k.segment >= static_cast<int>(c.model.ns))
     return c.fail(E_RANGE, "constraints[%zu].segment = %d is out of range [0, %u)", b, k.segment, c.model.ns);
   if (!k.point.allFinite()) return c.fail(E_NF, "constraints[%zu].point contains NaN or Inf", b);
+  if (k.classical && !k.classical_acceleration.allFinite())
+    return c.fail(E_NF, "constraints[%zu].classical_acceleration contains NaN or Inf", b);
   for (int j = 0; j < k.columns; ++j) {
     const double pf = k.f_ext_pass_through(j), pt = k.ff_pass_through(j);
     if (!(pf >= 0.0 && pf <= 1.0))
@@ -54,11 +56,18 @@ int checkInput(HdCore& c, const SolveInput& in) {
       return c.fail(E_RANGE, "wrenches[%zu].segment = %d is out of range [0, %u)", k, w.segment, c.model.ns);
     if (!w.wrench.allFinite() || !w.point.allFinite()) return c.fail(E_NF, "wrenches[%zu] contains NaN or Inf", k);
   }
+  bool classical = false, moving_base = false;
+  for (const ConstraintBlock& b : in.constraints) classical = classical || b.classical;
   for (int k = 0; k < 3; ++k) {
     if (!std::isfinite(in.gravity(k))) return c.fail(E_NF, "gravity contains NaN or Inf");
     if (!std::isfinite(in.base_acceleration.vel(k)) || !std::isfinite(in.base_acceleration.rot(k)))
       return c.fail(E_NF, "base_acceleration contains NaN or Inf");
+    moving_base = moving_base || in.base_acceleration.vel(k) != 0.0 || in.base_acceleration.rot(k) != 0.0;
   }
+  if (classical && moving_base)
+    return c.fail(E_RANGE,
+                  "a classical set-point (ConstraintBlock::classical) needs a base at rest: base_acceleration "
+                  "must be zero");
   return 0;
 }
 
@@ -66,11 +75,12 @@ int checkInput(HdCore& c, const SolveInput& in) {
 // root acceleration base_acceleration - [gravity; 0]; returns the column count.
 int assemble(DataImpl& d, const SolveInput& in) {
   int col = 0;
-  bool f_any = false, t_any = false, points = false;
+  bool f_any = false, t_any = false, points = false, classical = false;
   for (const ConstraintBlock& b : in.constraints) {
+    classical = classical || b.classical;
     for (int j = 0; j < b.columns; ++j, ++col) {
       d.alfa.col(col) = b.alfa.col(j);
-      d.beta(col) = b.beta(j);
+      d.beta(col) = b.classical ? 0.0 : b.beta(j);  // classical: set in the sweep (frame_loads.cpp)
       d.segments(col) = b.segment;
       d.weights.f(col) = b.f_ext_pass_through(j);
       d.weights.t(col) = b.ff_pass_through(j);
@@ -84,6 +94,7 @@ int assemble(DataImpl& d, const SolveInput& in) {
   d.weights.t_any = t_any;
   d.loads.input = &in;
   d.loads.points = points;
+  d.loads.classical = classical;
   d.loads.wrenches = !in.wrenches.empty();
   if (d.loads.wrenches) d.f_ext = in.f_ext;  // the wrenches are added in the sweep
   HdCore& c = d.core;
@@ -92,7 +103,7 @@ int assemble(DataImpl& d, const SolveInput& in) {
     c.root_acc(3 + k) = in.base_acceleration.rot(k);
   }
   c.ws.pt.weights = &d.weights;
-  c.loads = d.loads.points || d.loads.wrenches ? &d.loads : nullptr;
+  c.loads = d.loads.points || d.loads.wrenches || d.loads.classical ? &d.loads : nullptr;
   return col;
 }
 

@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainfksolvervel_recursive.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 #include <kdl/treefksolverpos_recursive.hpp>
 #include <kdl/treejnttojacsolver.hpp>
@@ -268,6 +269,76 @@ TEST_CASE("points of blocks and frame wrenches equal tip loads shifted by KDL's 
     CHECK(close(data.nu(), hd.nu(), 1e-12));
     CHECK(close(data.commandTorques(), hd.commandTorques(), 1e-12));
   }
+}
+
+// The oracle of a classical set-point: beta = alfa^T [a - w x v - g; alpha] with the frame's twist
+// [v; w] from KDL's velocity FK (the tip's twist moved to the point), then an ordinary solve.
+TEST_CASE("classical set-points equal beta from KDL's twists, with and without friction") {
+  RandomGen g(6);
+  const KDL::Vector gravity(0.3, -0.2, -9.81);
+  for (int trial = 0; trial < 30; ++trial) {
+    const int n = g.integer(2, 9);
+    const KDL::Chain chain = g.chain(n);
+    const unsigned ns = chain.getNrOfSegments();
+    const Model model(chain);
+    const int m = g.integer(1, 6);
+    testutil::SolveInputs in = testutil::randomInputs(g, n, ns, m);
+    const int seg = g.integer(0, static_cast<int>(ns) - 1);
+    const Vector3 point = trial % 3 == 0 ? Vector3::Zero() : vec(g.vector(-0.5, 0.5));
+    Vector6 a;
+    for (int k = 0; k < 6; ++k) a(k) = g.uniform(-4.0, 4.0);
+    KDL::ChainFkSolverVel_recursive fk(chain);
+    KDL::JntArrayVel state(n);
+    state.q.data = in.q;
+    state.qdot.data = in.qd;
+    KDL::FrameVel tip;
+    REQUIRE(fk.JntToCart(state, tip, seg + 1) >= 0);
+    const KDL::Twist t = tip.GetTwist().RefPoint(tip.M.R * KDL::Vector(point(0), point(1), point(2)));
+    Vector6 spatial;
+    spatial.head<3>() = a.head<3>() - vec(t.rot).cross(vec(t.vel)) - vec(gravity);
+    spatial.tail<3>() = a.tail<3>();
+    const Eigen::VectorXd beta = in.alfa.transpose() * spatial;
+    FrictionModel friction;
+    friction.static_friction = g.jntArray(n, 0.0, 2.0).data;
+    for (const bool with_friction : {false, true}) {
+      SolveInput classical(model), plain(model);
+      for (SolveInput* input : {&classical, &plain}) {
+        input->setState(JointPositions(in.q), JointVelocities(in.qd));
+        input->f_ext = in.fext;
+        input->ff_torques = in.ff;
+        input->gravity = gravity;
+        input->friction = with_friction ? &friction : nullptr;
+      }
+      REQUIRE(plain.addConstraint(seg, in.alfa, beta, point).ok());
+      REQUIRE(classical.addConstraint(seg, in.alfa, Eigen::VectorXd::Constant(m, 1e300), point).ok());
+      classical.constraints[0].classical = true;
+      classical.constraints[0].classical_acceleration = a;
+      Data d_classical(model), d_plain(model);
+      const Status s_plain = solve(model, d_plain, plain);
+      REQUIRE(solve(model, d_classical, classical).value() == s_plain.value());
+      if (!s_plain) continue;
+      CHECK(close(d_classical.qdd(), d_plain.qdd(), 1e-12));
+      CHECK(close(d_classical.nu(), d_plain.nu(), 1e-12));
+      CHECK(close(d_classical.commandTorques(), d_plain.commandTorques(), 1e-12));
+    }
+  }
+  // A moving base or a non-finite set-point is refused.
+  const KDL::Chain chain = g.chain(3);
+  const Model model(chain);
+  SolveInput input(model);
+  REQUIRE(input.addConstraint(2, Eigen::MatrixXd::Identity(6, 1), Eigen::VectorXd::Zero(1)).ok());
+  input.constraints[0].classical = true;
+  Data data(model);
+  REQUIRE(solve(model, data, input).ok());
+  input.base_acceleration.vel(0) = 1.0;
+  Status s = solve(model, data, input);
+  CHECK(s.code() == Error::OutOfRange);
+  CHECK(std::string(s.message()).find("base_acceleration must be zero") != std::string::npos);
+  input.base_acceleration = KDL::Twist::Zero();
+  input.constraints[0].classical_acceleration(2) = std::nan("");
+  s = solve(model, data, input);
+  CHECK(s.code() == Error::NonfiniteInput);
+  CHECK(std::string(s.message()).find("classical_acceleration") != std::string::npos);
 }
 
 TEST_CASE("kinematics equal KDL's FK and Jacobians (chains and trees)") {

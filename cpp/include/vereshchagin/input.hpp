@@ -51,6 +51,13 @@ struct ConstraintBlock {
   /// Driver pass-through per column (hd_solver.hpp, "Driver pass-through"), each in [0, 1].
   Eigen::Matrix<double, 6, 1> f_ext_pass_through = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> ff_pass_through = Eigen::Matrix<double, 6, 1>::Zero();  ///< see f_ext_pass_through
+  /// When true, `beta` is not read: the set-point is the CLASSICAL acceleration
+  /// `classical_acceleration` of the frame's origin ([m/s^2; rad/s^2], base axes, task.hpp), and
+  /// solve() sets beta = alfa^T spatialFromClassical(classical_acceleration, twist, gravity) with
+  /// the frame's twist from its own outward sweep at the input's state (no kinematics of its own).
+  /// Needs a base at rest (SolveInput::base_acceleration zero).
+  bool classical = false;
+  Vector6 classical_acceleration = Vector6::Zero();  ///< see classical
 };
 
 /// A wrench on a frame moving with a segment, added to f_ext.
