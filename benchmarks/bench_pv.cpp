@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "bench_common.hpp"
+#include "pinocchio_bridge.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
 
 namespace {
@@ -36,22 +37,8 @@ pinocchio::Model pinocchioModel(const KDL::Chain& chain) {
   pinocchio::Model model;
   pinocchio::JointIndex parent = 0;
   for (const KDL::Segment& seg : chain.segments) {
-    const KDL::Frame& f = seg.getFrameToTip();
-    Eigen::Matrix3d R;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R(r, c) = f.M(r, c);
-    const pinocchio::SE3 placement(R, Eigen::Vector3d(f.p.x(), f.p.y(), f.p.z()));
-    parent = model.addJoint(parent, pinocchio::JointModelRZ(), placement, seg.getName());
-    const KDL::RigidBodyInertia& I = seg.getInertia();
-    const KDL::Vector c = I.getCOG();
-    // KDL keeps the inertia about the frame origin; the one about the centre of mass is I_o - m [c]x^T [c]x.
-    const KDL::RotationalInertia& Io = I.getRotationalInertia();
-    Eigen::Matrix3d Icom;
-    for (int r = 0; r < 3; ++r)
-      for (int k = 0; k < 3; ++k) Icom(r, k) = Io.data[3 * r + k];
-    const Eigen::Vector3d cv(c.x(), c.y(), c.z());
-    Icom -= I.getMass() * (cv.squaredNorm() * Eigen::Matrix3d::Identity() - cv * cv.transpose());
-    model.appendBodyToJoint(parent, pinocchio::Inertia(I.getMass(), cv, Icom), pinocchio::SE3::Identity());
+    parent = model.addJoint(parent, pinocchio::JointModelRZ(), testutil::toSE3(seg.getFrameToTip()), seg.getName());
+    model.appendBodyToJoint(parent, testutil::toInertia(seg.getInertia()), pinocchio::SE3::Identity());
   }
   model.gravity.linear(Eigen::Vector3d(0.0, 0.0, -9.81));
   return model;

@@ -33,6 +33,7 @@
 #include <stdexcept>
 
 #include "bench_common.hpp"
+#include "pinocchio_bridge.hpp"
 #include "vereshchagin/tree_hd_solver.hpp"
 #include "vereshchagin/urdf_loader.hpp"
 
@@ -42,22 +43,8 @@ using vereshchagin::TreeHdSolver;
 using Matrix6X = TreeHdSolver::Matrix6X;
 const char* const kHands[2] = {"left_gripper_base_link", "right_gripper_base_link"};
 
-pinocchio::SE3 toSE3(const KDL::Frame& f) {
-  Eigen::Matrix3d r;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) r(i, j) = f.M(i, j);
-  return pinocchio::SE3(r, Eigen::Vector3d(f.p.x(), f.p.y(), f.p.z()));
-}
-
-// KDL's inertia is about the tip origin; Pinocchio's Inertia takes the one about the centre of mass.
-pinocchio::Inertia toInertia(const KDL::RigidBodyInertia& in) {
-  const double m = in.getMass();
-  const Eigen::Vector3d c(in.getCOG().x(), in.getCOG().y(), in.getCOG().z());
-  const KDL::RotationalInertia ro = in.getRotationalInertia();
-  Eigen::Matrix3d io = Eigen::Map<const Eigen::Matrix3d>(ro.data);
-  const Eigen::Matrix3d ic = io - m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
-  return pinocchio::Inertia(m, c, ic);
-}
+using testutil::toInertia;
+using testutil::toSE3;
 
 // Pinocchio's joint for a revolute or prismatic axis: the axis-aligned types for +x, +y, +z (as its
 // URDF parser picks them), the unaligned ones otherwise.

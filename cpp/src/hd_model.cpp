@@ -14,7 +14,7 @@ namespace vereshchagin {
 namespace detail {
 
 HdCore::HdCore(std::shared_ptr<const HdModel> model_in, const Vector6& root_acc_in, const SolverOptions& opts)
-    : options(opts), root_acc(root_acc_in), model_owner(std::move(model_in)), model(*model_owner) {
+    : model_owner(std::move(model_in)), model(*model_owner), options(opts), root_acc(root_acc_in) {
   options.inertia_check = model.inertia_check;
   allocateWorkspace();
   model_error = model.error;
