@@ -330,8 +330,8 @@ TEST_CASE_FIXTURE(Fixture, "tree solves do not allocate") {
                                                                       << str(t1.news - t0.news) << ", malloc "
                                                                       << str(t1.mallocs - t0.mallocs));
 
-  // The (model, data, input) API on the same tree: blocks with points, frame wrenches,
-  // pass-through weights, gravity, friction (workspace reserved), kinematics and the companions.
+  // The (model, data, input) API on the same tree: blocks with points, classical set-points,
+  // frame wrenches, pass-through weights, gravity, friction (workspace reserved), kinematics and the companions.
   const vereshchagin::Model model(tree);
   vereshchagin::Data data(model);
   data.reserveFriction();
@@ -352,6 +352,8 @@ TEST_CASE_FIXTURE(Fixture, "tree solves do not allocate") {
     if (!input.addConstraint(1, tA.leftCols(2), tb.head(2), vereshchagin::Vector3(0.0, 0.1, 0.0)).ok()) ++afail;
     if (!input.addWrench(tool, vereshchagin::Vector6::Constant(0.5)).ok()) ++afail;
     input.constraints[0].ff_pass_through(0) = it % 2 ? 0.5 : 0.0;
+    input.constraints[1].classical = it % 4 == 1;  // beta from a classical set-point in the sweep
+    input.constraints[1].classical_acceleration(2) = 0.3;
     input.f_ext = tfe;
     input.friction = it % 3 == 0 ? &fm : nullptr;
     if (!vereshchagin::solve(model, data, input).ok()) ++afail;
