@@ -43,65 +43,18 @@ using vereshchagin::TreeHdSolver;
 using Matrix6X = TreeHdSolver::Matrix6X;
 const char* const kHands[2] = {"left_gripper_base_link", "right_gripper_base_link"};
 
-using testutil::toInertia;
-using testutil::toSE3;
-
-// Pinocchio's joint for a revolute or prismatic axis: the axis-aligned types for +x, +y, +z (as its
-// URDF parser picks them), the unaligned ones otherwise.
-pinocchio::JointModel jointModel(const Eigen::Vector3d& axis, bool prismatic) {
-  for (int k = 0; k < 3; ++k) {
-    if (axis != Eigen::Vector3d::Unit(k)) continue;
-    if (k == 0) return prismatic ? pinocchio::JointModel(pinocchio::JointModelPX()) : pinocchio::JointModelRX();
-    if (k == 1) return prismatic ? pinocchio::JointModel(pinocchio::JointModelPY()) : pinocchio::JointModelRY();
-    return prismatic ? pinocchio::JointModel(pinocchio::JointModelPZ()) : pinocchio::JointModelRZ();
-  }
-  if (prismatic) return pinocchio::JointModelPrismaticUnaligned(axis);
-  return pinocchio::JointModelRevoluteUnaligned(axis);
-}
-
-// The robot twice: our solver and Pinocchio's model of the same KDL tree, with the map between
-// their joint orders and each segment's tip frame in its Pinocchio joint frame.
+// The robot twice: our solver and Pinocchio's model of the same KDL tree (pinocchio_bridge.hpp,
+// axis-aligned joint types where the axis is +x, +y or +z, as Pinocchio's URDF parser picks them).
 struct Robot {
   explicit Robot(const vereshchagin::RobotTree& rt)
-      : solver(rt.tree, KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero())) {
-    const auto& names = solver.segmentNames();
-    const int ns = static_cast<int>(names.size());
-    joint_of.assign(ns, 0);
-    tip.assign(ns, pinocchio::SE3::Identity());
-    for (int i = 0; i < ns; ++i) {
-      const KDL::Segment& seg = rt.tree.getSegment(names[i])->second.segment;
-      const int p = solver.parent()[i];
-      const pinocchio::JointIndex pj = p < 0 ? 0 : joint_of[p];
-      const pinocchio::SE3 parent_tip = p < 0 ? pinocchio::SE3::Identity() : tip[p];
-      const KDL::Joint& kj = seg.getJoint();
-      if (kj.getType() == KDL::Joint::None) {  // rigid: the body joins the parent's joint
-        joint_of[i] = pj;
-        tip[i] = parent_tip * toSE3(seg.getFrameToTip());
-      } else {  // motion about (along) the axis through the joint origin, parent tip axes
-        const Eigen::Vector3d o(kj.JointOrigin().x(), kj.JointOrigin().y(), kj.JointOrigin().z());
-        const Eigen::Vector3d axis(kj.JointAxis().x(), kj.JointAxis().y(), kj.JointAxis().z());
-        const pinocchio::SE3 placement = parent_tip * pinocchio::SE3(Eigen::Matrix3d::Identity(), o);
-        const bool prismatic = kj.getType() == KDL::Joint::TransAxis || kj.getType() == KDL::Joint::TransX ||
-                               kj.getType() == KDL::Joint::TransY || kj.getType() == KDL::Joint::TransZ;
-        joint_of[i] = model.addJoint(pj, jointModel(axis, prismatic), placement, kj.getName());
-        tip[i] = pinocchio::SE3(Eigen::Matrix3d::Identity(), -o) * toSE3(seg.getFrameToTip());
-      }
-      model.appendBodyToJoint(joint_of[i], toInertia(seg.getInertia()), tip[i]);
-    }
-    model.gravity.linear(Eigen::Vector3d(0, 0, -9.81));
-    for (const std::string& j : solver.jointNames()) v_index.push_back(model.idx_vs[model.getJointId(j)]);
+      : solver(rt.tree, KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero())),
+        pin(solver.model(), KDL::Vector(0, 0, -9.81), /*aligned_axes=*/true) {
     for (const char* h : kHands) hands.push_back(solver.segmentIndex(h));
   }
-  Eigen::VectorXd toPin(const Eigen::VectorXd& x) const {
-    Eigen::VectorXd out(x.size());
-    for (Eigen::Index j = 0; j < x.size(); ++j) out(v_index[j]) = x(j);
-    return out;
-  }
+  Eigen::VectorXd toPin(const Eigen::VectorXd& x) const { return pin.toPin(x); }
   TreeHdSolver solver;
-  pinocchio::Model model;
-  std::vector<pinocchio::JointIndex> joint_of;
-  std::vector<pinocchio::SE3> tip;
-  std::vector<int> v_index, hands;
+  testutil::PinRobot pin;
+  std::vector<int> hands;
 };
 
 struct State {
@@ -112,8 +65,8 @@ struct State {
 
 // The dense KKT pipeline on preallocated buffers.
 struct Kkt {
-  explicit Kkt(const Robot& r) : robot(r), data(r.model), ldlt(r.model.nv) {
-    const int n = r.model.nv;
+  explicit Kkt(const Robot& r) : robot(r), data(r.pin.model), ldlt(r.pin.model.nv) {
+    const int n = r.pin.model.nv;
     J.setZero(6, n);
     A.resize(12, n);
     Y.resize(n, 12);
@@ -124,7 +77,7 @@ struct Kkt {
     zero = Eigen::VectorXd::Zero(n);
   }
   const Eigen::VectorXd& solve(const State& s, int hands) {
-    const pinocchio::Model& model = robot.model;
+    const pinocchio::Model& model = robot.pin.model;
     const int m = 6 * hands;
     pinocchio::forwardKinematics(model, data, s.pq, s.pv, zero);
     pinocchio::computeJointJacobians(model, data);
@@ -136,9 +89,10 @@ struct Kkt {
     for (int h = 0; h < hands; ++h) {
       const int seg = robot.hands[h];
       J.setZero();
-      pinocchio::getFrameJacobian(model, data, robot.joint_of[seg], robot.tip[seg], pinocchio::LOCAL_WORLD_ALIGNED, J);
+      pinocchio::getFrameJacobian(model, data, robot.pin.joint_of[seg], robot.pin.tip[seg],
+                                  pinocchio::LOCAL_WORLD_ALIGNED, J);
       const Eigen::Matrix<double, 6, 1> a0 =
-          pinocchio::getFrameAcceleration(model, data, robot.joint_of[seg], robot.tip[seg],
+          pinocchio::getFrameAcceleration(model, data, robot.pin.joint_of[seg], robot.pin.tip[seg],
                                           pinocchio::LOCAL_WORLD_ALIGNED)
               .toVector() +
           up;
@@ -210,7 +164,7 @@ Row runCase(Robot& r, Kkt& kkt, const std::vector<State>& states, int hands) {
   Eigen::VectorXi segs(m);
   for (int c = 0; c < m; ++c) segs(c) = r.hands[c / 6];
   const Matrix6X no_fext(6, 0);
-  pinocchio::Data aba_data(r.model);
+  pinocchio::Data aba_data(r.pin.model);
   Row row{m, 0, 0, 0, 0, 0, 0};
   for (const State& s : states) {  // correctness first
     const int rc = r.solver.solve(s.q, s.qd, s.alfa.leftCols(m), s.beta.head(m), segs, no_fext, s.tau);
@@ -227,7 +181,7 @@ Row runCase(Robot& r, Kkt& kkt, const std::vector<State>& states, int hands) {
   bench::addBench(group, "kkt", bench::overStates(states, [&](const State& s) { return kkt.solve(s, hands)(0); }));
   if (m == 0)
     bench::addBench(group, "aba", bench::overStates(states, [&](const State& s) {
-                      return pinocchio::aba(r.model, aba_data, s.pq, s.pv, s.ptau)(0);
+                      return pinocchio::aba(r.pin.model, aba_data, s.pq, s.pv, s.ptau)(0);
                     }));
   bench::runGroup(group, "Baxter m = " + std::to_string(m));
   row.ours = bench::median(group[0].us);

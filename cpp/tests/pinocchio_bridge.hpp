@@ -39,14 +39,22 @@ inline bool isPrismatic(KDL::Joint::JointType t) {
   return t == KDL::Joint::TransAxis || t == KDL::Joint::TransX || t == KDL::Joint::TransY || t == KDL::Joint::TransZ;
 }
 
-// A revolute or prismatic joint about (along) `axis` (unit, joint frame).
-inline pinocchio::JointModel jointModel(const Eigen::Vector3d& axis, bool prismatic) {
+// A revolute or prismatic joint about (along) `axis` (unit, joint frame); with `aligned`, the
+// axis-aligned types for +x, +y, +z (as Pinocchio's URDF parser picks them: faster sweeps).
+inline pinocchio::JointModel jointModel(const Eigen::Vector3d& axis, bool prismatic, bool aligned) {
+  for (int k = 0; aligned && k < 3; ++k) {
+    if (axis != Eigen::Vector3d::Unit(k)) continue;
+    if (k == 0) return prismatic ? pinocchio::JointModel(pinocchio::JointModelPX()) : pinocchio::JointModelRX();
+    if (k == 1) return prismatic ? pinocchio::JointModel(pinocchio::JointModelPY()) : pinocchio::JointModelRY();
+    return prismatic ? pinocchio::JointModel(pinocchio::JointModelPZ()) : pinocchio::JointModelRZ();
+  }
   if (prismatic) return pinocchio::JointModelPrismaticUnaligned(axis);
   return pinocchio::JointModelRevoluteUnaligned(axis);
 }
 
 struct PinRobot {
-  explicit PinRobot(const vereshchagin::Model& ours, const KDL::Vector& gravity) {
+  // `gravity`: physical, base axes; `aligned_axes`: see jointModel().
+  PinRobot(const vereshchagin::Model& ours, const KDL::Vector& gravity, bool aligned_axes = false) {
     const int ns = static_cast<int>(ours.nrOfSegments());
     joint_of.assign(ns, 0);
     tip.assign(ns, pinocchio::SE3::Identity());
@@ -66,7 +74,8 @@ struct PinRobot {
         const Eigen::Vector3d o(kj.JointOrigin().x(), kj.JointOrigin().y(), kj.JointOrigin().z());
         const Eigen::Vector3d axis(kj.JointAxis().x(), kj.JointAxis().y(), kj.JointAxis().z());
         const pinocchio::SE3 placement = parent_tip * pinocchio::SE3(Eigen::Matrix3d::Identity(), o);
-        joint_of[i] = model.addJoint(pj, jointModel(axis, isPrismatic(kj.getType())), placement, kj.getName());
+        joint_of[i] =
+            model.addJoint(pj, jointModel(axis, isPrismatic(kj.getType()), aligned_axes), placement, kj.getName());
         tip[i] = pinocchio::SE3(Eigen::Matrix3d::Identity(), -o) * toSE3(seg.getFrameToTip());
         rotor[j] = kj.getInertia();
       }
