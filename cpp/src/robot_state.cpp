@@ -99,8 +99,6 @@ std::string metadataFault(const RobotRecord& record, const std::vector<int>& mov
     if (l.segment < -1 || l.segment > kMaxIndex)
       return ": link record segment is out of range (-1 .. " + std::to_string(kMaxIndex) + ")";
     if (!allFinite(l.frame)) return ": link record frame holds a non-finite value";
-    if (l.segment >= n_segments)
-      return ": link '" + l.link + "' names segment " + std::to_string(l.segment) + " of " + std::to_string(n_segments);
     links.push_back({l.link, static_cast<int>(l.segment), frameOf(l.frame)});
   }
   if (joints.size() != moving.size())
@@ -110,6 +108,9 @@ std::string metadataFault(const RobotRecord& record, const std::vector<int>& mov
     if (static_cast<int>(joints[k].segment) != moving[k])
       return ": joint record " + std::to_string(k) + " names segment " + std::to_string(joints[k].segment) +
              ", but that joint moves segment " + std::to_string(moving[k]);
+  for (const LinkRecord& l : record.links)
+    if (l.segment >= n_segments)
+      return ": link '" + l.link + "' names segment " + std::to_string(l.segment) + " of " + std::to_string(n_segments);
   return "";
 }
 

@@ -1,5 +1,5 @@
-// A small branched robot for the robot_* tests: base -rev- arm -rev- hand (-fixed- finger, a merged
-// link 0.05 m beyond the hand's tip) and base -prismatic- slider.
+// A small branched robot for the robot_* tests: base -rev- arm -rev- hand -fixed- finger (one
+// segment named 'finger', 'hand' merged into it 0.05 m below its tip) and base -prismatic- slider.
 #pragma once
 
 #include <doctest/doctest.h>

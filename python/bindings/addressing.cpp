@@ -75,8 +75,6 @@ Addressable::Target Addressable::resolveMoving(PyObject* which, const std::strin
 }
 
 int Addressable::resolveJoint(PyObject* which, const std::string& label) const {
-  const std::vector<vereshchagin::JointInfo>& joints = jointInfos();
-  const int nj = static_cast<int>(joints.size());
   if (PyUnicode_Check(which)) {
     const std::string name = py::handle(which).cast<std::string>();
     if (const int j = jointByName(name); j >= 0) return j;
@@ -85,7 +83,7 @@ int Addressable::resolveJoint(PyObject* which, const std::string& label) const {
   if (PyBool_Check(which) || !PyIndex_Check(which))
     raise(label + ": a joint is named by a str or an int index, got " +
           std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  return indexInRange(which, nj, label, "joint");
+  return indexInRange(which, static_cast<int>(jointInfos().size()), label, "joint");
 }
 
 }  // namespace vsbind

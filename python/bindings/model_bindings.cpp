@@ -1,71 +1,55 @@
 // vereshchagin.Chain and vereshchagin.Tree: what they share bound once (bindModel), then the
-// members of each. Conversion and argument messages only: the C++ library checks and edits the
-// robots (robot_access.hpp, robot_edit.hpp, robot_state.hpp, urdf_loader.hpp).
+// members only a Tree has. Conversion and argument messages only: the C++ library reads, checks
+// and edits the robots (robot_access.hpp, robot_edit.hpp, robot_state.hpp, urdf_loader.hpp).
 #include <pybind11/stl.h>
 
-#include <type_traits>
+#include <functional>
 
-#include "dynamics_common.hpp"
 #include "model_state.hpp"
 #include "tree_bindings.hpp"
-#include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
 namespace {
 
+using vereshchagin::JointInfo;
+
 template <class M>
 constexpr bool kIsTree = std::is_same_v<M, PyTree>;
 
-// The frame argument of fk, jacobian and twist: a Chain's defaults to its last segment.
-template <class M>
-FrameTarget frameArg(const M& m, const py::object& which) {
-  if constexpr (kIsTree<M>) return m.resolveTarget(which.ptr(), "segment");
-  return m.resolveOptional(which, "segment");
+py::array_t<double> array(const std::vector<double>& v) {
+  return copyVector(v.data(), static_cast<py::ssize_t>(v.size()));
 }
 
-template <class M, class Get>
-auto doubles(Get get) {
-  return [get](const M& m) {
-    const std::vector<double> v = get(m);
-    return copyVector(v.data(), static_cast<py::ssize_t>(v.size()));
-  };
-}
-
-// The joints' names, types, limits, friction and damping, in q order; docOf("lower") is the
-// docstring DOCS["Chain.lower"] or DOCS["Tree.lower"].
-template <class M, class Doc>
-void bindJointData(py::class_<M>& cls, const Doc& docOf) {
-  using vereshchagin::JointInfo;
-  const auto field = [](double JointInfo::*f) {
-    return doubles<M>([f](const M& m) {
-      std::vector<double> v;
-      for (const JointInfo& j : m.robot.joints) v.push_back(j.*f);
+// A property of every joint in q order: a float64 array of f's doubles, or a list.
+template <class M, class F>
+auto eachJoint(F f) {
+  return [f](const M& m) {
+    std::vector<std::decay_t<decltype(f(JointInfo()))>> v;
+    for (const JointInfo& j : m.robot.joints) v.push_back(f(j));
+    if constexpr (std::is_same_v<decltype(v), std::vector<double>>)
+      return array(v);
+    else
       return v;
-    });
   };
-  const auto strings = [](std::string (*get)(const JointInfo&)) {
-    return [get](const M& m) {
-      std::vector<std::string> v;
-      for (const JointInfo& j : m.robot.joints) v.push_back(get(j));
-      return v;
-    };
-  };
-  cls.def_property_readonly("joint_names", strings([](const JointInfo& j) { return j.name; }), docOf("joint_names"))
-      .def_property_readonly("joint_types", strings([](const JointInfo& j) { return j.type; }), docOf("joint_types"))
-      .def_property_readonly("lower", field(&JointInfo::lower), docOf("lower"))
-      .def_property_readonly("upper", field(&JointInfo::upper), docOf("upper"))
-      .def_property_readonly("velocity_limit", field(&JointInfo::velocity_limit), docOf("velocity_limit"))
-      .def_property_readonly("effort_limit", field(&JointInfo::effort_limit), docOf("effort_limit"))
-      .def_property_readonly("friction", field(&JointInfo::friction), docOf("friction"))
-      .def_property_readonly("damping", field(&JointInfo::damping), docOf("damping"));
 }
 
-// Sizes, names, the base, notes, the inertia check, masses, rotor inertia and the indices.
+// Sizes, names, the base, notes, joint data, masses, rotor inertia and the indices; docOf("lower")
+// is DOCS["Chain.lower"] or DOCS["Tree.lower"].
 template <class M, class Doc>
-void bindNames(py::class_<M>& cls, const Doc& docOf) {
-  cls.def_property_readonly(
-         "n_joints", [](const M& m) { return vereshchagin::jointCount(m.robot); }, docOf("n_joints"))
+void bindNamesAndData(py::class_<M>& cls, const Doc& docOf) {
+  const std::pair<const char*, double JointInfo::*> fields[] = {{"lower", &JointInfo::lower},
+                                                                {"upper", &JointInfo::upper},
+                                                                {"velocity_limit", &JointInfo::velocity_limit},
+                                                                {"effort_limit", &JointInfo::effort_limit},
+                                                                {"friction", &JointInfo::friction},
+                                                                {"damping", &JointInfo::damping}};
+  for (const auto& [name, field] : fields)
+    cls.def_property_readonly(name, eachJoint<M>(std::mem_fn(field)), docOf(name));
+  cls.def_property_readonly("joint_names", eachJoint<M>(std::mem_fn(&JointInfo::name)), docOf("joint_names"))
+      .def_property_readonly("joint_types", eachJoint<M>(std::mem_fn(&JointInfo::type)), docOf("joint_types"))
+      .def_property_readonly(
+          "n_joints", [](const M& m) { return vereshchagin::jointCount(m.robot); }, docOf("n_joints"))
       .def_property_readonly("n_segments", &M::segmentCount, docOf("n_segments"))
       .def_property_readonly("segment_names", &M::segmentNames, docOf("segment_names"))
       .def_property_readonly(
@@ -83,9 +67,9 @@ void bindNames(py::class_<M>& cls, const Doc& docOf) {
       .def_property_readonly(
           "inertia_check", [](const M& m) { return vereshchagin::inertiaCheckName(m.inertia_check); },
           docOf("inertia_check"))
-      .def_property_readonly("segment_masses",
-                             doubles<M>([](const M& m) { return vereshchagin::segmentMasses(m.robot); }),
-                             docOf("segment_masses"))
+      .def_property_readonly(
+          "segment_masses", [](const M& m) { return array(vereshchagin::segmentMasses(m.robot)); },
+          docOf("segment_masses"))
       .def_property("rotor_inertia", &M::rotorInertia, &M::setRotorInertia, docOf("rotor_inertia"))
       .def(
           "segment_index",
@@ -96,7 +80,12 @@ void bindNames(py::class_<M>& cls, const Doc& docOf) {
           py::arg("name"), docOf("joint_index"));
 }
 
-// The frame parameter of fk, jacobian and twist: optional on a Chain.
+// The frame of fk, jacobian and twist: a Chain's is optional (None: its last segment).
+template <class M>
+FrameTarget frameArg(const M& m, const py::object& which) {
+  if constexpr (kIsTree<M>) return m.resolveTarget(which.ptr(), "segment");
+  return m.resolveOptional(which, "segment");
+}
 template <class M>
 auto segmentParameter() {
   if constexpr (kIsTree<M>)
@@ -108,20 +97,16 @@ auto segmentParameter() {
 // fk, jacobian and twist of a segment or link; pickle, copy and repr.
 template <class M, class Doc>
 void bindKinematicsAndCopies(py::class_<M>& cls, const Doc& docOf) {
-  const auto segment = segmentParameter<M>();
+  using Q = const py::object&;
   cls.def(
-         "fk", [](const M& m, const py::object& q, const py::object& s) { return fkOf(m, q, frameArg(m, s)); },
-         py::arg("q"), segment, docOf("fk"))
+         "fk", [](const M& m, Q q, Q s) { return fkOf(m, q, frameArg(m, s)); }, py::arg("q"), segmentParameter<M>(),
+         docOf("fk"))
       .def(
-          "jacobian",
-          [](const M& m, const py::object& q, const py::object& s) { return jacobianOf(m, q, frameArg(m, s)); },
-          py::arg("q"), segment, docOf("jacobian"))
+          "jacobian", [](const M& m, Q q, Q s) { return jacobianOf(m, q, frameArg(m, s)); }, py::arg("q"),
+          segmentParameter<M>(), docOf("jacobian"))
       .def(
-          "twist",
-          [](const M& m, const py::object& q, const py::object& qd, const py::object& s) {
-            return twistOf(m, q, qd, frameArg(m, s));
-          },
-          py::arg("q"), py::arg("qd"), segment, docOf("twist"))
+          "twist", [](const M& m, Q q, Q qd, Q s) { return twistOf(m, q, qd, frameArg(m, s)); }, py::arg("q"),
+          py::arg("qd"), segmentParameter<M>(), docOf("twist"))
       .def(py::pickle(&modelState<M>, &modelFromState<M>))
       .def("__copy__", [](const M& m) { return m; })
       .def(
@@ -133,6 +118,13 @@ void bindKinematicsAndCopies(py::class_<M>& cls, const Doc& docOf) {
       });
 }
 
+PyChain pathChain(const PyTree& t, const py::object& tip) {
+  PyChain c;
+  c.robot = vereshchagin::pathChain(t.robot, t.resolveMoving(tip.ptr(), "tip").segment);
+  c.inertia_check = t.inertia_check;
+  return c;
+}
+
 }  // namespace
 
 template <class M>
@@ -140,8 +132,7 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
   py::class_<M> cls(mod, name, doc(name));
   const std::string prefix = std::string(name) + ".";
   const auto docOf = [prefix](const char* member) { return doc(prefix + member); };
-  bindJointData(cls, docOf);
-  bindNames(cls, docOf);
+  bindNamesAndData(cls, docOf);
   bindKinematicsAndCopies(cls, docOf);
   return cls;
 }
@@ -151,19 +142,8 @@ void bindTree(py::module_& mod) {
   py::class_<PyTree> cls = bindModel<PyTree>(mod, "Tree");
   cls.def_static(
          "from_urdf",
-         [](const py::object& source, const py::object& root, const std::string& check) {
-           vereshchagin::UrdfOptions options;
-           options.inertia_check = modelCheckArg(check, "");
-           const UrdfSource src = urdfSourceArg(source);
-           const std::string root_name = root.is_none() ? std::string() : root.cast<std::string>();
-           const vereshchagin::UrdfTreeResult r =
-               src.is_text ? vereshchagin::treeFromUrdfString(src.text_or_path, root_name, options)
-                           : vereshchagin::treeFromUrdfFile(src.text_or_path, root_name, options);
-           if (!r.ok) raise(r.message);
-           PyTree t;
-           t.robot = r.robot;
-           t.inertia_check = options.inertia_check;
-           return t;
+         [](const py::object& source, const py::object& root, const std::string& inertia_check) {
+           return modelFromUrdf<PyTree>(source, root.is_none() ? "" : root.cast<std::string>(), "", inertia_check);
          },
          py::arg("source"), py::arg("root") = py::none(), py::arg("inertia_check") = "physical", doc("Tree.from_urdf"))
       .def_property_readonly(
@@ -176,15 +156,7 @@ void bindTree(py::module_& mod) {
             return a;
           },
           doc("Tree.parent"))
-      .def(
-          "chain",
-          [](const PyTree& t, const py::object& tip) {
-            PyChain c;
-            c.robot = vereshchagin::pathChain(t.robot, t.resolveMoving(tip.ptr(), "tip").segment);
-            c.inertia_check = t.inertia_check;
-            return c;
-          },
-          py::arg("tip"), doc("Tree.chain"));
+      .def("chain", &pathChain, py::arg("tip"), doc("Tree.chain"));
   bindTreeDynamics(cls);
 }
 

@@ -1,11 +1,13 @@
 // The members only vereshchagin.Chain has (add_segment, segment_spec, from_urdf(root, tip)) and
 // vereshchagin.Joint, the joint argument of add_segment; the checks are the C++ library's
 // (robot_edit.hpp).
+#include <pybind11/eigen.h>
+
 #include <sstream>
 
 #include "model_state.hpp"
+#include "py_solver.hpp"  // inertiaCheckArg
 #include "vereshchagin/robot_edit.hpp"
-#include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
@@ -57,7 +59,7 @@ void addSegment(PyChain& c, const std::string& name, const py::object& joint, co
                 const py::object& mass, const py::object& com, const py::object& inertia, const py::object& rotor,
                 const std::string& joint_name, const std::string& inertia_check) {
   const std::string where = "segment '" + name + "': ";  // every message names segment and argument
-  const vereshchagin::InertiaCheck check = modelCheckArg(inertia_check, where);
+  const vereshchagin::InertiaCheck check = inertiaCheckArg(inertia_check, where);
   vereshchagin::SegmentSpec spec;
   spec.name = name;
   spec.joint_name = joint_name;
@@ -76,9 +78,6 @@ void addSegment(PyChain& c, const std::string& name, const py::object& joint, co
 py::dict segmentSpec(const PyChain& c, const py::object& which) {
   const int segment = c.resolveMoving(which.ptr(), "segment").segment;
   const vereshchagin::SegmentSpec s = vereshchagin::segmentSpec(vereshchagin::segmentAt(c.robot, segment));
-  py::array_t<double> inertia({3, 3});
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) inertia.mutable_at(r, k) = s.inertia(r, k);
   py::dict d;
   d["name"] = s.name;
   d["joint_type"] = vereshchagin::jointTypeName(s.joint.type);
@@ -88,24 +87,9 @@ py::dict segmentSpec(const PyChain& c, const py::object& which) {
   d["tip"] = homogeneous(s.tip);
   d["mass"] = s.mass;
   d["com"] = copyVector(s.com.data, 3);
-  d["inertia"] = inertia;
+  d["inertia"] = py::cast(Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(s.inertia));
   d["rotor_inertia"] = s.rotor_inertia;
   return d;
-}
-
-PyChain chainFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
-                      const std::string& inertia_check) {
-  vereshchagin::UrdfOptions options;
-  options.inertia_check = modelCheckArg(inertia_check, "");
-  const UrdfSource src = urdfSourceArg(source);
-  const vereshchagin::UrdfResult r = src.is_text
-                                         ? vereshchagin::chainFromUrdfString(src.text_or_path, root, tip, options)
-                                         : vereshchagin::chainFromUrdfFile(src.text_or_path, root, tip, options);
-  if (!r.ok) raise(r.message);
-  PyChain c;
-  c.robot = r.robot;
-  c.inertia_check = options.inertia_check;
-  return c;
 }
 
 void bindJoint(py::module_& mod) {
@@ -138,7 +122,7 @@ void bindChain(py::module_& mod) {
            py::arg("inertia") = py::none(), py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "",
            py::arg("inertia_check") = "physical")
       .def("segment_spec", &segmentSpec, py::arg("segment"), doc("Chain.segment_spec"))
-      .def_static("from_urdf", &chainFromUrdf, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
+      .def_static("from_urdf", &modelFromUrdf<PyChain>, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
                   py::arg("inertia_check") = "physical", doc("Chain.from_urdf"));
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "vereshchagin/inertia_check.hpp"
@@ -32,27 +33,40 @@ struct PyModel : CompanionModel {
   const std::string& rootLink() const override { return robot.root_link; }
 
   // Rotor inertia of each joint in q order; the setter (shape (n_joints,), >= 0) rebuilds the robot.
-  py::array_t<double> rotorInertia() const;
-  void setRotorInertia(const py::object& values);
+  py::array_t<double> rotorInertia() const {
+    const std::vector<double> values = vereshchagin::rotorInertia(robot);
+    return copyVector(values.data(), static_cast<py::ssize_t>(values.size()));
+  }
+  void setRotorInertia(const py::object& values) {
+    const Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(robot.joints.size()));
+    std::string message;
+    if (!vereshchagin::setRotorInertia(robot, std::vector<double>(a.data(), a.data() + a.size()), message))
+      raise(message);
+    invalidateCompanions();
+  }
 
  protected:
   bool frameByName(const std::string& name, vereshchagin::FrameRef& out) const override {
     return vereshchagin::findFrame(robot, name, out);
   }
   int jointByName(const std::string& name) const override { return vereshchagin::findJoint(robot, name); }
-  vereshchagin::Model buildModel() const override;
+  // A tree's Model must order its segments as the PyTree does (the preorder of the KDL::Tree).
+  vereshchagin::Model buildModel() const override {
+    vereshchagin::Model model(robot, vereshchagin::ModelOptions{inertia_check});
+    if constexpr (std::is_same_v<Robot, vereshchagin::RobotTree>)
+      if (model.segmentNames() != robot.segment_names)
+        raise("internal error: the tree's C++ model orders its segments differently");
+    return model;
+  }
 };
 
 using PyChain = PyModel<vereshchagin::RobotChain>;
 using PyTree = PyModel<vereshchagin::RobotTree>;
 
-// The Python class of M (Chain or Tree) with every member the two share (model_bindings.cpp).
+// The Python classes (model_bindings.cpp): bindModel binds what Chain and Tree share.
 template <class M>
 py::class_<M> bindModel(py::module_& mod, const char* name);
-void bindChain(py::module_& mod);  // model_chain.cpp
-void bindTree(py::module_& mod);   // model_bindings.cpp
-
-// An inertia_check argument: 'physical' or 'joint_space', else raises (message after `where`).
-vereshchagin::InertiaCheck modelCheckArg(const std::string& value, const std::string& where);
+void bindChain(py::module_& mod);  // model_chain.cpp: Joint and Chain
+void bindTree(py::module_& mod);
 
 }  // namespace vsbind

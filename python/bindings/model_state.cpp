@@ -1,5 +1,5 @@
 // Pickle states of Chain and Tree as tuples of robot_state.hpp's records (model_state.hpp), and
-// the URDF source argument.
+// from_urdf.
 #include "model_state.hpp"
 
 #include <pybind11/stl.h>
@@ -7,15 +7,15 @@
 #include <array>
 #include <fstream>
 #include <limits>
-#include <type_traits>
 
+#include "py_solver.hpp"  // inertiaCheckArg
 #include "vereshchagin/robot_state.hpp"
+#include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
 namespace {
 
-using vereshchagin::RobotRecord;
 constexpr long long kLo = std::numeric_limits<long long>::min(), kHi = std::numeric_limits<long long>::max();
 
 // A state record: a tuple of exactly n entries.
@@ -31,14 +31,14 @@ py::list stateList(const py::handle& obj, const std::string& what) {
 }
 
 template <std::size_t N>
-py::tuple doublesState(const std::array<double, N>& a) {
+py::tuple toTuple(const std::array<double, N>& a) {
   py::tuple t(N);
   for (std::size_t k = 0; k < N; ++k) t[k] = a[k];
   return t;
 }
 
 template <std::size_t N>
-std::array<double, N> doublesFrom(const py::handle& obj, const std::string& what) {
+std::array<double, N> doubles(const py::handle& obj, const std::string& what) {
   const py::tuple t = record(obj, N, what);
   std::array<double, N> out{};
   for (std::size_t k = 0; k < N; ++k) out[k] = t[k].cast<double>();
@@ -46,65 +46,50 @@ std::array<double, N> doublesFrom(const py::handle& obj, const std::string& what
 }
 
 py::tuple segmentState(const vereshchagin::SegmentRecord& s) {
-  return py::make_tuple(s.name, s.joint_name, s.joint_type, doublesState(s.origin), doublesState(s.axis),
-                        s.rotor_inertia, s.damping, s.stiffness, doublesState(s.tip), doublesState(s.inertia));
+  return py::make_tuple(s.name, s.joint_name, s.joint_type, toTuple(s.origin), toTuple(s.axis), s.rotor_inertia,
+                        s.damping, s.stiffness, toTuple(s.tip), toTuple(s.inertia));
 }
 
 vereshchagin::SegmentRecord segmentFrom(const py::handle& obj, const std::string& what) {
   const py::tuple t = record(obj, 10, what);
-  vereshchagin::SegmentRecord s;
-  s.name = t[0].cast<std::string>();
-  s.joint_name = t[1].cast<std::string>();
-  s.joint_type = stateInt(t[2], kLo, kHi, what + " joint type");
-  s.origin = doublesFrom<3>(t[3], what + " joint origin");
-  s.axis = doublesFrom<3>(t[4], what + " joint axis");
-  s.rotor_inertia = t[5].cast<double>();
-  s.damping = t[6].cast<double>();
-  s.stiffness = t[7].cast<double>();
-  s.tip = doublesFrom<12>(t[8], what + " tip frame");
-  s.inertia = doublesFrom<13>(t[9], what + " inertia");
-  return s;
-}
-
-py::tuple jointState(const vereshchagin::JointRecord& r) {
-  const vereshchagin::JointInfo& j = r.info;
-  return py::make_tuple(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction, j.damping,
-                        r.segment);
+  return {t[0].cast<std::string>(),
+          t[1].cast<std::string>(),
+          stateInt(t[2], kLo, kHi, what + " joint type"),
+          doubles<3>(t[3], what + " joint origin"),
+          doubles<3>(t[4], what + " joint axis"),
+          t[5].cast<double>(),
+          t[6].cast<double>(),
+          t[7].cast<double>(),
+          doubles<12>(t[8], what + " tip frame"),
+          doubles<13>(t[9], what + " inertia")};
 }
 
 vereshchagin::JointRecord jointFrom(const py::handle& obj, const std::string& what) {
   const py::tuple t = record(obj, 9, what);
-  vereshchagin::JointRecord r;
-  vereshchagin::JointInfo& j = r.info;
-  j.name = t[0].cast<std::string>();
-  j.type = t[1].cast<std::string>();
-  double* values[] = {&j.lower, &j.upper, &j.velocity_limit, &j.effort_limit, &j.friction, &j.damping};
-  for (std::size_t k = 0; k < 6; ++k) *values[k] = t[2 + k].cast<double>();
-  r.segment = stateInt(t[8], kLo, kHi, what + " segment");
-  return r;
+  vereshchagin::JointInfo j{t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].cast<double>(),
+                            t[3].cast<double>(),      t[4].cast<double>(),      t[5].cast<double>(),
+                            t[6].cast<double>(),      t[7].cast<double>()};
+  return {j, stateInt(t[8], kLo, kHi, what + " segment")};
 }
 
-// The records of a state tuple (see model_state.hpp for both layouts).
-RobotRecord recordFrom(const py::tuple& state, bool tree, const std::string& what) {
-  RobotRecord r;
+// The records of a state tuple (model_state.hpp gives both layouts).
+vereshchagin::RobotRecord recordFrom(const py::tuple& state, bool tree, const std::string& what) {
+  vereshchagin::RobotRecord r;
   r.root_link = state[tree ? 1 : 4].cast<std::string>();
   for (const auto& item : stateList(state[tree ? 2 : 1], what + ": segments")) {
     const std::string which = what + ": segment " + std::to_string(r.segments.size());
-    if (!tree) {
-      r.segments.push_back(segmentFrom(item, which));
-      continue;
-    }
-    if (!py::isinstance<py::tuple>(item) || py::len(item) != 2) raise(which + " must be a pair (segment, parent)");
-    const py::tuple entry = py::reinterpret_borrow<py::tuple>(item);
-    r.segments.push_back(segmentFrom(entry[0], which));
-    r.segments.back().parent = stateInt(entry[1], kLo, kHi, which + ": parent index");
+    if (tree && (!py::isinstance<py::tuple>(item) || py::len(item) != 2))
+      raise(which + " must be a pair (segment, parent)");
+    r.segments.push_back(
+        segmentFrom(tree ? py::object(item[py::int_(0)]) : py::reinterpret_borrow<py::object>(item), which));
+    if (tree) r.segments.back().parent = stateInt(py::object(item[py::int_(1)]), kLo, kHi, which + ": parent index");
   }
   for (const auto& item : stateList(state[tree ? 3 : 2], what + ": joints"))
     r.joints.push_back(jointFrom(item, what + ": joint record"));
   for (const auto& item : stateList(state[tree ? 4 : 3], what + ": links")) {
     const py::tuple t = record(item, 3, what + ": link record");
     r.links.push_back({t[0].cast<std::string>(), stateInt(t[1], kLo, kHi, what + ": link record segment"),
-                       doublesFrom<12>(t[2], what + ": link record frame")});
+                       doubles<12>(t[2], what + ": link record frame")});
   }
   r.notes = state[5].cast<std::vector<std::string>>();
   return r;
@@ -122,12 +107,14 @@ long long stateInt(const py::handle& obj, long long lo, long long hi, const std:
 template <class Model>
 py::tuple modelState(const Model& model) {
   constexpr bool tree = std::is_same_v<Model, PyTree>;
-  const RobotRecord r = vereshchagin::robotRecord(model.robot);
+  const vereshchagin::RobotRecord r = vereshchagin::robotRecord(model.robot);
   py::list segments, joints, links;
   for (const auto& s : r.segments)
     segments.append(tree ? py::object(py::make_tuple(segmentState(s), s.parent)) : py::object(segmentState(s)));
-  for (const auto& j : r.joints) joints.append(jointState(j));
-  for (const auto& l : r.links) links.append(py::make_tuple(l.link, l.segment, doublesState(l.frame)));
+  for (const auto& [j, segment] : r.joints)
+    joints.append(py::make_tuple(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction,
+                                 j.damping, segment));
+  for (const auto& l : r.links) links.append(py::make_tuple(l.link, l.segment, toTuple(l.frame)));
   const char* check = vereshchagin::inertiaCheckName(model.inertia_check);
   if (tree) return py::make_tuple(1, r.root_link, segments, joints, links, py::cast(r.notes), check);
   return py::make_tuple(1, segments, joints, links, r.root_link, py::cast(r.notes), check);
@@ -143,7 +130,7 @@ Model modelFromState(const py::tuple& state) {
   Model model;
   std::string message;
   if (!vereshchagin::robotFromRecord(recordFrom(state, tree, what), model.robot, message)) raise(message);
-  if (state.size() == 7) model.inertia_check = modelCheckArg(state[6].cast<std::string>(), what + ": ");
+  if (state.size() == 7) model.inertia_check = inertiaCheckArg(state[6].cast<std::string>(), what + ": ");
   return model;
 }
 
@@ -152,17 +139,32 @@ template py::tuple modelState(const PyTree&);
 template PyChain modelFromState(const py::tuple&);
 template PyTree modelFromState(const py::tuple&);
 
-UrdfSource urdfSourceArg(const py::object& source) {
+template <class Model>
+Model modelFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
+                    const std::string& inertia_check) {
+  vereshchagin::UrdfOptions options;
+  options.inertia_check = inertiaCheckArg(inertia_check, "");
   if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
     raise("source must be URDF XML text or a file path");
-  UrdfSource out;
-  out.text_or_path = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
-  out.is_text = out.text_or_path.find('<') != std::string::npos;
-  if (!out.is_text) {
-    std::ifstream probe(out.text_or_path);
-    if (!probe) raise("URDF source is neither XML text nor a readable file: '" + out.text_or_path + "'");
-  }
-  return out;
+  const std::string text = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
+  const bool is_text = text.find('<') != std::string::npos;
+  if (!is_text && !std::ifstream(text)) raise("URDF source is neither XML text nor a readable file: '" + text + "'");
+  Model model;
+  model.inertia_check = options.inertia_check;
+  const auto r = [&] {
+    if constexpr (std::is_same_v<Model, PyTree>)
+      return is_text ? vereshchagin::treeFromUrdfString(text, root, options)
+                     : vereshchagin::treeFromUrdfFile(text, root, options);
+    else
+      return is_text ? vereshchagin::chainFromUrdfString(text, root, tip, options)
+                     : vereshchagin::chainFromUrdfFile(text, root, tip, options);
+  }();
+  if (!r.ok) raise(r.message);
+  model.robot = r.robot;
+  return model;
 }
+
+template PyChain modelFromUrdf(const py::object&, const std::string&, const std::string&, const std::string&);
+template PyTree modelFromUrdf(const py::object&, const std::string&, const std::string&, const std::string&);
 
 }  // namespace vsbind

@@ -23,12 +23,10 @@ py::tuple modelState(const Model& model);
 template <class Model>
 Model modelFromState(const py::tuple& state);
 
-// A URDF `source` argument (str or os.PathLike): XML text when it contains '<', else a path that
-// must be readable. Raises SolverError otherwise.
-struct UrdfSource {
-  std::string text_or_path;
-  bool is_text = false;
-};
-UrdfSource urdfSourceArg(const py::object& source);
+// Chain.from_urdf / Tree.from_urdf: `source` is URDF XML text (str holding '<') or a readable file
+// path (str or os.PathLike); `tip` is unused for a Tree. Raises SolverError otherwise.
+template <class Model>
+Model modelFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
+                    const std::string& inertia_check);
 
 }  // namespace vsbind
