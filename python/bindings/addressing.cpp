@@ -43,21 +43,13 @@ Addressable::Target Addressable::resolveTarget(PyObject* which, const std::strin
   Target t;
   if (PyUnicode_Check(which)) {
     const std::string name = py::handle(which).cast<std::string>();
-    for (int i = 0; i < ns; ++i) {
-      if (segmentName(i) == name) {
-        t.segment = i;
-        return t;
-      }
+    vereshchagin::FrameRef ref;
+    if (frameByName(name, ref)) {
+      t.segment = ref.segment;  // -1: the base or a link of it
+      t.link_in_tip = ref.in_tip;
+      t.merged = ref.segment >= 0 && ref.in_tip.p.Norm() != 0.0;
+      return t;
     }
-    for (const auto& l : linkPlacements()) {
-      if (l.link == name) {
-        t.segment = l.segment;  // -1: a link of the base
-        t.link_in_tip = l.in_segment_tip;
-        t.merged = l.segment >= 0 && l.in_segment_tip.p.Norm() != 0.0;
-        return t;
-      }
-    }
-    if (!root_link.empty() && name == root_link) return t;  // the base
     raise(label + ": no segment or link named '" + name + "' (segments: " + nameList(segmentNames()) +
           (root_link.empty() ? "" : "; base: '" + root_link + "'") + ")");
   }
@@ -83,18 +75,15 @@ Addressable::Target Addressable::resolveMoving(PyObject* which, const std::strin
 }
 
 int Addressable::resolveJoint(PyObject* which, const std::string& label) const {
-  const std::vector<vereshchagin::JointInfo>& joints = jointInfos();
-  const int nj = static_cast<int>(joints.size());
   if (PyUnicode_Check(which)) {
     const std::string name = py::handle(which).cast<std::string>();
-    for (int j = 0; j < nj; ++j)
-      if (joints[j].name == name) return j;
+    if (const int j = jointByName(name); j >= 0) return j;
     raise(label + ": no joint named '" + name + "' (joints: " + nameList(jointNames()) + ")");
   }
   if (PyBool_Check(which) || !PyIndex_Check(which))
     raise(label + ": a joint is named by a str or an int index, got " +
           std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
-  return indexInRange(which, nj, label, "joint");
+  return indexInRange(which, static_cast<int>(jointInfos().size()), label, "joint");
 }
 
 }  // namespace vsbind

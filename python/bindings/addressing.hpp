@@ -9,6 +9,7 @@
 
 #include <kdl/frames.hpp>
 
+#include "vereshchagin/model.hpp"        // FrameRef
 #include "vereshchagin/robot_chain.hpp"  // JointInfo, LinkPlacement
 
 #include "common.hpp"
@@ -47,6 +48,11 @@ class Addressable {
   int resolveJoint(PyObject* which, const std::string& label) const;
 
  protected:
+  // A frame by name (segment, merged link or base) and a joint index by name (-1: none), by the
+  // C++ library's lookups (robot_access.hpp).
+  virtual bool frameByName(const std::string& name, vereshchagin::FrameRef& out) const = 0;
+  virtual int jointByName(const std::string& name) const = 0;
+
   Addressable() = default;
   Addressable(const Addressable&) = default;
   Addressable& operator=(const Addressable&) = default;

@@ -1,27 +1,22 @@
-// Pickle states of model parts and the URDF source argument (model_state.hpp).
+// Pickle states of Chain and Tree as tuples of robot_state.hpp's records (model_state.hpp), and
+// from_urdf.
 #include "model_state.hpp"
 
-#include <cmath>
-#include <cstring>
+#include <pybind11/stl.h>
+
+#include <array>
 #include <fstream>
 #include <limits>
+
+#include "py_solver.hpp"  // inertiaCheckArg
+#include "vereshchagin/robot_state.hpp"
+#include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
 namespace {
 
-// KDL::RigidBodyInertia keeps (m, m c, I about the reference point); its public constructor takes
-// the inertia about the centre of mass and would round the stored values differently. The
-// state copies the 13 stored doubles so a pickled chain solves bit for bit like the original.
-static_assert(sizeof(KDL::RigidBodyInertia) == 13 * sizeof(double), "unexpected KDL::RigidBodyInertia layout");
-
-py::tuple inertiaState(const KDL::RigidBodyInertia& I) {
-  double raw[13];
-  std::memcpy(raw, static_cast<const void*>(&I), sizeof(raw));
-  py::tuple t(13);
-  for (int k = 0; k < 13; ++k) t[k] = raw[k];
-  return t;
-}
+constexpr long long kLo = std::numeric_limits<long long>::min(), kHi = std::numeric_limits<long long>::max();
 
 // A state record: a tuple of exactly n entries.
 py::tuple record(const py::handle& obj, std::size_t n, const std::string& what) {
@@ -30,43 +25,74 @@ py::tuple record(const py::handle& obj, std::size_t n, const std::string& what) 
   return py::reinterpret_borrow<py::tuple>(obj);
 }
 
-// The entries of a state tuple as doubles: exactly `n` finite reals, or raises naming `what`.
-void finiteEntries(const py::handle& obj, std::size_t n, const std::string& what, double* out) {
-  const py::tuple t = record(obj, n, what);
-  for (std::size_t k = 0; k < n; ++k) {
-    out[k] = t[k].cast<double>();
-    if (!std::isfinite(out[k])) raise(what + " holds a non-finite value");
+py::list stateList(const py::handle& obj, const std::string& what) {
+  if (!py::isinstance<py::list>(obj)) raise(what + " must be a list");
+  return py::reinterpret_borrow<py::list>(obj);
+}
+
+template <std::size_t N>
+py::tuple toTuple(const std::array<double, N>& a) {
+  py::tuple t(N);
+  for (std::size_t k = 0; k < N; ++k) t[k] = a[k];
+  return t;
+}
+
+template <std::size_t N>
+std::array<double, N> doubles(const py::handle& obj, const std::string& what) {
+  const py::tuple t = record(obj, N, what);
+  std::array<double, N> out{};
+  for (std::size_t k = 0; k < N; ++k) out[k] = t[k].cast<double>();
+  return out;
+}
+
+py::tuple segmentState(const vereshchagin::SegmentRecord& s) {
+  return py::make_tuple(s.name, s.joint_name, s.joint_type, toTuple(s.origin), toTuple(s.axis), s.rotor_inertia,
+                        s.damping, s.stiffness, toTuple(s.tip), toTuple(s.inertia));
+}
+
+vereshchagin::SegmentRecord segmentFrom(const py::handle& obj, const std::string& what) {
+  const py::tuple t = record(obj, 10, what);
+  return {t[0].cast<std::string>(),
+          t[1].cast<std::string>(),
+          stateInt(t[2], kLo, kHi, what + " joint type"),
+          doubles<3>(t[3], what + " joint origin"),
+          doubles<3>(t[4], what + " joint axis"),
+          t[5].cast<double>(),
+          t[6].cast<double>(),
+          t[7].cast<double>(),
+          doubles<12>(t[8], what + " tip frame"),
+          doubles<13>(t[9], what + " inertia")};
+}
+
+vereshchagin::JointRecord jointFrom(const py::handle& obj, const std::string& what) {
+  const py::tuple t = record(obj, 9, what);
+  vereshchagin::JointInfo j{t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].cast<double>(),
+                            t[3].cast<double>(),      t[4].cast<double>(),      t[5].cast<double>(),
+                            t[6].cast<double>(),      t[7].cast<double>()};
+  return {j, stateInt(t[8], kLo, kHi, what + " segment")};
+}
+
+// The records of a state tuple (model_state.hpp gives both layouts).
+vereshchagin::RobotRecord recordFrom(const py::tuple& state, bool tree, const std::string& what) {
+  vereshchagin::RobotRecord r;
+  r.root_link = state[tree ? 1 : 4].cast<std::string>();
+  for (const auto& item : stateList(state[tree ? 2 : 1], what + ": segments")) {
+    const std::string which = what + ": segment " + std::to_string(r.segments.size());
+    if (tree && (!py::isinstance<py::tuple>(item) || py::len(item) != 2))
+      raise(which + " must be a pair (segment, parent)");
+    r.segments.push_back(
+        segmentFrom(tree ? py::object(item[py::int_(0)]) : py::reinterpret_borrow<py::object>(item), which));
+    if (tree) r.segments.back().parent = stateInt(py::object(item[py::int_(1)]), kLo, kHi, which + ": parent index");
   }
-}
-
-KDL::RigidBodyInertia inertiaFromState(const py::handle& obj, const std::string& what) {
-  double raw[13];
-  finiteEntries(obj, 13, what + " inertia", raw);
-  if (raw[0] < 0.0) raise(what + " inertia has a negative mass");
-  KDL::RigidBodyInertia I;
-  std::memcpy(static_cast<void*>(&I), raw, sizeof(raw));
-  return I;
-}
-
-py::tuple frameState(const KDL::Frame& f) {
-  return py::make_tuple(f.M(0, 0), f.M(0, 1), f.M(0, 2), f.M(1, 0), f.M(1, 1), f.M(1, 2), f.M(2, 0), f.M(2, 1),
-                        f.M(2, 2), f.p.x(), f.p.y(), f.p.z());
-}
-
-KDL::Frame frameFromState(const py::handle& obj, const std::string& what) {
-  double d[12];
-  finiteEntries(obj, 12, what, d);
-  return KDL::Frame(KDL::Rotation(d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7], d[8]),
-                    KDL::Vector(d[9], d[10], d[11]));
-}
-
-py::tuple vectorState(const KDL::Vector& v) {
-  return py::make_tuple(v.x(), v.y(), v.z());
-}
-KDL::Vector vectorFromState(const py::handle& obj, const std::string& what) {
-  double d[3];
-  finiteEntries(obj, 3, what, d);
-  return KDL::Vector(d[0], d[1], d[2]);
+  for (const auto& item : stateList(state[tree ? 3 : 2], what + ": joints"))
+    r.joints.push_back(jointFrom(item, what + ": joint record"));
+  for (const auto& item : stateList(state[tree ? 4 : 3], what + ": links")) {
+    const py::tuple t = record(item, 3, what + ": link record");
+    r.links.push_back({t[0].cast<std::string>(), stateInt(t[1], kLo, kHi, what + ": link record segment"),
+                       doubles<12>(t[2], what + ": link record frame")});
+  }
+  r.notes = state[5].cast<std::vector<std::string>>();
+  return r;
 }
 
 }  // namespace
@@ -78,95 +104,67 @@ long long stateInt(const py::handle& obj, long long lo, long long hi, const std:
   return *v;
 }
 
-py::tuple segmentState(const KDL::Segment& s) {
-  const KDL::Joint& j = s.getJoint();
-  return py::make_tuple(s.getName(), j.getName(), static_cast<int>(j.getType()), vectorState(j.JointOrigin()),
-                        vectorState(j.JointAxis()), j.getInertia(), j.getDamping(), j.getStiffness(),
-                        frameState(s.getFrameToTip()), inertiaState(s.getInertia()));
+template <class Model>
+py::tuple modelState(const Model& model) {
+  constexpr bool tree = std::is_same_v<Model, PyTree>;
+  const vereshchagin::RobotRecord r = vereshchagin::robotRecord(model.robot);
+  py::list segments, joints, links;
+  for (const auto& s : r.segments)
+    segments.append(tree ? py::object(py::make_tuple(segmentState(s), s.parent)) : py::object(segmentState(s)));
+  for (const auto& [j, segment] : r.joints)
+    joints.append(py::make_tuple(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction,
+                                 j.damping, segment));
+  for (const auto& l : r.links) links.append(py::make_tuple(l.link, l.segment, toTuple(l.frame)));
+  const char* check = vereshchagin::inertiaCheckName(model.inertia_check);
+  if (tree) return py::make_tuple(1, r.root_link, segments, joints, links, py::cast(r.notes), check);
+  return py::make_tuple(1, segments, joints, links, r.root_link, py::cast(r.notes), check);
 }
 
-KDL::Segment segmentFromState(const py::handle& obj, const std::string& what) {
-  const py::tuple t = record(obj, 10, what);
-  const auto type =
-      static_cast<KDL::Joint::JointType>(stateInt(t[2], KDL::Joint::RotAxis, KDL::Joint::Fixed, what + " joint type"));
-  const std::string jname = t[1].cast<std::string>();
-  double params[3];  // rotor inertia, damping, stiffness
-  for (int k = 0; k < 3; ++k) {
-    params[k] = t[5 + k].cast<double>();
-    if (!std::isfinite(params[k])) raise(what + " joint parameters must be finite");
-  }
-  if (params[0] < 0.0) raise(what + " rotor inertia must be >= 0");
-  const KDL::Vector origin = vectorFromState(t[3], what + " joint origin"),
-                    axis = vectorFromState(t[4], what + " joint axis");
-  const bool has_axis = type == KDL::Joint::RotAxis || type == KDL::Joint::TransAxis;
-  if (has_axis && !(axis.Norm() > 0.0)) raise(what + " joint axis must be non-zero");
-  const KDL::Joint j = has_axis ? KDL::Joint(jname, origin, axis, type, 1.0, 0.0, params[0], params[1], params[2])
-                                : KDL::Joint(jname, type, 1.0, 0.0, params[0], params[1], params[2]);
-  return KDL::Segment(t[0].cast<std::string>(), j, frameFromState(t[8], what + " tip frame"),
-                      inertiaFromState(t[9], what));
+template <class Model>
+Model modelFromState(const py::tuple& state) {
+  constexpr bool tree = std::is_same_v<Model, PyTree>;
+  const std::string what = tree ? "Tree state" : "Chain state";
+  if ((state.size() != 6 && state.size() != 7) || !py::isinstance<py::int_>(state[0]) ||
+      state[0].cast<long long>() != 1)
+    raise(what + ": unknown format");
+  Model model;
+  std::string message;
+  if (!vereshchagin::robotFromRecord(recordFrom(state, tree, what), model.robot, message)) raise(message);
+  if (state.size() == 7) model.inertia_check = inertiaCheckArg(state[6].cast<std::string>(), what + ": ");
+  return model;
 }
 
-py::tuple jointInfoState(const vereshchagin::JointInfo& j) {
-  return py::make_tuple(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction, j.damping,
-                        j.segment);
-}
+template py::tuple modelState(const PyChain&);
+template py::tuple modelState(const PyTree&);
+template PyChain modelFromState(const py::tuple&);
+template PyTree modelFromState(const py::tuple&);
 
-vereshchagin::JointInfo jointInfoFromState(const py::handle& obj, const std::string& what) {
-  const py::tuple t = record(obj, 9, what);
-  vereshchagin::JointInfo j;
-  j.name = t[0].cast<std::string>();
-  j.type = t[1].cast<std::string>();
-  j.lower = t[2].cast<double>();
-  j.upper = t[3].cast<double>();
-  j.velocity_limit = t[4].cast<double>();
-  j.effort_limit = t[5].cast<double>();
-  j.friction = t[6].cast<double>();
-  j.damping = t[7].cast<double>();
-  if (std::isnan(j.lower) || std::isnan(j.upper) || !(j.lower <= j.upper))
-    raise(what + " limits must satisfy lower <= upper");
-  if (!std::isfinite(j.friction) || j.friction < 0.0) raise(what + " friction must be finite and >= 0");
-  j.segment = static_cast<unsigned int>(stateInt(t[8], 0, std::numeric_limits<int>::max(), what + " segment"));
-  return j;
-}
-
-py::tuple linkState(const vereshchagin::LinkPlacement& l) {
-  return py::make_tuple(l.link, l.segment, frameState(l.in_segment_tip));
-}
-
-vereshchagin::LinkPlacement linkFromState(const py::handle& obj, const std::string& what) {
-  const py::tuple t = record(obj, 3, what);
-  return {t[0].cast<std::string>(),
-          static_cast<int>(stateInt(t[1], -1, std::numeric_limits<int>::max(), what + " segment")),
-          frameFromState(t[2], what + " frame")};
-}
-
-void checkStateIndices(const std::vector<vereshchagin::JointInfo>& joints,
-                       const std::vector<vereshchagin::LinkPlacement>& links, const std::vector<int>& moving_segments,
-                       int n_segments, const std::string& what) {
-  if (joints.size() != moving_segments.size())
-    raise(what + ": " + std::to_string(joints.size()) + " joint records for " + std::to_string(moving_segments.size()) +
-          " moving joints");
-  for (std::size_t k = 0; k < joints.size(); ++k)
-    if (static_cast<int>(joints[k].segment) != moving_segments[k])
-      raise(what + ": joint record " + std::to_string(k) + " names segment " + std::to_string(joints[k].segment) +
-            ", but that joint moves segment " + std::to_string(moving_segments[k]));
-  for (const vereshchagin::LinkPlacement& l : links)
-    if (l.segment >= n_segments)
-      raise(what + ": link '" + l.link + "' names segment " + std::to_string(l.segment) + " of " +
-            std::to_string(n_segments));
-}
-
-UrdfSource urdfSourceArg(const py::object& source) {
+template <class Model>
+Model modelFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
+                    const std::string& inertia_check) {
+  vereshchagin::UrdfOptions options;
+  options.inertia_check = inertiaCheckArg(inertia_check, "");
   if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
     raise("source must be URDF XML text or a file path");
-  UrdfSource out;
-  out.text_or_path = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
-  out.is_text = out.text_or_path.find('<') != std::string::npos;
-  if (!out.is_text) {
-    std::ifstream probe(out.text_or_path);
-    if (!probe) raise("URDF source is neither XML text nor a readable file: '" + out.text_or_path + "'");
-  }
-  return out;
+  const std::string text = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
+  const bool is_text = text.find('<') != std::string::npos;
+  if (!is_text && !std::ifstream(text)) raise("URDF source is neither XML text nor a readable file: '" + text + "'");
+  Model model;
+  model.inertia_check = options.inertia_check;
+  const auto r = [&] {
+    if constexpr (std::is_same_v<Model, PyTree>)
+      return is_text ? vereshchagin::treeFromUrdfString(text, root, options)
+                     : vereshchagin::treeFromUrdfFile(text, root, options);
+    else
+      return is_text ? vereshchagin::chainFromUrdfString(text, root, tip, options)
+                     : vereshchagin::chainFromUrdfFile(text, root, tip, options);
+  }();
+  if (!r.ok) raise(r.message);
+  model.robot = r.robot;
+  return model;
 }
+
+template PyChain modelFromUrdf(const py::object&, const std::string&, const std::string&, const std::string&);
+template PyTree modelFromUrdf(const py::object&, const std::string&, const std::string&, const std::string&);
 
 }  // namespace vsbind

@@ -1,47 +1,32 @@
-// Pickle states of model parts (KDL segments bit for bit, joint metadata, link placements) and
-// the URDF source argument, shared by Chain and Tree.
+// Pickle states of Chain and Tree (tuples of the C++ records of robot_state.hpp, which checks
+// them) and the URDF source argument of from_urdf.
 #pragma once
 
 #include <string>
-#include <vector>
-
-#include <kdl/segment.hpp>
-
-#include "vereshchagin/robot_chain.hpp"  // JointInfo, LinkPlacement
 
 #include "common.hpp"
+#include "model_class.hpp"
 
 namespace vsbind {
 
-// (name, joint name, joint type, origin, axis, rotor inertia, damping, stiffness, tip frame,
-// 13 stored inertia doubles): restores the segment bit for bit.
-py::tuple segmentState(const KDL::Segment& s);
-// The *FromState functions check every record (sizes, types, finite values, index ranges) and
-// raise SolverError naming `what`: a crafted state never reaches the solver.
-KDL::Segment segmentFromState(const py::handle& t, const std::string& what);
-py::tuple jointInfoState(const vereshchagin::JointInfo& j);
-vereshchagin::JointInfo jointInfoFromState(const py::handle& t, const std::string& what);
-py::tuple linkState(const vereshchagin::LinkPlacement& l);
-vereshchagin::LinkPlacement linkFromState(const py::handle& t, const std::string& what);
 // An int entry of a state record within [lo, hi] (raises naming `what` otherwise).
 long long stateInt(const py::handle& obj, long long lo, long long hi, const std::string& what);
-// A list entry of a state tuple (raises naming `what` otherwise).
-inline py::list stateList(const py::handle& obj, const std::string& what) {
-  if (!py::isinstance<py::list>(obj)) raise(what + " must be a list");
-  return py::reinterpret_borrow<py::list>(obj);
-}
-// Joint records one per moving segment (moving_segments: their indices in order, as the model
-// numbers joints), link records on segments that exist (-1: the base).
-void checkStateIndices(const std::vector<vereshchagin::JointInfo>& joints,
-                       const std::vector<vereshchagin::LinkPlacement>& links, const std::vector<int>& moving_segments,
-                       int n_segments, const std::string& what);
 
-// A URDF `source` argument (str or os.PathLike): XML text when it contains '<', else a path that
-// must be readable. Raises SolverError otherwise.
-struct UrdfSource {
-  std::string text_or_path;
-  bool is_text = false;
-};
-UrdfSource urdfSourceArg(const py::object& source);
+// Chain: (1, segments, joints, links, root_link, notes, inertia_check); Tree: (1, root_link,
+// [(segment, parent)], joints, links, notes, inertia_check). A segment: (name, joint name, joint
+// type, origin, axis, rotor inertia, damping, stiffness, tip frame (12), the 13 stored inertia
+// doubles), restored bit for bit; a joint: (name, type, lower, upper, velocity_limit,
+// effort_limit, friction, damping, segment); a link: (name, segment, frame (12)). States of six
+// entries (no inertia_check) load as 'physical'. Crafted states raise SolverError naming the record.
+template <class Model>
+py::tuple modelState(const Model& model);
+template <class Model>
+Model modelFromState(const py::tuple& state);
+
+// Chain.from_urdf / Tree.from_urdf: `source` is URDF XML text (str holding '<') or a readable file
+// path (str or os.PathLike); `tip` is unused for a Tree. Raises SolverError otherwise.
+template <class Model>
+Model modelFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
+                    const std::string& inertia_check);
 
 }  // namespace vsbind

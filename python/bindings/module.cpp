@@ -6,12 +6,11 @@
 #include "common.hpp"
 
 namespace vsbind {
-void bindChain(py::module_& mod);
-void bindTree(py::module_& mod);
+void bindChain(py::module_& mod);  // model_chain.cpp: Joint and Chain
+void bindTree(py::module_& mod);   // model_bindings.cpp
 void bindSolver(py::module_& mod);
 void bindResultType(py::module_& mod);
 void bindDynamics(py::module_& mod);
-void bindSegmentSpec(py::module_& mod);
 
 namespace {
 PyObject* g_docs = nullptr;  // vereshchagin._docstrings.DOCS, referenced for the interpreter's lifetime
@@ -34,7 +33,6 @@ PYBIND11_MODULE(_core, mod) {
   vsbind::bindChain(mod);
   vsbind::bindTree(mod);
   vsbind::bindResultType(mod);
-  vsbind::bindDynamics(mod);     // adds methods to Chain
-  vsbind::bindSegmentSpec(mod);  // adds Chain.segment_spec
+  vsbind::bindDynamics(mod);  // adds methods to Chain
   vsbind::bindSolver(mod);
 }

@@ -1,0 +1,78 @@
+/// @file
+/// One way to read and edit a RobotChain and a RobotTree alike: segments by index, names,
+/// masses, rotor inertias, lookups of frames and joints by name, and the chain of one
+/// root-to-segment path of a tree. Indices are segment indices (robot_tree.hpp's segment order;
+/// a chain's order) and joint indices (q order: RobotChain::joints / RobotTree::joints).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <kdl/segment.hpp>
+
+#include "vereshchagin/model.hpp"  // FrameRef
+#include "vereshchagin/robot_chain.hpp"
+#include "vereshchagin/robot_tree.hpp"
+#include "vereshchagin/status.hpp"
+
+namespace vereshchagin {
+
+int segmentCount(const RobotChain& robot);  ///< number of segments
+int segmentCount(const RobotTree& robot);   ///< number of segments, the base excluded
+int jointCount(const RobotChain& robot);    ///< number of moving joints (KDL's count)
+int jointCount(const RobotTree& robot);     ///< number of moving joints (KDL's count)
+/// Segment `index` (0 <= index < segmentCount): joint, tip frame, inertia about the tip origin.
+const KDL::Segment& segmentAt(const RobotChain& robot, int index);
+/// Segment `index` of the tree's segment order (0 <= index < segmentCount).
+const KDL::Segment& segmentAt(const RobotTree& robot, int index);
+/// The name of segment `index` (0 <= index < segmentCount).
+const std::string& segmentName(const RobotChain& robot, int index);
+/// The name of segment `index` (0 <= index < segmentCount).
+const std::string& segmentName(const RobotTree& robot, int index);
+
+/// Mass of every segment, kg, in segment order.
+template <class Robot>
+std::vector<double> segmentMasses(const Robot& robot) {
+  std::vector<double> out(static_cast<std::size_t>(segmentCount(robot)));
+  for (int i = 0; i < segmentCount(robot); ++i)
+    out[static_cast<std::size_t>(i)] = segmentAt(robot, i).getInertia().getMass();
+  return out;
+}
+
+/// Rotor inertia reflected to every moving joint, in q order (kg m^2 revolute, kg prismatic).
+template <class Robot>
+std::vector<double> rotorInertia(const Robot& robot) {
+  std::vector<double> out(robot.joints.size());
+  for (std::size_t k = 0; k < robot.joints.size(); ++k)
+    out[k] = segmentAt(robot, static_cast<int>(robot.joints[k].segment)).getJoint().getInertia();
+  return out;
+}
+
+/// Sets the rotor inertia of every moving joint (q order) and rebuilds the KDL chain; `values`
+/// must hold one finite entry >= 0 per joint. On failure `robot` is unchanged and the message
+/// ("rotor_inertia must be >= 0, got -0.100000 at joint 3", ...) is in `message`.
+Status setRotorInertia(RobotChain& robot, const std::vector<double>& values, std::string& message);
+/// The same for a tree: rebuilds its KDL::Tree in segment order (joint numbering unchanged).
+Status setRotorInertia(RobotTree& robot, const std::vector<double>& values, std::string& message);
+
+/// A frame by name: a segment (its tip frame), a link merged into a segment (its pose in that
+/// segment's tip frame) or the base (root_link, segment -1); segments first, then links, then the
+/// base. False (out unchanged) if the name is none of them.
+bool findFrame(const RobotChain& robot, const std::string& name, FrameRef& out);
+/// The same on a tree.
+bool findFrame(const RobotTree& robot, const std::string& name, FrameRef& out);
+
+/// Index (q order) of the moving joint named `name`, -1 if none.
+template <class Robot>
+int findJoint(const Robot& robot, const std::string& name) {
+  for (std::size_t k = 0; k < robot.joints.size(); ++k)
+    if (robot.joints[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+/// The serial chain from the tree's base to segment `tip` (0 <= tip < segmentCount): that path's
+/// segments, their joints and the links placed on them or on the base, the base's root_link, the
+/// tree's note about its root link and a note naming how many segments were left out.
+RobotChain pathChain(const RobotTree& robot, int tip);
+
+}  // namespace vereshchagin

@@ -1,0 +1,91 @@
+// robot_access.hpp on a RobotChain and a RobotTree (robot_fixture.hpp): counts, names, masses,
+// rotor inertias (getter, setter, its refusals with the robot unchanged), lookups by name and the
+// chain of one tree path, against the URDF's own numbers and the chain loader's result.
+#include <string>
+#include <vector>
+
+#include "robot_fixture.hpp"
+#include "vereshchagin/robot_access.hpp"
+
+TEST_CASE("counts, names and masses on a chain and a tree") {
+  const vereshchagin::RobotTree tree = robotfixture::tree();
+  const vereshchagin::RobotChain chain = robotfixture::chain();
+  CHECK(vereshchagin::segmentCount(tree) == 3);
+  CHECK(vereshchagin::jointCount(tree) == 3);
+  CHECK(vereshchagin::segmentCount(chain) == 2);
+  CHECK(vereshchagin::jointCount(chain) == 2);
+  CHECK(vereshchagin::segmentName(tree, 2) == "slider");
+  CHECK(vereshchagin::segmentAt(tree, 2).getInertia().getMass() == 3.0);
+  CHECK(vereshchagin::segmentName(chain, 1) == "finger");  // the merged group takes its last link's name
+  CHECK(vereshchagin::segmentMasses(tree) == std::vector<double>{2.0, 1.1, 3.0});
+  CHECK(vereshchagin::segmentMasses(chain) == std::vector<double>{2.0, 1.1});
+  CHECK(vereshchagin::findJoint(tree, "j_slider") == 2);
+  CHECK(vereshchagin::findJoint(chain, "j_slider") == -1);
+}
+
+TEST_CASE("frames by name: segments, merged links, the base") {
+  const vereshchagin::RobotTree tree = robotfixture::tree();
+  vereshchagin::FrameRef ref;
+  REQUIRE(vereshchagin::findFrame(tree, "finger", ref));
+  CHECK(ref.segment == 1);
+  CHECK(ref.in_tip.p.Norm() == 0.0);
+  REQUIRE(vereshchagin::findFrame(tree, "hand", ref));  // merged: 0.05 m below the tip
+  CHECK(ref.segment == 1);
+  CHECK(ref.in_tip.p.z() == doctest::Approx(-0.05));
+  REQUIRE(vereshchagin::findFrame(tree, "base", ref));
+  CHECK(ref.segment == -1);
+  ref.segment = 7;
+  CHECK_FALSE(vereshchagin::findFrame(tree, "nowhere", ref));
+  CHECK(ref.segment == 7);
+  REQUIRE(vereshchagin::findFrame(robotfixture::chain(), "finger", ref));
+  CHECK(ref.segment == 1);
+}
+
+TEST_CASE("rotor inertia is set per joint and refused when negative") {
+  for (int tree_or_chain = 0; tree_or_chain < 2; ++tree_or_chain) {
+    vereshchagin::RobotTree tree = robotfixture::tree();
+    vereshchagin::RobotChain chain = robotfixture::chain();
+    std::string message;
+    const std::vector<double> values =
+        tree_or_chain ? std::vector<double>{0.1, 0.2, 0.3} : std::vector<double>{0.1, 0.2};
+    const vereshchagin::Status ok = tree_or_chain ? vereshchagin::setRotorInertia(tree, values, message)
+                                                  : vereshchagin::setRotorInertia(chain, values, message);
+    REQUIRE(ok);
+    CHECK((tree_or_chain ? vereshchagin::rotorInertia(tree) : vereshchagin::rotorInertia(chain)) == values);
+    std::vector<double> bad = values;
+    bad.back() = -0.1;
+    const vereshchagin::Status s = tree_or_chain ? vereshchagin::setRotorInertia(tree, bad, message)
+                                                 : vereshchagin::setRotorInertia(chain, bad, message);
+    CHECK(s.code() == vereshchagin::Error::OutOfRange);
+    CHECK(std::string(s.message()) ==
+          "rotor_inertia must be >= 0, got -0.100000 at joint " + std::to_string(values.size() - 1));
+    CHECK((tree_or_chain ? vereshchagin::rotorInertia(tree) : vereshchagin::rotorInertia(chain)) == values);
+    const vereshchagin::Status size = vereshchagin::setRotorInertia(chain, {1.0, 2.0, 3.0, 4.0}, message);
+    CHECK(std::string(size.message()) == "rotor_inertia must have 2 entries, got 4");
+  }
+  vereshchagin::RobotTree tree = robotfixture::tree();
+  std::string message;
+  REQUIRE(vereshchagin::setRotorInertia(tree, {0.1, 0.2, 0.3}, message));
+  CHECK(tree.tree.getNrOfSegments() == 3);  // q numbering kept
+  CHECK(GetTreeElementQNr(tree.tree.getSegments().find("slider")->second) == 2);
+}
+
+TEST_CASE("pathChain is the chain loader's chain of the same path") {
+  const vereshchagin::RobotChain path = vereshchagin::pathChain(robotfixture::tree(), 1);
+  const vereshchagin::RobotChain loaded = robotfixture::chain();
+  REQUIRE(path.chain.getNrOfSegments() == 2);
+  CHECK(path.root_link == "base");
+  REQUIRE(path.joints.size() == 2);
+  CHECK(path.joints[1].name == "j_hand");
+  CHECK(path.joints[0].friction == 0.5);
+  CHECK(path.joints[1].segment == 1);
+  for (unsigned int i = 0; i < 2; ++i) {
+    CHECK(path.chain.getSegment(i).getName() == loaded.chain.getSegment(i).getName());
+    CHECK(path.chain.getSegment(i).getInertia().getMass() == loaded.chain.getSegment(i).getInertia().getMass());
+  }
+  std::vector<std::string> links;
+  for (const auto& l : path.links) links.push_back(l.link);
+  CHECK(links.size() == 4);
+  REQUIRE(!path.notes.empty());
+  CHECK(path.notes.back() == "extracted from a tree: the 1 segments off the path to 'finger' are left out");
+}
