@@ -171,17 +171,16 @@ auto on(py::array (*body)(const CompanionModel&, A...)) {
 // argument, `frame` resolves it.
 template <typename M, typename SegmentArg, typename Frame>
 void bindCompanions(py::class_<M>& cls, const std::string& name, const SegmentArg& segment, Frame frame) {
-  using namespace pybind11::literals;
   const std::vector<double> earth{0.0, 0.0, -9.81};  // physical gravity, base z up, m/s^2
   const auto key = [&name](const char* method) { return doc(name + "." + method); };
   const auto jdot = [frame](const M& m, O q, O qd, O s) { return jacobianDotTimesQd(m, q, qd, frame(m, s)); };
-  cls.def("inverse_dynamics", on<M>(inverseDynamics), "q"_a, "qd"_a, "qdd"_a, "f_ext"_a = py::none(),
-          "gravity"_a = earth, key("inverse_dynamics"))
-      .def("mass_matrix", on<M>(massMatrix), "q"_a, key("mass_matrix"))
-      .def("gravity_torques", on<M>(gravityTorques), "q"_a, "gravity"_a = earth, key("gravity_torques"))
-      .def("coriolis_torques", on<M>(coriolisTorques), "q"_a, "qd"_a, key("coriolis_torques"))
-      .def("jacobian_dot_times_qd", jdot, "q"_a, "qd"_a, segment, key("jacobian_dot_times_qd"))
-      .def("fk_all", on<M>(fkAll), "q"_a, key("fk_all"));
+  cls.def("inverse_dynamics", on<M>(inverseDynamics), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          py::arg("f_ext") = py::none(), py::arg("gravity") = earth, key("inverse_dynamics"))
+      .def("mass_matrix", on<M>(massMatrix), py::arg("q"), key("mass_matrix"))
+      .def("gravity_torques", on<M>(gravityTorques), py::arg("q"), py::arg("gravity") = earth, key("gravity_torques"))
+      .def("coriolis_torques", on<M>(coriolisTorques), py::arg("q"), py::arg("qd"), key("coriolis_torques"))
+      .def("jacobian_dot_times_qd", jdot, py::arg("q"), py::arg("qd"), segment, key("jacobian_dot_times_qd"))
+      .def("fk_all", on<M>(fkAll), py::arg("q"), key("fk_all"));
 }
 
 }  // namespace
