@@ -31,21 +31,29 @@ void check(const vs::Status& s) {
   if (!s) raise(s.message());
 }
 
-// q-like (n,) or, with `batch`, (N, n) rows: float64 C-contiguous arrays taken as they are,
+// q-like (n,) or, with `batch`, (N, n) rows: float64 C-contiguous arrays viewed in place,
 // anything else converted by toArray (its messages).
 struct JointRows {
-  JointRows(const py::handle& obj, const char* name, py::ssize_t n, bool batch = false)
-      : a(detail_np::nativeContiguousF64(obj.ptr()) ? py::reinterpret_borrow<Array>(obj) : toArray(obj, name)), n(n) {
-    batched = batch && a.ndim() == 2 && a.shape(1) == n;
-    if (!batched && (a.ndim() != 1 || a.shape(0) != n))
-      raise(std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + shapeStr(a));
-    requireFinite(a, name);
+  JointRows(const py::handle& obj, const char* name, py::ssize_t n, bool batch = false) : n(n) {
+    const auto wrong = [&](const std::string& got) {
+      raise(std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + got);
+    };
+    PyObject* arr = obj.ptr();
+    if (!detail_np::nativeContiguousF64(arr)) {
+      const Array a = toArray(obj, name);
+      if (a.ndim() > 3) wrong(shapeStr(a));  // an F64View holds 3 dimensions
+      arr = (v.keep = a).ptr();
+    }
+    detail_np::fill(arr, v);
+    batched = batch && v.ndim == 2 && v.shape[1] == n;
+    if (!batched && (v.ndim != 1 || v.shape[0] != n)) wrong(v.shapeString());
+    requireFiniteView(v, name);
   }
-  Eigen::Map<const Eigen::VectorXd> operator[](py::ssize_t r) const { return {a.data() + r * n, n}; }
+  Eigen::Map<const Eigen::VectorXd> operator[](py::ssize_t r) const { return {v.data + r * n, n}; }
   vs::JointPositions pos() const { return vs::JointPositions((*this)[0]); }
   vs::JointVelocities vel() const { return vs::JointVelocities((*this)[0]); }
-  py::ssize_t rows() const { return batched ? a.shape(0) : 1; }
-  Array a;
+  py::ssize_t rows() const { return batched ? v.shape[0] : 1; }
+  F64View v;
   py::ssize_t n;
   bool batched = false;
 };
