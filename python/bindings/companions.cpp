@@ -1,19 +1,24 @@
-// Companions of Chain and Tree (companions.hpp) on the C++ kinematics and dynamics.
+// The companions of Chain and Tree (companions.hpp), bound on both by one template: arguments read
+// into the C++ library's calls on the model's cached workspace, results checked for overflow.
+// Conventions (the solver's): physical gravity, base axes; f_ext ON each segment BY the environment.
 #include "companions.hpp"
 
-#include <optional>
-#include <string>
+#include <pybind11/stl.h>
 
-#include "dynamics_common.hpp"
+#include <string>
+#include <vector>
+
 #include "numpy_fast.hpp"
-#include "vereshchagin/task.hpp"
+#include "tree_bindings.hpp"
 
 namespace vsbind {
 
 namespace vs = vereshchagin;
+using O = const py::object&;
+using Vec = Eigen::Map<Eigen::VectorXd>;
 
 CompanionCache::CompanionCache(const vs::Model& m)
-    : model(m), dyn(model), f_ext(vs::Matrix6X::Zero(6, static_cast<Eigen::Index>(m.nrOfSegments()))) {}
+    : model(m), dyn(model), f_ext(6, m.nrOfSegments()), jacobian(6, m.nrOfJoints()), n(m.nrOfJoints()) {}
 
 CompanionCache& CompanionModel::companions() const {
   if (!cache_) cache_ = std::make_shared<CompanionCache>(buildModel());
@@ -22,279 +27,223 @@ CompanionCache& CompanionModel::companions() const {
 
 namespace {
 
-// Joint-space rows: one (n,) vector, or (with `batch`) N of them as an (N, n) array. float64
-// C-contiguous arrays are read in place; anything else goes through toArray (its messages).
-struct JointRows {
-  const double* data = nullptr;
-  py::ssize_t rows = 1;
-  bool batched = false;
-  py::object keep;
-  Eigen::Map<const Eigen::VectorXd> row(py::ssize_t r, py::ssize_t n) const { return {data + r * n, n}; }
-};
-
-JointRows jointRows(const py::handle& obj, const char* name, py::ssize_t n, bool batch = false) {
-  F64View v;
-  if (detail_np::nativeContiguousF64(obj.ptr())) {
-    detail_np::fill(obj.ptr(), v);
-  } else {
-    Array a = toArray(obj, name);
-    v.keep = a;
-    detail_np::fill(a.ptr(), v);
-  }
-  JointRows out;
-  out.data = v.data;
-  out.keep = v.keep;
-  if (batch && v.ndim == 2 && v.shape[1] == n) {
-    out.rows = v.shape[0];
-    out.batched = true;
-  } else if (v.ndim != 1 || v.shape[0] != n) {
-    raise(std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + v.shapeString());
-  }
-  requireFiniteView(v, name);
-  return out;
+void check(const vs::Status& s) {
+  if (!s) raise(s.message());
 }
 
-// gravity (3,): a list or tuple of three Python floats read directly (the default argument),
-// anything else through vec3 (its messages).
+// q-like (n,) or, with `batch`, (N, n) rows: float64 C-contiguous arrays viewed in place,
+// anything else converted by toArray (its messages).
+struct JointRows {
+  JointRows(const py::handle& obj, const char* name, py::ssize_t n, bool batch = false) : n(n) {
+    const auto wrong = [&](const std::string& got) {
+      raise(std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + got);
+    };
+    PyObject* arr = obj.ptr();
+    if (!detail_np::nativeContiguousF64(arr)) {
+      const Array a = toArray(obj, name);
+      if (a.ndim() > 3) wrong(shapeStr(a));  // an F64View holds 3 dimensions
+      arr = (v.keep = a).ptr();
+    }
+    detail_np::fill(arr, v);
+    batched = batch && v.ndim == 2 && v.shape[1] == n;
+    if (!batched && (v.ndim != 1 || v.shape[0] != n)) wrong(v.shapeString());
+    requireFiniteView(v, name);
+  }
+  Eigen::Map<const Eigen::VectorXd> operator[](py::ssize_t r) const { return {v.data + r * n, n}; }
+  vs::JointPositions pos() const { return vs::JointPositions((*this)[0]); }
+  vs::JointVelocities vel() const { return vs::JointVelocities((*this)[0]); }
+  py::ssize_t rows() const { return batched ? v.shape[0] : 1; }
+  F64View v;
+  py::ssize_t n;
+  bool batched = false;
+};
+
+// gravity (3,): the default list of three floats read directly, anything else through vec3.
 KDL::Vector gravityArg(const py::handle& obj) {
   PyObject* o = obj.ptr();
   if ((PyList_CheckExact(o) || PyTuple_CheckExact(o)) && PySequence_Fast_GET_SIZE(o) == 3) {
-    PyObject** items = PySequence_Fast_ITEMS(o);
-    if (PyFloat_CheckExact(items[0]) && PyFloat_CheckExact(items[1]) && PyFloat_CheckExact(items[2])) {
-      const KDL::Vector g(PyFloat_AS_DOUBLE(items[0]), PyFloat_AS_DOUBLE(items[1]), PyFloat_AS_DOUBLE(items[2]));
+    PyObject** x = PySequence_Fast_ITEMS(o);
+    if (PyFloat_CheckExact(x[0]) && PyFloat_CheckExact(x[1]) && PyFloat_CheckExact(x[2])) {
+      const KDL::Vector g(PyFloat_AS_DOUBLE(x[0]), PyFloat_AS_DOUBLE(x[1]), PyFloat_AS_DOUBLE(x[2]));
       if (std::isfinite(g.x()) && std::isfinite(g.y()) && std::isfinite(g.z())) return g;
     }
   }
   return vec3(obj, "gravity");
 }
 
-void check(const vs::Status& s) {
-  if (!s) raise(s.message());
-}
-
-vs::FrameRef frameRef(const FrameTarget& t) {
-  return vs::FrameRef{t.segment, t.link_in_tip};
-}
-
-void writePose(const KDL::Frame& f, double* out) {
-  writeHomogeneous(f, out);
-}
-
-py::array finiteResult(py::array a, const char* what) {
-  requireFiniteResult(doubles(a), static_cast<std::size_t>(a.size()), what);
+// Finite inputs can still overflow (|qd| = 1e160): never hand back Inf or NaN.
+py::array finite(py::array a, const char* what) {
+  if (!Eigen::Map<const Eigen::ArrayXd>(doubles(a), a.size()).allFinite())
+    raise(std::string(what) + ": the result overflows the double range");
   return a;
+}
+
+vs::FrameRef ref(const FrameTarget& t) {
+  return {t.segment, t.link_in_tip};
+}
+
+// f_ext into c.f_ext; its column count (0: None). An (n_segments, 6) array is taken as is, a dict
+// {segment or link: wrench (6,), moment about that frame's origin} is moved to the tips in C++.
+Eigen::Index wrenchColumns(const CompanionModel& m, CompanionCache& c, O f_ext, const JointRows& q) {
+  if (f_ext.is_none()) return 0;
+  const Eigen::Index ns = c.f_ext.cols();
+  if (!py::isinstance<py::dict>(f_ext)) {
+    const Array f = toArray(f_ext, "f_ext");
+    if (f.ndim() != 2 || f.shape(0) != ns || f.shape(1) != 6)
+      raise("f_ext must have shape (" + std::to_string(ns) + ", 6) or be a dict {segment: wrench (6,)}, got " +
+            shapeStr(f));
+    requireFinite(f, "f_ext");
+    c.f_ext = Eigen::Map<const vs::Matrix6X>(f.data(), 6, ns);
+    return ns;
+  }
+  c.f_ext.setZero();
+  check(vs::forwardKinematics(c.model, c.kin(), q.pos()));
+  for (const auto& item : f_ext.cast<py::dict>()) {
+    const std::string label = "f_ext[" + py::repr(item.first).cast<std::string>() + "]";
+    const FrameTarget t = m.resolveMoving(item.first.ptr(), label);
+    const Array w = vectorArg(item.second, label.c_str(), 6);
+    check(vs::addFrameWrench(c.model, c.kin(), ref(t), Eigen::Map<const vs::Vector6>(w.data()), c.f_ext));
+  }
+  return ns;
+}
+
+py::array inverseDynamics(const CompanionModel& m, O q_obj, O qd_obj, O qdd_obj, O f_ext, O gravity) {
+  CompanionCache& c = m.companions();
+  const JointRows q(q_obj, "q", c.n), qd(qd_obj, "qd", c.n), qdd(qdd_obj, "qdd", c.n);
+  const KDL::Vector g = gravityArg(gravity);
+  const Eigen::Index cols = wrenchColumns(m, c, f_ext, q);
+  py::array out = newDoubles({c.n});
+  check(vs::inverseDynamics(c.model, c.dyn, q.pos(), qd.vel(), vs::JointAccelerations(qdd[0]), c.f_ext.leftCols(cols),
+                            g, Vec(doubles(out), c.n)));
+  return finite(out, "inverse_dynamics");
+}
+
+py::array massMatrix(const CompanionModel& m, O q_obj) {
+  CompanionCache& c = m.companions();
+  const JointRows q(q_obj, "q", c.n);
+  py::array out = newDoubles({c.n, c.n});  // symmetric: row- and column-major alike
+  check(vs::massMatrix(c.model, c.dyn, q.pos(), Eigen::Map<Eigen::MatrixXd>(doubles(out), c.n, c.n)));
+  return finite(out, "mass_matrix");
+}
+
+py::array gravityTorques(const CompanionModel& m, O q_obj, O gravity) {
+  CompanionCache& c = m.companions();
+  const JointRows q(q_obj, "q", c.n);
+  const KDL::Vector g = gravityArg(gravity);
+  py::array out = newDoubles({c.n});
+  check(vs::gravityTorques(c.model, c.dyn, q.pos(), g, Vec(doubles(out), c.n)));
+  return finite(out, "gravity_torques");
+}
+
+py::array coriolisTorques(const CompanionModel& m, O q_obj, O qd_obj) {
+  CompanionCache& c = m.companions();
+  const JointRows q(q_obj, "q", c.n), qd(qd_obj, "qd", c.n);
+  py::array out = newDoubles({c.n});
+  check(vs::coriolisTorques(c.model, c.dyn, q.pos(), qd.vel(), Vec(doubles(out), c.n)));
+  return finite(out, "coriolis_torques");
+}
+
+py::array fkAll(const CompanionModel& m, O q_obj) {
+  CompanionCache& c = m.companions();
+  const JointRows q(q_obj, "q", c.n);
+  check(vs::forwardKinematics(c.model, c.kin(), q.pos()));
+  const auto ns = static_cast<int>(c.model.nrOfSegments());
+  py::array out = newDoubles({ns, 4, 4});
+  KDL::Frame f;
+  for (int i = 0; i < ns; ++i) {
+    check(vs::framePose(c.model, c.kin(), vs::FrameRef{i, KDL::Frame::Identity()}, f));
+    writeHomogeneous(f, doubles(out) + 16 * i);
+  }
+  return out;
+}
+
+// [classical acceleration of the frame's origin; angular acceleration] at qdd = 0, no gravity.
+py::array jacobianDotTimesQd(const CompanionModel& m, O q_obj, O qd_obj, const FrameTarget& target) {
+  CompanionCache& c = m.companions();
+  const JointRows q(q_obj, "q", c.n), qd(qd_obj, "qd", c.n);
+  check(vs::forwardKinematics(c.model, c.kin(), q.pos(), qd.vel()));
+  py::array out = newDoubles({6});
+  vs::Vector6 a;
+  check(vs::frameBiasAcceleration(c.model, c.kin(), ref(target), a));
+  Vec(doubles(out), 6) = a;
+  return finite(out, "jacobian_dot_times_qd");
+}
+
+// A companion as a method of M (pybind11 binds M's methods, not CompanionModel's).
+template <typename M, typename... A>
+auto on(py::array (*body)(const CompanionModel&, A...)) {
+  return [body](const M& m, A... a) { return body(m, a...); };
+}
+
+// Binds the companions on Chain or Tree (M): `segment` is the spec of jacobian_dot_times_qd's frame
+// argument, `frame` resolves it.
+template <typename M, typename SegmentArg, typename Frame>
+void bindCompanions(py::class_<M>& cls, const std::string& name, const SegmentArg& segment, Frame frame) {
+  const std::vector<double> earth{0.0, 0.0, -9.81};  // physical gravity, base z up, m/s^2
+  const auto key = [&name](const char* method) { return doc(name + "." + method); };
+  const auto jdot = [frame](const M& m, O q, O qd, O s) { return jacobianDotTimesQd(m, q, qd, frame(m, s)); };
+  cls.def("inverse_dynamics", on<M>(inverseDynamics), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          py::arg("f_ext") = py::none(), py::arg("gravity") = earth, key("inverse_dynamics"))
+      .def("mass_matrix", on<M>(massMatrix), py::arg("q"), key("mass_matrix"))
+      .def("gravity_torques", on<M>(gravityTorques), py::arg("q"), py::arg("gravity") = earth, key("gravity_torques"))
+      .def("coriolis_torques", on<M>(coriolisTorques), py::arg("q"), py::arg("qd"), key("coriolis_torques"))
+      .def("jacobian_dot_times_qd", jdot, py::arg("q"), py::arg("qd"), segment, key("jacobian_dot_times_qd"))
+      .def("fk_all", on<M>(fkAll), py::arg("q"), key("fk_all"));
 }
 
 }  // namespace
 
 py::array fkOf(const CompanionModel& m, const py::handle& q_obj, const FrameTarget& target) {
   CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n, true);
-  py::array out = q.batched ? newDoubles({q.rows, 4, 4}) : newDoubles({4, 4});
+  const JointRows q(q_obj, "q", c.n, true);
+  py::array out = q.batched ? newDoubles({q.rows(), 4, 4}) : newDoubles({4, 4});
   KDL::Frame f;
-  for (py::ssize_t r = 0; r < q.rows; ++r) {
-    check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q.row(r, n))));
-    check(vs::framePose(c.model, c.kin(), frameRef(target), f));
-    writePose(f, doubles(out) + 16 * r);
+  for (py::ssize_t r = 0; r < q.rows(); ++r) {
+    check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q[r])));
+    check(vs::framePose(c.model, c.kin(), ref(target), f));
+    writeHomogeneous(f, doubles(out) + 16 * r);
   }
   return out;
 }
 
 py::array jacobianOf(const CompanionModel& m, const py::handle& q_obj, const FrameTarget& target) {
   CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n);
-  check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q.row(0, n))));
-  py::array out = newDoubles({6, n});
-  // numpy's (6, n) row-major is Eigen's column-major n x 6 transposed.
-  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(doubles(out), 6, n);
-  Eigen::MatrixXd Jc(6, n);
-  check(vs::frameJacobian(c.model, c.kin(), frameRef(target), Jc));
-  J = Jc;
+  const JointRows q(q_obj, "q", c.n);
+  check(vs::forwardKinematics(c.model, c.kin(), q.pos()));
+  check(vs::frameJacobian(c.model, c.kin(), ref(target), c.jacobian));
+  py::array out = newDoubles({6, c.n});  // row-major
+  Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>>(doubles(out), 6, c.n) = c.jacobian;
   return out;
 }
 
 py::array twistOf(const CompanionModel& m, const py::handle& q_obj, const py::handle& qd_obj,
                   const FrameTarget& target) {
   CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n, true);
-  const JointRows qd = jointRows(qd_obj, "qd", n, true);
-  if (q.batched != qd.batched || q.rows != qd.rows)
-    raise("q and qd must have the same shape, got " + std::to_string(q.rows) + " and " + std::to_string(qd.rows) +
+  const JointRows q(q_obj, "q", c.n, true), qd(qd_obj, "qd", c.n, true);
+  if (q.batched != qd.batched || q.rows() != qd.rows())
+    raise("q and qd must have the same shape, got " + std::to_string(q.rows()) + " and " + std::to_string(qd.rows()) +
           " rows");
-  py::array out = q.batched ? newDoubles({q.rows, 6}) : newDoubles({6});
+  py::array out = q.batched ? newDoubles({q.rows(), 6}) : newDoubles({6});
   vs::Vector6 t;
-  for (py::ssize_t r = 0; r < q.rows; ++r) {
-    check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q.row(r, n)), vs::JointVelocities(qd.row(r, n))));
-    check(vs::frameTwist(c.model, c.kin(), frameRef(target), t));
-    std::copy(t.data(), t.data() + 6, doubles(out) + 6 * r);
+  for (py::ssize_t r = 0; r < q.rows(); ++r) {
+    check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q[r]), vs::JointVelocities(qd[r])));
+    check(vs::frameTwist(c.model, c.kin(), ref(target), t));
+    Vec(doubles(out) + 6 * r, 6) = t;
   }
-  return finiteResult(out, "twist");
+  return finite(out, "twist");
 }
 
-py::array jacobianDotTimesQdOf(const CompanionModel& m, const py::handle& q_obj, const py::handle& qd_obj,
-                               const FrameTarget& target) {
-  CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n), qd = jointRows(qd_obj, "qd", n);
-  check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q.row(0, n)), vs::JointVelocities(qd.row(0, n))));
-  vs::Vector6 a;
-  check(vs::frameBiasAcceleration(c.model, c.kin(), frameRef(target), a));
-  py::array out = newDoubles({6});
-  std::copy(a.data(), a.data() + 6, doubles(out));
-  return finiteResult(out, "jacobian_dot_times_qd");
+void bindDynamics(py::module_& mod) {
+  bindTaskHelpers(mod);
+  auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
+  bindCompanions(chain, "Chain", py::arg("segment") = py::none(),
+                 [](const PyChain& c, O s) { return c.resolveOptional(s, "segment"); });
 }
 
-py::array fkAllOf(const CompanionModel& m, const py::handle& q_obj) {
-  CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n);
-  check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q.row(0, n))));
-  const int ns = static_cast<int>(c.model.nrOfSegments());
-  py::array out = newDoubles({ns, 4, 4});
-  KDL::Frame f;
-  for (int i = 0; i < ns; ++i) {
-    check(vs::framePose(c.model, c.kin(), vs::FrameRef{i, KDL::Frame::Identity()}, f));
-    writePose(f, doubles(out) + 16 * i);
-  }
-  return out;
-}
-
-py::array inverseDynamicsOf(const CompanionModel& m, const py::handle& q_obj, const py::handle& qd_obj,
-                            const py::handle& qdd_obj, const py::object& f_ext, const py::handle& gravity) {
-  CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n), qd = jointRows(qd_obj, "qd", n), qdd = jointRows(qdd_obj, "qdd", n);
-  const KDL::Vector g = gravityArg(gravity);
-  Eigen::Index wrench_cols = 0;
-  if (!f_ext.is_none()) {  // the dict form needs the tip orientations at q
-    check(vs::forwardKinematics(c.model, c.kin(), vs::JointPositions(q.row(0, n))));
-    const auto rows = externalWrenchRows(f_ext, m, [&c](int s) {
-      const vs::Matrix3& R = c.kin().tipPose(s).R;
-      return KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2));
-    });
-    for (std::size_t i = 0; i < rows.size(); ++i) c.f_ext.col(static_cast<Eigen::Index>(i)) = rows[i];
-    wrench_cols = static_cast<Eigen::Index>(rows.size());
-  }
-  py::array out = newDoubles({n});
-  Eigen::Map<Eigen::VectorXd> tau(doubles(out), n);
-  check(vs::inverseDynamics(c.model, c.dyn, vs::JointPositions(q.row(0, n)), vs::JointVelocities(qd.row(0, n)),
-                            vs::JointAccelerations(qdd.row(0, n)), c.f_ext.leftCols(wrench_cols), g, tau));
-  return finiteResult(out, "inverse_dynamics");
-}
-
-py::array massMatrixOf(const CompanionModel& m, const py::handle& q_obj) {
-  CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n);
-  py::array out = newDoubles({n, n});
-  Eigen::Map<Eigen::MatrixXd> H(doubles(out), n, n);  // symmetric: row- and column-major alike
-  check(vs::massMatrix(c.model, c.dyn, vs::JointPositions(q.row(0, n)), H));
-  return finiteResult(out, "mass_matrix");
-}
-
-py::array gravityTorquesOf(const CompanionModel& m, const py::handle& q_obj, const py::handle& gravity) {
-  CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n);
-  const KDL::Vector g = gravityArg(gravity);
-  py::array out = newDoubles({n});
-  Eigen::Map<Eigen::VectorXd> tau(doubles(out), n);
-  check(vs::gravityTorques(c.model, c.dyn, vs::JointPositions(q.row(0, n)), g, tau));
-  return finiteResult(out, "gravity_torques");
-}
-
-py::array coriolisTorquesOf(const CompanionModel& m, const py::handle& q_obj, const py::handle& qd_obj) {
-  CompanionCache& c = m.companions();
-  const auto n = static_cast<py::ssize_t>(c.model.nrOfJoints());
-  const JointRows q = jointRows(q_obj, "q", n), qd = jointRows(qd_obj, "qd", n);
-  py::array out = newDoubles({n});
-  Eigen::Map<Eigen::VectorXd> tau(doubles(out), n);
-  check(vs::coriolisTorques(c.model, c.dyn, vs::JointPositions(q.row(0, n)), vs::JointVelocities(qd.row(0, n)), tau));
-  return finiteResult(out, "coriolis_torques");
-}
-
-}  // namespace vsbind
-
-// ---- task.py's beta_for on the C++ helper (task.hpp) ----
-
-namespace vsbind {
-
-namespace {
-
-// A float64 view of a real array, or nothing (nullopt: not convertible, left to task.py's checks).
-std::optional<F64View> realView(const py::handle& obj) {
-  F64View v;
-  if (detail_np::nativeContiguousF64(obj.ptr())) {
-    detail_np::fill(obj.ptr(), v);
-  } else {
-    if (PyBool_Check(obj.ptr()) || obj.is_none()) return std::nullopt;
-    py::array any = py::array::ensure(obj);
-    if (!any) {
-      PyErr_Clear();
-      return std::nullopt;
-    }
-    const char kind = any.dtype().kind();
-    if ((kind != 'f' && kind != 'i' && kind != 'u') || any.ndim() > 3) return std::nullopt;
-    Array a = Array::ensure(any);
-    if (!a) {
-      PyErr_Clear();
-      return std::nullopt;
-    }
-    v.keep = a;
-    detail_np::fill(a.ptr(), v);
-  }
-  for (py::ssize_t k = 0; k < v.size(); ++k)
-    if (!std::isfinite(v.data[k])) return std::nullopt;
-  return v;
-}
-
-// beta (m,) or, for N twists (N, 6), beta rows (N, m); None when an input is not plainly valid
-// (task.py then raises its own message).
-py::object betaFor(const py::handle& alpha, const py::handle& a_desired, const py::handle& twist,
-                   const py::handle& gravity) {
-  const auto A = realView(alpha), a = realView(a_desired), t = realView(twist), g = realView(gravity);
-  if (!A || !a || !t || !g || g->size() != 3) return py::none();
-  py::ssize_t m = 0;
-  if (A->ndim == 1 && A->shape[0] == 6)
-    m = 1;
-  else if (A->ndim == 2 && A->shape[0] == 6)
-    m = A->shape[1];
-  else
-    return py::none();
-  const bool batched = t->ndim == 2 && t->shape[1] == 6 && t->size() != 6;
-  const py::ssize_t rows = batched ? t->shape[0] : 1;
-  if (!batched && t->size() != 6) return py::none();
-  const bool a_rows = a->size() != 6;
-  if (a_rows && !(batched && a->ndim == 2 && a->shape[0] == rows && a->shape[1] == 6)) return py::none();
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const Eigen::Map<const RowMajor> alfa(A->data, 6, m);
-  const KDL::Vector grav(g->data[0], g->data[1], g->data[2]);
-  py::array out = batched ? newDoubles({rows, m}) : newDoubles({m});
-  for (py::ssize_t r = 0; r < rows; ++r) {
-    const vereshchagin::Vector6 acc = Eigen::Map<const vereshchagin::Vector6>(a->data + (a_rows ? 6 * r : 0));
-    const vereshchagin::Vector6 tw = Eigen::Map<const vereshchagin::Vector6>(t->data + 6 * r);
-    Eigen::Map<Eigen::VectorXd> beta(doubles(out) + m * r, m);
-    beta.noalias() = alfa.transpose() * vereshchagin::spatialFromClassical(acc, tw, grav);
-  }
-  if (!Eigen::Map<const Eigen::VectorXd>(doubles(out), out.size()).allFinite())
-    raise("beta_for: the result overflows the double range (inputs too large)");
-  return std::move(out);
-}
-
-}  // namespace
-
-// Task.solve's beta: the chain tip's twist at (q, qd) and beta_for in one call; None as betaFor.
-py::object taskBeta(const CompanionModel& m, const FrameTarget& tip, const py::handle& q, const py::handle& qd,
-                    const py::handle& alpha, const py::handle& a_desired, const py::handle& gravity) {
-  return betaFor(alpha, a_desired, twistOf(m, q, qd, tip), gravity);
-}
-
-void bindTaskHelpers(py::module_& mod) {
-  mod.def("_beta_for", &betaFor, py::arg("alpha"), py::arg("a_desired"), py::arg("twist"), py::arg("gravity"),
-          doc("_core._beta_for"));
+void bindTreeDynamics(py::class_<PyTree>& cls) {
+  bindCompanions(cls, "Tree", py::arg("segment"),
+                 [](const PyTree& t, O s) { return t.resolveTarget(s.ptr(), "segment"); });
+  cls.def_property("rotor_inertia", &PyTree::rotorInertia, &PyTree::setRotorInertia, doc("Tree.rotor_inertia"));
 }
 
 }  // namespace vsbind

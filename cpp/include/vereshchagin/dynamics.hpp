@@ -89,4 +89,17 @@ Status gravityTorques(const Model& model, DynamicsData& ddata, const JointPositi
 Status coriolisTorques(const Model& model, DynamicsData& ddata, const JointPositions& q, const JointVelocities& q_dot,
                        Eigen::Ref<Eigen::VectorXd> tau);
 
+/// Adds a wrench on a frame moving with a segment (a FrameRef of Model::findFrame: a segment's
+/// tip or a merged link) to f_ext in the layout of the functions above: `wrench` = [force f (N);
+/// moment n (N m) about the frame's origin], ON the body BY the environment, base axes. Column
+/// frame.segment of f_ext (6 x n_segments) gains [f; n + (R_tip p) x f], the moment moved to the
+/// tip origin, with p = frame.in_tip.p (m, tip axes; its orientation does not matter) and R_tip the
+/// tip's orientation in the base at the last forwardKinematics' q of kdata (e.g. dd.kinematics()
+/// after any call above at the same q). No allocation; f_ext is unchanged on failure. Errors:
+/// NotUpToDate, NoSolution (no forwardKinematics yet), OutOfRange (frame.segment not in
+/// [0, n_segments): the base takes no wrench), SizeMismatch (f_ext not 6 x n_segments),
+/// NonfiniteInput (NaN or Inf in wrench or p).
+Status addFrameWrench(const Model& model, KinematicsData& kdata, const FrameRef& frame, const Vector6& wrench,
+                      Eigen::Ref<Matrix6X> f_ext);
+
 }  // namespace vereshchagin
