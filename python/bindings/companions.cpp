@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "model_class.hpp"
 #include "numpy_fast.hpp"
-#include "tree_bindings.hpp"
 
 namespace vsbind {
 
@@ -238,12 +238,9 @@ void bindDynamics(py::module_& mod) {
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
   bindCompanions(chain, "Chain", py::arg("segment") = py::none(),
                  [](const PyChain& c, O s) { return c.resolveOptional(s, "segment"); });
-}
-
-void bindTreeDynamics(py::class_<PyTree>& cls) {
-  bindCompanions(cls, "Tree", py::arg("segment"),
+  auto tree = py::reinterpret_borrow<py::class_<PyTree>>(mod.attr("Tree"));
+  bindCompanions(tree, "Tree", py::arg("segment"),
                  [](const PyTree& t, O s) { return t.resolveTarget(s.ptr(), "segment"); });
-  cls.def_property("rotor_inertia", &PyTree::rotorInertia, &PyTree::setRotorInertia, doc("Tree.rotor_inertia"));
 }
 
 }  // namespace vsbind

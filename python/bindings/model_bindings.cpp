@@ -5,8 +5,8 @@
 
 #include <functional>
 
+#include "model_class.hpp"
 #include "model_state.hpp"
-#include "tree_bindings.hpp"
 
 namespace vsbind {
 
@@ -157,7 +157,6 @@ void bindTree(py::module_& mod) {
           },
           doc("Tree.parent"))
       .def("chain", &pathChain, py::arg("tip"), doc("Tree.chain"));
-  bindTreeDynamics(cls);
 }
 
 }  // namespace vsbind

@@ -33,6 +33,6 @@ PYBIND11_MODULE(_core, mod) {
   vsbind::bindChain(mod);
   vsbind::bindTree(mod);
   vsbind::bindResultType(mod);
-  vsbind::bindDynamics(mod);  // adds methods to Chain
+  vsbind::bindDynamics(mod);  // adds the companions to Chain and Tree
   vsbind::bindSolver(mod);
 }

@@ -2,10 +2,3 @@
 #pragma once
 
 #include "model_class.hpp"
-
-namespace vsbind {
-
-// Tree.inverse_dynamics, mass_matrix, ... (tree_dynamics.cpp).
-void bindTreeDynamics(py::class_<PyTree>& cls);
-
-}  // namespace vsbind
