@@ -1,27 +1,34 @@
-// Python Solver: construction, the fast solve entry point, results (new or
-// written into `out`), response columns, pickling.
+// Python Solver: construction, the lock, solve() (a METH_FASTCALL entry point) and its result
+// (new or written into `out`), rows on an engine, response columns, pickling.
 #include <pybind11/stl.h>
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
-
-#include <Eigen/QR>
 #include <limits>
 
 #include "py_solver.hpp"
+#include "result_type.hpp"
 
 namespace vsbind {
+
+vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where) {
+  if (value == "physical") return vereshchagin::InertiaCheck::Physical;
+  if (value == "joint_space") return vereshchagin::InertiaCheck::JointSpace;
+  raise(where +
+        "inertia_check must be 'physical' (every body a rigid body) or 'joint_space' (identified models: "
+        "any symmetric inertia, H(q) positive definite at each solve), got '" +
+        value + "'");
+}
 
 PySolver::PySolver(const py::object& model, const py::object& gravity, const py::object& rcond,
                    const py::object& damping, const py::object& inertia_check, const py::object& max_constraints)
     : damping_arg_(damping) {
   if (py::isinstance<PyChain>(model)) {
     chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
-    model_ = chain_.get();
+    addressing = chain_.get();
   } else if (py::isinstance<PyTree>(model)) {
     tree_ = std::make_unique<PyTree>(model.cast<const PyTree&>());
-    model_ = tree_.get();
+    addressing = tree_.get();
   } else {
     throw py::type_error("Solver(model): model must be a vereshchagin.Chain or vereshchagin.Tree, got " +
                          std::string(Py_TYPE(model.ptr())->tp_name));
@@ -52,19 +59,12 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
   const char* invalid = tree_ ? "invalid tree: " : "invalid chain: ";
   if (const vereshchagin::Status s = cpp_model_.status(); !s) raise(invalid + std::string(s.message()));
   auto probe = std::make_unique<Engine>(cpp_model_, gravity_, options_);
-  if (const vereshchagin::Status s = probe->data().status(); !s) raise(invalid + std::string(s.message()));
-  max_columns_ = probe->data().maxConstraints();
+  if (const vereshchagin::Status s = probe->data.status(); !s) raise(invalid + std::string(s.message()));
+  max_columns = probe->data.maxConstraints();
   engines_.push_back(std::move(probe));
   nj = cpp_model_.nrOfJoints();
   ns = cpp_model_.nrOfSegments();
-  const std::vector<vereshchagin::JointInfo>& joints = model_->jointInfos();
-  const auto n = static_cast<Eigen::Index>(joints.size());
-  chain_friction_.static_friction = chain_friction_.lower = chain_friction_.upper = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    chain_friction_.static_friction(k) = joints[k].friction;
-    chain_friction_.lower(k) = joints[k].lower;
-    chain_friction_.upper(k) = joints[k].upper;
-  }
+  friction.setModelValues(addressing->jointInfos());
 }
 
 PySolver::Lock::Lock(PySolver& s) : s_(s) {
@@ -91,9 +91,9 @@ Engine& PySolver::engine(std::size_t k) {
 
 void PySolver::setGravity(const py::object& gravity) {
   const KDL::Vector g = vec3(gravity, "gravity");
-  auto lk = lock();
+  Lock lk(*this);
   gravity_ = g;
-  for (auto& e : engines_) e->setGravity(g);
+  for (auto& e : engines_) e->input.gravity = g;
 }
 
 py::array PySolver::gravity() const {
@@ -102,63 +102,94 @@ py::array PySolver::gravity() const {
   return g;
 }
 
-void PySolver::runParsed(const ParsedSolve& p) {
-  Engine& e = *engines_[0];
-  int rc;
-  {
-    py::gil_scoped_release release;
-    rc = e.run(p.row);
-  }
-  last_state_ = rc == ChainHdSolver::E_NOERROR;
-  if (!last_state_) raise(e.errorMessage());
+const char* PySolver::runRow(const SolveArgs& a, py::ssize_t b, std::size_t k) {
+  Engine& e = *engines_[k];
+  a.fillRow(b, e.input);
+  const vereshchagin::Status s = vereshchagin::solve(cpp_model_, e.data, e.input);
+  return s.value() == 0 ? nullptr : s.message();
 }
 
-py::object PySolver::result(const ParsedSolve& p, PyObject* out) {
-  Engine& e = *engines_[0];
-  ResultLayout layout;
-  layout.nj = static_cast<int>(nj);
-  layout.ns = static_cast<int>(ns);
-  layout.m = e.columns();
-  layout.friction = e.lastHadFriction();
-  py::object r = newResult(layout, out);
-  const ResultPointers ptr = resultPointers(r.ptr());
+bool PySolver::writeRow(const SolveArgs& a, py::ssize_t b, std::size_t k, const RowOut& o) const {
+  const vereshchagin::Data& d = engines_[k]->data;
+  std::copy_n(d.qdd().data(), nj, o.qdd);
+  std::copy_n(d.commandTorques().data(), nj, o.tau_command);
+  // nu has no entry for columns on a chain without segments (nothing moves): their magnitude is 0.
+  std::fill_n(o.nu, a.columns, 0.0);
+  std::copy_n(d.nu().data(), d.nu().size(), o.nu);
+  if (o.link_acc) std::copy_n(d.linkAccelerations().data(), 6 * (ns + 1), o.link_acc);
+  *o.rank = d.constraintRank();
+  *o.smin = d.smallestSingularValue();
+  if (o.friction_torque == nullptr) return true;
+  if (a.friction(b) == nullptr) {  // a batch row without friction
+    std::fill_n(o.friction_torque, nj, std::nan(""));
+    std::fill_n(o.limit_torque, nj, std::nan(""));
+    std::fill_n(o.status, nj, -1);
+    *o.gauss = std::nan("");
+    *o.iterations = -1;
+    return true;
+  }
+  std::copy_n(d.frictionTorques().data(), nj, o.friction_torque);
+  std::copy_n(d.limitTorques().data(), nj, o.limit_torque);
+  for (unsigned int j = 0; j < nj; ++j) o.status[j] = static_cast<int>(d.jointStatus()[j]);
+  *o.gauss = d.gaussValue();
+  *o.iterations = d.iterations();
+  return std::isfinite(*o.gauss);
+}
+
+py::object PySolver::solve(PyObject* const* args, PyObject* out) {
+  Lock lk(*this);
+  last_state_ = false;
+  args_.parse(*this, args, /*batch=*/false);
+  const char* failure;
+  {
+    py::gil_scoped_release release;
+    failure = runRow(args_, 0, 0);
+  }
+  if (failure) raise(failure);
+  last_state_ = true;
+  py::object r =
+      newResult(ResultLayout{static_cast<int>(nj), static_cast<int>(ns), args_.columns, args_.any_friction}, out);
+  const ResultPointers p = resultPointers(r.ptr());
   int rank, iterations = 0;
   double smin, gauss = 0.0;
-  e.writeCore(ptr.qdd, ptr.tau_command, ptr.nu, ptr.link_acc, &rank, &smin);
-  if (layout.friction) {
-    e.writeFriction(ptr.friction_torque, ptr.limit_torque, ptr.status, &gauss, &iterations);
-    if (!std::isfinite(gauss)) raise("the results overflow: gauss_value is beyond the double range");
-  }
+  RowOut o{p.qdd, p.tau_command, p.nu, p.link_acc, &rank, &smin};
+  if (args_.any_friction)
+    o = {p.qdd,          p.tau_command, p.nu,   p.link_acc, &rank, &smin, p.friction_torque,
+         p.limit_torque, p.status,      &gauss, &iterations};
+  if (!writeRow(args_, 0, 0, o)) raise("the results overflow: gauss_value is beyond the double range");
   setResultScalars(r.ptr(), rank, smin, gauss, iterations);
-  if (!p.block_keys.empty()) {
-    const std::size_t nk = p.block_keys.size(), first = p.blocks.size() - nk;
+  if (!args_.keys.empty()) {
+    const std::size_t nk = args_.keys.size(), first = args_.blocks.size() - nk;
     py::tuple keys(nk), starts(nk), counts(nk);
-    py::ssize_t offset = p.alpha.data ? p.alpha.shape[1] : 0;
     for (std::size_t k = 0; k < nk; ++k) {
-      keys[k] = p.block_keys[k];
-      starts[k] = offset;
-      counts[k] = p.blocks[first + k].cols;
-      offset += p.blocks[first + k].cols;
+      keys[k] = args_.keys[k];
+      starts[k] = args_.starts[k];
+      counts[k] = args_.blocks[first + k].cols;
     }
     setSegmentLayout(r.ptr(), keys, starts, counts);
   }
   return r;
 }
 
-double PySolver::timeCpp(const ParsedSolve& p, long reps) {
-  Engine& e = *engines_[0];
-  const int m = static_cast<int>(p.blocks.empty() ? 0 : 6 * ns);
-  Eigen::VectorXd qdd(nj), tau(nj), nu(std::max(m, 1)), fr(nj), lim(nj);
+// Seconds per C++ solve of the parsed row, reading every output solve() returns.
+double PySolver::timeCpp(PyObject* const* args, long reps) {
+  Lock lk(*this);
+  SolveArgs a;
+  a.parse(*this, args, /*batch=*/false);
+  Eigen::VectorXd qdd(nj), tau(nj), nu(std::max(a.columns, 1)), fr(nj), lim(nj);
   Eigen::Matrix<double, 6, Eigen::Dynamic> acc(6, ns + 1);
   std::vector<int> status(nj);
   int rank, iters;
   double smin, gauss;
+  RowOut o{qdd.data(), tau.data(), nu.data(), acc.data(), &rank, &smin};
+  if (a.any_friction)
+    o = {qdd.data(), tau.data(), nu.data(),     acc.data(), &rank, &smin,
+         fr.data(),  lim.data(), status.data(), &gauss,     &iters};
   py::gil_scoped_release release;
   const auto t0 = std::chrono::steady_clock::now();
   for (long k = 0; k < reps; ++k) {
-    if (e.run(p.row) != ChainHdSolver::E_NOERROR) return std::numeric_limits<double>::quiet_NaN();
-    e.writeCore(qdd.data(), tau.data(), nu.data(), acc.data(), &rank, &smin);
-    if (e.lastHadFriction()) e.writeFriction(fr.data(), lim.data(), status.data(), &gauss, &iters);
+    if (runRow(a, 0, 0)) return std::numeric_limits<double>::quiet_NaN();
+    writeRow(a, 0, 0, o);
   }
   const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
   return dt.count() / static_cast<double>(reps);
@@ -191,8 +222,8 @@ Eigen::VectorXi jointList(const Addressable& chain, const py::object& joints) {
 }  // namespace
 
 py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking) {
-  const Eigen::VectorXi requested = jointList(*model_, joints);
-  auto lk = lock();
+  const Eigen::VectorXi requested = jointList(*addressing, joints);
+  Lock lk(*this);
   if (!last_state_)
     raise(
         "response_columns() linearises around the last successful solve() (or the last row of solve_batch()): "
@@ -203,8 +234,8 @@ py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking
   vereshchagin::Status rc;
   {
     py::gil_scoped_release release;
-    rc = hold_sticking ? e.data().responseColumnsHoldingSticking(requested, dq, dt)
-                       : e.data().responseColumns(requested, dq, dt);
+    rc = hold_sticking ? e.data.responseColumnsHoldingSticking(requested, dq, dt)
+                       : e.data.responseColumns(requested, dq, dt);
   }
   if (!rc) raise(rc.message());
   auto toNumpy = [&](const Eigen::MatrixXd& M) {
@@ -213,10 +244,6 @@ py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking
     return a;
   };
   return py::make_tuple(toNumpy(dq), toNumpy(dt));
-}
-
-py::object PySolver::model() const {
-  return tree_ ? py::cast(*tree_) : py::cast(*chain_);
 }
 
 py::tuple PySolver::getState() const {
@@ -308,13 +335,7 @@ PyObject* solveEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, Py
   return guarded([&]() -> py::object {
     PyObject* a[kNumSolveParams] = {};
     bindArguments("solve", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    PySolver& s = solverOf(self);
-    auto lk = s.lock();
-    s.beginStateCall();
-    s.parse(a, s.parsed);
-    s.runParsed(s.parsed);
-    PyObject* out = (a[kOut] == nullptr || a[kOut] == Py_None) ? nullptr : a[kOut];
-    return s.result(s.parsed, out);
+    return solverOf(self).solve(a, a[kOut] == Py_None ? nullptr : a[kOut]);
   });
 }
 
@@ -326,11 +347,7 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
     const long reps = py::handle(args[0]).cast<long>();
     PyObject* a[kNumSolveParams] = {};
     bindArguments("_time_cpp", args + 1, nargs - 1, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    PySolver& s = solverOf(self);
-    auto lk = s.lock();
-    ParsedSolve p;
-    s.parse(a, p);
-    return py::float_(s.timeCpp(p, reps));
+    return py::float_(solverOf(self).timeCpp(a, reps));
   });
 }
 
