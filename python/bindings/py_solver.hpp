@@ -116,15 +116,11 @@ class SolveArgs {
   std::vector<const vereshchagin::FrictionModel*> row_friction_;  // empty: friction_ for all
 };
 
-// Where one row's results go (nullptr: not wanted; friction ones: no friction outputs).
+// Where the results go: row b of each output starts at its pointer + b * (the row's size). The
+// friction outputs are left out when friction_torque is nullptr.
 struct RowOut {
-  double *qdd, *tau_command, *nu, *link_acc;
-  int* rank;
-  double* smin;
-  double *friction_torque = nullptr, *limit_torque = nullptr;
-  int* status = nullptr;
-  double* gauss = nullptr;
-  int* iterations = nullptr;
+  double *qdd, *tau_command, *nu, *link_acc, *smin, *friction_torque, *limit_torque, *gauss;
+  int *rank, *status, *iterations;
 };
 
 // A thread's workspace on the solver's Model.
@@ -146,7 +142,7 @@ class PySolver {
 
   // Row b of `a` on engine k (GIL released by the caller); returns the error message or nullptr.
   const char* runRow(const SolveArgs& a, py::ssize_t b, std::size_t k);
-  // Writes engine k's results (a's layout); false when gauss_value overflowed.
+  // Writes engine k's results as row b of `out` (a's layout); false when gauss_value overflowed.
   bool writeRow(const SolveArgs& a, py::ssize_t b, std::size_t k, const RowOut& out) const;
   // solve(): parses, solves on engine 0 and returns a SolveResult (new, or `out`).
   py::object solve(PyObject* const* args, PyObject* out);

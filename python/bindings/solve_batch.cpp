@@ -71,37 +71,20 @@ py::dict PySolver::solveBatch(const py::object& q, const py::object& qd, const p
                         tau_ff_pass_through.ptr()};
   SolveArgs a;
   a.parse(*this, args, /*batch=*/true);
-  const py::ssize_t B = a.rows, M = a.columns, n = nj, na = 6 * (ns + 1);
+  const py::ssize_t B = a.rows, M = a.columns, n = nj;
   const long threads = std::min<long>(threadsArg(threads_obj), std::max<py::ssize_t>(B, 1));
   for (long t = 0; t < threads; ++t) engine(static_cast<std::size_t>(t));
+  const py::ssize_t BF = a.any_friction ? B : 0;  // rows of the friction outputs
   py::array qdd = newDoubles({B, n}), tau = newDoubles({B, n}), nu = newDoubles({B, M});
   py::array acc = newDoubles({B, static_cast<py::ssize_t>(ns + 1), 6}), rank = newInts({B}), smin = newDoubles({B});
-  py::array fr, lim, status, gauss, iters;
-  if (a.any_friction) {
-    fr = newDoubles({B, n});
-    lim = newDoubles({B, n});
-    status = newInts({B, n});
-    gauss = newDoubles({B});
-    iters = newInts({B});
-  }
+  py::array fr = newDoubles({BF, n}), lim = newDoubles({BF, n}), status = newInts({BF, n});
+  py::array gauss = newDoubles({BF}), iters = newInts({BF});
+  const RowOut o{doubles(qdd), doubles(tau),   doubles(nu), doubles(acc), doubles(smin), BF ? doubles(fr) : nullptr,
+                 doubles(lim), doubles(gauss), ints(rank),  ints(status), ints(iters)};
   std::vector<std::pair<py::ssize_t, std::string>> failures(threads, {-1, ""});
   auto work = [&](long t, py::ssize_t begin, py::ssize_t end) {
     for (py::ssize_t b = begin; b < end; ++b) {
       if (const char* failure = runRow(a, b, t)) return void(failures[t] = {b, failure});
-      RowOut o{doubles(qdd) + b * n,  doubles(tau) + b * n, doubles(nu) + b * M,
-               doubles(acc) + b * na, ints(rank) + b,       doubles(smin) + b};
-      if (a.any_friction)
-        o = {o.qdd,
-             o.tau_command,
-             o.nu,
-             o.link_acc,
-             o.rank,
-             o.smin,
-             doubles(fr) + b * n,
-             doubles(lim) + b * n,
-             ints(status) + b * n,
-             doubles(gauss) + b,
-             ints(iters) + b};
       if (!writeRow(a, b, t, o))
         return void(failures[t] = {b, "the results overflow: gauss_value is beyond the double range"});
     }

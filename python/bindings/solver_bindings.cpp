@@ -111,29 +111,30 @@ const char* PySolver::runRow(const SolveArgs& a, py::ssize_t b, std::size_t k) {
 
 bool PySolver::writeRow(const SolveArgs& a, py::ssize_t b, std::size_t k, const RowOut& o) const {
   const vereshchagin::Data& d = engines_[k]->data;
-  std::copy_n(d.qdd().data(), nj, o.qdd);
-  std::copy_n(d.commandTorques().data(), nj, o.tau_command);
+  const py::ssize_t n = nj;
+  std::copy_n(d.qdd().data(), n, o.qdd + b * n);
+  std::copy_n(d.commandTorques().data(), n, o.tau_command + b * n);
   // nu has no entry for columns on a chain without segments (nothing moves): their magnitude is 0.
-  std::fill_n(o.nu, a.columns, 0.0);
-  std::copy_n(d.nu().data(), d.nu().size(), o.nu);
-  if (o.link_acc) std::copy_n(d.linkAccelerations().data(), 6 * (ns + 1), o.link_acc);
-  *o.rank = d.constraintRank();
-  *o.smin = d.smallestSingularValue();
+  std::fill_n(o.nu + b * a.columns, a.columns, 0.0);
+  std::copy_n(d.nu().data(), d.nu().size(), o.nu + b * a.columns);
+  std::copy_n(d.linkAccelerations().data(), 6 * (ns + 1), o.link_acc + b * 6 * (ns + 1));
+  o.rank[b] = d.constraintRank();
+  o.smin[b] = d.smallestSingularValue();
   if (o.friction_torque == nullptr) return true;
   if (a.friction(b) == nullptr) {  // a batch row without friction
-    std::fill_n(o.friction_torque, nj, std::nan(""));
-    std::fill_n(o.limit_torque, nj, std::nan(""));
-    std::fill_n(o.status, nj, -1);
-    *o.gauss = std::nan("");
-    *o.iterations = -1;
+    std::fill_n(o.friction_torque + b * n, n, std::nan(""));
+    std::fill_n(o.limit_torque + b * n, n, std::nan(""));
+    std::fill_n(o.status + b * n, n, -1);
+    o.gauss[b] = std::nan("");
+    o.iterations[b] = -1;
     return true;
   }
-  std::copy_n(d.frictionTorques().data(), nj, o.friction_torque);
-  std::copy_n(d.limitTorques().data(), nj, o.limit_torque);
-  for (unsigned int j = 0; j < nj; ++j) o.status[j] = static_cast<int>(d.jointStatus()[j]);
-  *o.gauss = d.gaussValue();
-  *o.iterations = d.iterations();
-  return std::isfinite(*o.gauss);
+  std::copy_n(d.frictionTorques().data(), n, o.friction_torque + b * n);
+  std::copy_n(d.limitTorques().data(), n, o.limit_torque + b * n);
+  for (py::ssize_t j = 0; j < n; ++j) o.status[b * n + j] = static_cast<int>(d.jointStatus()[j]);
+  o.gauss[b] = d.gaussValue();
+  o.iterations[b] = d.iterations();
+  return std::isfinite(o.gauss[b]);
 }
 
 py::object PySolver::solve(PyObject* const* args, PyObject* out) {
@@ -152,10 +153,9 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out) {
   const ResultPointers p = resultPointers(r.ptr());
   int rank, iterations = 0;
   double smin, gauss = 0.0;
-  RowOut o{p.qdd, p.tau_command, p.nu, p.link_acc, &rank, &smin};
-  if (args_.any_friction)
-    o = {p.qdd,          p.tau_command, p.nu,   p.link_acc, &rank, &smin, p.friction_torque,
-         p.limit_torque, p.status,      &gauss, &iterations};
+  const RowOut o{
+      p.qdd,          p.tau_command, p.nu,  p.link_acc, &smin,      args_.any_friction ? p.friction_torque : nullptr,
+      p.limit_torque, &gauss,        &rank, p.status,   &iterations};
   if (!writeRow(args_, 0, 0, o)) raise("the results overflow: gauss_value is beyond the double range");
   setResultScalars(r.ptr(), rank, smin, gauss, iterations);
   if (!args_.keys.empty()) {
@@ -181,10 +181,8 @@ double PySolver::timeCpp(PyObject* const* args, long reps) {
   std::vector<int> status(nj);
   int rank, iters;
   double smin, gauss;
-  RowOut o{qdd.data(), tau.data(), nu.data(), acc.data(), &rank, &smin};
-  if (a.any_friction)
-    o = {qdd.data(), tau.data(), nu.data(),     acc.data(), &rank, &smin,
-         fr.data(),  lim.data(), status.data(), &gauss,     &iters};
+  const RowOut o{qdd.data(), tau.data(), nu.data(), acc.data(),    &smin, a.any_friction ? fr.data() : nullptr,
+                 lim.data(), &gauss,     &rank,     status.data(), &iters};
   py::gil_scoped_release release;
   const auto t0 = std::chrono::steady_clock::now();
   for (long k = 0; k < reps; ++k) {
