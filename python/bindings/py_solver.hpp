@@ -1,7 +1,8 @@
 // The Python Solver: one parser for the arguments of solve() and solve_batch() (SolveArgs, with
 // friction in FrictionArg), one engine (a Data and a SolveInput) per thread, and PySolver itself.
-// solver_bindings.cpp: construction, solve(), results; solve_args.cpp: the parser;
-// solve_friction.cpp: friction=; solve_batch.cpp: solve_batch().
+// solve_args.cpp: the parser; solve_friction.cpp: friction=; solve_row.cpp: a row on an engine and
+// solve(); solve_batch.cpp: solve_batch(); solver_core.cpp: setup and state; solver_bindings.cpp:
+// the Python methods.
 #pragma once
 
 #include <atomic>
@@ -93,7 +94,8 @@ class SolveArgs {
   std::vector<py::ssize_t> starts;  // their first column in nu
 
  private:
-  Rows arg(const char* name, F64View v, int ndim, const py::ssize_t* shape, const char* hint = "");
+  enum Hint { kNoHint, kAlphaHint, kFExtHint };  // what a shape message adds
+  Rows arg(const char* name, F64View v, int ndim, const py::ssize_t* shape, Hint hint = kNoHint);
   Rows vector(PyObject* obj, const char* name, py::ssize_t n, bool scalar_ok = false);
   Rows weights(PyObject* obj, const char* name);
   void batchAxis(py::ssize_t n, const char* name, const std::string& shape);
@@ -168,7 +170,6 @@ class PySolver {
     explicit Lock(PySolver& s);
     ~Lock();
     Lock(const Lock&) = delete;
-    Lock& operator=(const Lock&) = delete;
 
    private:
     PySolver& s_;

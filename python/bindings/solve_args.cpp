@@ -7,14 +7,6 @@ namespace vsbind {
 
 namespace {
 
-constexpr const char* kAlphaHint = " (6 rows [force; moment], one column per constraint; (6,) for one column)";
-constexpr const char* kFExtHint =
-    ": one row [fx, fy, fz, mx, my, mz] per segment (base axes, moment about the segment's tip origin), or a dict "
-    "{segment: wrench (6,)}";
-constexpr const char* kWeightNote =
-    "] must be in [0, 1] (0: the constraint compensates that driver, 1: its effect "
-    "passes through), got ";
-
 bool given(PyObject* obj) {
   return obj != nullptr && obj != Py_None;
 }
@@ -47,15 +39,19 @@ void SolveArgs::batchAxis(py::ssize_t n, const char* name, const std::string& sh
 }
 
 // `v` as rows of `shape` (ndim dimensions), in a batch also with a leading batch axis; finite.
-Rows SolveArgs::arg(const char* name, F64View v, int ndim, const py::ssize_t* shape, const char* hint) {
+Rows SolveArgs::arg(const char* name, F64View v, int ndim, const py::ssize_t* shape, Hint hint) {
   const int batched = batch_ && v.ndim == ndim + 1;
   bool fits = v.ndim == ndim + batched;
   for (int k = 0; fits && k < ndim; ++k) fits = v.shape[k + batched] == shape[k];
   if (!fits) {
     const std::string expect = shapeText(ndim, shape);
     raise(std::string(name) + " must have shape (" + expect + ")" +
-          (batch_ ? " (shared by all rows) or (B, " + expect + ") (one per row)" : "") + hint + ", got " +
-          v.shapeString());
+          (batch_ ? " (shared by all rows) or (B, " + expect + ") (one per row)" : "") +
+          (hint == kAlphaHint ? " (6 rows [force; moment], one column per constraint; (6,) for one column)" : "") +
+          (hint == kFExtHint ? ": one row [fx, fy, fz, mx, my, mz] per segment (base axes, moment about the "
+                               "segment's tip origin), or a dict {segment: wrench (6,)}"
+                             : "") +
+          ", got " + v.shapeString());
   }
   Rows r{v.data, 0};
   if (batched) {
@@ -93,7 +89,8 @@ Rows SolveArgs::weights(PyObject* obj, const char* name) {
     for (int c = 0; c < columns; ++c)
       if (const double x = w.row(b)[c]; !(x >= 0.0 && x <= 1.0))
         raise((w.stride ? "batch row " + std::to_string(b) + ": " : std::string()) + name + "[" + std::to_string(c) +
-              kWeightNote + fmtDouble(x));
+              "] must be in [0, 1] (0: the constraint compensates that driver, 1: its effect passes through), got " +
+              fmtDouble(x));
   return w;
 }
 
