@@ -94,25 +94,27 @@ Rows SolveArgs::weights(PyObject* obj, const char* name) {
   return w;
 }
 
+// A block of alpha and beta (label: "" for solve's alpha/beta, else "constraints[key]").
 void SolveArgs::addBlock(int segment, PyObject* alpha, PyObject* beta, const std::string& label) {
-  const std::string an = label.empty() ? "alpha" : label + " alpha", bn = label.empty() ? "beta" : label + " beta";
-  F64View a = asF64(alpha, an.c_str());
+  const std::string an = label.empty() ? "" : label + " alpha", bn = label.empty() ? "" : label + " beta";
+  const char *a_name = label.empty() ? "alpha" : an.c_str(), *b_name = label.empty() ? "beta" : bn.c_str();
+  F64View a = asF64(alpha, a_name);
   if (a.ndim == 1 && a.shape[0] == 6) {  // one column
     a.ndim = 2;
     a.shape[1] = 1;
   }
   const py::ssize_t m = a.ndim >= 2 ? a.shape[a.ndim - 1] : -1, shape[2] = {6, m};
-  if (m > 6) raise(an + " has " + std::to_string(m) + " columns; at most 6 constraints per segment");
+  if (m > 6) raise(a_name + std::string(" has ") + std::to_string(m) + " columns; at most 6 constraints per segment");
   BlockArg& blk = blocks.emplace_back();
   blk.segment = segment;
   blk.cols = static_cast<int>(m);
-  blk.alpha = arg(an.c_str(), std::move(a), 2, shape, kAlphaHint);
+  blk.alpha = arg(a_name, std::move(a), 2, shape, kAlphaHint);
   if (beta == nullptr) raise("beta is required when alpha is given (shape (" + std::to_string(m) + ",))");
-  blk.beta = vector(beta, bn.c_str(), m, /*scalar_ok=*/true);
+  blk.beta = vector(beta, b_name, m, /*scalar_ok=*/true);
   columns += blk.cols;
-  if (segment < 0) return;
+  if (label.empty()) return;  // solve's alpha: counted when constraints= is parsed
   segment_cols_[segment] += blk.cols;
-  if (segment_cols_[segment] > 6 && !label.empty())
+  if (segment_cols_[segment] > 6)
     raise(label + ": more than 6 constraint columns on segment '" + addressing_->segmentName(segment) +
           "' (alpha and every key on it count)");
 }
@@ -142,6 +144,8 @@ void SolveArgs::parseFExt(PyObject* obj) {
 void SolveArgs::parseConstraints(PyObject* obj) {
   if (!PyDict_Check(obj)) raise("constraints must be a dict {segment name or index: (alpha (6, m_i), beta (m_i,))}");
   const std::size_t first = blocks.size();
+  segment_cols_.assign(ns_, 0);
+  if (first == 1 && blocks[0].segment >= 0) segment_cols_[blocks[0].segment] = blocks[0].cols;
   PyObject *key, *value;
   Py_ssize_t pos = 0;
   while (PyDict_Next(obj, &pos, &key, &value)) {
@@ -201,7 +205,6 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   starts.clear();
   wrenches_.clear();
   keep_.clear();
-  segment_cols_.assign(ns_, 0);
   f_ext_ = tau_ = f_ext_pass_ = tau_pass_ = Rows();
   if (a[0] == nullptr || a[1] == nullptr) raise("solve() needs q and qd");
   q_ = vector(a[0], "q", nj_);
