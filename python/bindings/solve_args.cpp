@@ -15,10 +15,10 @@ std::string keyLabel(const char* what, PyObject* key) {
   return std::string(what) + "[" + py::repr(key).cast<std::string>() + "]";
 }
 
-// "6, m" for {6, -1}: the shape one row must have.
+// "6, 2" for {6, 2}: the shape one row must have.
 std::string shapeText(int ndim, const py::ssize_t* shape) {
   std::string s;
-  for (int k = 0; k < ndim; ++k) s += (k ? ", " : "") + (shape[k] < 0 ? "m" : std::to_string(shape[k]));
+  for (int k = 0; k < ndim; ++k) s += (k ? ", " : "") + std::to_string(shape[k]);
   return ndim == 1 ? s + "," : s;
 }
 
@@ -44,14 +44,14 @@ Rows SolveArgs::arg(const char* name, F64View v, int ndim, const py::ssize_t* sh
   bool fits = v.ndim == ndim + batched;
   for (int k = 0; fits && k < ndim; ++k) fits = v.shape[k + batched] == shape[k];
   if (!fits) {
-    const std::string expect = shapeText(ndim, shape);
+    const std::string expect = hint == kAlphaHint ? "6, m" : shapeText(ndim, shape);
     raise(std::string(name) + " must have shape (" + expect + ")" +
           (batch_ ? " (shared by all rows) or (B, " + expect + ") (one per row)" : "") +
-          (hint == kAlphaHint ? " (6 rows [force; moment], one column per constraint; (6,) for one column)" : "") +
+          (hint == kAlphaHint ? " (columns: unit wrenches [force; moment]) or (6,) for one column, got " : "") +
           (hint == kFExtHint ? ": one row [fx, fy, fz, mx, my, mz] per segment (base axes, moment about the "
-                               "segment's tip origin), or a dict {segment: wrench (6,)}"
+                               "segment's tip origin), or a dict {segment: wrench (6,)}; got "
                              : "") +
-          ", got " + v.shapeString());
+          (hint == kNoHint ? ", got " : "") + v.shapeString());
   }
   Rows r{v.data, 0};
   if (batched) {
