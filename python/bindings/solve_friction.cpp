@@ -10,14 +10,11 @@ namespace vsbind {
 
 namespace {
 
-// The attributes of a vereshchagin.Friction, in the order of FrictionArg::cache_attrs_.
+// The attributes of a vereshchagin.Friction, in the order of FrictionArg::cache_attrs_ (interned).
 PyObject* attrName(int k) {
-  static PyObject* names[6] = {PyUnicode_InternFromString("static"),
-                               PyUnicode_InternFromString("kinetic"),
-                               PyUnicode_InternFromString("velocity_tolerance"),
-                               PyUnicode_InternFromString("lower"),
-                               PyUnicode_InternFromString("upper"),
-                               PyUnicode_InternFromString("limit_tolerance")};
+  static const char* const text[6] = {"static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance"};
+  static PyObject* names[6] = {};
+  if (names[k] == nullptr) names[k] = PyUnicode_InternFromString(text[k]);
   return names[k];
 }
 
