@@ -50,6 +50,50 @@ std::string runChunks(long threads, py::ssize_t B, const Work& work) {
   return "";
 }
 
+// The outputs of B rows (the friction ones with 0 rows when no row has friction).
+struct BatchOut {
+  BatchOut(py::ssize_t B, py::ssize_t n, py::ssize_t M, py::ssize_t ns, bool friction)
+      : BF(friction ? B : 0),
+        qdd(newDoubles({B, n})),
+        tau(newDoubles({B, n})),
+        nu(newDoubles({B, M})),
+        acc(newDoubles({B, ns + 1, 6})),
+        smin(newDoubles({B})),
+        fr(newDoubles({BF, n})),
+        lim(newDoubles({BF, n})),
+        gauss(newDoubles({BF})),
+        rank(newInts({B})),
+        status(newInts({BF, n})),
+        iters(newInts({BF})) {}
+  RowOut rows() const {
+    return {doubles(qdd), doubles(tau),   doubles(nu), doubles(acc), doubles(smin), BF ? doubles(fr) : nullptr,
+            doubles(lim), doubles(gauss), ints(rank),  ints(status), ints(iters)};
+  }
+  // The fields of a BatchResult; segment_nu: (B, m_i) views of nu per constraints= key.
+  py::dict fields(const SolveArgs& a) const {
+    py::dict out("qdd"_a = qdd, "tau_command"_a = tau, "nu"_a = nu, "link_acc"_a = acc, "constraint_rank"_a = rank,
+                 "smallest_singular_value"_a = smin);
+    if (a.any_friction) {
+      out["friction_torque"] = fr;
+      out["limit_torque"] = lim;
+      out["status"] = status;
+      out["gauss_value"] = gauss;
+      out["iterations"] = iters;
+    }
+    if (a.keys.empty()) return out;
+    py::dict per_key;
+    for (std::size_t k = 0; k < a.keys.size(); ++k) {
+      const py::ssize_t start = a.starts[k], count = a.blocks[a.blocks.size() - a.keys.size() + k].cols;
+      per_key[a.keys[k]] = nu[py::make_tuple(py::slice(0, a.rows, 1), py::slice(start, start + count, 1))];
+    }
+    out["segment_nu"] = per_key;
+    return out;
+  }
+
+  py::ssize_t BF;
+  py::array qdd, tau, nu, acc, smin, fr, lim, gauss, rank, status, iters;
+};
+
 }  // namespace
 
 py::dict PySolver::solveBatch(const py::object& q, const py::object& qd, const py::object& alpha,
@@ -59,28 +103,17 @@ py::dict PySolver::solveBatch(const py::object& q, const py::object& qd, const p
                               const py::object& threads_obj) {
   Lock lk(*this);
   last_state_ = false;  // until engine 0 holds the last row's state
-  PyObject* args[10] = {q.ptr(),
-                        qd.ptr(),
-                        alpha.ptr(),
-                        beta.ptr(),
-                        f_ext.ptr(),
-                        tau_ff.ptr(),
-                        friction_obj.ptr(),
-                        constraints.ptr(),
-                        f_ext_pass_through.ptr(),
-                        tau_ff_pass_through.ptr()};
+  // clang-format off
+  PyObject* args[10] = {q.ptr(), qd.ptr(), alpha.ptr(), beta.ptr(), f_ext.ptr(), tau_ff.ptr(), friction_obj.ptr(),
+                        constraints.ptr(), f_ext_pass_through.ptr(), tau_ff_pass_through.ptr()};
+  // clang-format on
   SolveArgs a;
   a.parse(*this, args, /*batch=*/true);
-  const py::ssize_t B = a.rows, M = a.columns, n = nj;
+  const py::ssize_t B = a.rows;
   const long threads = std::min<long>(threadsArg(threads_obj), std::max<py::ssize_t>(B, 1));
   for (long t = 0; t < threads; ++t) engine(static_cast<std::size_t>(t));
-  const py::ssize_t BF = a.any_friction ? B : 0;  // rows of the friction outputs
-  py::array qdd = newDoubles({B, n}), tau = newDoubles({B, n}), nu = newDoubles({B, M});
-  py::array acc = newDoubles({B, static_cast<py::ssize_t>(ns + 1), 6}), rank = newInts({B}), smin = newDoubles({B});
-  py::array fr = newDoubles({BF, n}), lim = newDoubles({BF, n}), status = newInts({BF, n});
-  py::array gauss = newDoubles({BF}), iters = newInts({BF});
-  const RowOut o{doubles(qdd), doubles(tau),   doubles(nu), doubles(acc), doubles(smin), BF ? doubles(fr) : nullptr,
-                 doubles(lim), doubles(gauss), ints(rank),  ints(status), ints(iters)};
+  const BatchOut out(B, nj, a.columns, ns, a.any_friction);
+  const RowOut o = out.rows();
   std::vector<std::pair<py::ssize_t, std::string>> failures(threads, {-1, ""});
   auto work = [&](long t, py::ssize_t begin, py::ssize_t end) {
     for (py::ssize_t b = begin; b < end; ++b) {
@@ -107,23 +140,7 @@ py::dict PySolver::solveBatch(const py::object& q, const py::object& qd, const p
     }
     last_state_ = failure == nullptr;
   }
-  py::dict out("qdd"_a = qdd, "tau_command"_a = tau, "nu"_a = nu, "link_acc"_a = acc, "constraint_rank"_a = rank,
-               "smallest_singular_value"_a = smin);
-  if (a.any_friction) {
-    out["friction_torque"] = fr;
-    out["limit_torque"] = lim;
-    out["status"] = status;
-    out["gauss_value"] = gauss;
-    out["iterations"] = iters;
-  }
-  if (a.keys.empty()) return out;
-  py::dict per_key;
-  for (std::size_t k = 0; k < a.keys.size(); ++k) {
-    const py::ssize_t start = a.starts[k], count = a.blocks[a.blocks.size() - a.keys.size() + k].cols;
-    per_key[a.keys[k]] = nu[py::make_tuple(py::slice(0, B, 1), py::slice(start, start + count, 1))];
-  }
-  out["segment_nu"] = per_key;
-  return out;
+  return out.fields(a);
 }
 
 }  // namespace vsbind
