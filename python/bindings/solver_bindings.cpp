@@ -1,246 +1,17 @@
-// Python Solver: construction, the fast solve entry point, results (new or
-// written into `out`), response columns, pickling.
+// Solver's Python methods: solve() and _time_cpp() as METH_FASTCALL entry points (keyword names
+// matched against interned strings), the rest through pybind11.
 #include <pybind11/stl.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cstring>
-
-#include <Eigen/QR>
-#include <limits>
 
 #include "py_solver.hpp"
 
 namespace vsbind {
 
-PySolver::PySolver(const py::object& model, const py::object& gravity, const py::object& rcond,
-                   const py::object& damping, const py::object& inertia_check, const py::object& max_constraints)
-    : damping_arg_(damping) {
-  if (py::isinstance<PyChain>(model)) {
-    chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
-    model_ = chain_.get();
-  } else if (py::isinstance<PyTree>(model)) {
-    tree_ = std::make_unique<PyTree>(model.cast<const PyTree&>());
-    model_ = tree_.get();
-  } else {
-    throw py::type_error("Solver(model): model must be a vereshchagin.Chain or vereshchagin.Tree, got " +
-                         std::string(Py_TYPE(model.ptr())->tp_name));
-  }
-  options_.rcond = scalarArg(rcond, "rcond");
-  if (inertia_check.is_none())  // the check the model was built with
-    options_.inertia_check = tree_ ? tree_->inertia_check : chain_->inertia_check;
-  else
-    options_.inertia_check = inertiaCheckArg(py::str(inertia_check).cast<std::string>(), "");
-  if (!damping.is_none()) {
-    options_.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
-    options_.damping = scalarArg(damping, "damping");
-  }
-  if (!max_constraints.is_none()) {
-    if (PyBool_Check(max_constraints.ptr()) || !PyIndex_Check(max_constraints.ptr()))
-      raise("max_constraints must be an int >= 1 (None: the default), got " +
-            py::repr(max_constraints).cast<std::string>());
-    const std::optional<long long> value = intWithin(max_constraints.ptr(), 1, 1 << 24);
-    if (!value)
-      raise("max_constraints must be in 1 .. 16777216 (None: the default), got " +
-            py::str(max_constraints).cast<std::string>());
-    options_.max_constraints = static_cast<int>(*value);
-  }
-  gravity_ = vec3(gravity, "gravity");
-  const vereshchagin::ModelOptions model_options{options_.inertia_check};
-  cpp_model_ = tree_ ? vereshchagin::Model(tree_->robot.tree, tree_->robot.root_link, model_options)
-                     : vereshchagin::Model(chain_->robot.chain, model_options);
-  const char* invalid = tree_ ? "invalid tree: " : "invalid chain: ";
-  if (const vereshchagin::Status s = cpp_model_.status(); !s) raise(invalid + std::string(s.message()));
-  auto probe = std::make_unique<Engine>(cpp_model_, gravity_, options_);
-  if (const vereshchagin::Status s = probe->data().status(); !s) raise(invalid + std::string(s.message()));
-  max_columns_ = probe->data().maxConstraints();
-  engines_.push_back(std::move(probe));
-  nj = cpp_model_.nrOfJoints();
-  ns = cpp_model_.nrOfSegments();
-  const std::vector<vereshchagin::JointInfo>& joints = model_->jointInfos();
-  const auto n = static_cast<Eigen::Index>(joints.size());
-  chain_friction_.static_friction = chain_friction_.lower = chain_friction_.upper = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    chain_friction_.static_friction(k) = joints[k].friction;
-    chain_friction_.lower(k) = joints[k].lower;
-    chain_friction_.upper(k) = joints[k].upper;
-  }
-}
-
-PySolver::Lock::Lock(PySolver& s) : s_(s) {
-  if (s.holder_.load() == std::this_thread::get_id())
-    raise(
-        "a Solver call re-entered the same Solver while it converts its arguments (an argument's __array__, "
-        "property or __index__ calls this solver): convert the arguments first, or use another Solver");
-  if (!s.mutex_.try_lock()) {
-    py::gil_scoped_release release;  // another thread solves: wait without blocking it
-    s.mutex_.lock();
-  }
-  s.holder_.store(std::this_thread::get_id());
-}
-
-PySolver::Lock::~Lock() {
-  s_.holder_.store(std::thread::id());
-  s_.mutex_.unlock();
-}
-
-Engine& PySolver::engine(std::size_t k) {
-  while (engines_.size() <= k) engines_.push_back(std::make_unique<Engine>(cpp_model_, gravity_, options_));
-  return *engines_[k];
-}
-
-void PySolver::setGravity(const py::object& gravity) {
-  const KDL::Vector g = vec3(gravity, "gravity");
-  auto lk = lock();
-  gravity_ = g;
-  for (auto& e : engines_) e->setGravity(g);
-}
-
-py::array PySolver::gravity() const {
-  py::array g = newDoubles({3});
-  for (int k = 0; k < 3; ++k) doubles(g)[k] = gravity_(k);
-  return g;
-}
-
-void PySolver::runParsed(const ParsedSolve& p) {
-  Engine& e = *engines_[0];
-  int rc;
-  {
-    py::gil_scoped_release release;
-    rc = e.run(p.row);
-  }
-  last_state_ = rc == ChainHdSolver::E_NOERROR;
-  if (!last_state_) raise(e.errorMessage());
-}
-
-py::object PySolver::result(const ParsedSolve& p, PyObject* out) {
-  Engine& e = *engines_[0];
-  ResultLayout layout;
-  layout.nj = static_cast<int>(nj);
-  layout.ns = static_cast<int>(ns);
-  layout.m = e.columns();
-  layout.friction = e.lastHadFriction();
-  py::object r = newResult(layout, out);
-  const ResultPointers ptr = resultPointers(r.ptr());
-  int rank, iterations = 0;
-  double smin, gauss = 0.0;
-  e.writeCore(ptr.qdd, ptr.tau_command, ptr.nu, ptr.link_acc, &rank, &smin);
-  if (layout.friction) {
-    e.writeFriction(ptr.friction_torque, ptr.limit_torque, ptr.status, &gauss, &iterations);
-    if (!std::isfinite(gauss)) raise("the results overflow: gauss_value is beyond the double range");
-  }
-  setResultScalars(r.ptr(), rank, smin, gauss, iterations);
-  if (!p.block_keys.empty()) {
-    const std::size_t nk = p.block_keys.size(), first = p.blocks.size() - nk;
-    py::tuple keys(nk), starts(nk), counts(nk);
-    py::ssize_t offset = p.alpha.data ? p.alpha.shape[1] : 0;
-    for (std::size_t k = 0; k < nk; ++k) {
-      keys[k] = p.block_keys[k];
-      starts[k] = offset;
-      counts[k] = p.blocks[first + k].cols;
-      offset += p.blocks[first + k].cols;
-    }
-    setSegmentLayout(r.ptr(), keys, starts, counts);
-  }
-  return r;
-}
-
-double PySolver::timeCpp(const ParsedSolve& p, long reps) {
-  Engine& e = *engines_[0];
-  const int m = static_cast<int>(p.blocks.empty() ? 0 : 6 * ns);
-  Eigen::VectorXd qdd(nj), tau(nj), nu(std::max(m, 1)), fr(nj), lim(nj);
-  Eigen::Matrix<double, 6, Eigen::Dynamic> acc(6, ns + 1);
-  std::vector<int> status(nj);
-  int rank, iters;
-  double smin, gauss;
-  py::gil_scoped_release release;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long k = 0; k < reps; ++k) {
-    if (e.run(p.row) != ChainHdSolver::E_NOERROR) return std::numeric_limits<double>::quiet_NaN();
-    e.writeCore(qdd.data(), tau.data(), nu.data(), acc.data(), &rank, &smin);
-    if (e.lastHadFriction()) e.writeFriction(fr.data(), lim.data(), status.data(), &gauss, &iters);
-  }
-  const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
-  return dt.count() / static_cast<double>(reps);
-}
-
 namespace {
 
-Eigen::VectorXi jointList(const Addressable& chain, const py::object& joints) {
-  const char* what = "joints must be a sequence of joint names or int indices";
-  if (joints.is_none() || py::isinstance<py::str>(joints)) raise(what);
-  py::sequence seq;
-  if (py::isinstance<py::array>(joints)) {
-    py::array a = joints.cast<py::array>();
-    const char kind = a.dtype().kind();
-    if (a.ndim() != 1 || (a.size() > 0 && kind != 'i' && kind != 'u' && kind != 'U'))
-      raise(std::string(what) + ", got an array of shape " + shapeStr(a) + " and dtype " +
-            std::string(py::str(a.dtype())));
-    seq = a.attr("tolist")();
-  } else if (py::isinstance<py::sequence>(joints)) {
-    seq = joints.cast<py::sequence>();
-  } else {
-    raise(what);
-  }
-  Eigen::VectorXi j(static_cast<Eigen::Index>(seq.size()));
-  for (Eigen::Index c = 0; c < j.size(); ++c)
-    j(c) = chain.resolveJoint(seq[c].ptr(), "joints[" + std::to_string(c) + "]");
-  return j;
-}
-
-}  // namespace
-
-py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking) {
-  const Eigen::VectorXi requested = jointList(*model_, joints);
-  auto lk = lock();
-  if (!last_state_)
-    raise(
-        "response_columns() linearises around the last successful solve() (or the last row of solve_batch()): "
-        "call solve() at the state first");
-  Engine& e = *engines_[0];
-  const Eigen::Index k = requested.size();
-  Eigen::MatrixXd dq(nj, k), dt(nj, k);
-  vereshchagin::Status rc;
-  {
-    py::gil_scoped_release release;
-    rc = hold_sticking ? e.data().responseColumnsHoldingSticking(requested, dq, dt)
-                       : e.data().responseColumns(requested, dq, dt);
-  }
-  if (!rc) raise(rc.message());
-  auto toNumpy = [&](const Eigen::MatrixXd& M) {
-    py::array a = newDoubles({static_cast<py::ssize_t>(nj), static_cast<py::ssize_t>(k)});
-    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(doubles(a), nj, k) = M;
-    return a;
-  };
-  return py::make_tuple(toNumpy(dq), toNumpy(dt));
-}
-
-py::object PySolver::model() const {
-  return tree_ ? py::cast(*tree_) : py::cast(*chain_);
-}
-
-py::tuple PySolver::getState() const {
-  return py::make_tuple(model(), gravity(), options_.rcond, damping_arg_,
-                        vereshchagin::inertiaCheckName(options_.inertia_check),
-                        options_.max_constraints > 0 ? py::object(py::int_(options_.max_constraints)) : py::none());
-}
-
-// ------------------------------------------------------------------------------------------------
-// solve(): a METH_FASTCALL | METH_KEYWORDS method. Keyword names are matched by identity against
-// interned strings first (what the interpreter passes for literal keywords), then by value.
-namespace {
-
-constexpr const char* kSolveParams[] = {"q",
-                                        "qd",
-                                        "alpha",
-                                        "beta",
-                                        "f_ext",
-                                        "tau_ff",
-                                        "friction",
-                                        "constraints",
-                                        "f_ext_pass_through",
-                                        "tau_ff_pass_through",
-                                        "out"};
+// clang-format off
+constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
+                                        "f_ext_pass_through", "tau_ff_pass_through", "out"};
+// clang-format on
 constexpr int kOut = 10;
 constexpr int kNumSolveParams = sizeof(kSolveParams) / sizeof(kSolveParams[0]);
 PyObject* g_solve_names[kNumSolveParams];
@@ -308,13 +79,7 @@ PyObject* solveEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, Py
   return guarded([&]() -> py::object {
     PyObject* a[kNumSolveParams] = {};
     bindArguments("solve", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    PySolver& s = solverOf(self);
-    auto lk = s.lock();
-    s.beginStateCall();
-    s.parse(a, s.parsed);
-    s.runParsed(s.parsed);
-    PyObject* out = (a[kOut] == nullptr || a[kOut] == Py_None) ? nullptr : a[kOut];
-    return s.result(s.parsed, out);
+    return solverOf(self).solve(a, a[kOut] == Py_None ? nullptr : a[kOut]);
   });
 }
 
@@ -326,11 +91,7 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
     const long reps = py::handle(args[0]).cast<long>();
     PyObject* a[kNumSolveParams] = {};
     bindArguments("_time_cpp", args + 1, nargs - 1, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    PySolver& s = solverOf(self);
-    auto lk = s.lock();
-    ParsedSolve p;
-    s.parse(a, p);
-    return py::float_(s.timeCpp(p, reps));
+    return py::float_(solverOf(self).timeCpp(a, reps));
   });
 }
 

@@ -1,0 +1,137 @@
+// friction= of Solver.solve and solve_batch (FrictionArg, py_solver.hpp): parsed and checked
+// against the Python names (friction.static, friction.kinetic, friction.velocity_tolerance,
+// friction.lower / upper, friction.limit_tolerance) before any computation; a vereshchagin.Friction
+// is parsed once and reused while its attributes are the same objects.
+#include <limits>
+
+#include "py_solver.hpp"
+
+namespace vsbind {
+
+namespace {
+
+// The attributes of a vereshchagin.Friction, in the order of FrictionArg::cache_attrs_ (interned).
+PyObject* attrName(int k) {
+  static const char* const text[6] = {"static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance"};
+  static PyObject* names[6] = {};
+  if (names[k] == nullptr) names[k] = PyUnicode_InternFromString(text[k]);
+  return names[k];
+}
+
+// The instance dict of a vereshchagin.Friction (a dataclass: its fields live there).
+PyObject* instanceDict(PyObject* obj) {
+  PyObject** dict = _PyObject_GetDictPtr(obj);
+  return dict == nullptr ? nullptr : *dict;
+}
+
+std::string at(const char* name, Eigen::Index j) {
+  return std::string(name) + "[" + std::to_string(j) + "]";
+}
+
+void check(const vereshchagin::FrictionModel& fm) {
+  for (Eigen::Index j = 0; j < fm.static_friction.size(); ++j) {
+    const double fs = fm.static_friction(j);
+    if (!std::isfinite(fs) || fs < 0.0)
+      raise(at("friction.static", j) + " must be finite and >= 0, got " + fmtDouble(fs));
+    if (fm.kinetic_friction.size() == 0) continue;
+    const double fk = fm.kinetic_friction(j);
+    if (!std::isfinite(fk) || fk < 0.0 || fk > fs)
+      raise(at("friction.kinetic", j) + " must be in [0, " + at("friction.static", j) + " = " + fmtDouble(fs) +
+            "] (kinetic <= static), got " + fmtDouble(fk));
+  }
+  if (!std::isfinite(fm.velocity_tolerance) || fm.velocity_tolerance < 0.0)
+    raise("friction.velocity_tolerance must be finite and >= 0, got " + fmtDouble(fm.velocity_tolerance));
+  if (fm.lower.size() == 0) return;
+  if (!std::isfinite(fm.limit_tolerance) || fm.limit_tolerance < 0.0)
+    raise("friction.limit_tolerance must be finite and >= 0, got " + fmtDouble(fm.limit_tolerance));
+  for (Eigen::Index j = 0; j < fm.lower.size(); ++j)
+    if (!(fm.lower(j) <= fm.upper(j)))
+      raise(at("friction.lower", j) + " and " + at("friction.upper", j) + " must satisfy lower <= upper, got " +
+            fmtDouble(fm.lower(j)) + " > " + fmtDouble(fm.upper(j)));
+}
+
+// friction.lower / friction.upper: (nj,), no NaN (infinite: no limit); None leaves `out` as is.
+void limitArg(PyObject* fr, const char* attr, const char* name, unsigned int nj, Eigen::VectorXd& out) {
+  const py::object obj = py::getattr(fr, attr, py::none());
+  if (obj.is_none()) return;
+  const F64View a = asF64(obj.ptr(), name);
+  if (a.ndim != 1 || a.shape[0] != static_cast<py::ssize_t>(nj))
+    raise(std::string(name) + " must have shape (" + std::to_string(nj) + ",), got " + a.shapeString());
+  for (unsigned int j = 0; j < nj; ++j) {
+    if (std::isnan(a.data[j])) raise(std::string(name) + " contains NaN");
+    out(j) = a.data[j];
+  }
+}
+
+double scalarAttr(PyObject* fr, const char* attr, const char* name, double fallback) {
+  const py::object obj = py::getattr(fr, attr, py::none());
+  return obj.is_none() ? fallback : scalarArg(obj, name);
+}
+
+}  // namespace
+
+void FrictionArg::setModelValues(const std::vector<vereshchagin::JointInfo>& joints) {
+  const auto n = static_cast<Eigen::Index>(joints.size());
+  model_values_.static_friction = model_values_.lower = model_values_.upper = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    model_values_.static_friction(k) = joints[k].friction;
+    model_values_.lower(k) = joints[k].lower;
+    model_values_.upper(k) = joints[k].upper;
+  }
+}
+
+// True while the cached Friction still holds the very attribute objects it was parsed from. Its
+// arrays are read-only views of immutable bytes (friction.py), so the same objects mean the same
+// values; an attribute replaced (object.__setattr__) makes the next solve parse it again.
+bool FrictionArg::unchanged(PyObject* obj) const {
+  PyObject* dict = instanceDict(obj);
+  if (dict == nullptr) return false;
+  for (int k = 0; k < 6; ++k)
+    if (PyDict_GetItem(dict, attrName(k)) != cache_attrs_[k].ptr()) return false;
+  return true;
+}
+
+void FrictionArg::remember(PyObject* obj) {
+  PyObject* dict = instanceDict(obj);
+  if (dict == nullptr) return;  // not cached
+  for (int k = 0; k < 6; ++k) cache_attrs_[k] = py::reinterpret_borrow<py::object>(PyDict_GetItem(dict, attrName(k)));
+  cache_key_ = py::reinterpret_borrow<py::object>(obj);
+}
+
+const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned int nj,
+                                                      vereshchagin::FrictionModel& scratch) {
+  if (obj == nullptr || obj == Py_None || PyBool_Check(obj)) return obj == Py_True ? &model_values_ : nullptr;
+  static py::object friction_type = py::module_::import("vereshchagin.friction").attr("Friction");
+  const bool cacheable = Py_TYPE(obj) == reinterpret_cast<PyTypeObject*>(friction_type.ptr());
+  if (cacheable && cache_key_.ptr() == obj && unchanged(obj)) return &cache_;
+  const py::object static_obj = py::reinterpret_steal<py::object>(PyObject_GetAttrString(obj, "static"));
+  if (!static_obj) {
+    if (!PyErr_ExceptionMatches(PyExc_AttributeError)) throw py::error_already_set();  // e.g. a property raised
+    PyErr_Clear();
+    raise("friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)");
+  }
+  vereshchagin::FrictionModel& fm = cacheable ? cache_ : scratch;
+  using MapV = Eigen::Map<const Eigen::VectorXd>;
+  fm.static_friction = MapV(vectorView(static_obj.ptr(), "friction.static", nj).data, nj);
+  const py::object kin = py::getattr(obj, "kinetic", py::none());
+  fm.kinetic_friction.resize(0);
+  if (!kin.is_none()) fm.kinetic_friction = MapV(vectorView(kin.ptr(), "friction.kinetic", nj).data, nj);
+  fm.velocity_tolerance = scalarAttr(obj, "velocity_tolerance", "friction.velocity_tolerance",
+                                     vereshchagin::FrictionModel().velocity_tolerance);
+  fm.lower.resize(0);
+  fm.upper.resize(0);
+  if (!py::getattr(obj, "lower", py::none()).is_none() || !py::getattr(obj, "upper", py::none()).is_none()) {
+    fm.lower = Eigen::VectorXd::Constant(nj, -std::numeric_limits<double>::infinity());
+    fm.upper = Eigen::VectorXd::Constant(nj, std::numeric_limits<double>::infinity());
+    limitArg(obj, "lower", "friction.lower", nj, fm.lower);
+    limitArg(obj, "upper", "friction.upper", nj, fm.upper);
+    fm.limit_tolerance =
+        scalarAttr(obj, "limit_tolerance", "friction.limit_tolerance", vereshchagin::FrictionModel().limit_tolerance);
+  }
+  if (cacheable) cache_key_ = py::object();  // invalid until checked
+  check(fm);
+  if (cacheable) remember(obj);
+  return &fm;
+}
+
+}  // namespace vsbind
