@@ -1,9 +1,9 @@
-// task.py's fast paths: _core._beta_for (beta_for's arithmetic, task.hpp, also for (N, 6) twists)
-// and _core._task_beta (Task.solve's beta from a Chain's tip twist). Both return None for inputs
-// that are not plainly valid: task.py then checks them and raises its own messages.
+// task.py's fast path: _core._beta_for (beta_for's arithmetic, task.hpp, also for (N, 6) twists).
+// It returns None for inputs that are not plainly valid: task.py then checks them and raises its
+// own messages.
 #include <optional>
 
-#include "chain_bindings.hpp"
+#include "model_class.hpp"
 #include "numpy_fast.hpp"
 #include "vereshchagin/task.hpp"
 
@@ -47,19 +47,11 @@ py::object betaFor(const py::handle& alpha, const py::handle& a_desired, const p
   return std::move(out);
 }
 
-// Task.solve's beta: the chain tip's twist at (q, qd), then betaFor.
-py::object taskBeta(const PyChain& c, const py::object& q, const py::object& qd, const py::object& alpha,
-                    const py::object& a_desired, const py::object& gravity) {
-  return betaFor(alpha, a_desired, twistOf(c, q, qd, c.resolveOptional(py::none(), "segment")), gravity);
-}
-
 }  // namespace
 
 void bindTaskHelpers(py::module_& mod) {
   mod.def("_beta_for", &betaFor, py::arg("alpha"), py::arg("a_desired"), py::arg("twist"), py::arg("gravity"),
           doc("_core._beta_for"));
-  mod.def("_task_beta", &taskBeta, py::arg("chain"), py::arg("q"), py::arg("qd"), py::arg("alpha"),
-          py::arg("a_desired"), py::arg("gravity"), doc("_core._task_beta"));
 }
 
 }  // namespace vsbind

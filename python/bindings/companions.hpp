@@ -40,6 +40,6 @@ class CompanionModel : public Addressable {
 py::array fkOf(const CompanionModel& m, const py::handle& q, const FrameTarget& target);
 py::array jacobianOf(const CompanionModel& m, const py::handle& q, const FrameTarget& target);
 py::array twistOf(const CompanionModel& m, const py::handle& q, const py::handle& qd, const FrameTarget& target);
-void bindTaskHelpers(py::module_& mod);  // _core._beta_for and _task_beta (companion_task.cpp)
+void bindTaskHelpers(py::module_& mod);  // _core._beta_for (companion_task.cpp)
 
 }  // namespace vsbind

@@ -15,12 +15,14 @@
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/friction_solver.hpp"
 
-#include "chain_bindings.hpp"
+#include "model_class.hpp"
 #include "common.hpp"
 #include "numpy_fast.hpp"
-#include "tree_bindings.hpp"
 
 namespace vsbind {
+
+// Positions in the argument array of SolveArgs::parse (solve()'s parameter order).
+inline constexpr int kOutArg = 10, kADesiredArg = 11, kNumSolveArgs = 12;
 
 // The most threads solve_batch starts (threads= beyond it is refused): each costs an OS thread and
 // an engine (a solver's workspace), and no machine gains from more.
@@ -47,6 +49,7 @@ struct BlockArg {
   vereshchagin::Vector3 point = vereshchagin::Vector3::Zero();
   KDL::Vector frame;  // the named frame's origin in the tip frame (one constraints= entry per frame)
   Rows alpha, beta;
+  Rows classical;  // a_desired (6,) instead of beta: ConstraintBlock::classical (data nullptr: beta)
 };
 
 // An f_ext dict entry: (6,) [force, moment] per row, base axes, moment about the frame's origin.
@@ -79,7 +82,7 @@ class FrictionArg {
 class SolveArgs {
  public:
   // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
-  // tau_ff_pass_through (nullptr or None: not given).
+  // tau_ff_pass_through, (out: not read), a_desired (nullptr or None: not given).
   void parse(class PySolver& s, PyObject* const* args, bool batch);
   void fillRow(py::ssize_t b, vereshchagin::SolveInput& in) const;
   const vereshchagin::FrictionModel* friction(py::ssize_t b) const {
@@ -99,7 +102,7 @@ class SolveArgs {
   Rows vector(PyObject* obj, const char* name, py::ssize_t n, bool scalar_ok = false);
   Rows weights(PyObject* obj, const char* name);
   void batchAxis(py::ssize_t n, const char* name, const std::string& shape);
-  void addBlock(int segment, PyObject* alpha, PyObject* beta, const std::string& label);
+  void addBlock(int segment, PyObject* alpha, PyObject* beta, const std::string& label, PyObject* classical = nullptr);
   void parseFExt(PyObject* obj);
   void parseConstraints(PyObject* obj);
   void parseFriction(FrictionArg& parser, PyObject* obj);
@@ -152,7 +155,7 @@ class PySolver {
   py::dict solveBatch(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
                       const py::object& f_ext, const py::object& tau_ff, const py::object& friction,
                       const py::object& constraints, const py::object& f_ext_pass_through,
-                      const py::object& tau_ff_pass_through, const py::object& threads);
+                      const py::object& tau_ff_pass_through, const py::object& threads, const py::object& a_desired);
   py::tuple responseColumns(const py::object& joints, bool hold_sticking);
 
   void setGravity(const py::object& gravity);

@@ -95,7 +95,7 @@ Rows SolveArgs::weights(PyObject* obj, const char* name) {
 }
 
 // A block of alpha and beta (label: "" for solve's alpha/beta, else "constraints[key]").
-void SolveArgs::addBlock(int segment, PyObject* alpha, PyObject* beta, const std::string& label) {
+void SolveArgs::addBlock(int segment, PyObject* alpha, PyObject* beta, const std::string& label, PyObject* classical) {
   const std::string an = label.empty() ? "" : label + " alpha", bn = label.empty() ? "" : label + " beta";
   const char *a_name = label.empty() ? "alpha" : an.c_str(), *b_name = label.empty() ? "beta" : bn.c_str();
   F64View a = asF64(alpha, a_name);
@@ -109,8 +109,16 @@ void SolveArgs::addBlock(int segment, PyObject* alpha, PyObject* beta, const std
   blk.segment = segment;
   blk.cols = static_cast<int>(m);
   blk.alpha = arg(a_name, std::move(a), 2, shape, kAlphaHint);
-  if (beta == nullptr) raise("beta is required when alpha is given (shape (" + std::to_string(m) + ",))");
-  blk.beta = vector(beta, b_name, m, /*scalar_ok=*/true);
+  if (classical != nullptr) {  // task.py's wording: Task.solve passes its a_desired here
+    F64View v = asF64(classical, "a_desired");
+    for (py::ssize_t k = 0; k < v.size(); ++k)
+      if (!std::isfinite(v.data[k])) raise("a_desired must be finite (no NaN or Inf), flat index " + std::to_string(k));
+    const py::ssize_t six = 6;
+    blk.classical = arg("a_desired", std::move(v), 1, &six);
+  } else {
+    if (beta == nullptr) raise("beta is required when alpha is given (shape (" + std::to_string(m) + ",))");
+    blk.beta = vector(beta, b_name, m, /*scalar_ok=*/true);
+  }
   columns += blk.cols;
   if (label.empty()) return;  // solve's alpha: counted when constraints= is parsed
   segment_cols_[segment] += blk.cols;
@@ -209,12 +217,15 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   if (a[0] == nullptr || a[1] == nullptr) raise("solve() needs q and qd");
   q_ = vector(a[0], "q", nj_);
   qd_ = vector(a[1], "qd", nj_);
+  PyObject* a_desired = given(a[kADesiredArg]) ? a[kADesiredArg] : nullptr;
   if (given(a[2])) {
     if (s.isTree()) raise(kTreeAlpha);
-    addBlock(static_cast<int>(ns_) - 1, a[2], given(a[3]) ? a[3] : nullptr, "");
+    if (a_desired && given(a[3]))
+      raise("beta and a_desired given: a_desired (the tip's classical acceleration) replaces beta");
+    addBlock(static_cast<int>(ns_) - 1, a[2], given(a[3]) ? a[3] : nullptr, "", a_desired);
     if (blocks.back().cols == 0) blocks.pop_back();  // no columns: nothing to constrain
-  } else if (given(a[3])) {
-    raise("beta given without alpha");
+  } else if (given(a[3]) || a_desired) {
+    raise(std::string(a_desired ? "a_desired" : "beta") + " given without alpha");
   }
   if (given(a[4])) parseFExt(a[4]);
   if (given(a[5])) tau_ = vector(a[5], "tau_ff", nj_);
@@ -259,10 +270,12 @@ void SolveArgs::fillRow(py::ssize_t b, vereshchagin::SolveInput& in) const {
     out.segment = blk.segment;
     out.columns = blk.cols;
     out.point = blk.point;
-    const double *alpha = blk.alpha.row(b), *beta = blk.beta.row(b);
+    out.classical = blk.classical.data != nullptr;
+    if (out.classical) out.classical_acceleration = Eigen::Map<const vereshchagin::Vector6>(blk.classical.row(b));
+    const double *alpha = blk.alpha.row(b), *beta = out.classical ? nullptr : blk.beta.row(b);
     for (int c = 0; c < blk.cols; ++c, ++col) {
       for (int r = 0; r < 6; ++r) out.alfa(r, c) = alpha[r * blk.cols + c];
-      out.beta(c) = beta[c];
+      out.beta(c) = beta ? beta[c] : 0.0;
       if (f_pass) out.f_ext_pass_through(c) = f_pass[col];
       if (t_pass) out.ff_pass_through(c) = t_pass[col];
     }

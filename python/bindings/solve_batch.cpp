@@ -100,12 +100,13 @@ py::dict PySolver::solveBatch(const py::object& q, const py::object& qd, const p
                               const py::object& beta, const py::object& f_ext, const py::object& tau_ff,
                               const py::object& friction_obj, const py::object& constraints,
                               const py::object& f_ext_pass_through, const py::object& tau_ff_pass_through,
-                              const py::object& threads_obj) {
+                              const py::object& threads_obj, const py::object& a_desired) {
   Lock lk(*this);
   last_state_ = false;  // until engine 0 holds the last row's state
   // clang-format off
-  PyObject* args[10] = {q.ptr(), qd.ptr(), alpha.ptr(), beta.ptr(), f_ext.ptr(), tau_ff.ptr(), friction_obj.ptr(),
-                        constraints.ptr(), f_ext_pass_through.ptr(), tau_ff_pass_through.ptr()};
+  PyObject* args[kNumSolveArgs] = {q.ptr(),           qd.ptr(),          alpha.ptr(),       beta.ptr(),
+                                   f_ext.ptr(),       tau_ff.ptr(),      friction_obj.ptr(), constraints.ptr(),
+                                   f_ext_pass_through.ptr(), tau_ff_pass_through.ptr(), nullptr, a_desired.ptr()};
   // clang-format on
   SolveArgs a;
   a.parse(*this, args, /*batch=*/true);

@@ -10,10 +10,10 @@ namespace {
 
 // clang-format off
 constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
-                                        "f_ext_pass_through", "tau_ff_pass_through", "out"};
+                                        "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired"};
 // clang-format on
-constexpr int kOut = 10;
 constexpr int kNumSolveParams = sizeof(kSolveParams) / sizeof(kSolveParams[0]);
+static_assert(kNumSolveParams == kNumSolveArgs, "solve()'s parameters are SolveArgs::parse's arguments");
 PyObject* g_solve_names[kNumSolveParams];
 PyObject* g_solver_error = nullptr;
 
@@ -79,7 +79,7 @@ PyObject* solveEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, Py
   return guarded([&]() -> py::object {
     PyObject* a[kNumSolveParams] = {};
     bindArguments("solve", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    return solverOf(self).solve(a, a[kOut] == Py_None ? nullptr : a[kOut]);
+    return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg]);
   });
 }
 
@@ -124,7 +124,7 @@ void bindSolver(py::module_& mod) {
            py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
            py::arg("friction") = py::none(), py::arg("constraints") = py::none(),
            py::arg("f_ext_pass_through") = py::none(), py::arg("tau_ff_pass_through") = py::none(),
-           py::arg("threads") = 1, doc("_core.Solver.solve_batch"))
+           py::arg("threads") = 1, py::arg("a_desired") = py::none(), doc("_core.Solver.solve_batch"))
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            doc("_core.Solver.response_columns"))
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, doc("_core.Solver.gravity"))

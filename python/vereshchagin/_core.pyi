@@ -217,6 +217,7 @@ class Solver:
         f_ext_pass_through: Optional[ArrayLike] = None,
         tau_ff_pass_through: Optional[ArrayLike] = None,
         out: Optional[SolveResult] = None,
+        a_desired: Optional[ArrayLike] = None,
     ) -> SolveResult: ...
     def _time_cpp(self, reps: int, /, *args: object, **kwargs: object) -> float: ...
     def solve_batch(
@@ -232,6 +233,7 @@ class Solver:
         f_ext_pass_through: Optional[ArrayLike] = None,
         tau_ff_pass_through: Optional[ArrayLike] = None,
         threads: int = 1,
+        a_desired: Optional[ArrayLike] = None,
     ) -> dict: ...
     def response_columns(
         self, joints: Sequence[Union[int, str]], hold_sticking: bool = True
@@ -254,7 +256,4 @@ class Solver:
 
 def _beta_for(
     alpha: ArrayLike, a_desired: ArrayLike, twist: ArrayLike, gravity: ArrayLike
-) -> Optional[NDArray[np.float64]]: ...
-def _task_beta(
-    chain: Chain, q: ArrayLike, qd: ArrayLike, alpha: ArrayLike, a_desired: ArrayLike, gravity: ArrayLike
 ) -> Optional[NDArray[np.float64]]: ...

@@ -16,7 +16,7 @@ DOCS = {}
 
 DOCS["_core"] = r"""C++ core of vereshchagin (Popov-Vereshchagin hybrid dynamics on KDL chains)."""
 
-# ---- Joint (chain_bindings.cpp) ----
+# ---- Joint (model_chain.cpp) ----
 
 DOCS["Joint"] = r"""A joint type for :meth:`Chain.add_segment`, made by the static methods.
 
@@ -32,7 +32,7 @@ DOCS["Joint.prismatic"] = r"""Translation along ``axis`` (3,), normalised, root-
 
 DOCS["Joint.fixed"] = r"""A rigid connection (no joint variable)."""
 
-# ---- Chain (chain_bindings.cpp, segment_spec_bindings.cpp) ----
+# ---- Chain (model_bindings.cpp, model_chain.cpp) ----
 
 DOCS["Chain"] = r"""A serial chain of segments (a joint followed by a rigid body), on a KDL::Chain.
 
@@ -159,7 +159,7 @@ dict
     ``rotor_inertia`` (kg m^2 or kg; 0 for a fixed joint).
 """
 
-# ---- Tree (tree_bindings.cpp, tree_dynamics.cpp) ----
+# ---- Tree (model_bindings.cpp) ----
 
 DOCS["Tree"] = r"""A kinematic tree of segments (a joint followed by a rigid body), on a KDL::Tree.
 
@@ -276,7 +276,7 @@ Chain
     into the path, the arms of a two-arm robot become independent chains.
 """
 
-# ---- Chain and Tree alike (model_properties.hpp and the segment masses) ----
+# ---- Chain and Tree alike (model_bindings.cpp) ----
 
 _SHARED = {}
 
@@ -341,7 +341,7 @@ for _model in ("Chain", "Tree"):
     for _name, _text in _SHARED.items():
         DOCS[f"{_model}.{_name}"] = _text
 
-# ---- Dynamics companions of Chain and Tree (dynamics_bindings.cpp, tree_dynamics.cpp) ----
+# ---- Dynamics companions of Chain and Tree (companions.cpp) ----
 # One text for both models; the arguments are the words in which the two differ (how the result
 # is computed, in which order rows come, what a segment argument defaults to).
 
@@ -492,7 +492,7 @@ DOCS["Tree.fk_all"] = _fk_all(", in segment order")
 
 # ---- Solver (solver_bindings.cpp): the C++ core of vereshchagin.Solver (solver.py) ----
 
-DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None)
+DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -510,7 +510,8 @@ beta : array_like, shape (m,), or float when m = 1
     Acceleration set-points ``alpha.T @ a_N``, ``a_N`` the last segment's spatial acceleration
     ``[linear; angular]`` (base axes, tip origin) **including** ``-gravity``: holding the tip
     still along z against gravity needs ``beta = 9.81``, not 0 (the helpers in
-    :mod:`vereshchagin.task` form beta for you). Required with ``alpha``.
+    :mod:`vereshchagin.task` form beta for you). Required with ``alpha``, unless ``a_desired``
+    is given instead.
 f_ext : array_like, shape (n_segments, 6), or dict, optional
     External wrenches applied **on** the segments by the environment (N, N m). Array: row i is
     ``[fx, fy, fz, mx, my, mz]`` on segment i, base-frame axes, moment about segment i's tip
@@ -539,6 +540,12 @@ f_ext_pass_through, tau_ff_pass_through : array_like, shape (m_total,), optional
 out : SolveResult, optional
     A result of an earlier solve with the same kind of arguments (same m, friction or not):
     its arrays are overwritten in place and it is returned (no allocation; for control loops).
+a_desired : array_like, shape (6,), optional
+    Instead of ``beta``: the **classical** acceleration ``[linear (m/s^2); angular (rad/s^2)]``
+    of the last segment's tip origin, base axes, that ``alpha`` constrains. The solve forms
+    ``beta = alpha.T @ [a_lin - omega x v - gravity; a_ang]`` itself, from the tip twist its own
+    sweep computes at ``(q, qd)`` (what :func:`vereshchagin.task.beta_for` does, without the
+    extra kinematics): ``a_desired = 0`` holds the tip still against gravity.
 
 Returns
 -------
@@ -559,7 +566,7 @@ The GIL is released during the solve. One solver serialises concurrent calls; us
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
 """
 
-DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1)
+DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 """
@@ -639,10 +646,9 @@ DOCS["SolveResult.__copy__"] = r"""An independent copy (its own data)."""
 
 DOCS["SolveResult.__deepcopy__"] = r"""An independent copy (its own data)."""
 
-# ---- helpers of the Python layer (companions.cpp, dynamics_bindings.cpp, result_type.cpp) ----
+# ---- helpers of the Python layer (companion_task.cpp, result_type.cpp) ----
 
 DOCS["_core._beta_for"] = r"""task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself."""
 
-DOCS["_core._task_beta"] = r"""Task.solve's beta (the tip twist and beta_for in one call); None for inputs task.py checks itself."""
 
 DOCS["_core._result_from_state"] = r"""Unpickle a SolveResult."""

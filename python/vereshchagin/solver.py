@@ -117,6 +117,7 @@ class Solver(_core.Solver):
         f_ext_pass_through=None,
         tau_ff_pass_through=None,
         threads=1,
+        a_desired=None,
     ) -> BatchResult:
         """Solve B states at once (each row exactly as :meth:`solve` would).
 
@@ -143,6 +144,8 @@ class Solver(_core.Solver):
             released (0: one per core; at most 256, and never more than B). Results do not
             depend on it. If the operating system refuses to start a thread, the started ones
             are joined and :class:`SolverError` says so.
+        a_desired : array_like, shape (B, 6) or (6,), optional
+            Instead of ``beta``: the last segment's classical acceleration (see :meth:`solve`).
 
         Returns
         -------
@@ -168,6 +171,7 @@ class Solver(_core.Solver):
                 f_ext_pass_through,
                 tau_ff_pass_through,
                 threads,
+                a_desired,
             )
         )
 

@@ -35,6 +35,7 @@ class Solver(_core.Solver):
         f_ext_pass_through: Optional[ArrayLike] = None,
         tau_ff_pass_through: Optional[ArrayLike] = None,
         threads: int = 1,
+        a_desired: Optional[ArrayLike] = None,
     ) -> BatchResult: ...
     def response_columns(  # type: ignore[override]
         self, joints: Sequence[Union[int, str]], hold_sticking: bool = True

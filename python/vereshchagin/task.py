@@ -20,7 +20,7 @@ from typing import Sequence, Union
 
 import numpy as np
 
-from ._core import Chain, SolverError, _beta_for, _task_beta
+from ._core import SolverError, _beta_for
 
 __all__ = ["Task", "beta_for", "directions", "pose_error", "twist_error"]
 
@@ -261,13 +261,12 @@ class Task:
         self.alpha = directions(names, frame)
 
     def solve(self, solver, chain, q, qd, a_desired, **kwargs):
-        """Solve with ``beta`` from :func:`beta_for` (tip twist from ``chain``, gravity from ``solver``).
+        """Solve for the tip's classical acceleration ``a_desired`` along this task's directions.
 
-        ``chain`` must be the chain the solver was built from; ``kwargs`` (``f_ext``, ``tau_ff``)
-        go to :meth:`Solver.solve`.
+        ``solver.solve(q, qd, self.alpha, a_desired=a_desired, **kwargs)``: the solve forms
+        ``beta`` (what :func:`beta_for` computes, from the tip twist at ``(q, qd)`` and the
+        solver's gravity) inside its own sweep. ``chain`` is the chain the solver was built from
+        (kept for compatibility: the solver's own model is used); ``kwargs`` (``f_ext``,
+        ``tau_ff``, ``friction`` ...) go to :meth:`Solver.solve`.
         """
-        gravity = solver.gravity
-        beta = _task_beta(chain, q, qd, self.alpha, a_desired, gravity) if type(chain) is Chain else None
-        if beta is None:  # not a Chain, or inputs beta_for must check and report
-            beta = beta_for(self.alpha, a_desired, chain.twist(q, qd), gravity)
-        return solver.solve(q, qd, self.alpha, beta, **kwargs)
+        return solver.solve(q, qd, self.alpha, a_desired=a_desired, **kwargs)

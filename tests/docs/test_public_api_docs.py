@@ -128,7 +128,18 @@ def test_solve_result_fields_say_shape_and_units(name):
 
 def test_solve_has_a_full_docstring_and_signature():
     doc = inspect.getdoc(vs.Solver.solve)
-    for section in ("Parameters", "Returns", "Raises", "alpha", "beta", "f_ext", "friction", "constraints", "out"):
+    for section in (
+        "Parameters",
+        "Returns",
+        "Raises",
+        "alpha",
+        "beta",
+        "f_ext",
+        "friction",
+        "constraints",
+        "out",
+        "a_desired",
+    ):
         assert section in doc, section
     params = list(inspect.signature(vs.Solver.solve).parameters)
     assert params == [
@@ -144,6 +155,7 @@ def test_solve_has_a_full_docstring_and_signature():
         "f_ext_pass_through",
         "tau_ff_pass_through",
         "out",
+        "a_desired",
     ]
 
 

@@ -130,6 +130,37 @@ def test_task_class_solves_for_the_classical_acceleration():
     assert_rel(task.alpha.T @ acc, task.alpha.T @ a_des, "Task.solve")
 
 
+def test_solve_a_desired_reaches_the_classical_acceleration():
+    """solve(..., a_desired=) against Pinocchio's classical tip acceleration, with friction and
+    f_ext, in solve_batch row by row, and its argument errors."""
+    r = Robot("gen3")
+    rng = np.random.default_rng(24)
+    alpha = np.c_[np.eye(6)[:, :3], [0, 0, 0, 0.6, 0.0, 0.8]]
+    rows = []
+    for k in range(6):
+        q, qd = r.random_state(rng)
+        a_des = rng.normal(size=6)
+        kw = dict(tau_ff=rng.normal(size=7), f_ext={r.solver.n_segments - 2: rng.normal(size=6)})
+        if k % 2:
+            kw["friction"] = vs.Friction(static=np.full(7, 0.5))
+        res = r.solver.solve(q, qd, alpha, a_desired=a_des, **kw)
+        acc, _ = r.classical(q, qd, res.qdd)
+        assert_rel(alpha.T @ acc, alpha.T @ a_des, "solve(a_desired=)")
+        rows.append((q, qd, a_des, res.qdd))
+    q, qd, a, qdd = (np.array(x) for x in zip(*rows))
+    batch = r.solver.solve_batch(q, qd, alpha, a_desired=a)
+    for b in range(len(rows)):
+        np.testing.assert_array_equal(batch.qdd[b], r.solver.solve(q[b], qd[b], alpha, a_desired=a[b]).qdd)
+    with pytest.raises(vs.SolverError, match="a_desired .*replaces beta"):
+        r.solver.solve(q[0], qd[0], alpha, np.zeros(4), a_desired=a[0])
+    with pytest.raises(vs.SolverError, match="a_desired given without alpha"):
+        r.solver.solve(q[0], qd[0], a_desired=a[0])
+    with pytest.raises(vs.SolverError, match=r"a_desired must have shape \(6,\)"):
+        r.solver.solve(q[0], qd[0], alpha, a_desired=a[0, :3])
+    with pytest.raises(vs.SolverError, match="a_desired must be finite"):
+        r.solver.solve(q[0], qd[0], alpha, a_desired=np.r_[a[0, :5], np.inf])
+
+
 def test_beta_for_by_hand():
     # tip at velocity v = (0, 1, 0) turning with omega = (0, 0, 2): omega x v = (-2, 0, 0)
     twist = np.array([0.0, 1.0, 0.0, 0.0, 0.0, 2.0])

@@ -1,4 +1,0 @@
-// The Python Chain (PyChain, model_class.hpp) for the files that use it; bound in model_bindings.cpp.
-#pragma once
-
-#include "model_class.hpp"
