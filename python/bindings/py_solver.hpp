@@ -15,8 +15,8 @@
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/friction_solver.hpp"
 
-#include "model_class.hpp"
 #include "common.hpp"
+#include "model_class.hpp"
 #include "numpy_fast.hpp"
 
 namespace vsbind {
@@ -152,6 +152,9 @@ class PySolver {
   // solve(): parses, solves on engine 0 and returns a SolveResult (new, or `out`).
   py::object solve(PyObject* const* args, PyObject* out);
   double timeCpp(PyObject* const* args, long reps);
+  // Benchmarks only (BENCHMARKS.md, "Call mechanism"): solve() returning a dict of new numpy
+  // arrays, as a result made of plain arrays would (no friction).
+  py::dict solveDict(PyObject* const* args);
   py::dict solveBatch(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
                       const py::object& f_ext, const py::object& tau_ff, const py::object& friction,
                       const py::object& constraints, const py::object& f_ext_pass_through,

@@ -78,6 +78,35 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out) {
   return r;
 }
 
+py::dict PySolver::solveDict(PyObject* const* args) {
+  Lock lk(*this);
+  last_state_ = false;
+  args_.parse(*this, args, /*batch=*/false);
+  if (args_.any_friction) raise("_solve_dict benchmarks the frictionless call: no friction");
+  const char* failure;
+  {
+    py::gil_scoped_release release;
+    failure = runRow(args_, 0, 0);
+  }
+  if (failure) raise(failure);
+  last_state_ = true;
+  py::array qdd = newDoubles({nj}), tau = newDoubles({nj}), nu = newDoubles({args_.columns}),
+            acc = newDoubles({ns + 1, 6});
+  int rank;
+  double smin;
+  writeRow(args_, 0, 0,
+           RowOut{doubles(qdd), doubles(tau), doubles(nu), doubles(acc), &smin, nullptr, nullptr, nullptr, &rank,
+                  nullptr, nullptr});
+  py::dict d;
+  d["qdd"] = qdd;
+  d["tau_command"] = tau;
+  d["nu"] = nu;
+  d["link_acc"] = acc;
+  d["constraint_rank"] = rank;
+  d["smallest_singular_value"] = smin;
+  return d;
+}
+
 // Seconds per C++ solve of the parsed row, reading every output solve() returns.
 double PySolver::timeCpp(PyObject* const* args, long reps) {
   Lock lk(*this);

@@ -95,9 +95,20 @@ PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, 
   });
 }
 
+// _solve_dict(q, qd, ...): solve() with the same fast call, returning a dict of new arrays.
+PyObject* solveDictEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
+  return guarded([&]() -> py::object {
+    PyObject* a[kNumSolveParams] = {};
+    bindArguments("_solve_dict", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
+    return solverOf(self).solveDict(a);
+  });
+}
+
 PyMethodDef g_solve_def = {"solve", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(solveEntry)),
                            METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
 PyMethodDef g_time_def = {"_time_cpp", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(timeCppEntry)),
+                          METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
+PyMethodDef g_dict_def = {"_solve_dict", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(solveDictEntry)),
                           METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
 
 void addFastMethod(py::handle cls, PyMethodDef* def) {
@@ -106,12 +117,24 @@ void addFastMethod(py::handle cls, PyMethodDef* def) {
   Py_DECREF(descr);
 }
 
+// _solve_pybind: solve() bound the plain pybind11 way (named arguments with defaults), for the
+// benchmark of the fast call's gain.
+py::object solvePybind(PySolver& s, py::object q, py::object qd, py::object alpha, py::object beta, py::object f_ext,
+                       py::object tau_ff, py::object friction, py::object constraints, py::object f_pass,
+                       py::object t_pass, py::object out, py::object a_desired) {
+  PyObject* a[kNumSolveParams] = {q.ptr(),      qd.ptr(),     alpha.ptr(),    beta.ptr(),
+                                  f_ext.ptr(),  tau_ff.ptr(), friction.ptr(), constraints.ptr(),
+                                  f_pass.ptr(), t_pass.ptr(), out.ptr(),      a_desired.ptr()};
+  return s.solve(a, out.is_none() ? nullptr : out.ptr());
+}
+
 }  // namespace
 
 void bindSolver(py::module_& mod) {
   g_solver_error = mod.attr("SolverError").ptr();
   g_solve_def.ml_doc = doc("_core.Solver.solve");
   g_time_def.ml_doc = doc("_core.Solver._time_cpp");
+  g_dict_def.ml_doc = doc("_core.Solver._solve_dict");
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
   py::class_<PySolver> cls(mod, "Solver", doc("_core.Solver"));
@@ -158,6 +181,12 @@ void bindSolver(py::module_& mod) {
                       }));
   addFastMethod(cls, &g_solve_def);
   addFastMethod(cls, &g_time_def);
+  addFastMethod(cls, &g_dict_def);
+  const py::object none = py::none();
+  cls.def("_solve_pybind", &solvePybind, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,
+          py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
+          py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, py::arg("out") = none,
+          py::arg("a_desired") = none, doc("_core.Solver._solve_pybind"));
 }
 
 }  // namespace vsbind
