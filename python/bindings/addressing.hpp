@@ -10,7 +10,7 @@
 #include <kdl/frames.hpp>
 
 #include "vereshchagin/model.hpp"        // FrameRef
-#include "vereshchagin/robot_chain.hpp"  // JointInfo, LinkPlacement
+#include "vereshchagin/robot_chain.hpp"  // JointInfo
 
 #include "common.hpp"
 
@@ -23,42 +23,29 @@ struct FrameTarget {
   bool merged = false;  // a merged link away from the tip: moments must be moved
 };
 
-// The names of a model (segments, links, joints, base) and the rule that resolves them.
+// The names of a model (as the derived type stores them) and the rule that resolves them.
 class Addressable {
  public:
-  using Target = FrameTarget;
   virtual ~Addressable() = default;
-
-  // The model's names, as the derived type stores them.
   virtual int segmentCount() const = 0;
   virtual const std::string& segmentName(int index) const = 0;
-  virtual const std::vector<vereshchagin::LinkPlacement>& linkPlacements() const = 0;
   virtual const std::vector<vereshchagin::JointInfo>& jointInfos() const = 0;
   virtual const std::string& rootLink() const = 0;
 
   std::vector<std::string> segmentNames() const;
-  std::vector<std::string> jointNames() const;
   // Any frame: segment, merged link, base link (segment -1) or index.
-  Target resolveTarget(PyObject* which, const std::string& label) const;
+  FrameTarget resolveTarget(PyObject* which, const std::string& label) const;
   // The same for calls that need a moving segment: the base raises.
-  Target resolveMoving(PyObject* which, const std::string& label) const;
+  FrameTarget resolveMoving(PyObject* which, const std::string& label) const;
   // resolveTarget, with None meaning the last segment (the default of Chain.fk, jacobian, ...).
-  Target resolveOptional(const py::object& which, const std::string& label) const;
+  FrameTarget resolveOptional(const py::object& which, const std::string& label) const;
   // Joint index from a joint name or an int index (negative from the end).
   int resolveJoint(PyObject* which, const std::string& label) const;
 
  protected:
-  // A frame by name (segment, merged link or base) and a joint index by name (-1: none), by the
-  // C++ library's lookups (robot_access.hpp).
+  // The C++ library's lookups (robot_access.hpp): a frame by name, a joint index by name (-1: none).
   virtual bool frameByName(const std::string& name, vereshchagin::FrameRef& out) const = 0;
   virtual int jointByName(const std::string& name) const = 0;
-
-  Addressable() = default;
-  Addressable(const Addressable&) = default;
-  Addressable& operator=(const Addressable&) = default;
 };
-
-// Up to 12 names, quoted, then "... (N in all)".
-std::string nameList(const std::vector<std::string>& names);
 
 }  // namespace vsbind

@@ -14,7 +14,6 @@
 namespace vsbind {
 
 namespace vs = vereshchagin;
-using O = const py::object&;
 using Vec = Eigen::Map<Eigen::VectorXd>;
 
 CompanionCache::CompanionCache(const vs::Model& m)
@@ -107,15 +106,23 @@ Eigen::Index wrenchColumns(const CompanionModel& m, CompanionCache& c, O f_ext, 
   return ns;
 }
 
+// n joint torques written by `f` (a vereshchagin call on c's workspace), checked for overflow.
+template <class F>
+py::array torques(const CompanionCache& c, const char* what, F f) {
+  py::array out = newDoubles({c.n});
+  check(f(Vec(doubles(out), c.n)));
+  return finite(out, what);
+}
+
 py::array inverseDynamics(const CompanionModel& m, O q_obj, O qd_obj, O qdd_obj, O f_ext, O gravity) {
   CompanionCache& c = m.companions();
   const JointRows q(q_obj, "q", c.n), qd(qd_obj, "qd", c.n), qdd(qdd_obj, "qdd", c.n);
   const KDL::Vector g = gravityArg(gravity);
   const Eigen::Index cols = wrenchColumns(m, c, f_ext, q);
-  py::array out = newDoubles({c.n});
-  check(vs::inverseDynamics(c.model, c.dyn, q.pos(), qd.vel(), vs::JointAccelerations(qdd[0]), c.f_ext.leftCols(cols),
-                            g, Vec(doubles(out), c.n)));
-  return finite(out, "inverse_dynamics");
+  return torques(c, "inverse_dynamics", [&](Vec out) {
+    return vs::inverseDynamics(c.model, c.dyn, q.pos(), qd.vel(), vs::JointAccelerations(qdd[0]),
+                               c.f_ext.leftCols(cols), g, out);
+  });
 }
 
 py::array massMatrix(const CompanionModel& m, O q_obj) {
@@ -130,17 +137,14 @@ py::array gravityTorques(const CompanionModel& m, O q_obj, O gravity) {
   CompanionCache& c = m.companions();
   const JointRows q(q_obj, "q", c.n);
   const KDL::Vector g = gravityArg(gravity);
-  py::array out = newDoubles({c.n});
-  check(vs::gravityTorques(c.model, c.dyn, q.pos(), g, Vec(doubles(out), c.n)));
-  return finite(out, "gravity_torques");
+  return torques(c, "gravity_torques", [&](Vec out) { return vs::gravityTorques(c.model, c.dyn, q.pos(), g, out); });
 }
 
 py::array coriolisTorques(const CompanionModel& m, O q_obj, O qd_obj) {
   CompanionCache& c = m.companions();
   const JointRows q(q_obj, "q", c.n), qd(qd_obj, "qd", c.n);
-  py::array out = newDoubles({c.n});
-  check(vs::coriolisTorques(c.model, c.dyn, q.pos(), qd.vel(), Vec(doubles(out), c.n)));
-  return finite(out, "coriolis_torques");
+  return torques(c, "coriolis_torques",
+                 [&](Vec out) { return vs::coriolisTorques(c.model, c.dyn, q.pos(), qd.vel(), out); });
 }
 
 py::array fkAll(const CompanionModel& m, O q_obj) {
@@ -168,30 +172,6 @@ py::array jacobianDotTimesQd(const CompanionModel& m, O q_obj, O qd_obj, const F
   Vec(doubles(out), 6) = a;
   return finite(out, "jacobian_dot_times_qd");
 }
-
-// A companion as a method of M (pybind11 binds M's methods, not CompanionModel's).
-template <typename M, typename... A>
-auto on(py::array (*body)(const CompanionModel&, A...)) {
-  return [body](const M& m, A... a) { return body(m, a...); };
-}
-
-// Binds the companions on Chain or Tree (M): `segment` is the spec of jacobian_dot_times_qd's frame
-// argument, `frame` resolves it.
-template <typename M, typename SegmentArg, typename Frame>
-void bindCompanions(py::class_<M>& cls, const std::string& name, const SegmentArg& segment, Frame frame) {
-  const std::vector<double> earth{0.0, 0.0, -9.81};  // physical gravity, base z up, m/s^2
-  const auto key = [&name](const char* method) { return doc(name + "." + method); };
-  const auto jdot = [frame](const M& m, O q, O qd, O s) { return jacobianDotTimesQd(m, q, qd, frame(m, s)); };
-  cls.def("inverse_dynamics", on<M>(inverseDynamics), py::arg("q"), py::arg("qd"), py::arg("qdd"),
-          py::arg("f_ext") = py::none(), py::arg("gravity") = earth, key("inverse_dynamics"))
-      .def("mass_matrix", on<M>(massMatrix), py::arg("q"), key("mass_matrix"))
-      .def("gravity_torques", on<M>(gravityTorques), py::arg("q"), py::arg("gravity") = earth, key("gravity_torques"))
-      .def("coriolis_torques", on<M>(coriolisTorques), py::arg("q"), py::arg("qd"), key("coriolis_torques"))
-      .def("jacobian_dot_times_qd", jdot, py::arg("q"), py::arg("qd"), segment, key("jacobian_dot_times_qd"))
-      .def("fk_all", on<M>(fkAll), py::arg("q"), key("fk_all"));
-}
-
-}  // namespace
 
 py::array fkOf(const CompanionModel& m, const py::handle& q_obj, const FrameTarget& target) {
   CompanionCache& c = m.companions();
@@ -232,6 +212,36 @@ py::array twistOf(const CompanionModel& m, const py::handle& q_obj, const py::ha
   }
   return finite(out, "twist");
 }
+
+// A companion as a method of M (pybind11 binds M's methods, not CompanionModel's).
+template <typename M, typename... A>
+auto on(py::array (*body)(const CompanionModel&, A...)) {
+  return [body](const M& m, A... a) { return body(m, a...); };
+}
+
+// Binds the companions on Chain or Tree (M): `segment` is the spec of the frame argument of fk,
+// jacobian, twist and jacobian_dot_times_qd, `frame` resolves it.
+template <typename M, typename SegmentArg, typename Frame>
+void bindCompanions(py::class_<M>& cls, const std::string& name, const SegmentArg& segment, Frame frame) {
+  const std::vector<double> earth{0.0, 0.0, -9.81};  // physical gravity, base z up, m/s^2
+  const auto key = [&name](const char* method) { return doc(name + "." + method); };
+  const auto fk = [frame](const M& m, O q, O s) { return fkOf(m, q, frame(m, s)); };
+  const auto jacobian = [frame](const M& m, O q, O s) { return jacobianOf(m, q, frame(m, s)); };
+  const auto twist = [frame](const M& m, O q, O qd, O s) { return twistOf(m, q, qd, frame(m, s)); };
+  const auto jdot = [frame](const M& m, O q, O qd, O s) { return jacobianDotTimesQd(m, q, qd, frame(m, s)); };
+  cls.def("fk", fk, py::arg("q"), segment, key("fk"))
+      .def("jacobian", jacobian, py::arg("q"), segment, key("jacobian"))
+      .def("twist", twist, py::arg("q"), py::arg("qd"), segment, key("twist"))
+      .def("inverse_dynamics", on<M>(inverseDynamics), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+           py::arg("f_ext") = py::none(), py::arg("gravity") = earth, key("inverse_dynamics"))
+      .def("mass_matrix", on<M>(massMatrix), py::arg("q"), key("mass_matrix"))
+      .def("gravity_torques", on<M>(gravityTorques), py::arg("q"), py::arg("gravity") = earth, key("gravity_torques"))
+      .def("coriolis_torques", on<M>(coriolisTorques), py::arg("q"), py::arg("qd"), key("coriolis_torques"))
+      .def("jacobian_dot_times_qd", jdot, py::arg("q"), py::arg("qd"), segment, key("jacobian_dot_times_qd"))
+      .def("fk_all", on<M>(fkAll), py::arg("q"), key("fk_all"));
+}
+
+}  // namespace
 
 void bindDynamics(py::module_& mod) {
   bindTaskHelpers(mod);

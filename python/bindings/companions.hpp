@@ -36,10 +36,6 @@ class CompanionModel : public Addressable {
   mutable std::shared_ptr<CompanionCache> cache_;
 };
 
-// fk, jacobian and twist at a resolved frame (companions.cpp); fk and twist also of (N, n) rows.
-py::array fkOf(const CompanionModel& m, const py::handle& q, const FrameTarget& target);
-py::array jacobianOf(const CompanionModel& m, const py::handle& q, const FrameTarget& target);
-py::array twistOf(const CompanionModel& m, const py::handle& q, const py::handle& qd, const FrameTarget& target);
 void bindTaskHelpers(py::module_& mod);  // _core._beta_for (companion_task.cpp)
 
 }  // namespace vsbind

@@ -24,14 +24,14 @@ std::string jointRepr(const JointSpec& j) {
   return s.str();
 }
 
-JointSpec axisJointArg(KDL::Joint::JointType type, const py::object& axis, const py::object& origin) {
+JointSpec axisJointArg(KDL::Joint::JointType type, O axis, O origin) {
   JointSpec j;
   const KDL::Vector o = origin.is_none() ? KDL::Vector::Zero() : vec3(origin, "origin");
   if (const vereshchagin::Status s = vereshchagin::axisJoint(type, vec3(axis, "axis"), o, j); !s) raise(s.message());
   return j;
 }
 
-JointSpec jointArg(const py::object& joint) {
+JointSpec jointArg(O joint) {
   JointSpec j;
   if (py::isinstance<JointSpec>(joint)) return joint.cast<JointSpec>();
   if (!py::isinstance<py::str>(joint))
@@ -43,7 +43,7 @@ JointSpec jointArg(const py::object& joint) {
   return j;
 }
 
-Eigen::Matrix3d inertiaArg(const py::object& inertia, const std::string& name) {
+Eigen::Matrix3d inertiaArg(O inertia, const std::string& name) {
   Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
   if (inertia.is_none()) return I;
   const Array a = toArray(inertia, name.c_str());
@@ -55,8 +55,7 @@ Eigen::Matrix3d inertiaArg(const py::object& inertia, const std::string& name) {
   return I;
 }
 
-void addSegment(PyChain& c, const std::string& name, const py::object& joint, const py::object& tip,
-                const py::object& mass, const py::object& com, const py::object& inertia, const py::object& rotor,
+void addSegment(PyChain& c, const std::string& name, O joint, O tip, O mass, O com, O inertia, O rotor,
                 const std::string& joint_name, const std::string& inertia_check) {
   const std::string where = "segment '" + name + "': ";  // every message names segment and argument
   const vereshchagin::InertiaCheck check = inertiaCheckArg(inertia_check, where);
@@ -75,39 +74,27 @@ void addSegment(PyChain& c, const std::string& name, const py::object& joint, co
   if (check == vereshchagin::InertiaCheck::JointSpace) c.inertia_check = check;
 }
 
-py::dict segmentSpec(const PyChain& c, const py::object& which) {
+py::dict segmentSpec(const PyChain& c, O which) {
   const int segment = c.resolveMoving(which.ptr(), "segment").segment;
   const vereshchagin::SegmentSpec s = vereshchagin::segmentSpec(vereshchagin::segmentAt(c.robot, segment));
-  py::dict d;
-  d["name"] = s.name;
-  d["joint_type"] = vereshchagin::jointTypeName(s.joint.type);
-  d["axis"] = s.joint.type == KDL::Joint::Fixed ? py::object(py::none()) : py::object(copyVector(s.joint.axis.data, 3));
-  d["origin"] = copyVector(s.joint.origin.data, 3);
-  d["joint_name"] = s.joint_name;
-  d["tip"] = homogeneous(s.tip);
-  d["mass"] = s.mass;
-  d["com"] = copyVector(s.com.data, 3);
-  d["inertia"] = py::cast(Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(s.inertia));
-  d["rotor_inertia"] = s.rotor_inertia;
-  return d;
+  const auto vec = [](const double* v) { return copyVector(v, 3); };
+  return py::dict(
+      py::arg("name") = s.name, py::arg("joint_type") = vereshchagin::jointTypeName(s.joint.type),
+      py::arg("axis") = s.joint.type == KDL::Joint::Fixed ? py::object(py::none()) : py::object(vec(s.joint.axis.data)),
+      py::arg("origin") = vec(s.joint.origin.data), py::arg("joint_name") = s.joint_name,
+      py::arg("tip") = homogeneous(s.tip), py::arg("mass") = s.mass, py::arg("com") = vec(s.com.data),
+      py::arg("inertia") = py::cast(Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(s.inertia)),
+      py::arg("rotor_inertia") = s.rotor_inertia);
 }
 
 void bindJoint(py::module_& mod) {
-  py::class_<JointSpec>(mod, "Joint", doc("Joint"))
-      .def_static(
-          "revolute",
-          [](const py::object& axis, const py::object& origin) {
-            return axisJointArg(KDL::Joint::RotAxis, axis, origin);
-          },
-          py::arg("axis"), py::arg("origin") = py::none(), doc("Joint.revolute"))
-      .def_static(
-          "prismatic",
-          [](const py::object& axis, const py::object& origin) {
-            return axisJointArg(KDL::Joint::TransAxis, axis, origin);
-          },
-          py::arg("axis"), py::arg("origin") = py::none(), doc("Joint.prismatic"))
-      .def_static(
-          "fixed", []() { return JointSpec(); }, doc("Joint.fixed"))
+  py::class_<JointSpec> cls(mod, "Joint", doc("Joint"));
+  for (const auto& [name, type] : {std::pair{"revolute", KDL::Joint::RotAxis}, {"prismatic", KDL::Joint::TransAxis}})
+    cls.def_static(
+        name, [type = type](O axis, O origin) { return axisJointArg(type, axis, origin); }, py::arg("axis"),
+        py::arg("origin") = py::none(), doc(std::string("Joint.") + name));
+  cls.def_static(
+         "fixed", [] { return JointSpec(); }, doc("Joint.fixed"))
       .def("__repr__", &jointRepr);
 }
 

@@ -18,6 +18,8 @@
 
 namespace vsbind {
 
+using O = const py::object&;  // a Python argument
+
 template <class Robot>
 struct PyModel : CompanionModel {
   Robot robot;
@@ -28,22 +30,8 @@ struct PyModel : CompanionModel {
 
   int segmentCount() const override { return vereshchagin::segmentCount(robot); }
   const std::string& segmentName(int index) const override { return vereshchagin::segmentName(robot, index); }
-  const std::vector<vereshchagin::LinkPlacement>& linkPlacements() const override { return robot.links; }
   const std::vector<vereshchagin::JointInfo>& jointInfos() const override { return robot.joints; }
   const std::string& rootLink() const override { return robot.root_link; }
-
-  // Rotor inertia of each joint in q order; the setter (shape (n_joints,), >= 0) rebuilds the robot.
-  py::array_t<double> rotorInertia() const {
-    const std::vector<double> values = vereshchagin::rotorInertia(robot);
-    return copyVector(values.data(), static_cast<py::ssize_t>(values.size()));
-  }
-  void setRotorInertia(const py::object& values) {
-    const Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(robot.joints.size()));
-    std::string message;
-    if (!vereshchagin::setRotorInertia(robot, std::vector<double>(a.data(), a.data() + a.size()), message))
-      raise(message);
-    invalidateCompanions();
-  }
 
  protected:
   bool frameByName(const std::string& name, vereshchagin::FrameRef& out) const override {
@@ -63,10 +51,8 @@ struct PyModel : CompanionModel {
 using PyChain = PyModel<vereshchagin::RobotChain>;
 using PyTree = PyModel<vereshchagin::RobotTree>;
 
-// The Python classes (model_bindings.cpp): bindModel binds what Chain and Tree share.
+// Binds what Chain and Tree share (model_bindings.cpp); module.cpp declares bindChain and bindTree.
 template <class M>
 py::class_<M> bindModel(py::module_& mod, const char* name);
-void bindChain(py::module_& mod);  // model_chain.cpp: Joint and Chain
-void bindTree(py::module_& mod);
 
 }  // namespace vsbind

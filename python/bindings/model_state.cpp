@@ -18,12 +18,30 @@ namespace {
 
 constexpr long long kLo = std::numeric_limits<long long>::min(), kHi = std::numeric_limits<long long>::max();
 
-// A state record: a tuple of exactly n entries.
-py::tuple record(const py::handle& obj, std::size_t n, const std::string& what) {
-  if (!py::isinstance<py::tuple>(obj) || py::len(obj) != n)
-    raise(what + " must be a tuple of " + std::to_string(n) + " entries");
-  return py::reinterpret_borrow<py::tuple>(obj);
-}
+// A state record: a tuple of exactly n entries, read in order as the types asked for.
+class Entries {
+ public:
+  Entries(const py::handle& obj, std::size_t n, std::string what) : what_(std::move(what)) {
+    if (!py::isinstance<py::tuple>(obj) || py::len(obj) != n)
+      raise(what_ + " must be a tuple of " + std::to_string(n) + " entries");
+    t_ = py::reinterpret_borrow<py::tuple>(obj);
+  }
+  std::string str() { return t_[k_++].cast<std::string>(); }
+  double num() { return t_[k_++].cast<double>(); }
+  long long integer(const char* entry) { return stateInt(t_[k_++], kLo, kHi, what_ + entry); }
+  template <std::size_t N>
+  std::array<double, N> doubles(const char* entry) {
+    Entries e(t_[k_++], N, what_ + entry);
+    std::array<double, N> out{};
+    for (double& x : out) x = e.num();
+    return out;
+  }
+
+ private:
+  std::string what_;
+  py::tuple t_;
+  std::size_t k_ = 0;
+};
 
 py::list stateList(const py::handle& obj, const std::string& what) {
   if (!py::isinstance<py::list>(obj)) raise(what + " must be a list");
@@ -37,39 +55,9 @@ py::tuple toTuple(const std::array<double, N>& a) {
   return t;
 }
 
-template <std::size_t N>
-std::array<double, N> doubles(const py::handle& obj, const std::string& what) {
-  const py::tuple t = record(obj, N, what);
-  std::array<double, N> out{};
-  for (std::size_t k = 0; k < N; ++k) out[k] = t[k].cast<double>();
-  return out;
-}
-
 py::tuple segmentState(const vereshchagin::SegmentRecord& s) {
   return py::make_tuple(s.name, s.joint_name, s.joint_type, toTuple(s.origin), toTuple(s.axis), s.rotor_inertia,
                         s.damping, s.stiffness, toTuple(s.tip), toTuple(s.inertia));
-}
-
-vereshchagin::SegmentRecord segmentFrom(const py::handle& obj, const std::string& what) {
-  const py::tuple t = record(obj, 10, what);
-  return {t[0].cast<std::string>(),
-          t[1].cast<std::string>(),
-          stateInt(t[2], kLo, kHi, what + " joint type"),
-          doubles<3>(t[3], what + " joint origin"),
-          doubles<3>(t[4], what + " joint axis"),
-          t[5].cast<double>(),
-          t[6].cast<double>(),
-          t[7].cast<double>(),
-          doubles<12>(t[8], what + " tip frame"),
-          doubles<13>(t[9], what + " inertia")};
-}
-
-vereshchagin::JointRecord jointFrom(const py::handle& obj, const std::string& what) {
-  const py::tuple t = record(obj, 9, what);
-  vereshchagin::JointInfo j{t[0].cast<std::string>(), t[1].cast<std::string>(), t[2].cast<double>(),
-                            t[3].cast<double>(),      t[4].cast<double>(),      t[5].cast<double>(),
-                            t[6].cast<double>(),      t[7].cast<double>()};
-  return {j, stateInt(t[8], kLo, kHi, what + " segment")};
 }
 
 // The records of a state tuple (model_state.hpp gives both layouts).
@@ -80,16 +68,20 @@ vereshchagin::RobotRecord recordFrom(const py::tuple& state, bool tree, const st
     const std::string which = what + ": segment " + std::to_string(r.segments.size());
     if (tree && (!py::isinstance<py::tuple>(item) || py::len(item) != 2))
       raise(which + " must be a pair (segment, parent)");
-    r.segments.push_back(
-        segmentFrom(tree ? py::object(item[py::int_(0)]) : py::reinterpret_borrow<py::object>(item), which));
+    Entries e(tree ? py::object(item[py::int_(0)]) : py::reinterpret_borrow<py::object>(item), 10, which);
+    r.segments.push_back({e.str(), e.str(), e.integer(" joint type"), e.doubles<3>(" joint origin"),
+                          e.doubles<3>(" joint axis"), e.num(), e.num(), e.num(), e.doubles<12>(" tip frame"),
+                          e.doubles<13>(" inertia")});  // braced lists evaluate left to right
     if (tree) r.segments.back().parent = stateInt(py::object(item[py::int_(1)]), kLo, kHi, which + ": parent index");
   }
-  for (const auto& item : stateList(state[tree ? 3 : 2], what + ": joints"))
-    r.joints.push_back(jointFrom(item, what + ": joint record"));
+  for (const auto& item : stateList(state[tree ? 3 : 2], what + ": joints")) {
+    Entries e(item, 9, what + ": joint record");
+    r.joints.push_back(
+        {{e.str(), e.str(), e.num(), e.num(), e.num(), e.num(), e.num(), e.num()}, e.integer(" segment")});
+  }
   for (const auto& item : stateList(state[tree ? 4 : 3], what + ": links")) {
-    const py::tuple t = record(item, 3, what + ": link record");
-    r.links.push_back({t[0].cast<std::string>(), stateInt(t[1], kLo, kHi, what + ": link record segment"),
-                       doubles<12>(t[2], what + ": link record frame")});
+    Entries e(item, 3, what + ": link record");
+    r.links.push_back({e.str(), e.integer(" segment"), e.doubles<12>(" frame")});
   }
   r.notes = state[5].cast<std::vector<std::string>>();
   return r;
