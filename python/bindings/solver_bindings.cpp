@@ -151,28 +151,22 @@ void bindSolver(py::module_& mod) {
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            doc("_core.Solver.response_columns"))
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, doc("_core.Solver.gravity"))
-      .def_property_readonly(
-          "n_joints", [](const PySolver& s) { return s.nj; }, doc("_core.Solver.n_joints"))
-      .def_property_readonly(
-          "n_segments", [](const PySolver& s) { return s.ns; }, doc("_core.Solver.n_segments"))
-      .def_property_readonly(
-          "model", [](const PySolver& s) { return s.model(); }, doc("_core.Solver.model"))
-      .def_property_readonly(
-          "chain",
-          [](const PySolver& s) {
-            if (s.isTree()) raise("this Solver is for a Tree: use solver.tree (or solver.model)");
-            return s.model();
-          },
-          doc("_core.Solver.chain"))
-      .def_property_readonly(
-          "tree",
-          [](const PySolver& s) {
-            if (!s.isTree()) raise("this Solver is for a Chain: use solver.chain (or solver.model)");
-            return s.model();
-          },
-          doc("_core.Solver.tree"))
-      .def_property_readonly(
-          "inertia_check", [](const PySolver& s) { return s.inertiaCheck(); }, doc("_core.Solver.inertia_check"))
+      .def_readonly("n_joints", &PySolver::nj, doc("_core.Solver.n_joints"))
+      .def_readonly("n_segments", &PySolver::ns, doc("_core.Solver.n_segments"))
+      .def_property_readonly("model", &PySolver::model, doc("_core.Solver.model"));
+  for (const bool tree : {false, true}) {  // solver.chain, solver.tree: the model if it is one
+    const std::string name = tree ? "tree" : "chain";
+    cls.def_property_readonly(
+        name.c_str(),
+        [tree](const PySolver& s) {
+          if (s.isTree() != tree)
+            raise(std::string("this Solver is for a ") + (tree ? "Chain: use solver.chain" : "Tree: use solver.tree") +
+                  " (or solver.model)");
+          return s.model();
+        },
+        doc("_core.Solver." + name));
+  }
+  cls.def_property_readonly("inertia_check", &PySolver::inertiaCheck, doc("_core.Solver.inertia_check"))
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
                         if (t.size() != 5 && t.size() != 6) raise("Solver state must have 5 or 6 entries");
