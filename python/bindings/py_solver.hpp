@@ -172,7 +172,10 @@ class PySolver {
   class Lock {
    public:
     explicit Lock(PySolver& s);
-    ~Lock();
+    ~Lock() {
+      s_.holder_.store(std::thread::id());
+      s_.mutex_.unlock();
+    }
     Lock(const Lock&) = delete;
 
    private:

@@ -77,11 +77,6 @@ PySolver::Lock::Lock(PySolver& s) : s_(s) {
   s.holder_.store(std::this_thread::get_id());
 }
 
-PySolver::Lock::~Lock() {
-  s_.holder_.store(std::thread::id());
-  s_.mutex_.unlock();
-}
-
 Engine& PySolver::engine(std::size_t k) {
   while (engines_.size() <= k) engines_.push_back(std::make_unique<Engine>(cpp_model_, gravity_, options_));
   return *engines_[k];
