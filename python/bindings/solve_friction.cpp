@@ -50,11 +50,6 @@ void check(const vereshchagin::FrictionModel& fm) {
             fmtDouble(fm.lower(j)) + " > " + fmtDouble(fm.upper(j)));
 }
 
-// friction.<attr>, None when it has none.
-py::object attrOrNone(PyObject* fr, const char* attr) {
-  return py::getattr(fr, attr, py::none());
-}
-
 // friction.lower / friction.upper: (nj,), no NaN (infinite: no limit); None leaves `out` as is.
 void limitArg(const py::object& obj, const char* name, unsigned int nj, Eigen::VectorXd& out) {
   if (obj.is_none()) return;
@@ -68,7 +63,7 @@ void limitArg(const py::object& obj, const char* name, unsigned int nj, Eigen::V
 }
 
 double scalarAttr(PyObject* fr, const char* attr, const char* name, double fallback) {
-  const py::object obj = attrOrNone(fr, attr);
+  const py::object obj = py::getattr(fr, attr, py::none());
   return obj.is_none() ? fallback : scalarArg(obj, name);
 }
 
@@ -117,7 +112,8 @@ const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned in
   vereshchagin::FrictionModel& fm = cacheable ? cache_ : scratch;
   using MapV = Eigen::Map<const Eigen::VectorXd>;
   fm.static_friction = MapV(vectorView(static_obj.ptr(), "friction.static", nj).data, nj);
-  const py::object kin = attrOrNone(obj, "kinetic"), lower = attrOrNone(obj, "lower"), upper = attrOrNone(obj, "upper");
+  const py::object none = py::none(), kin = py::getattr(obj, "kinetic", none), lower = py::getattr(obj, "lower", none),
+                   upper = py::getattr(obj, "upper", none);
   fm.kinetic_friction.resize(0);
   if (!kin.is_none()) fm.kinetic_friction = MapV(vectorView(kin.ptr(), "friction.kinetic", nj).data, nj);
   fm.velocity_tolerance = scalarAttr(obj, "velocity_tolerance", "friction.velocity_tolerance",
