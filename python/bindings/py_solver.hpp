@@ -155,10 +155,8 @@ class PySolver {
   // Benchmarks only (BENCHMARKS.md, "Call mechanism"): solve() returning a dict of new numpy
   // arrays, as a result made of plain arrays would (no friction).
   py::dict solveDict(PyObject* const* args);
-  py::dict solveBatch(const py::object& q, const py::object& qd, const py::object& alpha, const py::object& beta,
-                      const py::object& f_ext, const py::object& tau_ff, const py::object& friction,
-                      const py::object& constraints, const py::object& f_ext_pass_through,
-                      const py::object& tau_ff_pass_through, const py::object& threads, const py::object& a_desired);
+  // solve_batch(): args as solve()'s (`out` not read), threads: None or an int >= 0 (0: one per core).
+  py::dict solveBatch(PyObject* const* args, const py::object& threads);
   py::tuple responseColumns(const py::object& joints, bool hold_sticking);
 
   void setGravity(const py::object& gravity);
@@ -174,7 +172,10 @@ class PySolver {
   class Lock {
    public:
     explicit Lock(PySolver& s);
-    ~Lock();
+    ~Lock() {
+      s_.holder_.store(std::thread::id());
+      s_.mutex_.unlock();
+    }
     Lock(const Lock&) = delete;
 
    private:
@@ -188,6 +189,8 @@ class PySolver {
 
  private:
   Engine& engine(std::size_t k);
+  // Parses `args` into args_ and solves them on engine 0 (the caller holds the Lock).
+  void solveArgs(PyObject* const* args, bool frictionless);
 
   std::unique_ptr<PyChain> chain_;  // the model: one of these two
   std::unique_ptr<PyTree> tree_;
@@ -203,6 +206,11 @@ class PySolver {
   // successful solve_batch(): response_columns() linearises around it.
   bool last_state_ = false;
 };
+
+// An int in lo .. hi (not a bool); messages "<name> must be an int<bound> <hint>, got [type] repr"
+// and "<name> must be in lo .. hi <hint>, got str".
+long intOption(const py::object& obj, const char* name, long lo, long hi, const char* bound, const char* hint,
+               bool with_type);
 
 // "physical" or "joint_space" (raises otherwise, naming `where`).
 vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where);

@@ -16,15 +16,8 @@ namespace {
 // solve_batch's threads: an int >= 0 (0: one per core), at most kMaxBatchThreads.
 long threadsArg(const py::object& obj) {
   if (obj.is_none()) return 1;
-  if (PyBool_Check(obj.ptr()) || !PyIndex_Check(obj.ptr()))
-    raise("threads must be an int (0: one per core), got " + std::string(Py_TYPE(obj.ptr())->tp_name) + " " +
-          py::repr(obj).cast<std::string>());
-  const std::optional<long long> v = intWithin(obj.ptr(), 0, kMaxBatchThreads);
-  if (!v)
-    raise("threads must be in 0 .. " + std::to_string(kMaxBatchThreads) + " (0: one per core), got " +
-          py::str(obj).cast<std::string>());
-  if (*v == 0) return std::max(1u, std::thread::hardware_concurrency());
-  return static_cast<long>(*v);
+  const long v = intOption(obj, "threads", 0, kMaxBatchThreads, "", "(0: one per core)", true);
+  return v == 0 ? std::max(1u, std::thread::hardware_concurrency()) : v;
 }
 
 // Runs work(t, begin, end) on `threads` contiguous chunks of [0, B): chunk 0 on this thread.
@@ -50,71 +43,23 @@ std::string runChunks(long threads, py::ssize_t B, const Work& work) {
   return "";
 }
 
-// The outputs of B rows (the friction ones with 0 rows when no row has friction).
-struct BatchOut {
-  BatchOut(py::ssize_t B, py::ssize_t n, py::ssize_t M, py::ssize_t ns, bool friction)
-      : BF(friction ? B : 0),
-        qdd(newDoubles({B, n})),
-        tau(newDoubles({B, n})),
-        nu(newDoubles({B, M})),
-        acc(newDoubles({B, ns + 1, 6})),
-        smin(newDoubles({B})),
-        fr(newDoubles({BF, n})),
-        lim(newDoubles({BF, n})),
-        gauss(newDoubles({BF})),
-        rank(newInts({B})),
-        status(newInts({BF, n})),
-        iters(newInts({BF})) {}
-  RowOut rows() const {
-    return {doubles(qdd), doubles(tau),   doubles(nu), doubles(acc), doubles(smin), BF ? doubles(fr) : nullptr,
-            doubles(lim), doubles(gauss), ints(rank),  ints(status), ints(iters)};
-  }
-  // The fields of a BatchResult; segment_nu: (B, m_i) views of nu per constraints= key.
-  py::dict fields(const SolveArgs& a) const {
-    py::dict out("qdd"_a = qdd, "tau_command"_a = tau, "nu"_a = nu, "link_acc"_a = acc, "constraint_rank"_a = rank,
-                 "smallest_singular_value"_a = smin);
-    if (a.any_friction) {
-      out["friction_torque"] = fr;
-      out["limit_torque"] = lim;
-      out["status"] = status;
-      out["gauss_value"] = gauss;
-      out["iterations"] = iters;
-    }
-    if (a.keys.empty()) return out;
-    py::dict per_key;
-    for (std::size_t k = 0; k < a.keys.size(); ++k) {
-      const py::ssize_t start = a.starts[k], count = a.blocks[a.blocks.size() - a.keys.size() + k].cols;
-      per_key[a.keys[k]] = nu[py::make_tuple(py::slice(0, a.rows, 1), py::slice(start, start + count, 1))];
-    }
-    out["segment_nu"] = per_key;
-    return out;
-  }
-
-  py::ssize_t BF;
-  py::array qdd, tau, nu, acc, smin, fr, lim, gauss, rank, status, iters;
-};
-
 }  // namespace
 
-py::dict PySolver::solveBatch(const py::object& q, const py::object& qd, const py::object& alpha,
-                              const py::object& beta, const py::object& f_ext, const py::object& tau_ff,
-                              const py::object& friction_obj, const py::object& constraints,
-                              const py::object& f_ext_pass_through, const py::object& tau_ff_pass_through,
-                              const py::object& threads_obj, const py::object& a_desired) {
+py::dict PySolver::solveBatch(PyObject* const* args, const py::object& threads_obj) {
   Lock lk(*this);
   last_state_ = false;  // until engine 0 holds the last row's state
-  // clang-format off
-  PyObject* args[kNumSolveArgs] = {q.ptr(),           qd.ptr(),          alpha.ptr(),       beta.ptr(),
-                                   f_ext.ptr(),       tau_ff.ptr(),      friction_obj.ptr(), constraints.ptr(),
-                                   f_ext_pass_through.ptr(), tau_ff_pass_through.ptr(), nullptr, a_desired.ptr()};
-  // clang-format on
   SolveArgs a;
   a.parse(*this, args, /*batch=*/true);
   const py::ssize_t B = a.rows;
   const long threads = std::min<long>(threadsArg(threads_obj), std::max<py::ssize_t>(B, 1));
   for (long t = 0; t < threads; ++t) engine(static_cast<std::size_t>(t));
-  const BatchOut out(B, nj, a.columns, ns, a.any_friction);
-  const RowOut o = out.rows();
+  const py::ssize_t n = nj, BF = a.any_friction ? B : 0;  // the friction outputs: 0 rows without friction
+  const py::array qdd = newDoubles({B, n}), tau = newDoubles({B, n}), nu = newDoubles({B, a.columns}),
+                  acc = newDoubles({B, ns + 1, 6}), smin = newDoubles({B}), fr = newDoubles({BF, n}),
+                  lim = newDoubles({BF, n}), gauss = newDoubles({BF}), rank = newInts({B}), status = newInts({BF, n}),
+                  iters = newInts({BF});
+  const RowOut o{doubles(qdd), doubles(tau),   doubles(nu), doubles(acc), doubles(smin), BF ? doubles(fr) : nullptr,
+                 doubles(lim), doubles(gauss), ints(rank),  ints(status), ints(iters)};
   std::vector<std::pair<py::ssize_t, std::string>> failures(threads, {-1, ""});
   auto work = [&](long t, py::ssize_t begin, py::ssize_t end) {
     for (py::ssize_t b = begin; b < end; ++b) {
@@ -141,7 +86,23 @@ py::dict PySolver::solveBatch(const py::object& q, const py::object& qd, const p
     }
     last_state_ = failure == nullptr;
   }
-  return out.fields(a);
+  py::dict out("qdd"_a = qdd, "tau_command"_a = tau, "nu"_a = nu, "link_acc"_a = acc, "constraint_rank"_a = rank,
+               "smallest_singular_value"_a = smin);
+  if (a.any_friction) {
+    out["friction_torque"] = fr;
+    out["limit_torque"] = lim;
+    out["status"] = status;
+    out["gauss_value"] = gauss;
+    out["iterations"] = iters;
+  }
+  if (a.keys.empty()) return out;
+  py::dict per_key;  // segment_nu: (B, m_i) views of nu per constraints= key
+  for (std::size_t k = 0; k < a.keys.size(); ++k) {
+    const py::ssize_t start = a.starts[k], count = a.blocks[a.blocks.size() - a.keys.size() + k].cols;
+    per_key[a.keys[k]] = nu[py::make_tuple(py::slice(0, B, 1), py::slice(start, start + count, 1))];
+  }
+  out["segment_nu"] = per_key;
+  return out;
 }
 
 }  // namespace vsbind

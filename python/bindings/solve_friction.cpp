@@ -51,8 +51,7 @@ void check(const vereshchagin::FrictionModel& fm) {
 }
 
 // friction.lower / friction.upper: (nj,), no NaN (infinite: no limit); None leaves `out` as is.
-void limitArg(PyObject* fr, const char* attr, const char* name, unsigned int nj, Eigen::VectorXd& out) {
-  const py::object obj = py::getattr(fr, attr, py::none());
+void limitArg(const py::object& obj, const char* name, unsigned int nj, Eigen::VectorXd& out) {
   if (obj.is_none()) return;
   const F64View a = asF64(obj.ptr(), name);
   if (a.ndim != 1 || a.shape[0] != static_cast<py::ssize_t>(nj))
@@ -113,18 +112,19 @@ const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned in
   vereshchagin::FrictionModel& fm = cacheable ? cache_ : scratch;
   using MapV = Eigen::Map<const Eigen::VectorXd>;
   fm.static_friction = MapV(vectorView(static_obj.ptr(), "friction.static", nj).data, nj);
-  const py::object kin = py::getattr(obj, "kinetic", py::none());
+  const py::object none = py::none(), kin = py::getattr(obj, "kinetic", none), lower = py::getattr(obj, "lower", none),
+                   upper = py::getattr(obj, "upper", none);
   fm.kinetic_friction.resize(0);
   if (!kin.is_none()) fm.kinetic_friction = MapV(vectorView(kin.ptr(), "friction.kinetic", nj).data, nj);
   fm.velocity_tolerance = scalarAttr(obj, "velocity_tolerance", "friction.velocity_tolerance",
                                      vereshchagin::FrictionModel().velocity_tolerance);
   fm.lower.resize(0);
   fm.upper.resize(0);
-  if (!py::getattr(obj, "lower", py::none()).is_none() || !py::getattr(obj, "upper", py::none()).is_none()) {
+  if (!lower.is_none() || !upper.is_none()) {
     fm.lower = Eigen::VectorXd::Constant(nj, -std::numeric_limits<double>::infinity());
     fm.upper = Eigen::VectorXd::Constant(nj, std::numeric_limits<double>::infinity());
-    limitArg(obj, "lower", "friction.lower", nj, fm.lower);
-    limitArg(obj, "upper", "friction.upper", nj, fm.upper);
+    limitArg(lower, "friction.lower", nj, fm.lower);
+    limitArg(upper, "friction.upper", nj, fm.upper);
     fm.limit_tolerance =
         scalarAttr(obj, "limit_tolerance", "friction.limit_tolerance", vereshchagin::FrictionModel().limit_tolerance);
   }

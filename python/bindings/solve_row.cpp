@@ -9,6 +9,8 @@
 
 namespace vsbind {
 
+using namespace pybind11::literals;
+
 const char* PySolver::runRow(const SolveArgs& a, py::ssize_t b, std::size_t k) {
   Engine& e = *engines_[k];
   a.fillRow(b, e.input);
@@ -44,10 +46,10 @@ bool PySolver::writeRow(const SolveArgs& a, py::ssize_t b, std::size_t k, const 
   return std::isfinite(o.gauss[b]);
 }
 
-py::object PySolver::solve(PyObject* const* args, PyObject* out) {
-  Lock lk(*this);
+void PySolver::solveArgs(PyObject* const* args, bool frictionless) {
   last_state_ = false;
   args_.parse(*this, args, /*batch=*/false);
+  if (frictionless && args_.any_friction) raise("_solve_dict benchmarks the frictionless call: no friction");
   const char* failure;
   {
     py::gil_scoped_release release;
@@ -55,6 +57,11 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out) {
   }
   if (failure) raise(failure);
   last_state_ = true;
+}
+
+py::object PySolver::solve(PyObject* const* args, PyObject* out) {
+  Lock lk(*this);
+  solveArgs(args, false);
   py::object r =
       newResult(ResultLayout{static_cast<int>(nj), static_cast<int>(ns), args_.columns, args_.any_friction}, out);
   const ResultPointers p = resultPointers(r.ptr());
@@ -80,16 +87,7 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out) {
 
 py::dict PySolver::solveDict(PyObject* const* args) {
   Lock lk(*this);
-  last_state_ = false;
-  args_.parse(*this, args, /*batch=*/false);
-  if (args_.any_friction) raise("_solve_dict benchmarks the frictionless call: no friction");
-  const char* failure;
-  {
-    py::gil_scoped_release release;
-    failure = runRow(args_, 0, 0);
-  }
-  if (failure) raise(failure);
-  last_state_ = true;
+  solveArgs(args, true);
   py::array qdd = newDoubles({nj}), tau = newDoubles({nj}), nu = newDoubles({args_.columns}),
             acc = newDoubles({ns + 1, 6});
   int rank;
@@ -97,14 +95,8 @@ py::dict PySolver::solveDict(PyObject* const* args) {
   writeRow(args_, 0, 0,
            RowOut{doubles(qdd), doubles(tau), doubles(nu), doubles(acc), &smin, nullptr, nullptr, nullptr, &rank,
                   nullptr, nullptr});
-  py::dict d;
-  d["qdd"] = qdd;
-  d["tau_command"] = tau;
-  d["nu"] = nu;
-  d["link_acc"] = acc;
-  d["constraint_rank"] = rank;
-  d["smallest_singular_value"] = smin;
-  return d;
+  return py::dict("qdd"_a = qdd, "tau_command"_a = tau, "nu"_a = nu, "link_acc"_a = acc, "constraint_rank"_a = rank,
+                  "smallest_singular_value"_a = smin);
 }
 
 // Seconds per C++ solve of the parsed row, reading every output solve() returns.

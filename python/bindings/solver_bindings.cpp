@@ -17,27 +17,25 @@ static_assert(kNumSolveParams == kNumSolveArgs, "solve()'s parameters are SolveA
 PyObject* g_solve_names[kNumSolveParams];
 PyObject* g_solver_error = nullptr;
 
-// Fills `slots` from positional and keyword arguments; raises TypeError like Python functions.
-void bindArguments(const char* fname, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames, PyObject** slots,
-                   const char* const* names, PyObject** interned, int count) {
-  if (nargs > count)
-    throw py::type_error(std::string(fname) + "() takes at most " + std::to_string(count) + " positional arguments (" +
-                         std::to_string(nargs) + " given)");
+// Fills `slots` (solve()'s parameters) from positional and keyword arguments; raises TypeError
+// like Python functions.
+void bindArguments(const char* fname, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames, PyObject** slots) {
+  if (nargs > kNumSolveParams)
+    throw py::type_error(std::string(fname) + "() takes at most " + std::to_string(kNumSolveParams) +
+                         " positional arguments (" + std::to_string(nargs) + " given)");
   for (Py_ssize_t k = 0; k < nargs; ++k) slots[k] = args[k];
-  if (kwnames == nullptr) return;
-  const Py_ssize_t nkw = PyTuple_GET_SIZE(kwnames);
-  for (Py_ssize_t k = 0; k < nkw; ++k) {
+  for (Py_ssize_t k = 0; kwnames != nullptr && k < PyTuple_GET_SIZE(kwnames); ++k) {
     PyObject* name = PyTuple_GET_ITEM(kwnames, k);
     int slot = -1;
-    for (int s = 0; s < count && slot < 0; ++s)
-      if (name == interned[s]) slot = s;
-    for (int s = 0; s < count && slot < 0; ++s)
-      if (PyUnicode_Compare(name, interned[s]) == 0) slot = s;
+    for (int s = 0; s < kNumSolveParams && slot < 0; ++s)
+      if (name == g_solve_names[s]) slot = s;
+    for (int s = 0; s < kNumSolveParams && slot < 0; ++s)
+      if (PyUnicode_Compare(name, g_solve_names[s]) == 0) slot = s;
     if (slot < 0)
       throw py::type_error(std::string(fname) + "() got an unexpected keyword argument '" +
                            py::handle(name).cast<std::string>() + "'");
     if (slots[slot] != nullptr)
-      throw py::type_error(std::string(fname) + "() got multiple values for argument '" + names[slot] + "'");
+      throw py::type_error(std::string(fname) + "() got multiple values for argument '" + kSolveParams[slot] + "'");
     slots[slot] = args[nargs + k];
   }
 }
@@ -75,41 +73,36 @@ PyObject* guarded(Body&& body) {
   return nullptr;
 }
 
-PyObject* solveEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
+enum Entry { kSolve, kTimeCpp, kSolveDict };
+constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict"};
+
+// The METH_FASTCALL methods: solve(q, qd, ...); _time_cpp(reps, q, qd, ...): seconds per C++
+// solve (outputs read as solve() reads them), for benchmarks that compare the Python call with
+// the C++ work in the same process; _solve_dict(q, qd, ...): solve() returning a dict of arrays.
+template <Entry kind>
+PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
+    long reps = 0;
+    if (kind == kTimeCpp) {
+      if (nargs < 1) throw py::type_error("_time_cpp(reps, q, qd, ...) needs reps");
+      reps = py::handle(args[0]).cast<long>();
+      ++args, --nargs;
+    }
     PyObject* a[kNumSolveParams] = {};
-    bindArguments("solve", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
+    bindArguments(kEntryNames[kind], args, nargs, kwnames, a);
+    if (kind == kTimeCpp) return py::float_(solverOf(self).timeCpp(a, reps));
+    if (kind == kSolveDict) return solverOf(self).solveDict(a);
     return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg]);
   });
 }
 
-// _time_cpp(reps, q, qd, ...): seconds per C++ solve (outputs read as solve() reads them), for
-// benchmarks that compare the Python call with the C++ work in the same process.
-PyObject* timeCppEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
-  return guarded([&]() -> py::object {
-    if (nargs < 1) throw py::type_error("_time_cpp(reps, q, qd, ...) needs reps");
-    const long reps = py::handle(args[0]).cast<long>();
-    PyObject* a[kNumSolveParams] = {};
-    bindArguments("_time_cpp", args + 1, nargs - 1, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    return py::float_(solverOf(self).timeCpp(a, reps));
-  });
+template <Entry kind>
+PyMethodDef fastDef() {  // the doc is set in bindSolver()
+  return {kEntryNames[kind], reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(fastEntry<kind>)),
+          METH_FASTCALL | METH_KEYWORDS, nullptr};
 }
 
-// _solve_dict(q, qd, ...): solve() with the same fast call, returning a dict of new arrays.
-PyObject* solveDictEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
-  return guarded([&]() -> py::object {
-    PyObject* a[kNumSolveParams] = {};
-    bindArguments("_solve_dict", args, nargs, kwnames, a, kSolveParams, g_solve_names, kNumSolveParams);
-    return solverOf(self).solveDict(a);
-  });
-}
-
-PyMethodDef g_solve_def = {"solve", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(solveEntry)),
-                           METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
-PyMethodDef g_time_def = {"_time_cpp", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(timeCppEntry)),
-                          METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
-PyMethodDef g_dict_def = {"_solve_dict", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(solveDictEntry)),
-                          METH_FASTCALL | METH_KEYWORDS, nullptr};  // doc set in bindSolver()
+PyMethodDef g_fast_defs[] = {fastDef<kSolve>(), fastDef<kTimeCpp>(), fastDef<kSolveDict>()};
 
 void addFastMethod(py::handle cls, PyMethodDef* def) {
   PyObject* descr = PyDescr_NewMethod(reinterpret_cast<PyTypeObject*>(cls.ptr()), def);
@@ -117,24 +110,36 @@ void addFastMethod(py::handle cls, PyMethodDef* def) {
   Py_DECREF(descr);
 }
 
-// _solve_pybind: solve() bound the plain pybind11 way (named arguments with defaults), for the
-// benchmark of the fast call's gain.
-py::object solvePybind(PySolver& s, py::object q, py::object qd, py::object alpha, py::object beta, py::object f_ext,
-                       py::object tau_ff, py::object friction, py::object constraints, py::object f_pass,
-                       py::object t_pass, py::object out, py::object a_desired) {
-  PyObject* a[kNumSolveParams] = {q.ptr(),      qd.ptr(),     alpha.ptr(),    beta.ptr(),
-                                  f_ext.ptr(),  tau_ff.ptr(), friction.ptr(), constraints.ptr(),
-                                  f_pass.ptr(), t_pass.ptr(), out.ptr(),      a_desired.ptr()};
-  return s.solve(a, out.is_none() ? nullptr : out.ptr());
+using O = const py::object&;
+
+// solve_batch (`last`: threads) and _solve_pybind (`last`: out, the benchmark of the fast call's
+// gain) bound the plain pybind11 way: named arguments with defaults.
+template <bool kBatch>
+auto namedSolve(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_ff, O friction, O constraints, O f_pass,
+                O t_pass, O last, O a_desired) {
+  PyObject* const out = kBatch ? nullptr : last.ptr();  // solve_batch has no out
+  PyObject* a[kNumSolveParams] = {q.ptr(),      qd.ptr(),       alpha.ptr(),       beta.ptr(),   f_ext.ptr(),
+                                  tau_ff.ptr(), friction.ptr(), constraints.ptr(), f_pass.ptr(), t_pass.ptr(),
+                                  out,          a_desired.ptr()};
+  if constexpr (kBatch)
+    return s.solveBatch(a, last);
+  else
+    return s.solve(a, last.is_none() ? nullptr : last.ptr());
+}
+
+template <bool kBatch, typename... Last>
+void defNamedSolve(py::class_<PySolver>& cls, const char* name, const Last&... last) {
+  const py::object none = py::none();
+  cls.def(name, &namedSolve<kBatch>, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,
+          py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
+          py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, last...,
+          py::arg("a_desired") = none, doc("_core.Solver." + std::string(name)));
 }
 
 }  // namespace
 
 void bindSolver(py::module_& mod) {
   g_solver_error = mod.attr("SolverError").ptr();
-  g_solve_def.ml_doc = doc("_core.Solver.solve");
-  g_time_def.ml_doc = doc("_core.Solver._time_cpp");
-  g_dict_def.ml_doc = doc("_core.Solver._solve_dict");
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
 
   py::class_<PySolver> cls(mod, "Solver", doc("_core.Solver"));
@@ -143,50 +148,37 @@ void bindSolver(py::module_& mod) {
           py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
           py::arg("damping") = py::none(), py::arg("inertia_check") = py::none(),
           py::arg("max_constraints") = py::none())
-      .def("solve_batch", &PySolver::solveBatch, py::arg("q"), py::arg("qd"), py::arg("alpha") = py::none(),
-           py::arg("beta") = py::none(), py::arg("f_ext") = py::none(), py::arg("tau_ff") = py::none(),
-           py::arg("friction") = py::none(), py::arg("constraints") = py::none(),
-           py::arg("f_ext_pass_through") = py::none(), py::arg("tau_ff_pass_through") = py::none(),
-           py::arg("threads") = 1, py::arg("a_desired") = py::none(), doc("_core.Solver.solve_batch"))
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            doc("_core.Solver.response_columns"))
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, doc("_core.Solver.gravity"))
-      .def_property_readonly(
-          "n_joints", [](const PySolver& s) { return s.nj; }, doc("_core.Solver.n_joints"))
-      .def_property_readonly(
-          "n_segments", [](const PySolver& s) { return s.ns; }, doc("_core.Solver.n_segments"))
-      .def_property_readonly(
-          "model", [](const PySolver& s) { return s.model(); }, doc("_core.Solver.model"))
-      .def_property_readonly(
-          "chain",
-          [](const PySolver& s) {
-            if (s.isTree()) raise("this Solver is for a Tree: use solver.tree (or solver.model)");
-            return s.model();
-          },
-          doc("_core.Solver.chain"))
-      .def_property_readonly(
-          "tree",
-          [](const PySolver& s) {
-            if (!s.isTree()) raise("this Solver is for a Chain: use solver.chain (or solver.model)");
-            return s.model();
-          },
-          doc("_core.Solver.tree"))
-      .def_property_readonly(
-          "inertia_check", [](const PySolver& s) { return s.inertiaCheck(); }, doc("_core.Solver.inertia_check"))
+      .def_readonly("n_joints", &PySolver::nj, doc("_core.Solver.n_joints"))
+      .def_readonly("n_segments", &PySolver::ns, doc("_core.Solver.n_segments"))
+      .def_property_readonly("model", &PySolver::model, doc("_core.Solver.model"));
+  for (const bool tree : {false, true}) {  // solver.chain, solver.tree: the model if it is one
+    const std::string name = tree ? "tree" : "chain";
+    cls.def_property_readonly(
+        name.c_str(),
+        [tree](const PySolver& s) {
+          if (s.isTree() != tree)
+            raise(std::string("this Solver is for a ") + (tree ? "Chain: use solver.chain" : "Tree: use solver.tree") +
+                  " (or solver.model)");
+          return s.model();
+        },
+        doc("_core.Solver." + name));
+  }
+  cls.def_property_readonly("inertia_check", &PySolver::inertiaCheck, doc("_core.Solver.inertia_check"))
       .def(py::pickle([](const PySolver& s) { return s.getState(); },
                       [](const py::tuple& t) {
                         if (t.size() != 5 && t.size() != 6) raise("Solver state must have 5 or 6 entries");
                         return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4],
                                                           t.size() == 6 ? py::object(t[5]) : py::none());
                       }));
-  addFastMethod(cls, &g_solve_def);
-  addFastMethod(cls, &g_time_def);
-  addFastMethod(cls, &g_dict_def);
-  const py::object none = py::none();
-  cls.def("_solve_pybind", &solvePybind, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,
-          py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
-          py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, py::arg("out") = none,
-          py::arg("a_desired") = none, doc("_core.Solver._solve_pybind"));
+  for (PyMethodDef& def : g_fast_defs) {
+    def.ml_doc = doc("_core.Solver." + std::string(def.ml_name));
+    addFastMethod(cls, &def);
+  }
+  defNamedSolve<true>(cls, "solve_batch", py::arg("threads") = 1);
+  defNamedSolve<false>(cls, "_solve_pybind", py::arg("out") = py::none());
 }
 
 }  // namespace vsbind

@@ -4,6 +4,18 @@
 
 namespace vsbind {
 
+long intOption(const py::object& obj, const char* name, long lo, long hi, const char* bound, const char* hint,
+               bool with_type) {
+  if (PyBool_Check(obj.ptr()) || !PyIndex_Check(obj.ptr()))
+    raise(std::string(name) + " must be an int" + bound + " " + hint + ", got " +
+          (with_type ? std::string(Py_TYPE(obj.ptr())->tp_name) + " " : "") + py::repr(obj).cast<std::string>());
+  const std::optional<long long> v = intWithin(obj.ptr(), lo, hi);
+  if (!v)
+    raise(std::string(name) + " must be in " + std::to_string(lo) + " .. " + std::to_string(hi) + " " + hint +
+          ", got " + py::str(obj).cast<std::string>());
+  return static_cast<long>(*v);
+}
+
 vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where) {
   if (value == "physical") return vereshchagin::InertiaCheck::Physical;
   if (value == "joint_space") return vereshchagin::InertiaCheck::JointSpace;
@@ -35,16 +47,9 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
     options_.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
     options_.damping = scalarArg(damping, "damping");
   }
-  if (!max_constraints.is_none()) {
-    if (PyBool_Check(max_constraints.ptr()) || !PyIndex_Check(max_constraints.ptr()))
-      raise("max_constraints must be an int >= 1 (None: the default), got " +
-            py::repr(max_constraints).cast<std::string>());
-    const std::optional<long long> value = intWithin(max_constraints.ptr(), 1, 1 << 24);
-    if (!value)
-      raise("max_constraints must be in 1 .. 16777216 (None: the default), got " +
-            py::str(max_constraints).cast<std::string>());
-    options_.max_constraints = static_cast<int>(*value);
-  }
+  if (!max_constraints.is_none())
+    options_.max_constraints = static_cast<int>(
+        intOption(max_constraints, "max_constraints", 1, 1 << 24, " >= 1", "(None: the default)", false));
   gravity_ = vec3(gravity, "gravity");
   const vereshchagin::ModelOptions model_options{options_.inertia_check};
   cpp_model_ = tree_ ? vereshchagin::Model(tree_->robot.tree, tree_->robot.root_link, model_options)
@@ -70,11 +75,6 @@ PySolver::Lock::Lock(PySolver& s) : s_(s) {
     s.mutex_.lock();
   }
   s.holder_.store(std::this_thread::get_id());
-}
-
-PySolver::Lock::~Lock() {
-  s_.holder_.store(std::thread::id());
-  s_.mutex_.unlock();
 }
 
 Engine& PySolver::engine(std::size_t k) {
