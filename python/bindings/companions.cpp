@@ -17,7 +17,7 @@ namespace vs = vereshchagin;
 using Vec = Eigen::Map<Eigen::VectorXd>;
 
 CompanionCache::CompanionCache(const vs::Model& m)
-    : model(m), dyn(model), f_ext(6, m.nrOfSegments()), jacobian(6, m.nrOfJoints()), n(m.nrOfJoints()) {}
+    : model(m), dyn(model), f_ext(6, m.nrOfSegments()), n(m.nrOfJoints()) {}
 
 CompanionCache& CompanionModel::companions() const {
   if (!cache_) cache_ = std::make_shared<CompanionCache>(buildModel());
@@ -190,9 +190,10 @@ py::array jacobianOf(const CompanionModel& m, const py::handle& q_obj, const Fra
   CompanionCache& c = m.companions();
   const JointRows q(q_obj, "q", c.n);
   check(vs::forwardKinematics(c.model, c.kin(), q.pos()));
-  check(vs::frameJacobian(c.model, c.kin(), ref(target), c.jacobian));
-  py::array out = newDoubles({6, c.n});  // row-major
-  Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>>(doubles(out), 6, c.n) = c.jacobian;
+  const py::ssize_t dims[2] = {6, c.n};
+  py::array out = newArray(py::detail::npy_api::NPY_DOUBLE_, 2, dims, /*fortran=*/true);  // written in place
+  Eigen::Map<Eigen::MatrixXd> J(doubles(out), 6, c.n);
+  check(vs::frameJacobian(c.model, c.kin(), ref(target), J));
   return out;
 }
 

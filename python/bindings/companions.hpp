@@ -19,7 +19,6 @@ struct CompanionCache {
   vereshchagin::Model model;
   vereshchagin::DynamicsData dyn;
   vereshchagin::Matrix6X f_ext;  // scratch: 6 x n_segments
-  Eigen::MatrixXd jacobian;      // scratch: 6 x n_joints
   py::ssize_t n;                 // joints
 };
 

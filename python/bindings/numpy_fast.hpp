@@ -114,10 +114,11 @@ inline F64View vectorView(PyObject* obj, const char* name, py::ssize_t n, bool s
 }
 
 // New C-contiguous arrays, uninitialised (int arrays hold numpy int32).
-inline py::array newArray(int type_num, int nd, const py::ssize_t* dims) {
+// (fortran: column-major, so that an Eigen column-major matrix can be written in place).
+inline py::array newArray(int type_num, int nd, const py::ssize_t* dims, bool fortran = false) {
   const auto& api = py::detail::npy_api::get();
   PyObject* descr = api.PyArray_DescrFromType_(type_num);
-  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, descr, nd, dims, nullptr, nullptr, 0, nullptr);
+  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, descr, nd, dims, nullptr, nullptr, fortran, nullptr);
   if (a == nullptr) throw py::error_already_set();
   return py::reinterpret_steal<py::array>(a);
 }
