@@ -50,12 +50,11 @@ from support.friction_oracles import (
     enumeration_oracle,
     limit_flags,
     limit_margin,
-    null_space,
     pinocchio_problem,
     random_friction,
     scipy_oracle,
 )
-from support.friction_checks import hold_beta, rel
+from support.friction_checks import check_motion, check_oracle_optima, hold_beta, rel
 from support.urdf_robots import BUILDERS
 
 # Solver vs oracles: exact enumeration and the polished primal, so the exact-algorithm tolerance.
@@ -81,15 +80,7 @@ def check_limit_result(res, prob, rnea_tau, oracles, what=""):
     t_s = max(t_s, np.linalg.norm(lt))
 
     # --- KKT on its own ---
-    eom = rnea_tau(qdd) - (prob.extra["tau_ff"] + tc + fr + lt)
-    assert np.linalg.norm(eom) <= KKT_TOL * t_s, f"{what}: equation of motion residual {np.linalg.norm(eom):.2e}"
-    if prob.A.shape[0]:
-        task = prob.A @ qdd - prob.b
-        assert np.linalg.norm(task) <= KKT_TOL * max(1.0, np.linalg.norm(prob.b), np.linalg.norm(prob.A) * a_s), (
-            f"{what}: task residual {np.linalg.norm(task):.2e}"
-        )
-    off_range = null_space(prob.A).T @ tc
-    assert np.linalg.norm(off_range) <= KKT_TOL * t_s, f"{what}: tau_command not in range(-J^T alpha)"
+    check_motion(prob, rnea_tau, qdd, tc, fr + lt, a_s, t_s, what)
     for j in range(n):
         f = prob.static[j]
         lo, up = prob.at_lower[j], prob.at_upper[j]
@@ -124,11 +115,7 @@ def check_limit_result(res, prob, rnea_tau, oracles, what=""):
             assert lt[j] == 0.0, f"{tag}: limit reaction on a slipping joint"
 
     # --- the oracles ---
-    for name, o in oracles.items():
-        assert rel(qdd, o.qdd, a_s) <= RTOL, f"{what}: qdd vs oracle {name}\n{qdd}\n{o.qdd}"
-        assert abs(res.gauss_value - o.objective) <= RTOL * prob.objective_scale(o.qdd), (
-            f"{what}: gauss_value {res.gauss_value!r} vs oracle {name} {o.objective!r}"
-        )
+    check_oracle_optima(res, prob, qdd, oracles, what)
     ref = oracles["enumeration"]
     np.testing.assert_array_equal(st, ref.status, err_msg=f"{what}: status vs enumeration")
     assert rel(fr, ref.friction_torque, t_s) <= RTOL, f"{what}: friction_torque\n{fr}\n{ref.friction_torque}"

@@ -87,6 +87,33 @@ def complementarity_residual(prob, qdd, friction, status):
     return worst
 
 
+def check_motion(prob, rnea_tau, qdd, tau_command, joint_torques, a_s, t_s, what=""):
+    """Self-certifying checks of a friction-aware solve (no oracle): the equation of motion with
+    ``joint_torques`` (friction, plus the limit reactions when there are limits), the task, and
+    ``tau_command`` in range(-J^T alpha); ``a_s``, ``t_s``: the acceleration and torque scales."""
+    eom = rnea_tau(qdd) - (prob.extra["tau_ff"] + tau_command + joint_torques)
+    assert np.linalg.norm(eom) <= KKT_TOL * t_s, f"{what}: equation of motion residual {np.linalg.norm(eom):.2e}"
+    if prob.A.shape[0]:
+        task = prob.A @ qdd - prob.b
+        assert np.linalg.norm(task) <= KKT_TOL * max(1.0, np.linalg.norm(prob.b), np.linalg.norm(prob.A) * a_s), (
+            f"{what}: task residual {np.linalg.norm(task):.2e}"
+        )
+    off_range = null_space(prob.A).T @ tau_command
+    assert np.linalg.norm(off_range) <= KKT_TOL * t_s, (
+        f"{what}: tau_command not in range(-J^T alpha): {np.linalg.norm(off_range):.2e}"
+    )
+
+
+def check_oracle_optima(res, prob, qdd, oracles, what=""):
+    """qdd and gauss_value against each oracle's optimum."""
+    a_s = prob.accel_scale(qdd)
+    for name, o in oracles.items():
+        assert rel(qdd, o.qdd, a_s) <= RTOL, f"{what}: qdd vs oracle {name}\n{qdd}\n{o.qdd}"
+        assert abs(res.gauss_value - o.objective) <= RTOL * prob.objective_scale(o.qdd), (
+            f"{what}: gauss_value {res.gauss_value!r} vs oracle {name} {o.objective!r}"
+        )
+
+
 def check_against_oracles(res, prob, rnea_tau, *, oracles, what=""):
     """All checks of one friction-aware solve. rnea_tau(qdd) = pin.rnea(q, qd, qdd, f_ext)."""
     n = prob.n
@@ -101,27 +128,12 @@ def check_against_oracles(res, prob, rnea_tau, *, oracles, what=""):
     a_s, t_s = prob.accel_scale(qdd), prob.torque_scale(qdd)
 
     # --- self-certifying KKT checks (no oracle) ---
-    eom = rnea_tau(qdd) - (prob.extra["tau_ff"] + tc + fr)
-    assert np.linalg.norm(eom) <= KKT_TOL * t_s, f"{what}: equation of motion residual {np.linalg.norm(eom):.2e}"
-    if prob.A.shape[0]:
-        task = prob.A @ qdd - prob.b
-        assert np.linalg.norm(task) <= KKT_TOL * max(1.0, np.linalg.norm(prob.b), np.linalg.norm(prob.A) * a_s), (
-            f"{what}: task residual {np.linalg.norm(task):.2e}"
-        )
-    off_range = null_space(prob.A).T @ tc
-    assert np.linalg.norm(off_range) <= KKT_TOL * t_s, (
-        f"{what}: tau_command not in range(-J^T alpha): {np.linalg.norm(off_range):.2e}"
-    )
+    check_motion(prob, rnea_tau, qdd, tc, fr, a_s, t_s, what)
     comp = complementarity_residual(prob, qdd, fr, st)
     assert comp <= KKT_TOL, f"{what}: complementarity residual {comp:.2e}; status {st}, qdd {qdd}, friction {fr}"
 
     # --- the oracles ---
-    for name, o in oracles.items():
-        assert rel(qdd, o.qdd, a_s) <= RTOL, f"{what}: qdd vs oracle {name}\n{qdd}\n{o.qdd}"
-        scale = prob.objective_scale(o.qdd)
-        assert abs(res.gauss_value - o.objective) <= RTOL * scale, (
-            f"{what}: gauss_value {res.gauss_value!r} vs oracle {name} {o.objective!r}"
-        )
+    check_oracle_optima(res, prob, qdd, oracles, what)
     ref = oracles["enumeration"]
     np.testing.assert_array_equal(st, ref.status, err_msg=f"{what}: status vs enumeration")
     assert rel(fr, ref.friction_torque, t_s) <= RTOL, (
