@@ -50,7 +50,8 @@ struct WrenchRows {
 /// The inputs of `rows` solves (gravity and base_acceleration are the workspace inputs' own).
 struct BatchInput {
   std::ptrdiff_t rows = 1;           ///< B
-  StridedRows q, q_dot;              ///< n_joints per row (rad or m, rad/s or m/s); both required
+  StridedRows q;                     ///< n_joints per row (rad or m); required
+  StridedRows q_dot;                 ///< n_joints per row (rad/s or m/s); required
   StridedRows f_ext;                 ///< n_segments x 6 per row, row-major: SolveInput::f_ext transposed (nullptr: 0)
   StridedRows ff_torques;            ///< n_joints per row (N m or N; nullptr: 0)
   StridedRows f_ext_pass_through;    ///< one weight per column of nu per row (nullptr: 0); checked by solve()
