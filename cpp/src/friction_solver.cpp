@@ -228,11 +228,13 @@ int FrictionCore::checkFriction(const FrictionModel& friction) {
                 friction.velocity_tolerance);
   for (long j = 0; j < n; ++j) {
     if (!std::isfinite(fs(j)) || fs(j) < 0.0)
-      return fail(E_INVALID_FRICTION, "friction.static_friction(%ld) must be finite and >= 0, got %g", j, fs(j));
+      return fail(E_INVALID_FRICTION, "friction.static[%ld] (static_friction(%ld)) must be finite and >= 0, got %g", j,
+                  j, fs(j));
     if (!std::isfinite(fk(j)) || fk(j) < 0.0 || fk(j) > fs(j))
       return fail(E_INVALID_FRICTION,
-                  "friction.kinetic_friction(%ld) must be finite and in [0, static_friction = %g], got %g", j, fs(j),
-                  fk(j));
+                  "friction.kinetic[%ld] (kinetic_friction(%ld)) must be in [0, friction.static[%ld] = %g] (kinetic "
+                  "<= static), got %g",
+                  j, j, j, fs(j), fk(j));
   }
   if (friction.lower.size() == 0 && friction.upper.size() == 0) return ChainHdSolver::E_NOERROR;
   if (friction.lower.size() != n || friction.upper.size() != n)
@@ -243,8 +245,10 @@ int FrictionCore::checkFriction(const FrictionModel& friction) {
                 friction.limit_tolerance);
   for (long j = 0; j < n; ++j)
     if (std::isnan(friction.lower(j)) || std::isnan(friction.upper(j)) || friction.lower(j) > friction.upper(j))
-      return fail(E_INVALID_FRICTION, "friction.lower(%ld) must be <= friction.upper(%ld), neither NaN, got %g and %g",
-                  j, j, friction.lower(j), friction.upper(j));
+      return fail(E_INVALID_FRICTION,
+                  "friction.lower[%ld] and friction.upper[%ld] (friction.lower(%ld), friction.upper(%ld)) must satisfy "
+                  "lower <= upper, neither NaN, got %g > %g",
+                  j, j, j, j, friction.lower(j), friction.upper(j));
   return ChainHdSolver::E_NOERROR;
 }
 

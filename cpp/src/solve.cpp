@@ -18,9 +18,10 @@ using detail::DataImpl;
 using detail::HdCore;
 constexpr int E_SIZE = KDL::SolverI::E_SIZE_MISMATCH, E_RANGE = KDL::SolverI::E_OUT_OF_RANGE,
               E_NF = HdSolver::E_NONFINITE_INPUT;
+constexpr const char* kWeights = "(0: the constraint compensates that driver, 1: its effect passes through)";
 
 // A block's shape, segment, point and weights (its alfa and beta are checked assembled, with
-// HdSolver's messages); `first` is its first column in nu's order.
+// HdSolver's messages); `first` is its first column in nu's order, the index the messages give.
 int checkBlock(HdCore& c, std::size_t b, const ConstraintBlock& k, int first) {
   if (k.columns < 0 || k.columns > HdSolver::kMaxConstraints)
     return c.fail(E_SIZE, "constraints[%zu] has %d columns, expected 0 to %d", b, k.columns, HdSolver::kMaxConstraints);
@@ -32,8 +33,10 @@ int checkBlock(HdCore& c, std::size_t b, const ConstraintBlock& k, int first) {
   for (int j = 0; j < k.columns; ++j) {
     const double pf = k.f_ext_pass_through(j), pt = k.ff_pass_through(j);
     if (!(pf >= 0.0 && pf <= 1.0))
-      return c.fail(E_RANGE, "f_ext_pass_through(%d) = %g is not in [0, 1]", first + j, pf);
-    if (!(pt >= 0.0 && pt <= 1.0)) return c.fail(E_RANGE, "ff_pass_through(%d) = %g is not in [0, 1]", first + j, pt);
+      return c.fail(E_RANGE, "f_ext_pass_through[%d] must be in [0, 1] %s, got %g", first + j, kWeights, pf);
+    if (!(pt >= 0.0 && pt <= 1.0))
+      return c.fail(E_RANGE, "tau_ff_pass_through[%d] (ff_pass_through) must be in [0, 1] %s, got %g", first + j,
+                    kWeights, pt);
   }
   return 0;
 }
@@ -47,8 +50,8 @@ int checkInput(HdCore& c, const SolveInput& in) {
   }
   if (columns > c.mcap)
     return c.fail(HdSolver::E_TOO_MANY_CONSTRAINTS,
-                  "alfa has %d columns, at most %d constraints are supported (6 per segment, and at most "
-                  "SolverOptions::max_constraints in all)",
+                  "this solve has %d constraint columns; the solver takes at most %d in all (6 per segment, and "
+                  "SolverOptions::max_constraints, Solver(..., max_constraints=) in Python, sizes its workspace)",
                   columns, c.mcap);
   for (std::size_t k = 0; k < in.wrenches.size(); ++k) {
     const FrameWrench& w = in.wrenches[k];

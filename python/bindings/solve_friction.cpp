@@ -1,7 +1,7 @@
-// friction= of Solver.solve and solve_batch (FrictionArg, py_solver.hpp): parsed and checked
-// against the Python names (friction.static, friction.kinetic, friction.velocity_tolerance,
-// friction.lower / upper, friction.limit_tolerance) before any computation; a vereshchagin.Friction
-// is parsed once and reused while its attributes are the same objects.
+// friction= of Solver.solve and solve_batch (FrictionArg, py_solver.hpp): shapes checked with the
+// Python names (friction.static, friction.kinetic, friction.lower / upper, ...), values by
+// vereshchagin::solve with the same names; a vereshchagin.Friction is parsed once and reused while
+// its attributes are the same objects.
 #include <limits>
 
 #include "py_solver.hpp"
@@ -22,32 +22,6 @@ PyObject* attrName(int k) {
 PyObject* instanceDict(PyObject* obj) {
   PyObject** dict = _PyObject_GetDictPtr(obj);
   return dict == nullptr ? nullptr : *dict;
-}
-
-std::string at(const char* name, Eigen::Index j) {
-  return std::string(name) + "[" + std::to_string(j) + "]";
-}
-
-void check(const vereshchagin::FrictionModel& fm) {
-  for (Eigen::Index j = 0; j < fm.static_friction.size(); ++j) {
-    const double fs = fm.static_friction(j);
-    if (!std::isfinite(fs) || fs < 0.0)
-      raise(at("friction.static", j) + " must be finite and >= 0, got " + fmtDouble(fs));
-    if (fm.kinetic_friction.size() == 0) continue;
-    const double fk = fm.kinetic_friction(j);
-    if (!std::isfinite(fk) || fk < 0.0 || fk > fs)
-      raise(at("friction.kinetic", j) + " must be in [0, " + at("friction.static", j) + " = " + fmtDouble(fs) +
-            "] (kinetic <= static), got " + fmtDouble(fk));
-  }
-  if (!std::isfinite(fm.velocity_tolerance) || fm.velocity_tolerance < 0.0)
-    raise("friction.velocity_tolerance must be finite and >= 0, got " + fmtDouble(fm.velocity_tolerance));
-  if (fm.lower.size() == 0) return;
-  if (!std::isfinite(fm.limit_tolerance) || fm.limit_tolerance < 0.0)
-    raise("friction.limit_tolerance must be finite and >= 0, got " + fmtDouble(fm.limit_tolerance));
-  for (Eigen::Index j = 0; j < fm.lower.size(); ++j)
-    if (!(fm.lower(j) <= fm.upper(j)))
-      raise(at("friction.lower", j) + " and " + at("friction.upper", j) + " must satisfy lower <= upper, got " +
-            fmtDouble(fm.lower(j)) + " > " + fmtDouble(fm.upper(j)));
 }
 
 // friction.lower / friction.upper: (nj,), no NaN (infinite: no limit); None leaves `out` as is.
@@ -90,13 +64,6 @@ bool FrictionArg::unchanged(PyObject* obj) const {
   return true;
 }
 
-void FrictionArg::remember(PyObject* obj) {
-  PyObject* dict = instanceDict(obj);
-  if (dict == nullptr) return;  // not cached
-  for (int k = 0; k < 6; ++k) cache_attrs_[k] = py::reinterpret_borrow<py::object>(PyDict_GetItem(dict, attrName(k)));
-  cache_key_ = py::reinterpret_borrow<py::object>(obj);
-}
-
 const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned int nj,
                                                       vereshchagin::FrictionModel& scratch) {
   if (obj == nullptr || obj == Py_None || PyBool_Check(obj)) return obj == Py_True ? &model_values_ : nullptr;
@@ -110,6 +77,7 @@ const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned in
     raise("friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)");
   }
   vereshchagin::FrictionModel& fm = cacheable ? cache_ : scratch;
+  if (cacheable) cache_key_ = py::object();  // invalid until parsed
   using MapV = Eigen::Map<const Eigen::VectorXd>;
   fm.static_friction = MapV(vectorView(static_obj.ptr(), "friction.static", nj).data, nj);
   const py::object none = py::none(), kin = py::getattr(obj, "kinetic", none), lower = py::getattr(obj, "lower", none),
@@ -128,9 +96,10 @@ const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned in
     fm.limit_tolerance =
         scalarAttr(obj, "limit_tolerance", "friction.limit_tolerance", vereshchagin::FrictionModel().limit_tolerance);
   }
-  if (cacheable) cache_key_ = py::object();  // invalid until checked
-  check(fm);
-  if (cacheable) remember(obj);
+  PyObject* dict = cacheable ? instanceDict(obj) : nullptr;
+  if (dict == nullptr) return &fm;  // not cached
+  for (int k = 0; k < 6; ++k) cache_attrs_[k] = py::reinterpret_borrow<py::object>(PyDict_GetItem(dict, attrName(k)));
+  cache_key_ = py::reinterpret_borrow<py::object>(obj);
   return &fm;
 }
 

@@ -1,5 +1,5 @@
-// The Python Solver's setup and state: construction (model, options, engine 0), the lock with
-// re-entry detection, gravity, response_columns() around engine 0's last solve, pickling state.
+// The Python Solver's setup and state: construction (model, options, workspace 0), the lock with
+// re-entry detection, gravity, response_columns() around workspace 0's last solve, pickling state.
 #include "py_solver.hpp"
 
 namespace vsbind {
@@ -56,10 +56,7 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
                      : vereshchagin::Model(chain_->robot.chain, model_options);
   const char* invalid = tree_ ? "invalid tree: " : "invalid chain: ";
   if (const vereshchagin::Status s = cpp_model_.status(); !s) raise(invalid + std::string(s.message()));
-  auto probe = std::make_unique<Engine>(cpp_model_, gravity_, options_);
-  if (const vereshchagin::Status s = probe->data.status(); !s) raise(invalid + std::string(s.message()));
-  max_columns = probe->data.maxConstraints();
-  engines_.push_back(std::move(probe));
+  if (const vereshchagin::Status s = workspace(0).data.status(); !s) raise(invalid + std::string(s.message()));
   nj = cpp_model_.nrOfJoints();
   ns = cpp_model_.nrOfSegments();
   friction.setModelValues(addressing->jointInfos());
@@ -77,16 +74,17 @@ PySolver::Lock::Lock(PySolver& s) : s_(s) {
   s.holder_.store(std::this_thread::get_id());
 }
 
-Engine& PySolver::engine(std::size_t k) {
-  while (engines_.size() <= k) engines_.push_back(std::make_unique<Engine>(cpp_model_, gravity_, options_));
-  return *engines_[k];
+vereshchagin::BatchWorkspace& PySolver::workspace(std::size_t k) {
+  while (workspaces_.size() <= k)
+    workspaces_.push_back(std::make_unique<vereshchagin::BatchWorkspace>(cpp_model_, options_, gravity_));
+  return *workspaces_[k];
 }
 
 void PySolver::setGravity(const py::object& gravity) {
   const KDL::Vector g = vec3(gravity, "gravity");
   Lock lk(*this);
   gravity_ = g;
-  for (auto& e : engines_) e->input.gravity = g;
+  for (auto& w : workspaces_) w->input.gravity = g;
 }
 
 py::array PySolver::gravity() const {
@@ -95,47 +93,22 @@ py::array PySolver::gravity() const {
   return g;
 }
 
-namespace {
-
-Eigen::VectorXi jointList(const Addressable& chain, const py::object& joints) {
-  const char* what = "joints must be a sequence of joint names or int indices";
-  if (joints.is_none() || py::isinstance<py::str>(joints)) raise(what);
-  py::sequence seq;
-  if (py::isinstance<py::array>(joints)) {
-    py::array a = joints.cast<py::array>();
-    const char kind = a.dtype().kind();
-    if (a.ndim() != 1 || (a.size() > 0 && kind != 'i' && kind != 'u' && kind != 'U'))
-      raise(std::string(what) + ", got an array of shape " + shapeStr(a) + " and dtype " +
-            std::string(py::str(a.dtype())));
-    seq = a.attr("tolist")();
-  } else if (py::isinstance<py::sequence>(joints)) {
-    seq = joints.cast<py::sequence>();
-  } else {
-    raise(what);
-  }
-  Eigen::VectorXi j(static_cast<Eigen::Index>(seq.size()));
-  for (Eigen::Index c = 0; c < j.size(); ++c)
-    j(c) = chain.resolveJoint(seq[c].ptr(), "joints[" + std::to_string(c) + "]");
-  return j;
-}
-
-}  // namespace
-
-py::tuple PySolver::responseColumns(const py::object& joints, bool hold_sticking) {
-  const Eigen::VectorXi requested = jointList(*addressing, joints);
+py::tuple PySolver::responseColumns(const std::vector<int>& joints, bool hold_sticking) {
+  const Eigen::VectorXi requested =
+      Eigen::Map<const Eigen::VectorXi>(joints.data(), static_cast<Eigen::Index>(joints.size()));
   Lock lk(*this);
   if (!last_state_)
     raise(
         "response_columns() linearises around the last successful solve() (or the last row of solve_batch()): "
         "call solve() at the state first");
-  Engine& e = *engines_[0];
+  vereshchagin::Data& data = workspaces_[0]->data;
   const Eigen::Index k = requested.size();
   Eigen::MatrixXd dq(nj, k), dt(nj, k);
   vereshchagin::Status rc;
   {
     py::gil_scoped_release release;
-    rc = hold_sticking ? e.data.responseColumnsHoldingSticking(requested, dq, dt)
-                       : e.data.responseColumns(requested, dq, dt);
+    rc = hold_sticking ? data.responseColumnsHoldingSticking(requested, dq, dt)
+                       : data.responseColumns(requested, dq, dt);
   }
   if (!rc) raise(rc.message());
   auto toNumpy = [&](const Eigen::MatrixXd& M) {

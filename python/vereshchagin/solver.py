@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Optional
 
@@ -158,22 +159,26 @@ class Solver(_core.Solver):
             ``threads`` that is not an int in 0 .. 256, or the first failing row
             (``"batch row 3: ..."``).
         """
-        return BatchResult(
-            **super().solve_batch(
-                q,
-                qd,
-                alpha,
-                beta,
-                f_ext,
-                tau_ff,
-                friction,
-                constraints,
-                f_ext_pass_through,
-                tau_ff_pass_through,
-                threads,
-                a_desired,
-            )
+        out = super().solve_batch(
+            q,
+            qd,
+            alpha,
+            beta,
+            f_ext,
+            tau_ff,
+            friction,
+            constraints,
+            f_ext_pass_through,
+            tau_ff_pass_through,
+            threads,
+            a_desired,
         )
+        if not out.pop("any_friction"):
+            for key in ("friction_torque", "limit_torque", "status", "gauss_value", "iterations"):
+                out[key] = None
+        layout = out.pop("segment_nu")  # (key, first column, columns) per constraints= entry
+        segment_nu = {key: out["nu"][:, start : start + count] for key, start, count in layout}
+        return BatchResult(**out, segment_nu=segment_nu or None)
 
     def response_columns(self, joints, hold_sticking=True):
         """Affine response of the last solve to unit feed-forward joint torques.
@@ -206,4 +211,29 @@ class Solver(_core.Solver):
         -------
         dqdd, dtau_command : ndarray, shape (n, k)
         """
-        return super().response_columns(joints, hold_sticking)
+        return super().response_columns(_joint_indices(self.model, joints), hold_sticking)
+
+
+def _joint_indices(model, joints) -> list:
+    """The joint indices of ``joints`` (names or int indices, negative from the end).
+
+    Raises
+    ------
+    SolverError
+        ``joints`` is not a sequence or 1-D array of names or ints, or names no joint of ``model``
+        (the message of ``model.joint_index``, naming ``joints[c]``).
+    """
+    what = "joints must be a sequence of joint names or int indices"
+    if isinstance(joints, np.ndarray):
+        if joints.ndim != 1 or (joints.size > 0 and joints.dtype.kind not in "iuU"):
+            raise _core.SolverError(f"{what}, got an array of shape {joints.shape} and dtype {joints.dtype}")
+        joints = joints.tolist()
+    elif joints is None or isinstance(joints, (str, bytes)) or not isinstance(joints, Sequence):
+        raise _core.SolverError(what)
+    indices = []
+    for c, joint in enumerate(joints):
+        try:
+            indices.append(model.joint_index(joint))
+        except _core.SolverError as e:  # "joint_index: ..." names the argument instead
+            raise _core.SolverError(f"joints[{c}]" + str(e).removeprefix("joint_index")) from None
+    return indices
