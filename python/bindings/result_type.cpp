@@ -1,5 +1,5 @@
 // vereshchagin.SolveResult: storage, views and the solve path's fast access (result_type.hpp).
-// Pickling, copies and segment_nu are Python code over this storage (vereshchagin/_results.py).
+// Pickling, copies, segment_nu and repr are Python code over this storage (vereshchagin/_results.py).
 #include "result_type.hpp"
 
 #include <cstring>
@@ -98,19 +98,11 @@ PyObject* getSegments(PyObject* o, void*) {
   return PyTuple_Pack(3, s[0], s[1], s[2]);
 }
 
-PyObject* repr(PyObject* o) {
-  const ResultObject* r = self(o);
-  const std::string s = "<vereshchagin.SolveResult n_joints=" + std::to_string(r->layout.nj) +
-                        " m=" + std::to_string(r->layout.m) + " rank=" + std::to_string(r->rank) +
-                        (r->layout.friction ? " friction" : "") + ">";
-  return PyUnicode_FromString(s.c_str());
-}
-
 void* closure(intptr_t which) {
   return reinterpret_cast<void*>(which);
 }
 
-// Docstrings are set in bindResultType(); segment_nu is a property added by vereshchagin/_results.py.
+// Docstrings are set in bindResultType(); segment_nu and __repr__ are vereshchagin/_results.py's.
 PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, closure(kQdd)},
                           {"tau_command", getView, nullptr, nullptr, closure(kTau)},
                           {"nu", getView, nullptr, nullptr, closure(kNu)},
@@ -125,15 +117,11 @@ PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, closure(kQdd)},
                           {"_segment_layout", getSegments, nullptr, nullptr, nullptr},
                           {nullptr, nullptr, nullptr, nullptr, nullptr}};
 
-ResultObject* checked(const py::handle& o) {
-  if (Py_TYPE(o.ptr()) != g_type) raise("expected a SolveResult");
-  return self(o.ptr());
-}
-
 // The pickle state (n_joints, n_segments, m, friction, smin, gauss, rank, iterations, data bytes,
 // keys, starts, counts), the last three None without constraints= keys.
 py::tuple resultState(const py::handle& o) {
-  const ResultObject* r = checked(o);
+  if (Py_TYPE(o.ptr()) != g_type) raise("expected a SolveResult");
+  const ResultObject* r = self(o.ptr());
   const ResultLayout& l = r->layout;
   const auto seg = [r](int k) { return py::reinterpret_borrow<py::object>(r->segments[k] ? r->segments[k] : Py_None); };
   const py::bytes data(reinterpret_cast<const char*>(r->data), sizeof(double) * bufferDoubles(l));
@@ -166,7 +154,6 @@ py::object resultFromParts(const py::tuple& sizes, const py::tuple& scalars, con
 void bindResultType(py::module_& mod) {
   for (PyGetSetDef* g = g_getset; g->name[0] != '_'; ++g) g->doc = doc(std::string("SolveResult.") + g->name);
   static PyType_Slot slots[] = {{Py_tp_dealloc, reinterpret_cast<void*>(dealloc)},
-                                {Py_tp_repr, reinterpret_cast<void*>(repr)},
                                 {Py_tp_getset, g_getset},
                                 {Py_tp_doc, const_cast<char*>(doc("SolveResult"))},
                                 {0, nullptr}};

@@ -1,4 +1,4 @@
-"""SolveResult's pickling, copies and ``segment_nu``, written in Python over the compiled type.
+"""SolveResult's pickling, copies, ``segment_nu`` and repr, written in Python over the compiled type.
 
 The compiled ``_core.SolveResult`` keeps only the storage, its array views and the solve path's
 fast access (``python/bindings/result_type.cpp``). Its pickle state is the 12-tuple of
@@ -74,7 +74,7 @@ def _result_from_state(*state) -> SolveResult:
     if not isinstance(state[8], bytes):
         raise ValueError("SolveResult state: data must be bytes")
     if state[9] is not None:
-        _check_segment_layout(*state[9:], sizes[2])
+        _check_segment_layout(state[9], state[10], state[11], sizes[2])
     return _result_from_parts(sizes, (rank, state[4], state[5], iterations), state[8], state[9:])
 
 
@@ -102,7 +102,19 @@ def _segment_nu(self: SolveResult):
     return {key: nu[start : start + count] for key, start, count in zip(*layout)}
 
 
-SolveResult.__reduce__ = _reduce
-SolveResult.__copy__ = _copy
-SolveResult.__deepcopy__ = _deepcopy
-SolveResult.segment_nu = property(_segment_nu, doc=DOCS["SolveResult.segment_nu"])
+def _repr(self: SolveResult) -> str:
+    """``<vereshchagin.SolveResult n_joints=7 m=6 rank=6 friction>`` (" friction": a friction solve)."""
+    friction = " friction" if self.friction_torque is not None else ""
+    return f"<vereshchagin.SolveResult n_joints={len(self.qdd)} m={len(self.nu)} rank={self.constraint_rank}{friction}>"
+
+
+# Attached to the compiled type (its stub declares them; setattr because a type checker rejects
+# assigning to a declared method).
+for _name, _value in [
+    ("__repr__", _repr),
+    ("__reduce__", _reduce),
+    ("__copy__", _copy),
+    ("__deepcopy__", _deepcopy),
+    ("segment_nu", property(_segment_nu, doc=DOCS["SolveResult.segment_nu"])),
+]:
+    setattr(SolveResult, _name, _value)
