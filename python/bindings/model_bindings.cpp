@@ -5,8 +5,6 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
-#include <sstream>
-
 #include "model_class.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg, the F64View helpers
 #include "vereshchagin/robot_edit.hpp"
@@ -96,15 +94,6 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
   return cls;
 }
 
-std::string jointRepr(const JointSpec& j) {
-  if (j.type == KDL::Joint::Fixed) return "Joint.fixed()";
-  std::ostringstream s;
-  s << (j.type == KDL::Joint::RotAxis ? "Joint.revolute(" : "Joint.prismatic(") << "axis=[" << j.axis.x() << ", "
-    << j.axis.y() << ", " << j.axis.z() << "], origin=[" << j.origin.x() << ", " << j.origin.y() << ", " << j.origin.z()
-    << "])";
-  return s.str();
-}
-
 JointSpec axisJointArg(KDL::Joint::JointType type, O axis, O origin) {
   JointSpec j;
   const KDL::Vector o = origin.is_none() ? KDL::Vector::Zero() : vec3(origin, "origin");
@@ -117,10 +106,8 @@ JointSpec jointArg(O joint) {
   if (py::isinstance<JointSpec>(joint)) return joint.cast<JointSpec>();
   if (!py::isinstance<py::str>(joint))
     raise("joint must be a joint-type string such as 'rot_z' or a vereshchagin.Joint");
-  if (!vereshchagin::jointFromName(joint.cast<std::string>(), j))
-    raise("unknown joint type '" + joint.cast<std::string>() +
-          "': use 'rot_x', 'rot_y', 'rot_z', 'trans_x', 'trans_y', 'trans_z', 'fixed', "
-          "Joint.revolute(axis, origin) or Joint.prismatic(axis, origin)");
+  std::string message;
+  if (!vereshchagin::jointFromName(joint.cast<std::string>(), j, message)) raise(message);
   return j;
 }
 
@@ -177,7 +164,7 @@ void bindChain(py::module_& mod) {
   joint
       .def_static(
           "fixed", [] { return JointSpec(); }, doc("Joint.fixed"))
-      .def("__repr__", &jointRepr);
+      .def("__repr__", &vereshchagin::jointExpression);
   bindModel<PyChain>(mod, "Chain")
       .def(py::init<>())
       .def("add_segment", &addSegment, doc("Chain.add_segment"), py::arg("name"), py::arg("joint"),

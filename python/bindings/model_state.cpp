@@ -2,7 +2,6 @@
 // casters; the C++ library checks the records), and from_urdf's source argument.
 #include <pybind11/stl.h>
 
-#include <fstream>
 #include <tuple>
 
 #include "model_class.hpp"
@@ -98,25 +97,20 @@ Model modelFromState(const py::tuple& state) {
 template <class Model>
 Model modelFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
                     const std::string& inertia_check) {
-  vereshchagin::UrdfOptions options;
-  options.inertia_check = inertiaCheckArg(inertia_check, "");
+  const vereshchagin::UrdfOptions options{inertiaCheckArg(inertia_check, "")};
   if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
     raise("source must be URDF XML text or a file path");
-  const std::string text = py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>();
-  const bool is_text = text.find('<') != std::string::npos;
-  if (!is_text && !std::ifstream(text)) raise("URDF source is neither XML text nor a readable file: '" + text + "'");
-  Model model;
-  model.inertia_check = options.inertia_check;
-  const auto r = [&] {
+  const std::string text = py::str(py::module_::import("os").attr("fspath")(source));
+  auto r = [&] {
     if constexpr (std::is_same_v<Model, PyTree>)
-      return is_text ? vereshchagin::treeFromUrdfString(text, root, options)
-                     : vereshchagin::treeFromUrdfFile(text, root, options);
+      return vereshchagin::treeFromUrdf(text, root, options);
     else
-      return is_text ? vereshchagin::chainFromUrdfString(text, root, tip, options)
-                     : vereshchagin::chainFromUrdfFile(text, root, tip, options);
+      return vereshchagin::chainFromUrdf(text, root, tip, options);
   }();
   if (!r.ok) raise(r.message);
-  model.robot = r.robot;
+  Model model;
+  model.robot = std::move(r.robot);
+  model.inertia_check = options.inertia_check;
   return model;
 }
 
