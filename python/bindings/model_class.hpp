@@ -57,7 +57,8 @@ using PyTree = PyModel<vereshchagin::RobotTree>;
 // A segment: (name, joint name, joint type, origin, axis, rotor inertia, damping, stiffness, tip
 // frame (12), the 13 stored inertia doubles), restored bit for bit; a joint: (name, type, lower,
 // upper, velocity_limit, effort_limit, friction, damping, segment); a link: (name, segment, frame
-// (12)). States of six entries (no inertia_check) load as 'physical'. Crafted states raise
+// (12)); lists hold the records, the vectors of 3, 12 and 13 doubles are lists (any sequence
+// loads). States of six entries (no inertia_check) load as 'physical'. Crafted states raise
 // SolverError naming the record ("Chain state: ...", "Tree state: ...").
 template <class Model>
 py::tuple modelState(const Model& model);

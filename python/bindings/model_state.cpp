@@ -2,8 +2,6 @@
 // casters; the C++ library checks the records), and from_urdf's source argument.
 #include <pybind11/stl.h>
 
-#include <tuple>
-
 #include "model_class.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg
 #include "vereshchagin/robot_state.hpp"
@@ -13,47 +11,35 @@ namespace vsbind {
 
 namespace {
 
+using vereshchagin::RecordTuples;
 using vereshchagin::RobotRecord;
-using Frame12 = std::array<double, 12>;
-using SegmentState = std::tuple<std::string, std::string, long long, std::array<double, 3>, std::array<double, 3>,
-                                double, double, double, Frame12, std::array<double, 13>>;
-using JointState = std::tuple<std::string, std::string, double, double, double, double, double, double, long long>;
-using LinkState = std::tuple<std::string, long long, Frame12>;
-// A state's segments, joints and links: a Tree's segments are (segment, parent index) pairs.
+// A state's segments: a Tree's are (segment, parent index) pairs, a Chain's segments alone.
 template <bool tree>
-using Records = std::tuple<std::vector<std::conditional_t<tree, std::pair<SegmentState, long long>, SegmentState>>,
-                           std::vector<JointState>, std::vector<LinkState>>;
-
-SegmentState segmentState(const vereshchagin::SegmentRecord& s) {
-  return {s.name,          s.joint_name, s.joint_type, s.origin, s.axis,
-          s.rotor_inertia, s.damping,    s.stiffness,  s.tip,    s.inertia};
-}
-
-void addSegment(RobotRecord& r, const SegmentState& s, long long parent) {
-  r.segments.push_back(std::apply([&](const auto&... x) { return vereshchagin::SegmentRecord{x..., parent}; }, s));
-}
+using Segments =
+    std::vector<std::conditional_t<tree, std::pair<vereshchagin::SegmentTuple, long long>, vereshchagin::SegmentTuple>>;
 
 // The records of a state (model_class.hpp gives both layouts); a malformed entry raises naming `what`.
 template <bool tree>
 RobotRecord recordFrom(const py::tuple& state, const std::string& what) {
   RobotRecord r;
-  Records<tree> records;
+  RecordTuples t;
+  Segments<tree> segments;
   try {
-    records = py::make_tuple(state[tree ? 2 : 1], state[tree ? 3 : 2], state[tree ? 4 : 3]).cast<Records<tree>>();
+    segments = state[tree ? 2 : 1].template cast<Segments<tree>>();
+    t.joints = state[tree ? 3 : 2].template cast<std::vector<vereshchagin::JointTuple>>();
+    t.links = state[tree ? 4 : 3].template cast<std::vector<vereshchagin::LinkTuple>>();
     r.root_link = state[tree ? 1 : 4].template cast<std::string>();
     r.notes = state[5].template cast<std::vector<std::string>>();
   } catch (const py::cast_error&) {
     raise(what + ": malformed records (segments, joints and links must be lists of tuples of the pickled layout)");
   }
-  for (const auto& s : std::get<0>(records)) {
+  for (const auto& s : segments) {
     if constexpr (tree)
-      addSegment(r, s.first, s.second);
+      t.segments.push_back(s);
     else
-      addSegment(r, s, -1);  // a chain's parent field is unused
+      t.segments.emplace_back(s, -1);  // a chain's parent field is unused
   }
-  for (const auto& [name, type, lower, upper, velocity, effort, friction, damping, segment] : std::get<1>(records))
-    r.joints.push_back({{name, type, lower, upper, velocity, effort, friction, damping}, segment});
-  for (const auto& [link, segment, frame] : std::get<2>(records)) r.links.push_back({link, segment, frame});
+  vereshchagin::setRecordTuples(t, r);
   return r;
 }
 
@@ -63,21 +49,17 @@ template <class Model>
 py::tuple modelState(const Model& model) {
   constexpr bool tree = std::is_same_v<Model, PyTree>;
   const RobotRecord r = vereshchagin::robotRecord(model.robot);
-  Records<tree> records;
-  for (const auto& s : r.segments) {
+  const RecordTuples t = vereshchagin::recordTuples(r);
+  Segments<tree> segments;
+  for (const auto& s : t.segments) {
     if constexpr (tree)
-      std::get<0>(records).emplace_back(segmentState(s), s.parent);
+      segments.push_back(s);
     else
-      std::get<0>(records).push_back(segmentState(s));
+      segments.push_back(s.first);
   }
-  for (const auto& [j, segment] : r.joints)
-    std::get<1>(records).emplace_back(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction,
-                                      j.damping, segment);
-  for (const auto& l : r.links) std::get<2>(records).emplace_back(l.link, l.segment, l.frame);
-  const py::tuple t = py::cast(records);  // segments, joints, links
   const char* check = vereshchagin::inertiaCheckName(model.inertia_check);
-  if (tree) return py::make_tuple(1, r.root_link, t[0], t[1], t[2], r.notes, check);
-  return py::make_tuple(1, t[0], t[1], t[2], r.root_link, r.notes, check);
+  if (tree) return py::make_tuple(1, r.root_link, segments, t.joints, t.links, r.notes, check);
+  return py::make_tuple(1, segments, t.joints, t.links, r.root_link, r.notes, check);
 }
 
 template <class Model>
