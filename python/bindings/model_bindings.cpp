@@ -41,16 +41,8 @@ auto each(T Item::*field) {
   };
 }
 
-template <class M>
-std::string repr(const M& m) {
-  const bool tree = std::is_same_v<M, PyTree>;
-  return std::string(tree ? "<vereshchagin.Tree with " : "<vereshchagin.Chain with ") +
-         std::to_string(m.segmentCount()) + " segments, " + std::to_string(vereshchagin::jointCount(m.robot)) +
-         " joints" + (tree ? ", base '" + m.robot.root_link + "'>" : ">");
-}
-
-// Sizes, names, the base, notes, joint data, masses, rotor inertia, the indices, pickle, copies
-// and repr; the docstring of Chain.lower is DOCS["Chain.lower"].
+// Sizes, names, the base, notes, joint data, masses, rotor inertia, the indices, pickle and
+// copies (repr: vereshchagin/_models.py); the docstring of Chain.lower is DOCS["Chain.lower"].
 template <class M>
 py::class_<M> bindModel(py::module_& mod, const char* name) {
   py::class_<M> cls(mod, name, doc(name));
@@ -89,8 +81,7 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
       .def(py::pickle(&modelState<M>, &modelFromState<M>))
       .def("__copy__", [](const M& m) { return m; })
       .def(
-          "__deepcopy__", [](const M& m, const py::dict&) { return m; }, py::arg("memo"))
-      .def("__repr__", &repr<M>);
+          "__deepcopy__", [](const M& m, const py::dict&) { return m; }, py::arg("memo"));
   return cls;
 }
 
