@@ -1,5 +1,5 @@
-// Reading and editing RobotChain and RobotTree alike: segments, rotor inertias, name lookups and
-// the chain of a tree path (robot_access.hpp).
+// Reading and editing RobotChain and RobotTree alike: segments, rotor inertias, name lookups (with
+// the messages naming what exists) and the chain of a tree path (robot_access.hpp).
 #include "vereshchagin/robot_access.hpp"
 
 #include <algorithm>
@@ -43,7 +43,45 @@ bool findFrameIn(const Robot& robot, const std::string& name, FrameRef& out) {
   return true;
 }
 
+template <class Robot>
+Status findFrameOrSay(const Robot& robot, const std::string& name, FrameRef& out, std::string& message) {
+  if (findFrameIn(robot, name, out)) return Status();
+  message = "no segment or link named '" + name + "' (segments: " + nameList(segmentNames(robot)) +
+            (robot.root_link.empty() ? "" : "; base: '" + robot.root_link + "'") + ")";
+  return Status(Error::OutOfRange, message.c_str());
+}
+
+template <class Robot>
+Status findJointOrSay(const Robot& robot, const std::string& name, int& index, std::string& message) {
+  index = findJoint(robot, name);
+  if (index >= 0) return Status();
+  std::vector<std::string> names;
+  for (const JointInfo& j : robot.joints) names.push_back(j.name);
+  message = "no joint named '" + name + "' (joints: " + nameList(names) + ")";
+  return Status(Error::OutOfRange, message.c_str());
+}
+
 }  // namespace
+
+std::string nameList(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t k = 0; k < names.size() && k < 12; ++k) out += (k ? ", '" : "'") + names[k] + "'";
+  if (names.size() > 12) out += ", ... (" + std::to_string(names.size()) + " in all)";
+  return out;
+}
+
+Status findFrame(const RobotChain& robot, const std::string& name, FrameRef& out, std::string& message) {
+  return findFrameOrSay(robot, name, out, message);
+}
+Status findFrame(const RobotTree& robot, const std::string& name, FrameRef& out, std::string& message) {
+  return findFrameOrSay(robot, name, out, message);
+}
+Status findJoint(const RobotChain& robot, const std::string& name, int& index, std::string& message) {
+  return findJointOrSay(robot, name, index, message);
+}
+Status findJoint(const RobotTree& robot, const std::string& name, int& index, std::string& message) {
+  return findJointOrSay(robot, name, index, message);
+}
 
 int segmentCount(const RobotChain& robot) {
   return static_cast<int>(robot.chain.getNrOfSegments());

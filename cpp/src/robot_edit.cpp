@@ -82,6 +82,23 @@ bool jointFromName(const std::string& name, JointSpec& out) {
   return false;
 }
 
+Status jointFromName(const std::string& name, JointSpec& out, std::string& message) {
+  if (jointFromName(name, out)) return Status();
+  message = "unknown joint type '" + name +
+            "': use 'rot_x', 'rot_y', 'rot_z', 'trans_x', 'trans_y', 'trans_z', 'fixed', "
+            "Joint.revolute(axis, origin) or Joint.prismatic(axis, origin)";
+  return Status(Error::OutOfRange, message.c_str());
+}
+
+std::string jointExpression(const JointSpec& j) {
+  if (j.type == KDL::Joint::Fixed) return "Joint.fixed()";
+  std::ostringstream s;
+  s << (j.type == KDL::Joint::RotAxis ? "Joint.revolute(" : "Joint.prismatic(") << "axis=[" << j.axis.x() << ", "
+    << j.axis.y() << ", " << j.axis.z() << "], origin=[" << j.origin.x() << ", " << j.origin.y() << ", " << j.origin.z()
+    << "])";
+  return s.str();
+}
+
 Status axisJoint(KDL::Joint::JointType type, const KDL::Vector& axis, const KDL::Vector& origin, JointSpec& out) {
   const double norm = axis.Norm();
   if (!finite(axis) || !(norm > 1e-12)) return Status(Error::OutOfRange, "axis must be a non-zero 3-vector");

@@ -121,6 +121,30 @@ Status failed(std::string& message, const std::string& text) {
 
 }  // namespace
 
+RecordTuples recordTuples(const RobotRecord& record) {
+  RecordTuples t;
+  for (const SegmentRecord& s : record.segments)
+    t.segments.push_back({{s.name, s.joint_name, s.joint_type, s.origin, s.axis, s.rotor_inertia, s.damping,
+                           s.stiffness, s.tip, s.inertia},
+                          s.parent});
+  for (const auto& [j, segment] : record.joints)
+    t.joints.emplace_back(j.name, j.type, j.lower, j.upper, j.velocity_limit, j.effort_limit, j.friction, j.damping,
+                          segment);
+  for (const LinkRecord& l : record.links) t.links.emplace_back(l.link, l.segment, l.frame);
+  return t;
+}
+
+void setRecordTuples(const RecordTuples& tuples, RobotRecord& record) {
+  record.segments.clear();
+  record.joints.clear();
+  record.links.clear();
+  for (const auto& [s, parent] : tuples.segments)
+    record.segments.push_back(std::apply([p = parent](const auto&... x) { return SegmentRecord{x..., p}; }, s));
+  for (const auto& [name, type, lower, upper, velocity, effort, friction, damping, segment] : tuples.joints)
+    record.joints.push_back({{name, type, lower, upper, velocity, effort, friction, damping}, segment});
+  for (const auto& [link, segment, frame] : tuples.links) record.links.push_back({link, segment, frame});
+}
+
 RobotRecord robotRecord(const RobotChain& robot) {
   RobotRecord r;
   r.root_link = robot.root_link;

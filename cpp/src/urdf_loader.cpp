@@ -2,6 +2,7 @@
 #include "vereshchagin/urdf_loader.hpp"
 
 #include <algorithm>
+#include <fstream>
 
 #include <urdf_model/model.h>
 
@@ -199,6 +200,15 @@ UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root, c
   std::string xml;
   if (!urdfparts::readFile(path, xml, r.message)) return r;
   return load(xml, root, tip, options);
+}
+
+UrdfResult chainFromUrdf(const std::string& source, const std::string& root, const std::string& tip,
+                         const UrdfOptions& options) {
+  if (source.find('<') != std::string::npos) return chainFromUrdfString(source, root, tip, options);
+  if (std::ifstream(source)) return chainFromUrdfFile(source, root, tip, options);
+  UrdfResult r;
+  r.message = "URDF source is neither XML text nor a readable file: '" + source + "'";
+  return r;
 }
 
 }  // namespace vereshchagin

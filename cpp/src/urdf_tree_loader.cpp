@@ -1,5 +1,6 @@
 // URDF -> RobotTree. See urdf_loader.hpp for the frame conventions and the segment order.
 #include <algorithm>
+#include <fstream>
 
 #include <urdf_model/model.h>
 
@@ -200,6 +201,14 @@ UrdfTreeResult treeFromUrdfFile(const std::string& path, const std::string& root
   std::string xml;
   if (!urdfparts::readFile(path, xml, r.message)) return r;
   return loadTree(xml, root, options);
+}
+
+UrdfTreeResult treeFromUrdf(const std::string& source, const std::string& root, const UrdfOptions& options) {
+  if (source.find('<') != std::string::npos) return treeFromUrdfString(source, root, options);
+  if (std::ifstream(source)) return treeFromUrdfFile(source, root, options);
+  UrdfTreeResult r;
+  r.message = "URDF source is neither XML text nor a readable file: '" + source + "'";
+  return r;
 }
 
 }  // namespace vereshchagin

@@ -1,6 +1,6 @@
 // robot_access.hpp on a RobotChain and a RobotTree (robot_fixture.hpp): counts, names, masses,
-// rotor inertias (getter, setter, its refusals with the robot unchanged), lookups by name and the
-// chain of one tree path, against the URDF's own numbers and the chain loader's result.
+// rotor inertias (getter, setter, its refusals with the robot unchanged), lookups by name (and
+// their messages) and the chain of one tree path, against the URDF's own numbers and the chain loader's result.
 #include <string>
 #include <vector>
 
@@ -39,6 +39,30 @@ TEST_CASE("frames by name: segments, merged links, the base") {
   CHECK(ref.segment == 7);
   REQUIRE(vereshchagin::findFrame(robotfixture::chain(), "finger", ref));
   CHECK(ref.segment == 1);
+}
+
+TEST_CASE("lookups by name name what exists when they fail") {
+  const vereshchagin::RobotTree tree = robotfixture::tree();
+  vereshchagin::FrameRef ref;
+  std::string message;
+  CHECK(vereshchagin::findFrame(tree, "hand", ref, message));
+  CHECK(ref.segment == 1);
+  CHECK(message.empty());
+  const vereshchagin::Status s = vereshchagin::findFrame(tree, "nowhere", ref, message);
+  CHECK(s.code() == vereshchagin::Error::OutOfRange);
+  CHECK(std::string(s.message()) == message);
+  CHECK(message.rfind("no segment or link named 'nowhere' (segments: '", 0) == 0);
+  CHECK(message.find("'slider'; base: 'base')") != std::string::npos);
+  int index = -1;
+  CHECK(vereshchagin::findJoint(tree, "j_slider", index, message));
+  CHECK(index == 2);
+  CHECK_FALSE(vereshchagin::findJoint(robotfixture::chain(), "j_slider", index, message));
+  CHECK(message.rfind("no joint named 'j_slider' (joints: '", 0) == 0);
+  std::vector<std::string> many;
+  for (int k = 0; k < 13; ++k) many.push_back("n" + std::to_string(k));
+  CHECK(vereshchagin::nameList({"a", "b"}) == "'a', 'b'");
+  CHECK(vereshchagin::nameList(many).find("'n11', ... (13 in all)") != std::string::npos);
+  CHECK(vereshchagin::nameList(many).find("'n12'") == std::string::npos);
 }
 
 TEST_CASE("rotor inertia is set per joint and refused when negative") {

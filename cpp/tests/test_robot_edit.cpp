@@ -1,6 +1,7 @@
 // RobotChain built with addSegment (robot_edit.hpp): each check's message, the robot left
 // unchanged on failure, and segmentSpec reading a segment back (inertia about the centre of mass
-// by the parallel-axis theorem, against the inertia given), plus the joint helpers.
+// by the parallel-axis theorem, against the inertia given), plus the joint helpers and their
+// messages.
 #include <string>
 
 #include <doctest/doctest.h>
@@ -122,4 +123,20 @@ TEST_CASE("joint names and axis joints") {
   CHECK(std::string(zero.message()) == "axis must be a non-zero 3-vector");
   CHECK(std::string(vereshchagin::jointTypeName(KDL::Joint::Fixed)) == "fixed");
   CHECK(std::string(vereshchagin::jointTypeName(KDL::Joint::RotX)) == "rot_x");
+}
+
+TEST_CASE("joint names with messages and joints as Python expressions") {
+  vereshchagin::JointSpec j;
+  std::string message;
+  CHECK(vereshchagin::jointFromName("rot_x", j, message));
+  CHECK(message.empty());
+  const vereshchagin::Status s = vereshchagin::jointFromName("hinge", j, message);
+  CHECK(s.code() == vereshchagin::Error::OutOfRange);
+  CHECK(message.rfind("unknown joint type 'hinge': use 'rot_x', ", 0) == 0);
+  CHECK(message.find("Joint.prismatic(axis, origin)") != std::string::npos);
+  CHECK(vereshchagin::jointExpression(vereshchagin::JointSpec()) == "Joint.fixed()");
+  REQUIRE(vereshchagin::axisJoint(KDL::Joint::RotAxis, {0, 0, 2}, {0.5, 0, 0}, j));
+  CHECK(vereshchagin::jointExpression(j) == "Joint.revolute(axis=[0, 0, 1], origin=[0.5, 0, 0])");
+  REQUIRE(vereshchagin::axisJoint(KDL::Joint::TransAxis, {1, 0, 0}, {}, j));
+  CHECK(vereshchagin::jointExpression(j) == "Joint.prismatic(axis=[1, 0, 0], origin=[0, 0, 0])");
 }

@@ -59,6 +59,21 @@ TEST_CASE("records round-trip a chain and a tree bit for bit") {
   CHECK(GetTreeElementQNr(t.tree.getSegments().find("slider")->second) == 2);
 }
 
+TEST_CASE("record tuples round-trip a tree's records bit for bit") {
+  const vereshchagin::RobotRecord tree = vereshchagin::robotRecord(robotfixture::tree());
+  const vereshchagin::RecordTuples tuples = vereshchagin::recordTuples(tree);
+  REQUIRE(tuples.segments.size() == tree.segments.size());
+  CHECK(std::get<0>(tuples.segments[2].first) == "slider");
+  CHECK(tuples.segments[2].second == tree.segments[2].parent);
+  CHECK(std::get<8>(tuples.joints[2]) == tree.joints[2].segment);
+  vereshchagin::RobotRecord back;
+  back.root_link = tree.root_link;
+  back.notes = tree.notes;
+  back.links.push_back({"stale", 0, {}});  // replaced, not appended to
+  vereshchagin::setRecordTuples(tuples, back);
+  CHECK(sameRecords(back, tree));
+}
+
 TEST_CASE("robotFromRecord refuses crafted records naming the record") {
   using R = vereshchagin::RobotRecord;
   CHECK(refusal(false, [](R&) {}).empty());

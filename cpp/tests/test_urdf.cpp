@@ -122,6 +122,18 @@ std::string replaced(std::string s, const std::string& from, const std::string& 
   return s;
 }
 
+TEST_CASE("chainFromUrdf and treeFromUrdf tell XML text from a file path") {
+  CHECK(vereshchagin::chainFromUrdf(kArm).ok);
+  CHECK(vereshchagin::treeFromUrdf(kArm).ok);
+  const vereshchagin::UrdfResult missing = vereshchagin::chainFromUrdf("/no/such/robot.urdf");
+  CHECK_FALSE(missing.ok);
+  CHECK(missing.message == "URDF source is neither XML text nor a readable file: '/no/such/robot.urdf'");
+  CHECK(vereshchagin::treeFromUrdf("/no/such/robot.urdf").message == missing.message);
+  const vereshchagin::UrdfTreeResult directory = vereshchagin::treeFromUrdf(".");
+  CHECK_FALSE(directory.ok);
+  CHECK(directory.message.find("is a directory") != std::string::npos);
+}
+
 TEST_CASE("malformed or unusable URDFs and missing files are refused with a message") {
   expectError("<robot name='x'><link name='a'>", "", "", "malformed URDF", "malformed XML");
   expectError(kArm, "nowhere", "", "root link 'nowhere' not found", "missing root");

@@ -5,14 +5,6 @@ namespace vsbind {
 
 namespace {
 
-// Up to 12 names, quoted, then "... (N in all)".
-std::string nameList(const std::vector<std::string>& names) {
-  std::string out;
-  for (std::size_t k = 0; k < names.size() && k < 12; ++k) out += (k ? ", '" : "'") + names[k] + "'";
-  if (names.size() > 12) out += ", ... (" + std::to_string(names.size()) + " in all)";
-  return out;
-}
-
 // The int value of an index argument, or raises naming the valid range (an int beyond the C range
 // is out of range like any other) or, for a non-int, what names a `what`.
 int indexInRange(PyObject* which, int n, const std::string& label, const std::string& what, const char* named_by) {
@@ -29,20 +21,12 @@ int indexInRange(PyObject* which, int n, const std::string& label, const std::st
 
 }  // namespace
 
-std::vector<std::string> Addressable::segmentNames() const {
-  std::vector<std::string> out;
-  for (int i = 0; i < segmentCount(); ++i) out.push_back(segmentName(i));
-  return out;
-}
-
 FrameTarget Addressable::resolveTarget(PyObject* which, const std::string& label) const {
   if (!PyUnicode_Check(which))
     return {indexInRange(which, segmentCount(), label, "segment", "a str (segment or link name)")};
-  const std::string name = py::handle(which).cast<std::string>();
   vereshchagin::FrameRef ref;
-  if (!frameByName(name, ref))
-    raise(label + ": no segment or link named '" + name + "' (segments: " + nameList(segmentNames()) +
-          (rootLink().empty() ? "" : "; base: '" + rootLink() + "'") + ")");
+  std::string message;
+  if (!frameByName(py::handle(which).cast<std::string>(), ref, message)) raise(label + ": " + message);
   return {ref.segment, ref.in_tip, ref.segment >= 0 && ref.in_tip.p.Norm() != 0.0};  // -1: the base or on it
 }
 
@@ -60,11 +44,10 @@ FrameTarget Addressable::resolveMoving(PyObject* which, const std::string& label
 int Addressable::resolveJoint(PyObject* which, const std::string& label) const {
   if (!PyUnicode_Check(which))
     return indexInRange(which, static_cast<int>(jointInfos().size()), label, "joint", "a str");
-  const std::string name = py::handle(which).cast<std::string>();
-  if (const int j = jointByName(name); j >= 0) return j;
-  std::vector<std::string> names;
-  for (const auto& j : jointInfos()) names.push_back(j.name);
-  raise(label + ": no joint named '" + name + "' (joints: " + nameList(names) + ")");
+  int index = -1;
+  std::string message;
+  if (!jointByName(py::handle(which).cast<std::string>(), index, message)) raise(label + ": " + message);
+  return index;
 }
 
 }  // namespace vsbind

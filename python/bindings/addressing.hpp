@@ -1,7 +1,8 @@
 // One addressing rule for every Python call that names a frame or a joint, shared by Chain and
 // Tree: a segment name, a link merged into a segment by fixed joints (its pose in that segment's
 // tip frame), the base link by its own name (segment -1), or an int index (negative from the
-// end); joints by name or index. Error messages start with the caller's `label`.
+// end); joints by name or index. The lookups and their messages are the C++ library's
+// (robot_access.hpp); error messages start with the caller's `label`.
 #pragma once
 
 #include <string>
@@ -11,6 +12,7 @@
 
 #include "vereshchagin/model.hpp"        // FrameRef
 #include "vereshchagin/robot_chain.hpp"  // JointInfo
+#include "vereshchagin/status.hpp"
 
 #include "common.hpp"
 
@@ -30,9 +32,7 @@ class Addressable {
   virtual int segmentCount() const = 0;
   virtual const std::string& segmentName(int index) const = 0;
   virtual const std::vector<vereshchagin::JointInfo>& jointInfos() const = 0;
-  virtual const std::string& rootLink() const = 0;
 
-  std::vector<std::string> segmentNames() const;
   // Any frame: segment, merged link, base link (segment -1) or index.
   FrameTarget resolveTarget(PyObject* which, const std::string& label) const;
   // The same for calls that need a moving segment: the base raises.
@@ -43,9 +43,10 @@ class Addressable {
   int resolveJoint(PyObject* which, const std::string& label) const;
 
  protected:
-  // The C++ library's lookups (robot_access.hpp): a frame by name, a joint index by name (-1: none).
-  virtual bool frameByName(const std::string& name, vereshchagin::FrameRef& out) const = 0;
-  virtual int jointByName(const std::string& name) const = 0;
+  // robot_access.hpp's findFrame and findJoint with their messages.
+  using Status = vereshchagin::Status;
+  virtual Status frameByName(const std::string& name, vereshchagin::FrameRef& out, std::string& message) const = 0;
+  virtual Status jointByName(const std::string& name, int& index, std::string& message) const = 0;
 };
 
 }  // namespace vsbind

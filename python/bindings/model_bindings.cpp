@@ -1,19 +1,28 @@
-// vereshchagin.Chain and vereshchagin.Tree: what they share bound once (bindModel), then the
-// members only a Tree has. Conversion and argument messages only: the C++ library reads, checks
-// and edits the robots (robot_access.hpp, robot_edit.hpp, robot_state.hpp, urdf_loader.hpp).
+// vereshchagin.Chain, vereshchagin.Tree and vereshchagin.Joint: what Chain and Tree share bound
+// once (bindModel), then the members only one of them has. Conversion and argument messages only:
+// the C++ library reads, checks and edits the robots (robot_access.hpp, robot_edit.hpp); pickle
+// states and from_urdf are model_state.cpp's.
+#include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "model_class.hpp"
-#include "model_state.hpp"
+#include "py_solver.hpp"  // inertiaCheckArg, the F64View helpers
+#include "vereshchagin/robot_edit.hpp"
 
 namespace vsbind {
 
 namespace {
 
 using vereshchagin::JointInfo;
+using vereshchagin::JointSpec;
 
-py::array_t<double> array(const std::vector<double>& v) {
-  return copyVector(v.data(), static_cast<py::ssize_t>(v.size()));
+py::array array(const double* p, std::size_t n) {
+  py::array a = newDoubles({static_cast<py::ssize_t>(n)});
+  std::copy(p, p + n, doubles(a));
+  return a;
+}
+py::array array(const std::vector<double>& v) {
+  return array(v.data(), v.size());
 }
 
 // A property of every joint (in q order) or link: a float64 array of doubles, or a list.
@@ -32,26 +41,8 @@ auto each(T Item::*field) {
   };
 }
 
-std::string repr(const PyChain& c) {
-  return "<vereshchagin.Chain with " + std::to_string(c.segmentCount()) + " segments, " +
-         std::to_string(vereshchagin::jointCount(c.robot)) + " joints>";
-}
-std::string repr(const PyTree& t) {
-  return "<vereshchagin.Tree with " + std::to_string(t.segmentCount()) + " segments, " +
-         std::to_string(vereshchagin::jointCount(t.robot)) + " joints, base '" + t.robot.root_link + "'>";
-}
-
-PyChain pathChain(const PyTree& t, const py::object& tip) {
-  PyChain c;
-  c.robot = vereshchagin::pathChain(t.robot, t.resolveMoving(tip.ptr(), "tip").segment);
-  c.inertia_check = t.inertia_check;
-  return c;
-}
-
-}  // namespace
-
-// Sizes, names, the base, notes, joint data, masses, rotor inertia, the indices, pickle, copies
-// and repr; the docstring of Chain.lower is DOCS["Chain.lower"].
+// Sizes, names, the base, notes, joint data, masses, rotor inertia, the indices, pickle and
+// copies (repr: vereshchagin/_models.py); the docstring of Chain.lower is DOCS["Chain.lower"].
 template <class M>
 py::class_<M> bindModel(py::module_& mod, const char* name) {
   py::class_<M> cls(mod, name, doc(name));
@@ -66,22 +57,21 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
   prop("link_names", each<M>(&vereshchagin::LinkPlacement::link));
   prop("n_joints", [](const M& m) { return vereshchagin::jointCount(m.robot); });
   prop("n_segments", &M::segmentCount);
-  prop("segment_names", &M::segmentNames);
+  prop("segment_names", [](const M& m) { return vereshchagin::segmentNames(m.robot); });
   prop("root_link", [](const M& m) { return m.robot.root_link; });
   prop("notes", [](const M& m) { return m.robot.notes; });
   prop("inertia_check", [](const M& m) { return vereshchagin::inertiaCheckName(m.inertia_check); });
   prop("segment_masses", [](const M& m) { return array(vereshchagin::segmentMasses(m.robot)); });
   // rotor_inertia: one per joint in q order; the setter (shape (n_joints,), >= 0) rebuilds the robot.
   const auto setRotorInertia = [](M& m, O values) {
-    const Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(m.robot.joints.size()));
+    const F64View v = vectorView(values.ptr(), "rotor_inertia", static_cast<py::ssize_t>(m.robot.joints.size()));
     std::string message;
-    if (!vereshchagin::setRotorInertia(m.robot, std::vector<double>(a.data(), a.data() + a.size()), message))
+    if (!vereshchagin::setRotorInertia(m.robot, std::vector<double>(v.data, v.data + v.size()), message))
       raise(message);
     m.invalidateCompanions();
   };
-  cls.def_property(
-         "rotor_inertia", [](const M& m) { return array(vereshchagin::rotorInertia(m.robot)); }, setRotorInertia,
-         docOf("rotor_inertia"))
+  const auto rotorInertia = [](const M& m) { return array(vereshchagin::rotorInertia(m.robot)); };
+  cls.def_property("rotor_inertia", rotorInertia, setRotorInertia, docOf("rotor_inertia"))
       .def(
           "segment_index", [](const M& m, O which) { return m.resolveMoving(which.ptr(), "segment_index").segment; },
           py::arg("name"), docOf("segment_index"))
@@ -91,11 +81,91 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
       .def(py::pickle(&modelState<M>, &modelFromState<M>))
       .def("__copy__", [](const M& m) { return m; })
       .def(
-          "__deepcopy__", [](const M& m, const py::dict&) { return m; }, py::arg("memo"))
-      .def("__repr__", [](const M& m) { return repr(m); });
+          "__deepcopy__", [](const M& m, const py::dict&) { return m; }, py::arg("memo"));
   return cls;
 }
-template py::class_<PyChain> bindModel<PyChain>(py::module_&, const char*);
+
+JointSpec axisJointArg(KDL::Joint::JointType type, O axis, O origin) {
+  JointSpec j;
+  const KDL::Vector o = origin.is_none() ? KDL::Vector::Zero() : vec3(origin, "origin");
+  if (const vereshchagin::Status s = vereshchagin::axisJoint(type, vec3(axis, "axis"), o, j); !s) raise(s.message());
+  return j;
+}
+
+JointSpec jointArg(O joint) {
+  JointSpec j;
+  if (py::isinstance<JointSpec>(joint)) return joint.cast<JointSpec>();
+  if (!py::isinstance<py::str>(joint))
+    raise("joint must be a joint-type string such as 'rot_z' or a vereshchagin.Joint");
+  std::string message;
+  if (!vereshchagin::jointFromName(joint.cast<std::string>(), j, message)) raise(message);
+  return j;
+}
+
+Eigen::Matrix3d inertiaArg(O inertia, const std::string& name) {
+  if (inertia.is_none()) return Eigen::Matrix3d::Zero();
+  const F64View v = asF64(inertia.ptr(), name.c_str());
+  if (v.ndim != 2 || v.shape[0] != 3 || v.shape[1] != 3)
+    raise(name + " must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + v.shapeString());
+  requireFiniteView(v, name.c_str());
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(v.data);
+}
+
+void addSegment(PyChain& c, const std::string& name, O joint, O tip, O mass, O com, O inertia, O rotor,
+                const std::string& joint_name, const std::string& inertia_check) {
+  const std::string where = "segment '" + name + "': ";  // every message names segment and argument
+  const vereshchagin::InertiaCheck check = inertiaCheckArg(inertia_check, where);
+  vereshchagin::SegmentSpec spec;
+  spec.name = name;
+  spec.joint_name = joint_name;
+  spec.mass = scalarArg(mass, (where + "mass").c_str());
+  spec.rotor_inertia = scalarArg(rotor, (where + "rotor_inertia").c_str());
+  spec.joint = jointArg(joint);
+  if (!tip.is_none()) spec.tip = frameFrom4x4(tip, (where + "tip").c_str());
+  if (!com.is_none()) spec.com = vec3(com, (where + "com").c_str());
+  spec.inertia = inertiaArg(inertia, where + "inertia");
+  std::string message;
+  if (!vereshchagin::addSegment(c.robot, spec, check, message)) raise(message);
+  c.invalidateCompanions();
+  if (check == vereshchagin::InertiaCheck::JointSpace) c.inertia_check = check;
+}
+
+py::dict segmentSpec(const PyChain& c, O which) {
+  const int segment = c.resolveMoving(which.ptr(), "segment").segment;
+  const vereshchagin::SegmentSpec s = vereshchagin::segmentSpec(vereshchagin::segmentAt(c.robot, segment));
+  py::array tip = newDoubles({4, 4});
+  for (int k = 0; k < 16; ++k) doubles(tip)[k] = s.tip(k / 4, k % 4);
+  return py::dict(
+      py::arg("name") = s.name, py::arg("joint_type") = vereshchagin::jointTypeName(s.joint.type),
+      py::arg("axis") = s.joint.type == KDL::Joint::Fixed ? py::object(py::none()) : array(s.joint.axis.data, 3),
+      py::arg("origin") = array(s.joint.origin.data, 3), py::arg("joint_name") = s.joint_name, py::arg("tip") = tip,
+      py::arg("mass") = s.mass, py::arg("com") = array(s.com.data, 3),
+      py::arg("inertia") = py::cast(Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(s.inertia)),
+      py::arg("rotor_inertia") = s.rotor_inertia);
+}
+
+}  // namespace
+
+void bindChain(py::module_& mod) {
+  py::class_<JointSpec> joint(mod, "Joint", doc("Joint"));
+  for (const auto& [name, type] : {std::pair{"revolute", KDL::Joint::RotAxis}, {"prismatic", KDL::Joint::TransAxis}})
+    joint.def_static(
+        name, [type = type](O axis, O origin) { return axisJointArg(type, axis, origin); }, py::arg("axis"),
+        py::arg("origin") = py::none(), doc(std::string("Joint.") + name));
+  joint
+      .def_static(
+          "fixed", [] { return JointSpec(); }, doc("Joint.fixed"))
+      .def("__repr__", &vereshchagin::jointExpression);
+  bindModel<PyChain>(mod, "Chain")
+      .def(py::init<>())
+      .def("add_segment", &addSegment, doc("Chain.add_segment"), py::arg("name"), py::arg("joint"),
+           py::arg("tip") = py::none(), py::arg("mass") = 0.0, py::arg("com") = py::none(),
+           py::arg("inertia") = py::none(), py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "",
+           py::arg("inertia_check") = "physical")
+      .def("segment_spec", &segmentSpec, py::arg("segment"), doc("Chain.segment_spec"))
+      .def_static("from_urdf", &modelFromUrdf<PyChain>, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
+                  py::arg("inertia_check") = "physical", doc("Chain.from_urdf"));
+}
 
 void bindTree(py::module_& mod) {
   const auto fromUrdf = [](O source, O root, const std::string& inertia_check) {
@@ -106,13 +176,19 @@ void bindTree(py::module_& mod) {
     std::copy(t.robot.parent.begin(), t.robot.parent.end(), a.mutable_data());
     return a;
   };
+  const auto chain = [](const PyTree& t, O tip) {
+    PyChain c;
+    c.robot = vereshchagin::pathChain(t.robot, t.resolveMoving(tip.ptr(), "tip").segment);
+    c.inertia_check = t.inertia_check;
+    return c;
+  };
   bindModel<PyTree>(mod, "Tree")
       .def_static("from_urdf", fromUrdf, py::arg("source"), py::arg("root") = py::none(),
                   py::arg("inertia_check") = "physical", doc("Tree.from_urdf"))
       .def_property_readonly(
           "base_name", [](const PyTree& t) { return t.robot.root_link; }, doc("Tree.base_name"))
       .def_property_readonly("parent", parent, doc("Tree.parent"))
-      .def("chain", &pathChain, py::arg("tip"), doc("Tree.chain"));
+      .def("chain", chain, py::arg("tip"), doc("Tree.chain"));
 }
 
 }  // namespace vsbind

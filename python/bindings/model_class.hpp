@@ -31,13 +31,14 @@ struct PyModel : CompanionModel {
   int segmentCount() const override { return vereshchagin::segmentCount(robot); }
   const std::string& segmentName(int index) const override { return vereshchagin::segmentName(robot, index); }
   const std::vector<vereshchagin::JointInfo>& jointInfos() const override { return robot.joints; }
-  const std::string& rootLink() const override { return robot.root_link; }
 
  protected:
-  bool frameByName(const std::string& name, vereshchagin::FrameRef& out) const override {
-    return vereshchagin::findFrame(robot, name, out);
+  Status frameByName(const std::string& name, vereshchagin::FrameRef& out, std::string& message) const override {
+    return vereshchagin::findFrame(robot, name, out, message);
   }
-  int jointByName(const std::string& name) const override { return vereshchagin::findJoint(robot, name); }
+  Status jointByName(const std::string& name, int& index, std::string& message) const override {
+    return vereshchagin::findJoint(robot, name, index, message);
+  }
   // A tree's Model must order its segments as the PyTree does (the preorder of the KDL::Tree).
   vereshchagin::Model buildModel() const override {
     vereshchagin::Model model(robot, vereshchagin::ModelOptions{inertia_check});
@@ -51,8 +52,23 @@ struct PyModel : CompanionModel {
 using PyChain = PyModel<vereshchagin::RobotChain>;
 using PyTree = PyModel<vereshchagin::RobotTree>;
 
-// Binds what Chain and Tree share (model_bindings.cpp); module.cpp declares bindChain and bindTree.
-template <class M>
-py::class_<M> bindModel(py::module_& mod, const char* name);
+// Pickle states (model_state.cpp). Chain: (1, segments, joints, links, root_link, notes,
+// inertia_check); Tree: (1, root_link, [(segment, parent)], joints, links, notes, inertia_check).
+// A segment: (name, joint name, joint type, origin, axis, rotor inertia, damping, stiffness, tip
+// frame (12), the 13 stored inertia doubles), restored bit for bit; a joint: (name, type, lower,
+// upper, velocity_limit, effort_limit, friction, damping, segment); a link: (name, segment, frame
+// (12)); lists hold the records, the vectors of 3, 12 and 13 doubles are lists (any sequence
+// loads). States of six entries (no inertia_check) load as 'physical'. Crafted states raise
+// SolverError naming the record ("Chain state: ...", "Tree state: ...").
+template <class Model>
+py::tuple modelState(const Model& model);
+template <class Model>
+Model modelFromState(const py::tuple& state);
+
+// Chain.from_urdf / Tree.from_urdf: `source` is URDF XML text (str holding '<') or a readable file
+// path (str or os.PathLike); `tip` is unused for a Tree. Raises SolverError otherwise.
+template <class Model>
+Model modelFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
+                    const std::string& inertia_check);
 
 }  // namespace vsbind

@@ -1,32 +1,26 @@
+// vereshchagin.SolveResult: storage, views and the solve path's fast access (result_type.hpp).
+// Pickling, copies, segment_nu and repr are Python code over this storage (vereshchagin/_results.py).
 #include "result_type.hpp"
 
-#include <pybind11/numpy.h>
-
-#include <cstddef>
 #include <cstring>
 #include <string>
 
 #include "common.hpp"
-#include "model_state.hpp"
 
 namespace vsbind {
 
 namespace {
 
-enum View { kQdd, kTau, kNu, kLinkAcc, kFriction, kLimit, kStatus, kNumViews };
+enum View { kQdd, kTau, kNu, kLinkAcc, kFriction, kLimit, kStatus };
 
 // Every numeric output lives in `data` (allocated with the object: one allocation per solve).
 // Array fields are views of it whose base is the result; they are not cached (a cache would be a
 // reference cycle), so each attribute access makes a new view of the same memory.
 struct ResultObject {
-  PyObject_VAR_HEAD PyObject* segment_keys;  // tuple or NULL: constraints= keys
-  PyObject* segment_starts;                  // tuple of int: first entry of each key's part of nu
-  PyObject* segment_counts;                  // tuple of int: its length
+  PyObject_VAR_HEAD PyObject* segments[3];  // constraints= keys, starts and counts in nu (tuples), or NULL
   ResultLayout layout;
-  int rank;
-  double smin;
-  double gauss;
-  int iterations;
+  int rank, iterations;
+  double smin, gauss;
   double data[1];  // bufferDoubles(layout) entries
 };
 
@@ -34,32 +28,19 @@ PyTypeObject* g_type = nullptr;
 
 Py_ssize_t bufferDoubles(const ResultLayout& l) {
   const Py_ssize_t nj = l.nj, ns = l.ns, m = l.m;  // no int arithmetic: sizes from a state are checked first
-  Py_ssize_t n = 2 * nj + m + 6 * (ns + 1);
-  if (l.friction) n += 2 * nj + (nj + 1) / 2;  // friction, limit torques; int32 status
-  return n;
-}
-
-// Sizes a result can have: up to kMaxSize joints or segments, m <= 6 per segment.
-constexpr long long kMaxSize = 1 << 24;
-
-// A size entry of a SolveResult state, in [0, hi] (model_state.hpp's stateInt).
-int stateSize(const py::handle& obj, long long hi, const char* what) {
-  return static_cast<int>(stateInt(obj, 0, hi, std::string("SolveResult state: ") + what));
+  return 2 * nj + m + 6 * (ns + 1) + (l.friction ? 2 * nj + (nj + 1) / 2 : 0);  // friction, limit, int32 status
 }
 
 ResultObject* self(PyObject* o) {
   return reinterpret_cast<ResultObject*>(o);
 }
 
-double* base(PyObject* o) {
-  return self(o)->data;
+void clearSegments(ResultObject* r) {
+  for (PyObject*& p : r->segments) Py_CLEAR(p);
 }
 
 void dealloc(PyObject* o) {
-  ResultObject* r = self(o);
-  Py_CLEAR(r->segment_keys);
-  Py_CLEAR(r->segment_starts);
-  Py_CLEAR(r->segment_counts);
+  clearSegments(self(o));
   PyTypeObject* tp = Py_TYPE(o);
   tp->tp_free(o);
   Py_DECREF(tp);
@@ -68,233 +49,112 @@ void dealloc(PyObject* o) {
 PyObject* allocate(const ResultLayout& layout) {
   ResultObject* r = PyObject_NewVar(ResultObject, g_type, bufferDoubles(layout));
   if (r == nullptr) throw py::error_already_set();
-  r->segment_keys = r->segment_starts = r->segment_counts = nullptr;
+  r->segments[0] = r->segments[1] = r->segments[2] = nullptr;
   r->layout = layout;
-  r->rank = 0;
+  r->rank = r->iterations = 0;
   r->smin = r->gauss = 0.0;
-  r->iterations = 0;
   return reinterpret_cast<PyObject*>(r);
-}
-
-// A view at `offset_doubles` into the result's data, shaped `dims`; its base is the result.
-PyObject* makeView(ResultObject* r, Py_ssize_t offset_doubles, int nd, const Py_ssize_t* dims, int type_num) {
-  const auto& api = py::detail::npy_api::get();
-  constexpr int flags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_ |
-                        py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  void* data = r->data + offset_doubles;
-  PyObject* v = api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(type_num), nd, dims, nullptr,
-                                          data, flags, nullptr);
-  if (v == nullptr) return nullptr;
-  Py_INCREF(r);
-  if (api.PyArray_SetBaseObject_(v, reinterpret_cast<PyObject*>(r)) != 0) {
-    Py_DECREF(v);
-    return nullptr;
-  }
-  return v;
 }
 
 Py_ssize_t offsetOf(const ResultLayout& l, int which) {
   const Py_ssize_t nj = l.nj, link = 6 * (l.ns + 1);
-  switch (which) {
-    case kQdd:
-      return 0;
-    case kTau:
-      return nj;
-    case kNu:
-      return 2 * nj;
-    case kLinkAcc:
-      return 2 * nj + l.m;
-    case kFriction:
-      return 2 * nj + l.m + link;
-    case kLimit:
-      return 3 * nj + l.m + link;
-    default:
-      return 4 * nj + l.m + link;  // kStatus
-  }
+  const Py_ssize_t offsets[] = {0, nj, 2 * nj, 2 * nj + l.m, 2 * nj + l.m + link, 3 * nj + l.m + link};
+  return which < kStatus ? offsets[which] : 4 * nj + l.m + link;
 }
 
+// Field `which` (closure) as a view into the result's data whose base is the result.
 PyObject* getView(PyObject* o, void* closure) {
   ResultObject* r = self(o);
   const int which = static_cast<int>(reinterpret_cast<intptr_t>(closure));
-  if (which >= kFriction && !r->layout.friction) Py_RETURN_NONE;
   const ResultLayout& l = r->layout;
-  Py_ssize_t dims[2] = {l.nj, 0};
-  int nd = 1;
-  if (which == kNu) dims[0] = l.m;
-  if (which == kLinkAcc) {
-    dims[0] = l.ns + 1;
-    dims[1] = 6;
-    nd = 2;
-  }
+  if (which >= kFriction && !l.friction) Py_RETURN_NONE;
+  const Py_ssize_t dims[2] = {which == kNu ? l.m : which == kLinkAcc ? l.ns + 1 : l.nj, 6};
+  const auto& api = py::detail::npy_api::get();
+  constexpr int flags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_ |
+                        py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   const int type = which == kStatus ? py::detail::npy_api::NPY_INT_ : py::detail::npy_api::NPY_DOUBLE_;
-  return makeView(r, offsetOf(l, which), nd, dims, type);
+  PyObject* v =
+      api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(type), which == kLinkAcc ? 2 : 1, dims,
+                                nullptr, r->data + offsetOf(l, which), flags, nullptr);
+  if (v == nullptr) return nullptr;
+  Py_INCREF(o);
+  if (api.PyArray_SetBaseObject_(v, o) != 0) Py_CLEAR(v);
+  return v;
 }
 
-PyObject* getRank(PyObject* o, void*) {
-  return PyLong_FromLong(self(o)->rank);
-}
-PyObject* getSmin(PyObject* o, void*) {
-  return PyFloat_FromDouble(self(o)->smin);
-}
-PyObject* getGauss(PyObject* o, void*) {
-  if (!self(o)->layout.friction) Py_RETURN_NONE;
-  return PyFloat_FromDouble(self(o)->gauss);
-}
-PyObject* getIterations(PyObject* o, void*) {
-  if (!self(o)->layout.friction) Py_RETURN_NONE;
-  return PyLong_FromLong(self(o)->iterations);
-}
-
-PyObject* getSegmentNu(PyObject* o, void*) {
-  ResultObject* r = self(o);
-  if (r->segment_keys == nullptr) Py_RETURN_NONE;
-  {
-    try {
-      py::object nu = py::reinterpret_steal<py::object>(getView(o, reinterpret_cast<void*>(kNu)));
-      if (!nu) throw py::error_already_set();
-      py::dict d;
-      const py::tuple keys = py::reinterpret_borrow<py::tuple>(r->segment_keys);
-      const py::tuple starts = py::reinterpret_borrow<py::tuple>(r->segment_starts);
-      const py::tuple counts = py::reinterpret_borrow<py::tuple>(r->segment_counts);
-      for (std::size_t k = 0; k < keys.size(); ++k) {
-        const Py_ssize_t a = starts[k].cast<Py_ssize_t>(), c = counts[k].cast<Py_ssize_t>();
-        d[keys[k]] = nu[py::slice(a, a + c, 1)];
-      }
-      return d.release().ptr();
-    } catch (py::error_already_set& e) {
-      e.restore();
-      return nullptr;
-    }
-  }
-}
-
-PyObject* repr(PyObject* o) {
+// Scalar `which` (closure): 0 rank, 1 smin, 2 gauss, 3 iterations (2 and 3: None without friction).
+PyObject* getScalar(PyObject* o, void* closure) {
   const ResultObject* r = self(o);
-  const std::string s = "<vereshchagin.SolveResult n_joints=" + std::to_string(r->layout.nj) +
-                        " m=" + std::to_string(r->layout.m) + " rank=" + std::to_string(r->rank) +
-                        (r->layout.friction ? " friction" : "") + ">";
-  return PyUnicode_FromString(s.c_str());
+  const intptr_t which = reinterpret_cast<intptr_t>(closure);
+  if (which >= 2 && !r->layout.friction) Py_RETURN_NONE;
+  if (which == 0 || which == 3) return PyLong_FromLong(which == 0 ? r->rank : r->iterations);
+  return PyFloat_FromDouble(which == 1 ? r->smin : r->gauss);
 }
 
-PyObject* stateTuple(PyObject* o) {
-  const ResultObject* r = self(o);
-  PyObject* buf = PyBytes_FromStringAndSize(reinterpret_cast<const char*>(r->data),
-                                            static_cast<Py_ssize_t>(sizeof(double)) * bufferDoubles(r->layout));
-  if (buf == nullptr) return nullptr;
-  auto orNone = [](PyObject* x) {
-    PyObject* v = x ? x : Py_None;
-    Py_INCREF(v);
-    return v;
-  };
-  return Py_BuildValue("(iiiiddiiNNNN)", r->layout.nj, r->layout.ns, r->layout.m, static_cast<int>(r->layout.friction),
-                       r->smin, r->gauss, r->rank, r->iterations, buf, orNone(r->segment_keys),
-                       orNone(r->segment_starts), orNone(r->segment_counts));
+// (keys, starts, counts) of segment_nu, or None (vereshchagin/_results.py assembles the dict).
+PyObject* getSegments(PyObject* o, void*) {
+  PyObject* const* s = self(o)->segments;
+  if (s[0] == nullptr) Py_RETURN_NONE;
+  return PyTuple_Pack(3, s[0], s[1], s[2]);
 }
 
-// A segment_nu layout: keys, starts and counts of equal length, each part inside nu (m entries).
-void checkSegmentLayout(const py::handle& keys, const py::handle& starts, const py::handle& counts, int m) {
-  if (starts.is_none() || counts.is_none() || py::len(keys) != py::len(starts) || py::len(keys) != py::len(counts))
-    throw SolverError("SolveResult state: segment layout of inconsistent lengths");
-  const py::tuple s = py::reinterpret_borrow<py::tuple>(starts), c = py::reinterpret_borrow<py::tuple>(counts);
-  for (std::size_t k = 0; k < s.size(); ++k) {
-    const int a = stateSize(s[k], m, "segment layout start"), n = stateSize(c[k], m, "segment layout count");
-    if (a + n > m) throw SolverError("SolveResult state: segment layout beyond nu");
-  }
+void* closure(intptr_t which) {
+  return reinterpret_cast<void*>(which);
 }
 
-PyObject* fromState(PyObject*, PyObject* args) {
-  try {
-    const py::tuple t = py::reinterpret_borrow<py::tuple>(args);
-    if (t.size() != 12) throw SolverError("SolveResult state must have 12 entries");
-    ResultLayout l;
-    l.nj = stateSize(t[0], kMaxSize, "n_joints");
-    l.ns = stateSize(t[1], kMaxSize, "n_segments");
-    l.m = stateSize(t[2], 6LL * l.ns, "m");
-    l.friction = stateSize(t[3], 1, "the friction flag") != 0;
-    if (!PyBytes_Check(t[8].ptr())) throw SolverError("SolveResult state: data must be bytes");
-    const std::string buf = t[8].cast<std::string>();
-    if (buf.size() != sizeof(double) * static_cast<std::size_t>(bufferDoubles(l)))
-      throw SolverError("SolveResult state: data of the wrong size");
-    for (int k = 9; k < 12; ++k)
-      if (!t[k].is_none() && !py::isinstance<py::tuple>(t[k]))
-        throw SolverError("SolveResult state: segment layout entries must be tuples or None");
-    if (!t[9].is_none()) checkSegmentLayout(t[9], t[10], t[11], l.m);
-    PyObject* o = allocate(l);
-    ResultObject* r = self(o);
-    std::memcpy(r->data, buf.data(), buf.size());
-    r->smin = t[4].cast<double>();
-    r->gauss = t[5].cast<double>();
-    r->rank = t[6].cast<int>();
-    r->iterations = t[7].cast<int>();
-    if (!t[9].is_none()) {
-      r->segment_keys = t[9].cast<py::tuple>().release().ptr();
-      r->segment_starts = t[10].cast<py::tuple>().release().ptr();
-      r->segment_counts = t[11].cast<py::tuple>().release().ptr();
-    }
-    return o;
-  } catch (const SolverError& e) {
-    PyErr_SetString(PyExc_ValueError, e.what());
-  } catch (py::error_already_set& e) {
-    e.restore();
-  } catch (const std::exception& e) {
-    PyErr_SetString(PyExc_ValueError, e.what());
-  }
-  return nullptr;
-}
-
-PyObject* g_from_state = nullptr;
-
-PyObject* reduce(PyObject* o, PyObject*) {
-  PyObject* state = stateTuple(o);
-  if (state == nullptr) return nullptr;
-  return Py_BuildValue("(ON)", g_from_state, state);
-}
-
-PyObject* copyResult(PyObject* o, PyObject*) {
-  PyObject* state = stateTuple(o);
-  if (state == nullptr) return nullptr;
-  PyObject* r = fromState(nullptr, state);
-  Py_DECREF(state);
-  return r;
-}
-
-PyObject* deepcopyResult(PyObject* o, PyObject*) {
-  return copyResult(o, nullptr);
-}
-
-PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, reinterpret_cast<void*>(kQdd)},
-                          {"tau_command", getView, nullptr, nullptr, reinterpret_cast<void*>(kTau)},
-                          {"nu", getView, nullptr, nullptr, reinterpret_cast<void*>(kNu)},
-                          {"link_acc", getView, nullptr, nullptr, reinterpret_cast<void*>(kLinkAcc)},
-                          {"constraint_rank", getRank, nullptr, nullptr, nullptr},
-                          {"smallest_singular_value", getSmin, nullptr, nullptr, nullptr},
-                          {"friction_torque", getView, nullptr, nullptr, reinterpret_cast<void*>(kFriction)},
-                          {"limit_torque", getView, nullptr, nullptr, reinterpret_cast<void*>(kLimit)},
-                          {"status", getView, nullptr, nullptr, reinterpret_cast<void*>(kStatus)},
-                          {"gauss_value", getGauss, nullptr, nullptr, nullptr},
-                          {"iterations", getIterations, nullptr, nullptr, nullptr},
-                          {"segment_nu", getSegmentNu, nullptr, nullptr, nullptr},
+// Docstrings are set in bindResultType(); segment_nu and __repr__ are vereshchagin/_results.py's.
+PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, closure(kQdd)},
+                          {"tau_command", getView, nullptr, nullptr, closure(kTau)},
+                          {"nu", getView, nullptr, nullptr, closure(kNu)},
+                          {"link_acc", getView, nullptr, nullptr, closure(kLinkAcc)},
+                          {"constraint_rank", getScalar, nullptr, nullptr, closure(0)},
+                          {"smallest_singular_value", getScalar, nullptr, nullptr, closure(1)},
+                          {"friction_torque", getView, nullptr, nullptr, closure(kFriction)},
+                          {"limit_torque", getView, nullptr, nullptr, closure(kLimit)},
+                          {"status", getView, nullptr, nullptr, closure(kStatus)},
+                          {"gauss_value", getScalar, nullptr, nullptr, closure(2)},
+                          {"iterations", getScalar, nullptr, nullptr, closure(3)},
+                          {"_segment_layout", getSegments, nullptr, nullptr, nullptr},
                           {nullptr, nullptr, nullptr, nullptr, nullptr}};
 
-// Docstrings (and those of g_getset, g_from_state_def) are set in bindResultType().
-PyMethodDef g_methods[] = {{"__reduce__", reduce, METH_NOARGS, nullptr},
-                           {"__copy__", copyResult, METH_NOARGS, nullptr},
-                           {"__deepcopy__", deepcopyResult, METH_O, nullptr},
-                           {nullptr, nullptr, 0, nullptr}};
+// The pickle state (n_joints, n_segments, m, friction, smin, gauss, rank, iterations, data bytes,
+// keys, starts, counts), the last three None without constraints= keys.
+py::tuple resultState(const py::handle& o) {
+  if (Py_TYPE(o.ptr()) != g_type) raise("expected a SolveResult");
+  const ResultObject* r = self(o.ptr());
+  const ResultLayout& l = r->layout;
+  const auto seg = [r](int k) { return py::reinterpret_borrow<py::object>(r->segments[k] ? r->segments[k] : Py_None); };
+  const py::bytes data(reinterpret_cast<const char*>(r->data), sizeof(double) * bufferDoubles(l));
+  return py::make_tuple(l.nj, l.ns, l.m, static_cast<int>(l.friction), r->smin, r->gauss, r->rank, r->iterations, data,
+                        seg(0), seg(1), seg(2));
+}
 
-PyMethodDef g_from_state_def = {"_result_from_state", fromState, METH_VARARGS, nullptr};
+// A result from the entries of a state that vereshchagin/_results.py checked; the sizes and the
+// data length are checked again here, before anything is allocated.
+py::object resultFromParts(const py::tuple& sizes, const py::tuple& scalars, const py::bytes& data,
+                           const py::tuple& seg) {
+  const ResultLayout l{sizes[0].cast<int>(), sizes[1].cast<int>(), sizes[2].cast<int>(), sizes[3].cast<bool>()};
+  if (l.nj < 0 || l.ns < 0 || l.m < 0 || l.nj > (1 << 24) || l.ns > (1 << 24) || l.m > 6 * l.ns)
+    raise("SolveResult state: sizes out of range");
+  const std::string buf = data;
+  if (buf.size() != sizeof(double) * static_cast<std::size_t>(bufferDoubles(l)))
+    raise("SolveResult state: data of the wrong size");
+  py::object o = py::reinterpret_steal<py::object>(allocate(l));
+  ResultObject* r = self(o.ptr());
+  std::memcpy(r->data, buf.data(), buf.size());
+  setResultScalars(o.ptr(), scalars[0].cast<int>(), scalars[1].cast<double>(), scalars[2].cast<double>(),
+                   scalars[3].cast<int>());
+  if (!seg[0].is_none())
+    setSegmentLayout(o.ptr(), seg[0].cast<py::tuple>(), seg[1].cast<py::tuple>(), seg[2].cast<py::tuple>());
+  return o;
+}
 
 }  // namespace
 
 void bindResultType(py::module_& mod) {
-  for (PyGetSetDef* g = g_getset; g->name != nullptr; ++g) g->doc = doc(std::string("SolveResult.") + g->name);
-  for (PyMethodDef* m = g_methods; m->ml_name != nullptr; ++m)
-    m->ml_doc = doc(std::string("SolveResult.") + m->ml_name);
-  g_from_state_def.ml_doc = doc("_core._result_from_state");
+  for (PyGetSetDef* g = g_getset; g->name[0] != '_'; ++g) g->doc = doc(std::string("SolveResult.") + g->name);
   static PyType_Slot slots[] = {{Py_tp_dealloc, reinterpret_cast<void*>(dealloc)},
-                                {Py_tp_repr, reinterpret_cast<void*>(repr)},
                                 {Py_tp_getset, g_getset},
-                                {Py_tp_methods, g_methods},
                                 {Py_tp_doc, const_cast<char*>(doc("SolveResult"))},
                                 {0, nullptr}};
   static PyType_Spec spec = {"vereshchagin._core.SolveResult", static_cast<int>(offsetof(ResultObject, data)),
@@ -303,19 +163,9 @@ void bindResultType(py::module_& mod) {
   if (type == nullptr) throw py::error_already_set();
   g_type = reinterpret_cast<PyTypeObject*>(type);
   mod.add_object("SolveResult", py::reinterpret_borrow<py::object>(type));
-  g_from_state = PyCFunction_NewEx(&g_from_state_def, nullptr, mod.attr("__name__").ptr());
-  if (g_from_state == nullptr) throw py::error_already_set();
-  mod.add_object("_result_from_state", py::reinterpret_borrow<py::object>(g_from_state));
+  mod.def("_result_state", &resultState, doc("_core._result_state"));
+  mod.def("_result_from_parts", &resultFromParts, doc("_core._result_from_parts"));
 }
-
-namespace {
-
-std::string layoutString(const ResultLayout& l) {
-  return "n_joints = " + std::to_string(l.nj) + ", n_segments = " + std::to_string(l.ns) +
-         ", m = " + std::to_string(l.m) + (l.friction ? " with" : " without") + " friction";
-}
-
-}  // namespace
 
 py::object newResult(const ResultLayout& layout, PyObject* out) {
   if (out == nullptr) return py::reinterpret_steal<py::object>(allocate(layout));
@@ -324,27 +174,21 @@ py::object newResult(const ResultLayout& layout, PyObject* out) {
                       std::string(Py_TYPE(out)->tp_name));
   ResultObject* r = self(out);
   const ResultLayout& l = r->layout;
+  const auto str = [](const ResultLayout& x) {
+    return "n_joints = " + std::to_string(x.nj) + ", n_segments = " + std::to_string(x.ns) +
+           ", m = " + std::to_string(x.m) + (x.friction ? " with" : " without") + " friction";
+  };
   if (l.nj != layout.nj || l.ns != layout.ns || l.m != layout.m || l.friction != layout.friction)
-    throw SolverError("out does not fit this solve: it holds " + layoutString(l) + ", this solve has " +
-                      layoutString(layout));
-  Py_CLEAR(r->segment_keys);
-  Py_CLEAR(r->segment_starts);
-  Py_CLEAR(r->segment_counts);
+    throw SolverError("out does not fit this solve: it holds " + str(l) + ", this solve has " + str(layout));
+  clearSegments(r);
   return py::reinterpret_borrow<py::object>(out);
 }
 
 ResultPointers resultPointers(PyObject* o) {
   const ResultLayout& l = self(o)->layout;
-  double* b = base(o);
-  ResultPointers p;
-  p.qdd = b + offsetOf(l, kQdd);
-  p.tau_command = b + offsetOf(l, kTau);
-  p.nu = b + offsetOf(l, kNu);
-  p.link_acc = b + offsetOf(l, kLinkAcc);
-  p.friction_torque = l.friction ? b + offsetOf(l, kFriction) : nullptr;
-  p.limit_torque = l.friction ? b + offsetOf(l, kLimit) : nullptr;
-  p.status = l.friction ? reinterpret_cast<int*>(b + offsetOf(l, kStatus)) : nullptr;
-  return p;
+  double* b = self(o)->data;
+  const auto at = [&](int which) { return l.friction || which < kFriction ? b + offsetOf(l, which) : nullptr; };
+  return {at(kQdd), at(kTau), at(kNu), at(kLinkAcc), at(kFriction), at(kLimit), reinterpret_cast<int*>(at(kStatus))};
 }
 
 void setResultScalars(PyObject* o, int rank, double smin, double gauss, int iterations) {
@@ -356,10 +200,10 @@ void setResultScalars(PyObject* o, int rank, double smin, double gauss, int iter
 }
 
 void setSegmentLayout(PyObject* o, py::tuple keys, py::tuple starts, py::tuple counts) {
-  ResultObject* r = self(o);
-  r->segment_keys = keys.release().ptr();
-  r->segment_starts = starts.release().ptr();
-  r->segment_counts = counts.release().ptr();
+  PyObject** s = self(o)->segments;
+  s[0] = keys.release().ptr();
+  s[1] = starts.release().ptr();
+  s[2] = counts.release().ptr();
 }
 
 }  // namespace vsbind

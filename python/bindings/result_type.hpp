@@ -20,7 +20,8 @@ struct ResultPointers {
   int* status;
 };
 
-// Registers the type on `mod` (as SolveResult) and _result_from_state for unpickling.
+// Registers the type on `mod` (as SolveResult) and _result_state / _result_from_parts, the
+// storage side of pickling (vereshchagin/_results.py).
 void bindResultType(py::module_& mod);
 
 // A new result for `layout` (data uninitialised), or `out` after checking that it is a

@@ -8,7 +8,7 @@ feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL
 """
 
 from ._core import Chain, Joint, SolveResult, SolverError, Tree
-from . import robots, task
+from . import _models, _results, robots, task  # noqa: F401 (_models, _results: members in Python)
 from ._version import __version__ as __version__  # written once: CMakeLists.txt
 from .friction import Friction
 from .kdl_interop import chain_from_kdl as _chain_from_kdl, chain_to_kdl as _chain_to_kdl

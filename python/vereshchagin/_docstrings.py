@@ -644,15 +644,11 @@ DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max
 
 DOCS["SolveResult.segment_nu"] = r"""dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``."""
 
-DOCS["SolveResult.__reduce__"] = r"""Pickle support."""
-
-DOCS["SolveResult.__copy__"] = r"""An independent copy (its own data)."""
-
-DOCS["SolveResult.__deepcopy__"] = r"""An independent copy (its own data)."""
-
 # ---- helpers of the Python layer (companion_task.cpp, result_type.cpp) ----
 
 DOCS["_core._beta_for"] = r"""task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself."""
 
 
-DOCS["_core._result_from_state"] = r"""Unpickle a SolveResult."""
+DOCS["_core._result_state"] = r"""A SolveResult's pickle state (vereshchagin/_results.py restores it)."""
+
+DOCS["_core._result_from_parts"] = r"""A SolveResult from the entries of a state vereshchagin/_results.py checked."""

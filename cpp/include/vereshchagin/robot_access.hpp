@@ -70,6 +70,30 @@ int findJoint(const Robot& robot, const std::string& name) {
   return -1;
 }
 
+/// The names of every segment, in segment order.
+template <class Robot>
+std::vector<std::string> segmentNames(const Robot& robot) {
+  std::vector<std::string> out;
+  for (int i = 0; i < segmentCount(robot); ++i) out.push_back(segmentName(robot, i));
+  return out;
+}
+
+/// `names` as messages list them: up to 12, quoted and comma-separated ("'a', 'b'"), then
+/// ", ... (N in all)" when there are more.
+std::string nameList(const std::vector<std::string>& names);
+
+/// findFrame with the message of a failure: Error::OutOfRange and, in `message`, "no segment or
+/// link named 'x' (segments: 'a', 'b'; base: 'root')" (nameList's list; no base part when the
+/// robot's root_link is empty). On success `out` is set and `message` is untouched.
+Status findFrame(const RobotChain& robot, const std::string& name, FrameRef& out, std::string& message);
+/// The same on a tree.
+Status findFrame(const RobotTree& robot, const std::string& name, FrameRef& out, std::string& message);
+/// findJoint with the message of a failure: Error::OutOfRange and "no joint named 'x' (joints:
+/// 'j1', 'j2')" in `message`; on success `index` is the joint's index in q order.
+Status findJoint(const RobotChain& robot, const std::string& name, int& index, std::string& message);
+/// The same on a tree.
+Status findJoint(const RobotTree& robot, const std::string& name, int& index, std::string& message);
+
 /// The serial chain from the tree's base to segment `tip` (0 <= tip < segmentCount): that path's
 /// segments, their joints and the links placed on them or on the base, the base's root_link, the
 /// tree's note about its root link and a note naming how many segments were left out.

@@ -33,6 +33,16 @@ struct JointSpec {
 /// (out unchanged) for any other name.
 bool jointFromName(const std::string& name, JointSpec& out);
 
+/// jointFromName with the message of a failure: Error::OutOfRange and "unknown joint type 'x':
+/// use 'rot_x', ..., 'fixed', Joint.revolute(axis, origin) or Joint.prismatic(axis, origin)" in
+/// `message` (the names of the Python API).
+Status jointFromName(const std::string& name, JointSpec& out, std::string& message);
+
+/// The Python expression that makes `joint`: "Joint.fixed()", or "Joint.revolute(axis=[0, 0, 1],
+/// origin=[0.1, 0, 0])" / "Joint.prismatic(...)" for RotAxis / TransAxis (values as std::ostream
+/// prints doubles). The named types (RotX, ...) print as "Joint.prismatic(...)" with their fields.
+std::string jointExpression(const JointSpec& joint);
+
 /// A revolute (RotAxis) or prismatic (TransAxis) joint about / along `axis` through `origin`
 /// (parent tip frame, m). The axis is normalised; Error::OutOfRange ("axis must be a non-zero
 /// 3-vector") for an axis of norm <= 1e-12 or not finite, or a non-finite origin ("origin must be

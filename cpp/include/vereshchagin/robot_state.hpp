@@ -7,6 +7,8 @@
 
 #include <array>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "vereshchagin/robot_chain.hpp"
@@ -54,6 +56,29 @@ struct RobotRecord {
   std::vector<LinkRecord> links;        ///< every link and where it went
   std::vector<std::string> notes;       ///< approximations made while building
 };
+
+/// A SegmentRecord's fields but `parent`, in declaration order: an entry of a pickle state.
+using SegmentTuple = std::tuple<std::string, std::string, long long, std::array<double, 3>, std::array<double, 3>,
+                                double, double, double, std::array<double, 12>, std::array<double, 13>>;
+/// A JointRecord: its JointInfo's name, type, lower, upper, velocity_limit, effort_limit,
+/// friction and damping, then the segment index.
+using JointTuple = std::tuple<std::string, std::string, double, double, double, double, double, double, long long>;
+/// A LinkRecord: link, segment, frame.
+using LinkTuple = std::tuple<std::string, long long, std::array<double, 12>>;
+
+/// A RobotRecord's segments, joints and links as tuples of plain values (what the Python pickle
+/// states hold; root_link and notes stay with the RobotRecord).
+struct RecordTuples {
+  std::vector<std::pair<SegmentTuple, long long>> segments;  ///< each segment and its parent index
+  std::vector<JointTuple> joints;                            ///< q order
+  std::vector<LinkTuple> links;                              ///< as RobotRecord::links
+};
+
+/// The tuples of `record`'s segments, joints and links, bit for bit.
+RecordTuples recordTuples(const RobotRecord& record);
+/// The inverse of recordTuples: sets `record`'s segments, joints and links (nothing is checked
+/// here: robotFromRecord checks the result).
+void setRecordTuples(const RecordTuples& tuples, RobotRecord& record);
 
 /// The records of a chain (SegmentRecord::parent = i - 1) and of a tree.
 RobotRecord robotRecord(const RobotChain& robot);

@@ -82,6 +82,12 @@ UrdfResult chainFromUrdfString(const std::string& xml, const std::string& root =
 UrdfResult chainFromUrdfFile(const std::string& path, const std::string& root = "", const std::string& tip = "",
                              const UrdfOptions& options = UrdfOptions());
 
+/// `source` is either URDF XML text (it holds a '<': chainFromUrdfString) or a file path
+/// (chainFromUrdfFile); a path that cannot be opened fails with "URDF source is neither XML text
+/// nor a readable file: '<source>'".
+UrdfResult chainFromUrdf(const std::string& source, const std::string& root = "", const std::string& tip = "",
+                         const UrdfOptions& options = UrdfOptions());
+
 /// xml: the URDF document; root: a link name, empty = the URDF's root link. The tree holds every
 /// link below root (see above for fixed-joint merging, segment order and joint order).
 UrdfTreeResult treeFromUrdfString(const std::string& xml, const std::string& root = "",
@@ -89,5 +95,8 @@ UrdfTreeResult treeFromUrdfString(const std::string& xml, const std::string& roo
 /// The same from the URDF file at path (errors say whether it is missing, a directory or unreadable).
 UrdfTreeResult treeFromUrdfFile(const std::string& path, const std::string& root = "",
                                 const UrdfOptions& options = UrdfOptions());
+/// The same from URDF XML text or a file path, told apart as chainFromUrdf does.
+UrdfTreeResult treeFromUrdf(const std::string& source, const std::string& root = "",
+                            const UrdfOptions& options = UrdfOptions());
 
 }  // namespace vereshchagin
