@@ -13,7 +13,9 @@ namespace {
 using vereshchagin::JointInfo;
 
 py::array_t<double> array(const std::vector<double>& v) {
-  return copyVector(v.data(), static_cast<py::ssize_t>(v.size()));
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
 }
 
 // A property of every joint (in q order) or link: a float64 array of doubles, or a list.
@@ -73,9 +75,9 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
   prop("segment_masses", [](const M& m) { return array(vereshchagin::segmentMasses(m.robot)); });
   // rotor_inertia: one per joint in q order; the setter (shape (n_joints,), >= 0) rebuilds the robot.
   const auto setRotorInertia = [](M& m, O values) {
-    const Array a = vectorArg(values, "rotor_inertia", static_cast<py::ssize_t>(m.robot.joints.size()));
+    const F64View a = vectorView(values.ptr(), "rotor_inertia", static_cast<py::ssize_t>(m.robot.joints.size()));
     std::string message;
-    if (!vereshchagin::setRotorInertia(m.robot, std::vector<double>(a.data(), a.data() + a.size()), message))
+    if (!vereshchagin::setRotorInertia(m.robot, std::vector<double>(a.data, a.data + a.size()), message))
       raise(message);
     m.invalidateCompanions();
   };

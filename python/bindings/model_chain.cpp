@@ -46,12 +46,12 @@ JointSpec jointArg(O joint) {
 Eigen::Matrix3d inertiaArg(O inertia, const std::string& name) {
   Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
   if (inertia.is_none()) return I;
-  const Array a = toArray(inertia, name.c_str());
-  if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
-    raise(name + " must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + shapeStr(a));
-  requireFinite(a, name.c_str());
+  const F64View a = asF64(inertia.ptr(), name.c_str());
+  if (a.ndim != 2 || a.shape[0] != 3 || a.shape[1] != 3)
+    raise(name + " must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + a.shapeString());
+  requireFiniteView(a, name.c_str());
   for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) I(r, k) = a.at(r, k);
+    for (int k = 0; k < 3; ++k) I(r, k) = a.data[3 * r + k];
   return I;
 }
 
@@ -77,12 +77,13 @@ void addSegment(PyChain& c, const std::string& name, O joint, O tip, O mass, O c
 py::dict segmentSpec(const PyChain& c, O which) {
   const int segment = c.resolveMoving(which.ptr(), "segment").segment;
   const vereshchagin::SegmentSpec s = vereshchagin::segmentSpec(vereshchagin::segmentAt(c.robot, segment));
-  const auto vec = [](const double* v) { return copyVector(v, 3); };
+  const auto vec = [](const double* v) { return py::array_t<double>(3, v); };
   return py::dict(
       py::arg("name") = s.name, py::arg("joint_type") = vereshchagin::jointTypeName(s.joint.type),
       py::arg("axis") = s.joint.type == KDL::Joint::Fixed ? py::object(py::none()) : py::object(vec(s.joint.axis.data)),
       py::arg("origin") = vec(s.joint.origin.data), py::arg("joint_name") = s.joint_name,
-      py::arg("tip") = homogeneous(s.tip), py::arg("mass") = s.mass, py::arg("com") = vec(s.com.data),
+      py::arg("tip") = py::cast(vereshchagin::homogeneous(s.tip)), py::arg("mass") = s.mass,
+      py::arg("com") = vec(s.com.data),
       py::arg("inertia") = py::cast(Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(s.inertia)),
       py::arg("rotor_inertia") = s.rotor_inertia);
 }

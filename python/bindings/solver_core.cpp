@@ -105,7 +105,7 @@ Eigen::VectorXi jointList(const Addressable& chain, const py::object& joints) {
     py::array a = joints.cast<py::array>();
     const char kind = a.dtype().kind();
     if (a.ndim() != 1 || (a.size() > 0 && kind != 'i' && kind != 'u' && kind != 'U'))
-      raise(std::string(what) + ", got an array of shape " + shapeStr(a) + " and dtype " +
+      raise(std::string(what) + ", got an array of shape " + std::string(py::str(a.attr("shape"))) + " and dtype " +
             std::string(py::str(a.dtype())));
     seq = a.attr("tolist")();
   } else if (py::isinstance<py::sequence>(joints)) {
