@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "kinematics_impl.hpp"
+#include "dynamics_impl.hpp"
 
 namespace vereshchagin {
 
@@ -30,6 +30,24 @@ bool hasShape(const ArrayArg& a, long rows, long cols) {
   return rows < 0 ? a.ndim == 1 && a.shape[0] == cols : a.ndim == 2 && a.shape[0] == rows && a.shape[1] == cols;
 }
 
+// The 6 x n_segments f_ext of inverse_dynamics: the rows of args[FExt], or the frame wrenches
+// summed onto the tips at q in dd's scratch.
+Status wrenchColumns(const Model& model, DynamicsData& dd, const CompanionCall& c, Eigen::Map<const Matrix6X>& f_ext) {
+  const ArrayArg& f = c.args[static_cast<int>(CompanionArg::FExt)];
+  const long ns = dd.kinematics().impl().ns;
+  if (!c.frame_wrenches_given) {
+    new (&f_ext) Eigen::Map<const Matrix6X>(f.data, 6, f.data ? ns : 0);
+    return Status();
+  }
+  Matrix6X& sums = dd.impl().f_frames;
+  sums.setZero();
+  if (const Status s = forwardKinematics(model, dd.kinematics(), JointPositions(vec(c.args[0]))); !s) return s;
+  for (const auto& [frame, wrench] : c.frame_wrenches)
+    if (const Status s = addFrameWrench(model, dd.kinematics(), frame, wrench, sums); !s) return s;
+  new (&f_ext) Eigen::Map<const Matrix6X>(sums.data(), 6, ns);
+  return Status();
+}
+
 Status dispatch(const Model& model, DynamicsData& dd, const CompanionCall& c, double* out) {
   KinematicsData& kd = dd.kinematics();
   const long n = kd.impl().nj, ns = kd.impl().ns;
@@ -38,10 +56,10 @@ Status dispatch(const Model& model, DynamicsData& dd, const CompanionCall& c, do
   Eigen::Map<Eigen::VectorXd> tau(out, n);
   switch (c.kind) {
     case Companion::InverseDynamics: {
-      const ArrayArg& f = c.args[4];
+      Eigen::Map<const Matrix6X> f_ext(nullptr, 6, 0);
+      if (const Status s = wrenchColumns(model, dd, c, f_ext); !s) return s;
       return inverseDynamics(model, dd, JointPositions(vec(q)), JointVelocities(vec(qd)),
-                             JointAccelerations(vec(c.args[2])), Eigen::Map<const Matrix6X>(f.data, 6, f.data ? ns : 0),
-                             gravity, tau);
+                             JointAccelerations(vec(c.args[2])), f_ext, gravity, tau);
     }
     case Companion::MassMatrix:
       return massMatrix(model, dd, JointPositions(vec(q)), Eigen::Map<Eigen::MatrixXd>(out, n, n));
@@ -77,6 +95,11 @@ const char* companionName(Companion kind) noexcept {
                                       "jacobian",         "twist",       "jacobian_dot_times_qd"};
   const int k = static_cast<int>(kind);
   return k >= 0 && k < 9 ? names[k] : "unknown companion";
+}
+
+const char* companionArgName(CompanionArg arg) noexcept {
+  const int k = static_cast<int>(arg);
+  return k >= 0 && k < 5 ? kArgNames[k] : "unknown argument";
 }
 
 Status checkCompanionArg(KinematicsData& kdata, const CompanionCall& call, CompanionArg arg) {

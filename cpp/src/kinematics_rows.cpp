@@ -1,6 +1,7 @@
 // Kinematics of several states at once and poses as homogeneous matrices (kinematics.hpp): the
 // loops and layouts behind the batched fk and twist of the Python companions, one state per row.
 #include <cmath>
+#include <string>
 
 #include "kinematics_impl.hpp"
 
@@ -21,16 +22,20 @@ Homogeneous homogeneous(const KDL::Frame& pose) {
   return T;
 }
 
-const char* poseFromHomogeneous(const Homogeneous& T, KDL::Frame& pose) {
-  if (std::abs(T(3, 0)) > 1e-12 || std::abs(T(3, 1)) > 1e-12 || std::abs(T(3, 2)) > 1e-12 ||
-      std::abs(T(3, 3) - 1.0) > 1e-12)
-    return " must have last row [0, 0, 0, 1]";
-  const Matrix3 R = T.topLeftCorner<3, 3>();
+std::string poseFromArray(const ArrayArg& T, const char* name, KDL::Frame& pose) {
+  if (T.ndim != 2 || T.shape[0] != 4 || T.shape[1] != 4)
+    return std::string(name) + " must be a 4x4 homogeneous transform, got shape " + T.shapeString();
+  if (std::string why = nonfiniteMessage(T, name); !why.empty()) return why;
+  const Eigen::Map<const Homogeneous> t(T.data);
+  if (std::abs(t(3, 0)) > 1e-12 || std::abs(t(3, 1)) > 1e-12 || std::abs(t(3, 2)) > 1e-12 ||
+      std::abs(t(3, 3) - 1.0) > 1e-12)
+    return std::string(name) + " must have last row [0, 0, 0, 1]";
+  const Matrix3 R = t.topLeftCorner<3, 3>();
   if ((R.transpose() * R - Matrix3::Identity()).cwiseAbs().maxCoeff() > 1e-9 || R.determinant() < 0.0)
-    return ": the upper-left 3x3 block must be a rotation matrix (orthonormal, det +1)";
+    return std::string(name) + ": the upper-left 3x3 block must be a rotation matrix (orthonormal, det +1)";
   pose = KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
-                    KDL::Vector(T(0, 3), T(1, 3), T(2, 3)));
-  return nullptr;
+                    KDL::Vector(t(0, 3), t(1, 3), t(2, 3)));
+  return "";
 }
 
 Status framePoses(const Model& model, KinematicsData& kdata, const Eigen::Ref<const JointRows>& q,

@@ -7,14 +7,13 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include <cmath>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "vereshchagin/array_arg.hpp"
-#include "vereshchagin/kinematics.hpp"  // poseFromHomogeneous
+#include "vereshchagin/kinematics.hpp"  // poseFromArray
 
 namespace vsbind {
 
@@ -24,9 +23,8 @@ struct SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The docstring `key` of vereshchagin/_docstrings.py, where the Python API is documented once;
-// `key` is the Python-visible dotted name ("Chain.fk", "_core.Solver.solve"). Only from the bind
-// functions, never from a namespace-scope initialiser. The text lives as long as the interpreter.
+// The docstring `key` ("Chain.fk", "_core.Solver.solve": the Python-visible dotted name) of
+// vereshchagin/_docstrings.py, which documents the Python API once; only from the bind functions.
 inline const char* doc(const std::string& key) {
   static PyObject* const docs =
       py::object(py::module_::import("vereshchagin._docstrings").attr("DOCS")).release().ptr();
@@ -73,8 +71,7 @@ inline double scalarArg(const py::handle& obj, const char* name) {
   return PyFloat_AsDouble(f.ptr());
 }
 
-// Clears the pending Python error and returns " (its conversion raised Type: message)", so that a
-// message about a failed conversion keeps the reason (e.g. an __array__ that raised).
+// " (its conversion raised Type: message)" for the pending Python error, cleared (or "" if none).
 inline std::string pendingErrorNote() {
   if (!PyErr_Occurred()) return "";
   py::error_already_set e;  // fetches and clears it
@@ -127,9 +124,7 @@ inline F64View asF64(PyObject* obj, const char* name) {
 }
 
 inline void requireFiniteView(const F64View& v, const char* name) {
-  for (py::ssize_t k = 0, n = v.size(); k < n; ++k)
-    if (!std::isfinite(v.data[k]))
-      raise(std::string(name) + " contains NaN or Inf (flat index " + std::to_string(k) + ")");
+  if (const std::string why = vereshchagin::nonfiniteMessage(v, name); !why.empty()) raise(why);
 }
 
 // A checked (n,) vector argument (a scalar is accepted for n == 1 when scalar_ok).
@@ -139,9 +134,7 @@ inline F64View vectorView(PyObject* obj, const char* name, py::ssize_t n, bool s
     v.ndim = 1;
     v.shape[0] = 1;
   }
-  if (v.ndim != 1 || v.shape[0] != n)
-    raise(std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + v.shapeString());
-  requireFiniteView(v, name);
+  if (const std::string why = vereshchagin::vectorMessage(v, name, n); !why.empty()) raise(why);
   return v;
 }
 
@@ -150,15 +143,10 @@ inline KDL::Vector vec3(const py::handle& obj, const char* name) {
   return KDL::Vector(a.data[0], a.data[1], a.data[2]);
 }
 
-// A finite 4x4 homogeneous transform with a proper rotation (vereshchagin::poseFromHomogeneous).
+// A finite 4x4 homogeneous transform with a proper rotation (vereshchagin::poseFromArray).
 inline KDL::Frame frameFrom4x4(const py::handle& obj, const char* name) {
-  const F64View T = asF64(obj.ptr(), name);
-  if (T.ndim != 2 || T.shape[0] != 4 || T.shape[1] != 4)
-    raise(std::string(name) + " must be a 4x4 homogeneous transform, got shape " + T.shapeString());
-  requireFiniteView(T, name);
   KDL::Frame pose;
-  if (const char* why = vereshchagin::poseFromHomogeneous(vereshchagin::Homogeneous(T.data), pose))
-    raise(name + std::string(why));
+  if (const std::string why = vereshchagin::poseFromArray(asF64(obj.ptr(), name), name, pose); !why.empty()) raise(why);
   return pose;
 }
 

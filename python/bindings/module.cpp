@@ -4,12 +4,11 @@
 #include "common.hpp"
 
 namespace vsbind {
-void bindChain(py::module_& mod);        // model_chain.cpp: Joint and Chain
-void bindTree(py::module_& mod);         // model_bindings.cpp
-void bindSolver(py::module_& mod);       // solver_bindings.cpp
-void bindResultType(py::module_& mod);   // result_type.cpp
-void bindDynamics(py::module_& mod);     // companions.cpp: adds the companions to Chain and Tree
-void bindTaskHelpers(py::module_& mod);  // companion_task.cpp: _beta_for
+void bindChain(py::module_& mod);       // model_chain.cpp: Joint and Chain
+void bindTree(py::module_& mod);        // model_bindings.cpp
+void bindSolver(py::module_& mod);      // solver_bindings.cpp
+void bindResultType(py::module_& mod);  // result_type.cpp
+void bindDynamics(py::module_& mod);    // companions.cpp: the companions of Chain and Tree, _beta_for
 }  // namespace vsbind
 
 PYBIND11_MODULE(_core, mod) {
@@ -18,7 +17,6 @@ PYBIND11_MODULE(_core, mod) {
   vsbind::bindChain(mod);
   vsbind::bindTree(mod);
   vsbind::bindResultType(mod);
-  vsbind::bindTaskHelpers(mod);
   vsbind::bindDynamics(mod);
   vsbind::bindSolver(mod);
 }

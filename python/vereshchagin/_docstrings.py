@@ -650,7 +650,7 @@ DOCS["SolveResult.__copy__"] = r"""An independent copy (its own data)."""
 
 DOCS["SolveResult.__deepcopy__"] = r"""An independent copy (its own data)."""
 
-# ---- helpers of the Python layer (companion_task.cpp, result_type.cpp) ----
+# ---- helpers of the Python layer (companions.cpp, result_type.cpp) ----
 
 DOCS["_core._beta_for"] = r"""task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself."""
 

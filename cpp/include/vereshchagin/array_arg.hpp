@@ -1,6 +1,7 @@
 /// @file
 /// A row-major array of doubles with its shape, as a caller hands it over (e.g. the buffer of a
-/// float64 numpy array): what the array-based entry points of companion_call.hpp and task.hpp read.
+/// float64 numpy array): what the array-based entry points of companion_call.hpp, kinematics.hpp
+/// and task.hpp read, and the messages that name such an argument when it is not what they need.
 #pragma once
 
 #include <string>
@@ -26,5 +27,13 @@ struct ArrayArg {
     return s + (ndim == 1 ? ",)" : ")");
   }
 };
+
+/// "" if every element of `a` is finite, else "<name> contains NaN or Inf (flat index k)" for the
+/// first that is not (k counts in row-major order).
+std::string nonfiniteMessage(const ArrayArg& a, const char* name);
+
+/// "" if `a` is a finite vector of shape (n,), else "<name> must have shape (n,), got <shape>" or
+/// nonfiniteMessage's.
+std::string vectorMessage(const ArrayArg& a, const char* name, long n);
 
 }  // namespace vereshchagin

@@ -15,6 +15,9 @@
 /// message lives in the KinematicsData (dd.kinematics()); no allocation on success.
 #pragma once
 
+#include <utility>
+#include <vector>
+
 #include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/dynamics.hpp"
 #include "vereshchagin/kinematics.hpp"
@@ -45,10 +48,18 @@ struct CompanionCall {
   Companion kind = Companion::MassMatrix;  ///< the companion
   ArrayArg args[5];                        ///< indexed by CompanionArg
   FrameRef frame;                          ///< the frame the frame companions are asked of
+  /// inverse_dynamics' f_ext as wrenches on frames instead of rows, when frame_wrenches_given:
+  /// [force (N); moment (N m) about the frame's origin] ON the frame's body BY the environment,
+  /// base axes, summed onto the tips at q (addFrameWrench, dynamics.hpp).
+  std::vector<std::pair<FrameRef, Vector6>> frame_wrenches;
+  bool frame_wrenches_given = false;  ///< use frame_wrenches (even none) as f_ext
 };
 
 /// The Python name of a companion ("jacobian_dot_times_qd", ...).
 const char* companionName(Companion kind) noexcept;
+
+/// The Python name of an argument ("q", "qd", "qdd", "gravity", "f_ext").
+const char* companionArgName(CompanionArg arg) noexcept;
 
 /// Checks call.args[arg] (names: q, qd, qdd, gravity, f_ext): its shape ("q must have shape (7,),
 /// got (6,)", "f_ext must have shape (7, 6) or be a dict {segment: wrench (6,)}, got (7, 3)") as

@@ -31,10 +31,12 @@
 
 #include <array>
 #include <memory>
+#include <string>
 
 #include <Eigen/Core>
 #include <kdl/frames.hpp>
 
+#include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/input.hpp"  // JointPositions, JointVelocities
 #include "vereshchagin/model.hpp"
 #include "vereshchagin/spatial.hpp"
@@ -124,11 +126,12 @@ using TwistRows = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
 /// `pose` (a frame in the base frame, m) as a homogeneous transform.
 Homogeneous homogeneous(const KDL::Frame& pose);
 
-/// The frame of a finite homogeneous transform T (m), written to `pose`. Returns nullptr on success,
-/// else why T is no pose, as a suffix to the argument's name (`pose` is then unchanged):
-/// " must have last row [0, 0, 0, 1]" (an entry off by more than 1e-12), or ": the upper-left 3x3
+/// The pose of a 4x4 homogeneous transform T (row-major array, m), written to `pose`. Returns "" on
+/// success, else the message naming T `name` (`pose` is then unchanged): "<name> must be a 4x4
+/// homogeneous transform, got shape <shape>", nonfiniteMessage's (array_arg.hpp), "<name> must
+/// have last row [0, 0, 0, 1]" (an entry off by more than 1e-12), or "<name>: the upper-left 3x3
 /// block must be a rotation matrix (orthonormal, det +1)" (|R^T R - I| above 1e-9 or det R < 0).
-const char* poseFromHomogeneous(const Homogeneous& T, KDL::Frame& pose);
+std::string poseFromArray(const ArrayArg& T, const char* name, KDL::Frame& pose);
 
 /// framePose at each state: row r of `poses` (rows x 16) is the pose of `frame` at q.row(r) (q:
 /// rows x n_joints). kdata then holds the last row's kinematics. Errors: those of forwardKinematics
