@@ -33,7 +33,7 @@ vs::Status prepare(vs::KinematicsData& kd, vs::CompanionCall& call, int& ndim, l
 }
 
 struct Arm {
-  vs::Model model{kukaLwr4()};
+  vs::Model model{testutil::kukaLwr4()};
   vs::DynamicsData dd{model};
   long n = static_cast<long>(model.nrOfJoints()), ns = static_cast<long>(model.nrOfSegments());
   std::vector<double> q, qd, qdd, g{0.0, 0.0, -9.81};

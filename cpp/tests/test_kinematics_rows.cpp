@@ -49,7 +49,7 @@ TEST_CASE("poses become homogeneous matrices and matrices poses, or say why not"
 }
 
 TEST_CASE("several states at once equal one state at a time") {
-  const vs::Model model(kukaLwr4());
+  const vs::Model model(testutil::kukaLwr4());
   vs::KinematicsData kd(model), ref(model);
   const int n = static_cast<int>(model.nrOfJoints()), ns = static_cast<int>(model.nrOfSegments());
   vs::JointRows q(3, n), qd(3, n);
