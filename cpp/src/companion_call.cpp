@@ -11,8 +11,6 @@ namespace vereshchagin {
 
 namespace {
 
-const char* const kArgNames[5] = {"q", "qd", "qdd", "gravity", "f_ext"};
-
 Eigen::Map<const Eigen::VectorXd> vec(const ArrayArg& a) {
   return Eigen::Map<const Eigen::VectorXd>(a.data, a.size());
 }
@@ -97,15 +95,10 @@ const char* companionName(Companion kind) noexcept {
   return k >= 0 && k < 9 ? names[k] : "unknown companion";
 }
 
-const char* companionArgName(CompanionArg arg) noexcept {
-  const int k = static_cast<int>(arg);
-  return k >= 0 && k < 5 ? kArgNames[k] : "unknown argument";
-}
-
 Status checkCompanionArg(KinematicsData& kdata, const CompanionCall& call, CompanionArg arg) {
   detail::KinematicsImpl& k = kdata.impl();
   const ArrayArg& a = call.args[static_cast<int>(arg)];
-  const char* name = kArgNames[static_cast<int>(arg)];
+  const char* name = companionArgName(arg);
   const bool state_rows = (call.kind == Companion::Fk || call.kind == Companion::Twist) && arg != CompanionArg::Qdd;
   if (arg == CompanionArg::FExt) {
     if (a.data && !hasShape(a, k.ns, 6))

@@ -25,7 +25,7 @@ bool betaShape(const ArrayArg& alfa, const ArrayArg& classical, const ArrayArg& 
   for (const ArrayArg* a : {&alfa, &classical, &twist, &gravity})
     for (long i = 0; i < a->size(); ++i)
       if (!std::isfinite(a->data[i])) return false;
-  if (gravity.size() != 3 || alfa.shape[0] != 6 || (alfa.ndim != 1 && alfa.ndim != 2)) return false;
+  if (gravity.size() != 3 || (alfa.ndim != 1 && alfa.ndim != 2) || alfa.shape[0] != 6) return false;
   const bool batched = twist.ndim == 2 && twist.shape[1] == 6 && twist.size() != 6;
   const long rows = batched ? twist.shape[0] : 1;
   const bool classical_rows = classical.size() != 6;

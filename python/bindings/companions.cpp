@@ -1,8 +1,7 @@
-// The companions of Chain and Tree (companions.hpp), bound on both by one template: Python arguments
-// converted to arrays and handed, one at a time, to the C++ library's checks (companion_call.hpp),
-// which then computes into a numpy array of the shape it reports. Conventions (the solver's):
-// physical gravity, base axes; f_ext ON each segment BY the environment. Also task.py's fast path
-// _core._beta_for (task.hpp's betaShape and betaFromArrays).
+// The companions of Chain and Tree (companions.hpp), bound on both by one template, and task.py's
+// fast path _core._beta_for (task.hpp's betaShape, betaFromArrays). Each Python argument becomes an
+// array that the C++ library checks (companion_call.hpp) and computes on, into a numpy array of the
+// shape it reports. Conventions (the solver's): physical gravity, base axes; f_ext ON each segment.
 #include "model_class.hpp"
 #include "vereshchagin/companion_call.hpp"
 #include "vereshchagin/task.hpp"
@@ -23,7 +22,8 @@ void check(const vs::Status& s) {
 // checked in turn. An f_ext dict {segment or link: wrench (6,), moment about that frame's origin}
 // becomes the call's frame wrenches.
 py::array run(const CompanionModel& m, K kind, std::array<py::handle, 5> args, const FrameTarget& frame = {}) {
-  vs::DynamicsData& d = m.companions();
+  vs::DynamicsData& d = m.companions();  // kd: its kinematics, where every message lives
+  vs::KinematicsData& kd = d.kinematics();
   vs::CompanionCall call{kind, {}, {frame.segment, frame.link_in_tip}};
   F64View views[5];
   for (int k = 0; k < 5; ++k) {
@@ -39,11 +39,11 @@ py::array run(const CompanionModel& m, K kind, std::array<py::handle, 5> args, c
       continue;
     }
     call.args[k] = views[k] = asF64(args[k].ptr(), vs::companionArgName(static_cast<vs::CompanionArg>(k)));
-    check(vs::checkCompanionArg(d.kinematics(), call, static_cast<vs::CompanionArg>(k)));
+    check(vs::checkCompanionArg(kd, call, static_cast<vs::CompanionArg>(k)));
   }
   int ndim = 0;
   py::ssize_t shape[3];
-  check(vs::companionShape(d.kinematics(), call, ndim, shape));
+  check(vs::companionShape(kd, call, ndim, shape));
   py::array out = newArray(py::detail::npy_api::NPY_DOUBLE_, ndim, shape, /*fortran=*/kind == K::Jacobian);
   check(vs::callCompanion(d.model(), d, call, doubles(out)));
   return out;

@@ -59,7 +59,11 @@ struct CompanionCall {
 const char* companionName(Companion kind) noexcept;
 
 /// The Python name of an argument ("q", "qd", "qdd", "gravity", "f_ext").
-const char* companionArgName(CompanionArg arg) noexcept;
+inline const char* companionArgName(CompanionArg arg) noexcept {
+  constexpr const char* names[5] = {"q", "qd", "qdd", "gravity", "f_ext"};
+  const int k = static_cast<int>(arg);
+  return k >= 0 && k < 5 ? names[k] : "unknown argument";
+}
 
 /// Checks call.args[arg] (names: q, qd, qdd, gravity, f_ext): its shape ("q must have shape (7,),
 /// got (6,)", "f_ext must have shape (7, 6) or be a dict {segment: wrench (6,)}, got (7, 3)") as
