@@ -127,7 +127,7 @@ Status inverseDynamics(const Model& model, DynamicsData& ddata, const JointPosit
   k.place(*q);
   d.rnea(q_dot.value().data(), q_ddot.value().data(), f_ext, detail::toEigen(gravity), tau);
   k.has_q = k.has_qd = true;
-  return Status();
+  return k.checkResult(tau);
 }
 
 Status coriolisTorques(const Model& model, DynamicsData& ddata, const JointPositions& q, const JointVelocities& q_dot,
@@ -141,7 +141,7 @@ Status coriolisTorques(const Model& model, DynamicsData& ddata, const JointPosit
   k.place(*q);
   d.rnea(q_dot.value().data(), nullptr, kNoWrenches, Vector3::Zero(), tau);
   k.has_q = k.has_qd = true;
-  return Status();
+  return k.checkResult(tau);
 }
 
 }  // namespace vereshchagin

@@ -63,7 +63,7 @@ Status massMatrix(const Model& model, DynamicsData& ddata, const JointPositions&
     if (s.parent >= 0) addToParent(d, i, s.parent, true);
   }
   k.has_q = true;
-  return Status();
+  return k.checkResult(H);
 }
 
 // With the base accelerated by -g and the bodies at rest, each body needs the wrench
@@ -90,7 +90,7 @@ Status gravityTorques(const Model& model, DynamicsData& ddata, const JointPositi
     if (s.parent >= 0) addToParent(d, i, s.parent, false);
   }
   k.has_q = true;
-  return Status();
+  return k.checkResult(tau);
 }
 
 }  // namespace vereshchagin

@@ -18,13 +18,15 @@ struct DynamicsImpl {
         f(m.nrOfSegments(), Vector6::Zero()),
         mass(m.nrOfSegments(), 0.0),
         h(m.nrOfSegments(), Vector3::Zero()),
-        J(m.nrOfSegments(), Matrix3::Zero()) {}
+        J(m.nrOfSegments(), Matrix3::Zero()),
+        f_frames(6, m.nrOfSegments()) {}
 
   KinematicsData kin;
   std::vector<Vector6> A, f;  // spatial accelerations; transmitted wrenches (about O)
   std::vector<double> mass;   // composite: mass,
   std::vector<Vector3> h;     // first moment sum m c,
   std::vector<Matrix3> J;     // rotational inertia about O
+  Matrix6X f_frames;          // companion_call.cpp: f_ext summed from wrenches on frames
 
   KinematicsImpl& k() { return kin.impl(); }
   Status start(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q) {

@@ -89,6 +89,11 @@ Status KinematicsImpl::checkModel(const Model& m) {
   return Status();
 }
 
+Status KinematicsImpl::checkResult(const Eigen::Ref<const Eigen::MatrixXd>& out) {
+  if (!out.allFinite()) return fail(Error::NonfiniteResult, "the result overflows the double range");
+  return Status();
+}
+
 Status KinematicsImpl::checkVector(const Eigen::Ref<const Eigen::VectorXd>& v, const char* name) {
   if (v.size() != nj)
     return fail(Error::SizeMismatch, "%s has %ld entries, the model has %d joints", name, static_cast<long>(v.size()),

@@ -40,7 +40,7 @@ Status frameTwist(const Model& model, KinematicsData& kdata, const FrameRef& fra
     return Status();
   }
   twist = atPoint(k.st[static_cast<std::size_t>(frame.segment)].V, k.origin(frame));
-  return Status();
+  return k.checkResult(twist);
 }
 
 Status frameJacobian(const Model& model, KinematicsData& kdata, const FrameRef& frame,
@@ -85,7 +85,7 @@ Status frameBiasAcceleration(const Model& model, KinematicsData& kdata, const Fr
   const Vector3 v_P = V.head<3>() + w.cross(P);
   bias.head<3>() = A.head<3>() + A.tail<3>().cross(P) + w.cross(v_P);
   bias.tail<3>() = A.tail<3>();
-  return Status();
+  return k.checkResult(bias);
 }
 
 }  // namespace vereshchagin

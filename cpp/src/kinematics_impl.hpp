@@ -56,6 +56,8 @@ struct KinematicsImpl {
   Status checkModel(const Model& m);
   Status checkVector(const Eigen::Ref<const Eigen::VectorXd>& v, const char* name);
   Status checkFrame(const FrameRef& frame, bool need_qd);
+  // NonfiniteResult when a result of finite inputs overflowed to Inf or NaN (|q_dot| ~ 1e160).
+  Status checkResult(const Eigen::Ref<const Eigen::MatrixXd>& out);
   // Sweeps without checks: poses and axes at q; velocities at q_dot (after place()).
   void place(const Eigen::Ref<const Eigen::VectorXd>& q);
   void velocities(const Eigen::Ref<const Eigen::VectorXd>& qd);

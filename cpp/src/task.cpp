@@ -20,6 +20,40 @@ void betaFromClassical(const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Vect
   beta.noalias() = alfa.transpose() * spatialFromClassical(classical, twist, gravity);
 }
 
+bool betaShape(const ArrayArg& alfa, const ArrayArg& classical, const ArrayArg& twist, const ArrayArg& gravity,
+               int& ndim, long shape[2]) {
+  for (const ArrayArg* a : {&alfa, &classical, &twist, &gravity})
+    for (long i = 0; i < a->size(); ++i)
+      if (!std::isfinite(a->data[i])) return false;
+  if (gravity.size() != 3 || (alfa.ndim != 1 && alfa.ndim != 2) || alfa.shape[0] != 6) return false;
+  const bool batched = twist.ndim == 2 && twist.shape[1] == 6 && twist.size() != 6;
+  const long rows = batched ? twist.shape[0] : 1;
+  const bool classical_rows = classical.size() != 6;
+  if ((!batched && twist.size() != 6) ||
+      (classical_rows && !(batched && classical.ndim == 2 && classical.shape[0] == rows && classical.shape[1] == 6)))
+    return false;
+  const long m = alfa.ndim == 1 ? 1 : alfa.shape[1];
+  ndim = batched ? 2 : 1;
+  shape[0] = batched ? rows : m;
+  shape[1] = m;
+  return true;
+}
+
+bool betaFromArrays(const ArrayArg& alfa, const ArrayArg& classical, const ArrayArg& twist, const ArrayArg& gravity,
+                    double* beta) {
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Index m = alfa.ndim == 1 ? 1 : alfa.shape[1];
+  const Eigen::Index rows = twist.size() / 6;
+  const Eigen::Map<const RowMajor> alfa_rows(alfa.data, 6, m);
+  const KDL::Vector g(gravity.data[0], gravity.data[1], gravity.data[2]);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const Vector6 acc = Eigen::Map<const Vector6>(classical.data + (classical.size() != 6 ? 6 * r : 0));
+    const Vector6 tw = Eigen::Map<const Vector6>(twist.data + 6 * r);
+    Eigen::Map<Eigen::VectorXd>(beta + m * r, m).noalias() = alfa_rows.transpose() * spatialFromClassical(acc, tw, g);
+  }
+  return Eigen::Map<const Eigen::ArrayXd>(beta, rows * m).allFinite();
+}
+
 Status betaForFrame(const Model& model, KinematicsData& kdata, const FrameRef& frame,
                     const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Vector6& classical, const KDL::Vector& gravity,
                     Eigen::Ref<Eigen::VectorXd> beta) {

@@ -1,19 +1,19 @@
-// Shared helpers of the Python bindings: the exception type and checked numpy conversions that
-// name the offending argument in their messages.
+// The conversion vocabulary of the bindings: the exception type, the docstrings, and checked numpy
+// conversions whose messages name the offending argument. Float64 C-contiguous inputs are viewed
+// in place (one type check and a few field reads through numpy's C API table that pybind11 already
+// loads), anything else is converted once with a dtype check; outputs come from PyArray_NewFromDescr.
 #pragma once
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include <cmath>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
-#include <Eigen/Dense>
-#include <kdl/frames.hpp>
-#include <kdl/jntarray.hpp>
+#include "vereshchagin/array_arg.hpp"
+#include "vereshchagin/kinematics.hpp"  // poseFromArray
 
 namespace vsbind {
 
@@ -23,20 +23,21 @@ struct SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The docstring `key` of vereshchagin/_docstrings.py, where the Python API is documented once
-// (module.cpp); `key` is the Python-visible dotted name ("Chain.fk", "_core.Solver.solve"). Only
-// from the bind functions (DOCS is imported when module initialisation starts), never from a
-// namespace-scope initialiser. The text stays alive for the interpreter's lifetime.
-const char* doc(const char* key);
+// The docstring `key` ("Chain.fk", "_core.Solver.solve": the Python-visible dotted name) of
+// vereshchagin/_docstrings.py, which documents the Python API once; only from the bind functions.
 inline const char* doc(const std::string& key) {
-  return doc(key.c_str());
+  static PyObject* const docs =
+      py::object(py::module_::import("vereshchagin._docstrings").attr("DOCS")).release().ptr();
+  PyObject* text = PyDict_GetItemString(docs, key.c_str());  // borrowed
+  if (text == nullptr) throw std::runtime_error("vereshchagin._docstrings has no entry '" + key + "'");
+  const char* utf8 = PyUnicode_AsUTF8(text);
+  if (utf8 == nullptr) throw py::error_already_set();
+  return utf8;
 }
 
 [[noreturn]] inline void raise(const std::string& msg) {
   throw SolverError(msg);
 }
-
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 // The value of an integer argument (an int or anything with __index__; each caller refuses bool
 // and other types with its own message) when it lies in [lo, hi], else std::nullopt: a value
@@ -50,126 +51,125 @@ inline std::optional<long long> intWithin(PyObject* obj, long long lo, long long
   return v;
 }
 
-inline std::string shapeStr(const py::array& a) {
-  std::ostringstream s;
-  s << "(";
-  for (py::ssize_t k = 0; k < a.ndim(); ++k) s << (k ? ", " : "") << a.shape(k);
-  if (a.ndim() == 1) s << ",";
-  s << ")";
-  return s.str();
-}
-
-// A float64 C-contiguous array of a real argument: int and float dtypes (and nested sequences of
-// numbers) are converted; bool, complex, string and object values raise naming `name`.
-inline Array toArray(const py::handle& obj, const char* name) {
-  if (PyBool_Check(obj.ptr())) raise(std::string(name) + " must be a real number or array, got bool");
-  if (obj.is_none()) raise(std::string(name) + " must be a real array, got None");
-  py::array any = py::array::ensure(obj);
-  if (!any) {
-    PyErr_Clear();
-    raise(std::string(name) + " must be a numeric array-like of floats");
-  }
-  const char kind = any.dtype().kind();
-  if (kind != 'f' && kind != 'i' && kind != 'u')
-    raise(std::string(name) + " must hold real numbers (int or float), got dtype " + std::string(py::str(any.dtype())));
-  Array a = Array::ensure(any);
-  if (!a) {
-    PyErr_Clear();
-    raise(std::string(name) + " could not be converted to float64");
-  }
-  return a;
-}
-
 inline std::string fmtDouble(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
 }
 
-// A real scalar (Python int or float, numpy scalar, 0-d array); bool and everything else raise.
+// A real scalar (Python int or float, numpy scalar, 0-d array); bool, str, bytes, None and
+// anything without __float__ raise.
 inline double scalarArg(const py::handle& obj, const char* name) {
-  if (py::isinstance<py::bool_>(obj) || py::isinstance<py::str>(obj) || py::isinstance<py::bytes>(obj) || obj.is_none())
-    raise(std::string(name) + " must be a real number, got " +
-          std::string(py::str(py::type::of(obj).attr("__name__"))));
-  PyObject* f = PyNumber_Float(obj.ptr());
-  if (f == nullptr) {
+  PyObject* o = obj.ptr();
+  const bool refused = PyBool_Check(o) || PyUnicode_Check(o) || PyBytes_Check(o) || o == Py_None;
+  const py::object f = py::reinterpret_steal<py::object>(refused ? nullptr : PyNumber_Float(o));
+  if (!f) {
     PyErr_Clear();
     raise(std::string(name) + " must be a real number, got " +
           std::string(py::str(py::type::of(obj).attr("__name__"))));
   }
-  const double v = PyFloat_AsDouble(f);
-  Py_DECREF(f);
+  return PyFloat_AsDouble(f.ptr());
+}
+
+// " (its conversion raised Type: message)" for the pending Python error, cleared (or "" if none).
+inline std::string pendingErrorNote() {
+  if (!PyErr_Occurred()) return "";
+  py::error_already_set e;  // fetches and clears it
+  const std::string type = py::str(e.type().attr("__name__"));
+  return " (its conversion raised " + type + ": " + std::string(py::str(e.value())) + ")";
+}
+
+// A read-only view of a real array argument (data, ndim, shape, size(), shapeString()). `data`
+// points into numpy memory owned by the caller's object or by `keep` (a converted copy).
+struct F64View : vereshchagin::ArrayArg {
+  py::object keep;
+};
+
+// Views `obj` as float64. Integer and floating arrays (and nested sequences of numbers) are
+// accepted; bool, complex, string, object and other dtypes raise naming `name`. Values are not
+// checked here (see requireFiniteView).
+inline F64View asF64(PyObject* obj, const char* name) {
+  namespace d = py::detail;
+  constexpr int need = d::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | d::npy_api::NPY_ARRAY_ALIGNED_;
+  const auto& api = d::npy_api::get();
+  const auto* arr = api.PyArray_Check_(obj) ? d::array_proxy(obj) : nullptr;
+  const auto* descr = arr ? d::array_descriptor_proxy(arr->descr) : nullptr;
+  F64View v;
+  if (!arr || arr->nd > 3 || (arr->flags & need) != need || descr->type_num != d::npy_api::NPY_DOUBLE_ ||
+      descr->byteorder == '>') {
+    if (obj == Py_None) raise(std::string(name) + " must be a real array, got None");
+    if (PyBool_Check(obj)) raise(std::string(name) + " must be a real number or array, got bool");
+    // PyArray_FromAny keeps the error of a failed conversion (py::array::ensure clears it).
+    const py::array any = py::reinterpret_steal<py::array>(api.PyArray_FromAny_(obj, nullptr, 0, 0, 0, nullptr));
+    if (!any)
+      raise(std::string(name) + " must be a real array (numbers of equal-length rows), got " +
+            std::string(py::str(py::type::of(py::handle(obj)).attr("__name__"))) + pendingErrorNote());
+    const char kind = any.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u')
+      raise(std::string(name) + " must hold real numbers (int or float), got dtype " +
+            std::string(py::str(any.dtype())));
+    if (any.ndim() > 3)
+      raise(std::string(name) + " has " + std::to_string(any.ndim()) + " dimensions; at most 3 are meaningful");
+    v.keep = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(any);  // a float64 copy
+    if (!v.keep) {
+      PyErr_Clear();
+      raise(std::string(name) + " could not be converted to float64");
+    }
+    arr = d::array_proxy(v.keep.ptr());
+  }
+  v.data = reinterpret_cast<const double*>(arr->data);
+  v.ndim = arr->nd;
+  for (int k = 0; k < v.ndim; ++k) v.shape[k] = arr->dimensions[k];
   return v;
 }
 
-inline void requireFinite(const Array& a, const char* name) {
-  const double* p = a.data();
-  for (py::ssize_t k = 0; k < a.size(); ++k) {
-    if (!std::isfinite(p[k])) {
-      raise(std::string(name) + " contains NaN or Inf (flat index " + std::to_string(k) + ")");
-    }
-  }
+inline void requireFiniteView(const F64View& v, const char* name) {
+  if (const std::string why = vereshchagin::nonfiniteMessage(v, name); !why.empty()) raise(why);
 }
 
-inline Array vectorArg(const py::handle& obj, const char* name, py::ssize_t n) {
-  Array a = toArray(obj, name);
-  if (a.ndim() != 1 || a.shape(0) != n) {
-    raise(std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + shapeStr(a));
+// A checked (n,) vector argument (a scalar is accepted for n == 1 when scalar_ok).
+inline F64View vectorView(PyObject* obj, const char* name, py::ssize_t n, bool scalar_ok = false) {
+  F64View v = asF64(obj, name);
+  if (v.ndim == 0 && scalar_ok && n == 1) {
+    v.ndim = 1;
+    v.shape[0] = 1;
   }
-  requireFinite(a, name);
-  return a;
-}
-
-// A finite vector of shape (n,) as joint values.
-inline KDL::JntArray jntArrayArg(const py::handle& obj, const char* name, unsigned int n) {
-  const Array a = vectorArg(obj, name, n);
-  KDL::JntArray out(n);
-  for (unsigned int k = 0; k < n; ++k) out(k) = a.at(k);
-  return out;
-}
-
-inline KDL::Frame frameFrom4x4(const py::handle& obj, const char* name) {
-  Array T = toArray(obj, name);
-  if (T.ndim() != 2 || T.shape(0) != 4 || T.shape(1) != 4) {
-    raise(std::string(name) + " must be a 4x4 homogeneous transform, got shape " + shapeStr(T));
-  }
-  requireFinite(T, name);
-  auto t = T.unchecked<2>();
-  if (std::abs(t(3, 0)) > 1e-12 || std::abs(t(3, 1)) > 1e-12 || std::abs(t(3, 2)) > 1e-12 ||
-      std::abs(t(3, 3) - 1.0) > 1e-12) {
-    raise(std::string(name) + " must have last row [0, 0, 0, 1]");
-  }
-  Eigen::Matrix3d R;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) R(r, c) = t(r, c);
-  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-9 || R.determinant() < 0.0) {
-    raise(std::string(name) + ": the upper-left 3x3 block must be a rotation matrix (orthonormal, det +1)");
-  }
-  return KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
-                    KDL::Vector(t(0, 3), t(1, 3), t(2, 3)));
+  if (const std::string why = vereshchagin::vectorMessage(v, name, n); !why.empty()) raise(why);
+  return v;
 }
 
 inline KDL::Vector vec3(const py::handle& obj, const char* name) {
-  Array a = vectorArg(obj, name, 3);
-  return KDL::Vector(a.at(0), a.at(1), a.at(2));
+  const F64View a = vectorView(obj.ptr(), name, 3);
+  return KDL::Vector(a.data[0], a.data[1], a.data[2]);
 }
 
-inline py::array_t<double> copyVector(const double* p, py::ssize_t n) {
-  py::array_t<double> a(n);
-  std::copy(p, p + n, a.mutable_data());
-  return a;
+// A finite 4x4 homogeneous transform with a proper rotation (vereshchagin::poseFromArray).
+inline KDL::Frame frameFrom4x4(const py::handle& obj, const char* name) {
+  KDL::Frame pose;
+  if (const std::string why = vereshchagin::poseFromArray(asF64(obj.ptr(), name), name, pose); !why.empty()) raise(why);
+  return pose;
 }
 
-// A KDL frame as a row-major 4x4 homogeneous transform written to out[0..15].
-inline void writeHomogeneous(const KDL::Frame& f, double* out) {
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) out[4 * r + c] = r < 3 ? (c < 3 ? f.M(r, c) : f.p(r)) : (c == 3 ? 1.0 : 0.0);
+// New arrays, uninitialised (int arrays hold numpy int32): C-contiguous, or with fortran = true
+// column-major, so that an Eigen column-major matrix can be written in place.
+inline py::array newArray(int type_num, int nd, const py::ssize_t* dims, bool fortran = false) {
+  const auto& api = py::detail::npy_api::get();
+  PyObject* descr = api.PyArray_DescrFromType_(type_num);
+  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, descr, nd, dims, nullptr, nullptr, fortran, nullptr);
+  if (a == nullptr) throw py::error_already_set();
+  return py::reinterpret_steal<py::array>(a);
 }
-
-inline py::array_t<double> homogeneous(const KDL::Frame& f) {
-  py::array_t<double> T({4, 4});
-  writeHomogeneous(f, T.mutable_data());
-  return T;
+inline py::array newDoubles(std::initializer_list<py::ssize_t> shape) {
+  return newArray(py::detail::npy_api::NPY_DOUBLE_, static_cast<int>(shape.size()), shape.begin());
+}
+inline py::array newInts(std::initializer_list<py::ssize_t> shape) {
+  return newArray(py::detail::npy_api::NPY_INT_, static_cast<int>(shape.size()), shape.begin());
+}
+inline double* doubles(const py::array& a) {
+  return reinterpret_cast<double*>(py::detail::array_proxy(a.ptr())->data);
+}
+inline int* ints(const py::array& a) {
+  return reinterpret_cast<int*>(py::detail::array_proxy(a.ptr())->data);
 }
 
 }  // namespace vsbind

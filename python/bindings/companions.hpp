@@ -1,7 +1,6 @@
-// The kinematics and dynamics companions of Chain and Tree (fk, jacobian, twist, fk_all,
-// inverse_dynamics, mass_matrix, ...): the C++ library's kinematics.hpp and dynamics.hpp on a
-// vereshchagin::Model built from the Python model at its first companion call and kept until the
-// model changes (add_segment, rotor_inertia). Callers hold the GIL: one workspace per model.
+// The kinematics and dynamics companions of Chain and Tree (fk, jacobian, inverse_dynamics, ...) run
+// on a vereshchagin::Model built from the Python model at its first companion call and kept, with its
+// workspace, until the model changes (add_segment, rotor_inertia). Callers hold the GIL.
 #pragma once
 
 #include <memory>
@@ -9,32 +8,23 @@
 #include "vereshchagin/dynamics.hpp"
 
 #include "addressing.hpp"
-#include "common.hpp"
 
 namespace vsbind {
-
-struct CompanionCache {
-  explicit CompanionCache(const vereshchagin::Model& m);
-  vereshchagin::KinematicsData& kin() { return dyn.kinematics(); }
-  vereshchagin::Model model;
-  vereshchagin::DynamicsData dyn;
-  vereshchagin::Matrix6X f_ext;  // scratch: 6 x n_segments
-  py::ssize_t n;                 // joints
-};
 
 // What the companions need of a Python model: its names (Addressable) and its cached C++ model.
 class CompanionModel : public Addressable {
  public:
-  CompanionCache& companions() const;              // built at first use from buildModel()
+  vereshchagin::DynamicsData& companions() const {  // built at first use from buildModel()
+    if (!cache_) cache_ = std::make_shared<vereshchagin::DynamicsData>(buildModel());
+    return *cache_;
+  }
   void invalidateCompanions() { cache_.reset(); }  // the robot changed
 
  protected:
   virtual vereshchagin::Model buildModel() const = 0;
 
  private:
-  mutable std::shared_ptr<CompanionCache> cache_;
+  mutable std::shared_ptr<vereshchagin::DynamicsData> cache_;  // its model(): the one built
 };
-
-void bindTaskHelpers(py::module_& mod);  // _core._beta_for (companion_task.cpp)
 
 }  // namespace vsbind

@@ -16,7 +16,6 @@
 
 #include "common.hpp"
 #include "model_class.hpp"
-#include "numpy_fast.hpp"
 
 namespace vsbind {
 

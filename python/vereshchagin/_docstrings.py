@@ -644,7 +644,7 @@ DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max
 
 DOCS["SolveResult.segment_nu"] = r"""dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``."""
 
-# ---- helpers of the Python layer (companion_task.cpp, result_type.cpp) ----
+# ---- helpers of the Python layer (companions.cpp, result_type.cpp) ----
 
 DOCS["_core._beta_for"] = r"""task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself."""
 

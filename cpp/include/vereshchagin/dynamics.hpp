@@ -26,7 +26,9 @@
 /// After a call, dd.kinematics() holds the forward kinematics at q (and at q_dot for
 /// inverseDynamics and coriolisTorques): framePose() etc. of kinematics.hpp can be asked of it.
 /// Errors: NotUpToDate (dd built for another model), SizeMismatch (a vector, f_ext or the output
-/// of the wrong size), NonfiniteInput (NaN or Inf in an input); the message lives in dd. Any Model
+/// of the wrong size), NonfiniteInput (NaN or Inf in an input), NonfiniteResult (finite inputs whose
+/// result overflows, |q_dot| ~ 1e160: message "the result overflows the double range", the output
+/// then holds the overflowing values); the message lives in dd. Any Model
 /// works, also one whose status() reports an inertia problem (the numbers are used as given).
 #pragma once
 

@@ -31,10 +31,12 @@
 
 #include <array>
 #include <memory>
+#include <string>
 
 #include <Eigen/Core>
 #include <kdl/frames.hpp>
 
+#include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/input.hpp"  // JointPositions, JointVelocities
 #include "vereshchagin/model.hpp"
 #include "vereshchagin/spatial.hpp"
@@ -91,7 +93,9 @@ Status forwardKinematics(const Model& model, KinematicsData& kdata, const JointP
 Status framePose(const Model& model, KinematicsData& kdata, const FrameRef& frame, KDL::Frame& pose);
 
 /// Twist [v of the frame's origin (m/s); omega (rad/s)], base axes (zero for the base), at the last
-/// forwardKinematics' q and q_dot. Errors as framePose; NoSolution also without q_dot.
+/// forwardKinematics' q and q_dot. Errors as framePose; NoSolution also without q_dot;
+/// NonfiniteResult (message "the result overflows the double range") when finite inputs give a
+/// twist with Inf or NaN (|q_dot| ~ 1e308).
 Status frameTwist(const Model& model, KinematicsData& kdata, const FrameRef& frame, Vector6& twist);
 
 /// Jacobian (6 x n_joints, columns in joint order, rows [linear; angular], base axes, reference
@@ -101,7 +105,48 @@ Status frameJacobian(const Model& model, KinematicsData& kdata, const FrameRef& 
                      Eigen::Ref<Eigen::MatrixXd> jacobian);
 
 /// Bias acceleration d/dt(J) q_dot = [classical acceleration of the frame's origin (m/s^2); angular
-/// acceleration (rad/s^2)] at q_ddot = 0, gravity excluded, base axes. Needs q_dot (as frameTwist).
+/// acceleration (rad/s^2)] at q_ddot = 0, gravity excluded, base axes. Needs q_dot (as frameTwist);
+/// NonfiniteResult as frameTwist when the result overflows.
 Status frameBiasAcceleration(const Model& model, KinematicsData& kdata, const FrameRef& frame, Vector6& bias);
+
+// ------------------------------------------------------------------------------------------------
+// Several states at once, and poses as homogeneous matrices (kinematics_rows.cpp)
+// ------------------------------------------------------------------------------------------------
+
+/// q or q_dot of several states, one state per row (rows x n_joints, rad or m, rad/s or m/s).
+using JointRows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+/// A pose as the row-major 4x4 homogeneous transform [R p; 0 0 0 1] (R: the frame's axes as
+/// columns in base coordinates; p: its origin in the base frame, m).
+using Homogeneous = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
+/// Poses, one per row: row r holds a Homogeneous in row-major order (rows x 16).
+using PoseRows = Eigen::Matrix<double, Eigen::Dynamic, 16, Eigen::RowMajor>;
+/// Twists [v of the frame's origin (m/s); omega (rad/s)], base axes, one per row (rows x 6).
+using TwistRows = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
+
+/// `pose` (a frame in the base frame, m) as a homogeneous transform.
+Homogeneous homogeneous(const KDL::Frame& pose);
+
+/// The pose of a 4x4 homogeneous transform T (row-major array, m), written to `pose`. Returns "" on
+/// success, else the message naming T `name` (`pose` is then unchanged): "<name> must be a 4x4
+/// homogeneous transform, got shape <shape>", nonfiniteMessage's (array_arg.hpp), "<name> must
+/// have last row [0, 0, 0, 1]" (an entry off by more than 1e-12), or "<name>: the upper-left 3x3
+/// block must be a rotation matrix (orthonormal, det +1)" (|R^T R - I| above 1e-9 or det R < 0).
+std::string poseFromArray(const ArrayArg& T, const char* name, KDL::Frame& pose);
+
+/// framePose at each state: row r of `poses` (rows x 16) is the pose of `frame` at q.row(r) (q:
+/// rows x n_joints). kdata then holds the last row's kinematics. Errors: those of forwardKinematics
+/// and framePose, SizeMismatch for poses without q's row count.
+Status framePoses(const Model& model, KinematicsData& kdata, const Eigen::Ref<const JointRows>& q,
+                  const FrameRef& frame, Eigen::Ref<PoseRows> poses);
+
+/// frameTwist at each state: row r of `twists` (rows x 6) is the twist of `frame` at q.row(r) and
+/// q_dot.row(r) (both rows x n_joints). Errors: those of forwardKinematics and frameTwist,
+/// SizeMismatch for q_dot or twists without q's row count.
+Status frameTwists(const Model& model, KinematicsData& kdata, const Eigen::Ref<const JointRows>& q,
+                   const Eigen::Ref<const JointRows>& q_dot, const FrameRef& frame, Eigen::Ref<TwistRows> twists);
+
+/// The tip pose of every segment at q: row i of `poses` (n_segments x 16) is segment i's. Errors:
+/// those of forwardKinematics, SizeMismatch for poses not n_segments x 16.
+Status segmentPoses(const Model& model, KinematicsData& kdata, const JointPositions& q, Eigen::Ref<PoseRows> poses);
 
 }  // namespace vereshchagin

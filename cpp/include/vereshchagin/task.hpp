@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <kdl/frames.hpp>
 
+#include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/kinematics.hpp"
 #include "vereshchagin/model.hpp"
 #include "vereshchagin/spatial.hpp"
@@ -32,6 +33,19 @@ Vector6 spatialFromClassical(const Vector6& classical, const Vector6& twist, con
 /// beta = alfa^T [-omega x v - gravity; 0], not zero.
 void betaFromClassical(const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Vector6& classical, const Vector6& twist,
                        const KDL::Vector& gravity, Eigen::Ref<Eigen::VectorXd> beta);
+
+/// The shape of beta for the arrays of the Python face's task.beta_for (array_arg.hpp): alfa (6,)
+/// or (6, m) row-major, twist (6,) or (N, 6) one state per row, classical (6,) for every state or
+/// (N, 6) one per twist row, gravity (3,), all finite. Returns false for anything else (the caller
+/// then says what is wrong); else beta's shape, (m,) or (N, m), in ndim and shape.
+bool betaShape(const ArrayArg& alfa, const ArrayArg& classical, const ArrayArg& twist, const ArrayArg& gravity,
+               int& ndim, long shape[2]);
+
+/// betaFromClassical for arrays that passed betaShape: row r of beta (betaShape's shape, row-major)
+/// from twist row r and classical row r (or its only row). Returns false when a beta is not finite
+/// (finite inputs too large; beta then holds it), else true.
+bool betaFromArrays(const ArrayArg& alfa, const ArrayArg& classical, const ArrayArg& twist, const ArrayArg& gravity,
+                    double* beta);
 
 /// The same with the frame's twist from kdata (forwardKinematics with q_dot first). Errors: those
 /// of frameTwist (kinematics.hpp), SizeMismatch for alfa not 6 x m or beta not m long.
