@@ -108,6 +108,14 @@ Status Data::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Ei
   return impl_->status(c.responseColumns(joints, dqdd, dtau_cmd, nullptr));
 }
 
+Status Data::wrenchResponseColumns(const Eigen::Ref<const Eigen::VectorXi>& segments,
+                                   const Eigen::Ref<const Matrix6X>& wrenches, Eigen::Ref<Eigen::MatrixXd> dqdd) {
+  detail::HdCore& c = impl_->core;
+  const EntryGuard guard(c.busy);
+  if (!guard) return Status(Error::ConcurrentCall, "another thread is inside a call on this Data");
+  return impl_->status(c.wrenchResponse(segments, wrenches, dqdd, nullptr));
+}
+
 Status Data::commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) {
   detail::HdCore& c = impl_->core;
   const EntryGuard guard(c.busy);
