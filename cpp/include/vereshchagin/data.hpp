@@ -77,6 +77,12 @@ class Data {
   const std::vector<JointStatus>& jointStatus() const noexcept;  ///< JointStatus of each joint
   double gaussValue() const;                                     ///< NaN without a friction solve
   int iterations() const noexcept;                               ///< active-set iterations of the friction solve
+  /// With contacts (contact.hpp): the force each surface applies to the robot at its point (3 x k,
+  /// base axes, N; a set-point's normal force included), each contact's status, and how the
+  /// forces were determined. Without contacts: 3 x 0, empty, ContactOutcome::None.
+  Eigen::Map<const Matrix3X> contactForces() const noexcept;
+  const std::vector<ContactStatus>& contactStatus() const noexcept;  ///< ContactStatus of each contact
+  ContactOutcome contactOutcome() const noexcept;                    ///< see contactForces()
 
   /// Kinematics at the last solve's state, base axes (allocation-free, O(depth) per call):
   /// the pose of a frame in the base frame, its twist [linear velocity of its origin; angular],
