@@ -3,6 +3,7 @@
 
 #include <limits>
 
+#include "contact_stage.hpp"
 #include "data_impl.hpp"
 #include "entry_guard.hpp"
 #include "friction_core.hpp"
@@ -29,6 +30,11 @@ DataImpl::DataImpl(const Model& m, const SolverOptions& options)
 }
 
 DataImpl::~DataImpl() = default;
+
+ContactStage& DataImpl::contacts() {
+  if (!contact_stage) contact_stage = std::make_unique<ContactStage>(model);
+  return *contact_stage;
+}
 
 }  // namespace detail
 
@@ -64,6 +70,8 @@ const Eigen::VectorXd& Data::commandTorques() const noexcept {
   return impl_->friction_last ? impl_->friction_core->tau_cmd_ : impl_->core.res.tau_cmd;
 }
 Eigen::Map<const Eigen::VectorXd> Data::nu() const noexcept {
+  if (impl_->contacts_last)
+    return Eigen::Map<const Eigen::VectorXd>(impl_->core.nu().data(), impl_->contact_stage->user_columns);
   if (!impl_->friction_last) return impl_->core.nu();
   const detail::FrictionCore& f = *impl_->friction_core;
   return Eigen::Map<const Eigen::VectorXd>(f.nu_.data(), f.m_keep_);
@@ -100,12 +108,32 @@ int Data::iterations() const noexcept {
   return impl_->friction_last ? impl_->friction_core->iterations_ : 0;
 }
 
+Eigen::Map<const Matrix3X> Data::contactForces() const noexcept {
+  if (!impl_->contacts_last) return Eigen::Map<const Matrix3X>(nullptr, 3, 0);
+  return Eigen::Map<const Matrix3X>(impl_->contact_stage->forces.data(), 3, impl_->contact_stage->count);
+}
+const std::vector<ContactStatus>& Data::contactStatus() const noexcept {
+  static const std::vector<ContactStatus> none;
+  return impl_->contacts_last ? impl_->contact_stage->status : none;
+}
+ContactOutcome Data::contactOutcome() const noexcept {
+  return impl_->contacts_last ? impl_->contact_stage->outcome : ContactOutcome::None;
+}
+
 Status Data::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                              Eigen::Ref<Eigen::MatrixXd> dtau_cmd) {
   detail::HdCore& c = impl_->core;
   const EntryGuard guard(c.busy);
   if (!guard) return Status(Error::ConcurrentCall, "another thread is inside a call on this Data");
   return impl_->status(c.responseColumns(joints, dqdd, dtau_cmd, nullptr));
+}
+
+Status Data::wrenchResponseColumns(const Eigen::Ref<const Eigen::VectorXi>& segments,
+                                   const Eigen::Ref<const Matrix6X>& wrenches, Eigen::Ref<Eigen::MatrixXd> dqdd) {
+  detail::HdCore& c = impl_->core;
+  const EntryGuard guard(c.busy);
+  if (!guard) return Status(Error::ConcurrentCall, "another thread is inside a call on this Data");
+  return impl_->status(c.wrenchResponse(segments, wrenches, dqdd, nullptr));
 }
 
 Status Data::commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd) {

@@ -13,6 +13,7 @@ namespace vereshchagin {
 namespace detail {
 
 class FrictionCore;
+class ContactStage;
 
 struct DataImpl {
   DataImpl(const Model& model, const SolverOptions& options);
@@ -22,6 +23,8 @@ struct DataImpl {
   Status status(int code) const { return Status(static_cast<Error>(code), code ? core.message.data() : ""); }
   // The friction stage on this Data's core, built at first use (O(n^2) memory).
   FrictionCore& friction();
+  // The contact stage, built at the first solve with contacts.
+  ContactStage& contacts();
 
   Model model;
   HdCore core;
@@ -37,7 +40,13 @@ struct DataImpl {
   bool friction_last = false;  // the last successful solve had friction
   Eigen::VectorXd zeros;       // n_joints
   std::vector<JointStatus> status_per_joint;
+  std::unique_ptr<ContactStage> contact_stage;
+  bool contacts_last = false;  // the last successful solve had contacts
 };
+
+// Assembles `in` into the core's arguments and runs the sweeps (with the friction stage when it
+// has friction), without its contacts; 0 or an error code with the core's message (solve.cpp).
+int runInput(DataImpl& d, const SolveInput& in);
 
 }  // namespace detail
 }  // namespace vereshchagin

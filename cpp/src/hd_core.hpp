@@ -229,6 +229,11 @@ class HdCore {
                     const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   int responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                       Eigen::Ref<Eigen::MatrixXd> dtau_cmd, Eigen::Ref<Eigen::MatrixXd>* dnu);
+  // The affine response of the last solve to wrenches: column c of dqdd (n_joints x k) is the
+  // change of qdd per wrench wrenches.col(c) ([force; moment] ON segment segments(c), base axes,
+  // moment about its tip origin), with the constraints held; dnu (caller's column order) likewise.
+  int wrenchResponse(const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& wrenches,
+                     Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd>* dnu);
   int commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
   // Validates weights (messages of HdSolver::setPassThrough) into `out`; 0 or an error code.
   int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
@@ -344,10 +349,12 @@ class HdCore {
                         const Eigen::Ref<Eigen::MatrixXd>& dtau_cmd, bool want_tau);
   void commandPerNu();
   void baseAxes();
-  void responseInward(const Eigen::Ref<const Eigen::VectorXi>& joints, long c0, long kc);
+  // Sources: JointTorqueSources or WrenchSources (response_columns.cpp).
+  template <typename Sources>
+  void responseInward(const Sources& src, long c0, long kc);
   void responseCoupling(long c0, long kc, Eigen::Ref<Eigen::MatrixXd>* dnu_out);
-  void responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, long c0, long kc,
-                       Eigen::Ref<Eigen::MatrixXd> dqdd);
+  template <typename Sources>
+  void responseOutward(const Sources& src, long c0, long kc, Eigen::Ref<Eigen::MatrixXd> dqdd);
 };
 
 }  // namespace detail

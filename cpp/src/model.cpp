@@ -192,6 +192,10 @@ const char* errorName(Error code) noexcept {
       return "InvalidFriction";
     case Error::NotConverged:
       return "NotConverged";
+    case Error::InvalidContact:
+      return "InvalidContact";
+    case Error::NoContactSolution:
+      return "NoContactSolution";
   }
   return "Unknown";
 }

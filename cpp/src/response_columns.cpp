@@ -1,6 +1,7 @@
-// HdCore::responseColumns(): the affine response of the last solve to unit joint torques, on
-// chains and trees, reusing the solve's articulated inertias and coupling factorisation.
-// Conventions in hd_solver.hpp.
+// HdCore::responseColumns() and wrenchResponse(): the affine response of the last solve to unit
+// joint torques or to wrenches on segments (the columns of contact forces), on chains and trees,
+// reusing the solve's articulated inertias and coupling factorisation. Conventions in
+// hd_solver.hpp.
 //
 // A unit torque at joint j changes only the force part of the sweeps: in the inward pass its
 // apparent force change is non-zero only on the path from j's segment to the base, so each
@@ -19,6 +20,36 @@
 
 namespace vereshchagin {
 namespace detail {
+
+// The sources of response columns: column c is the response to a unit torque at joint joints(c)
+// (JointTorqueSources) or to the wrench wrenches.col(c) on segment segments(c)
+// (WrenchSources: [force; moment] ON the body, base axes, moment about that segment's tip origin).
+// A column is alive from its source's segment towards the base in the inward pass, where it starts
+// with the change of that segment's bias force: zero for a torque, minus the wrench for a wrench.
+struct JointTorqueSources {
+  const Eigen::Ref<const Eigen::VectorXi>& joints;
+  const HdModel& model;
+  int segment(long c) const { return model.joint_segment[joints(c)]; }
+  double torque(long c, int joint) const { return joints(c) == joint ? 1.0 : 0.0; }
+  void start(long, Vector3& f, Vector3& n) const { f.setZero(), n.setZero(); }
+  bool identity(long c0, long kc) const {  // every joint in order: the response is symmetric
+    bool all = model.is_chain && c0 == 0 && kc == static_cast<long>(model.nj);
+    for (long c = 0; c < kc && all; ++c) all = joints(c) == c;
+    return all;
+  }
+};
+
+struct WrenchSources {
+  const Eigen::Ref<const Eigen::VectorXi>& segments;
+  const Eigen::Ref<const Matrix6X>& wrenches;
+  int segment(long c) const { return segments(c); }
+  double torque(long, int) const { return 0.0; }
+  void start(long c, Vector3& f, Vector3& n) const {
+    f = -wrenches.col(c).head<3>();
+    n = -wrenches.col(c).tail<3>();
+  }
+  bool identity(long, long) const { return false; }
+};
 
 int HdCore::checkResponseArgs(const Eigen::Ref<const Eigen::VectorXi>& joints, const Eigen::Ref<Eigen::MatrixXd>& dqdd,
                               const Eigen::Ref<Eigen::MatrixXd>& dtau_cmd, bool want_tau) {
@@ -46,11 +77,12 @@ int HdCore::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eig
   baseAxes();
   // All columns, in chunks of at most the workspace width (n_joints, at most kResponseWidth).
   const long k = joints.size(), width = ws.response.width;
+  const JointTorqueSources src{joints, model};
   for (long c0 = 0; c0 < k; c0 += width) {
     const long kc = std::min<long>(width, k - c0);
-    responseInward(joints, c0, kc);
+    responseInward(src, c0, kc);
     responseCoupling(c0, kc, dnu_out);
-    responseOutward(joints, c0, kc, dqdd);
+    responseOutward(src, c0, kc, dqdd);
     // tau_cmd is linear in nu: d tau_cmd = (d tau_cmd / d nu) d nu, the m columns built once.
     if (!want_tau) continue;
     if (m > 0) {
@@ -59,6 +91,29 @@ int HdCore::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eig
     } else {
       dtau_cmd.middleCols(c0, kc).setZero();
     }
+  }
+  return 0;
+}
+
+int HdCore::wrenchResponse(const Eigen::Ref<const Eigen::VectorXi>& segments,
+                           const Eigen::Ref<const Matrix6X>& wrenches, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                           Eigen::Ref<Eigen::MatrixXd>* dnu_out) {
+  if (!res.solved) return fail(HdSolver::E_NO_SOLUTION, "wrenchResponse() needs a successful solve() first");
+  const long k = segments.size();
+  if (wrenches.cols() != k || dqdd.rows() != static_cast<long>(model.nj) || dqdd.cols() != k)
+    return fail(KDL::SolverI::E_SIZE_MISMATCH, "wrenchResponse(): %ld segments, %ld wrenches, dqdd %ldx%ld", k,
+                (long)wrenches.cols(), (long)dqdd.rows(), (long)dqdd.cols());
+  for (long c = 0; c < k; ++c)
+    if (segments(c) < 0 || segments(c) >= static_cast<int>(model.ns))
+      return fail(KDL::SolverI::E_OUT_OF_RANGE, "segment index %d out of range [0, %u)", segments(c), model.ns);
+  baseAxes();
+  const long width = ws.response.width;
+  for (long c0 = 0; c0 < k; c0 += width) {
+    const long kc = std::min<long>(width, k - c0);
+    const WrenchSources src{segments, wrenches};
+    responseInward(src, c0, kc);
+    responseCoupling(c0, kc, dnu_out);
+    responseOutward(src, c0, kc, dqdd);
   }
   return 0;
 }
@@ -123,14 +178,15 @@ void HdCore::baseAxes() {
 // Inward pass of columns [c0, c0 + kc): per column the apparent bias-force change passed towards
 // the base (force), its joint-axis share per segment (sdp) and the energy change along the
 // constraint columns (energy).
-void HdCore::responseInward(const Eigen::Ref<const Eigen::VectorXi>& joints, long c0, long kc) {
+template <typename Sources>
+void HdCore::responseInward(const Sources& src, long c0, long kc) {
   ResponseWorkspace& r = ws.response;
   const int m = res.m;
   auto DP = r.force.leftCols(kc);
   auto DU = r.energy.topLeftCorner(m, kc);
   auto SDP = r.sdp.leftCols(kc);
   DU.setZero();
-  const auto joint_seg = [&](long c) { return model.joint_segment[joints(c0 + c)]; };
+  const auto joint_seg = [&](long c) { return src.segment(c0 + c); };
   // On a chain with the joints in chain order, the columns alive at segment i are a suffix
   // [lo, kc) that grows towards the base (the friction solver asks in that order).
   bool ascending = model.is_chain;
@@ -154,8 +210,10 @@ void HdCore::responseInward(const Eigen::Ref<const Eigen::VectorXi>& joints, lon
       // Force part f and moment part n as separate 3-vectors: a 6-vector updated in its top half
       // and reloaded whole stalls on store forwarding.
       double* dp = DP.col(c).data();
-      Vector3 f = Vector3::Zero(), n = Vector3::Zero();  // becomes alive at the joint's segment
-      if (js != i) {  // the child on the path passed its apparent force about its tip: n += d x f
+      Vector3 f, n;
+      if (js == i) {  // becomes alive at the source's segment
+        src.start(c0 + c, f, n);
+      } else {  // the child on the path passed its apparent force about its tip: n += d x f
         f = Vector3(dp[0], dp[1], dp[2]);
         n = Vector3(dp[3], dp[4], dp[5]) + Vector3(r.offset.col(r.holder(c))).cross(f);
       }
@@ -164,7 +222,7 @@ void HdCore::responseInward(const Eigen::Ref<const Eigen::VectorXi>& joints, lon
       if (sm.joint >= 0) {
         const double sd = S0.head<3>().dot(f) + S0.tail<3>().dot(n);
         SDP(i, c) = sd;
-        acc = ((joints(c0 + c) == sm.joint ? 1.0 : 0.0) - sd) * Dinv;
+        acc = (src.torque(c0 + c, sm.joint) - sd) * Dinv;
         f += u0.head<3>() * acc;
         n += u0.tail<3>() * acc;
       } else {
@@ -201,13 +259,11 @@ void HdCore::responseCoupling(long c0, long kc, Eigen::Ref<Eigen::MatrixXd>* dnu
 // the joints up to its own (G(j, c) for j <= c); the rows below come from the columns already
 // computed (G(j, c) = G(c, j)). The columns alive at segment i are then the suffix c >= (joints
 // before segment i): about half the work.
-void HdCore::responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, long c0, long kc,
-                             Eigen::Ref<Eigen::MatrixXd> dqdd) {
+template <typename Sources>
+void HdCore::responseOutward(const Sources& src, long c0, long kc, Eigen::Ref<Eigen::MatrixXd> dqdd) {
   ResponseWorkspace& r = ws.response;
   const int m = res.m;
-  const long nj = model.nj;
-  bool symmetric = model.is_chain && c0 == 0 && kc == nj;
-  for (long c = 0; c < kc && symmetric; ++c) symmetric = joints(c) == c;
+  const bool symmetric = src.identity(c0, kc);
   auto ACC = r.force.leftCols(kc);  // per column: linear part a, angular part w
   const auto SDP = r.sdp.leftCols(kc);
   const auto DNU = r.dnu.topLeftCorner(m, kc);
@@ -236,7 +292,7 @@ void HdCore::responseOutward(const Eigen::Ref<const Eigen::VectorXi>& joints, lo
         for (int t = 0; t < 3; ++t) acc[t] = a(t);
         continue;
       }
-      double v = (joints(c0 + c) == sm.joint ? 1.0 : 0.0) - SDP(i, c) - u0.head<3>().dot(a) - u0.tail<3>().dot(w);
+      double v = src.torque(c0 + c, sm.joint) - SDP(i, c) - u0.head<3>().dot(a) - u0.tail<3>().dot(w);
       const double* dnu = DNU.col(c).data();
       for (int t = felt.first; t < felt.second; ++t) v -= eg[t] * dnu[t];
       v *= Dinv;

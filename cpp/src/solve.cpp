@@ -5,6 +5,7 @@
 
 #include "vereshchagin/data.hpp"
 
+#include "contact_stage.hpp"
 #include "data_impl.hpp"
 #include "entry_guard.hpp"
 #include "friction_core.hpp"
@@ -150,12 +151,13 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
     c.res.solved = false;
     recordStatus(d, false);
     d.friction_last = false;
+    d.contacts_last = false;
     return d.status(rc);
   }
-  const int m = assemble(d, input);
-  rc = run(d, input, m);
-  c.loads = nullptr;
-  c.ws.pt.weights = nullptr;
+  const bool with_contacts = !input.contacts.empty();
+  if (with_contacts) rc = d.contacts().check(c, input);
+  if (rc == 0) rc = with_contacts ? d.contacts().solve(d, input) : detail::runInput(d, input);
+  d.contacts_last = with_contacts && rc == 0;
   const bool with_friction = input.friction != nullptr;
   recordStatus(d, with_friction && rc == 0);
   d.friction_last = with_friction && rc == 0;
@@ -168,6 +170,14 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
 }
 
 namespace detail {
+
+int runInput(DataImpl& d, const SolveInput& in) {
+  const int m = assemble(d, in);
+  const int rc = run(d, in, m);
+  d.core.loads = nullptr;
+  d.core.ws.pt.weights = nullptr;
+  return rc;
+}
 
 FrictionCore& DataImpl::friction() {
   if (!friction_core) friction_core = std::make_unique<FrictionCore>(core);

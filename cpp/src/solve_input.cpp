@@ -67,12 +67,14 @@ void SolveInput::clear() {
   ff_torques.setZero();
   constraints.clear();
   wrenches.clear();
+  contacts.clear();
   friction = nullptr;
 }
 
 void SolveInput::reserve(int blocks, int wrench_count) {
   constraints.reserve(static_cast<std::size_t>(std::max(blocks, 0)));
   wrenches.reserve(static_cast<std::size_t>(std::max(wrench_count, 0)));
+  contacts.reserve(static_cast<std::size_t>(std::max(wrench_count, 0)));
 }
 
 }  // namespace vereshchagin

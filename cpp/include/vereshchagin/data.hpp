@@ -77,6 +77,12 @@ class Data {
   const std::vector<JointStatus>& jointStatus() const noexcept;  ///< JointStatus of each joint
   double gaussValue() const;                                     ///< NaN without a friction solve
   int iterations() const noexcept;                               ///< active-set iterations of the friction solve
+  /// With contacts (contact.hpp): the force each surface applies to the robot at its point (3 x k,
+  /// base axes, N; a set-point's normal force included), each contact's status, and how the
+  /// forces were determined. Without contacts: 3 x 0, empty, ContactOutcome::None.
+  Eigen::Map<const Matrix3X> contactForces() const noexcept;
+  const std::vector<ContactStatus>& contactStatus() const noexcept;  ///< ContactStatus of each contact
+  ContactOutcome contactOutcome() const noexcept;                    ///< see contactForces()
 
   /// Kinematics at the last solve's state, base axes (allocation-free, O(depth) per call):
   /// the pose of a frame in the base frame, its twist [linear velocity of its origin; angular],
@@ -98,6 +104,13 @@ class Data {
   /// real-time loop). dqdd, dtau_cmd: n_joints x joints.size().
   Status responseColumnsHoldingSticking(const Eigen::Ref<const Eigen::VectorXi>& joints,
                                         Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
+  /// Affine response to wrenches, after a solve: column c of dqdd (n_joints x k) is the change of
+  /// qdd per the wrench wrenches.col(c) added to f_ext ([force; moment] ON segment segments(c) BY
+  /// the environment, base axes, moment about that segment's tip origin), the constraints held
+  /// (their magnitudes change with it). O(n) per column, allocation-free; the results of the solve
+  /// stay as they are. Error::NoSolution before a successful solve; SizeMismatch, OutOfRange.
+  Status wrenchResponseColumns(const Eigen::Ref<const Eigen::VectorXi>& segments,
+                               const Eigen::Ref<const Matrix6X>& wrenches, Eigen::Ref<Eigen::MatrixXd> dqdd);
   /// tau_cmd of given constraint magnitudes at the last solve's state.
   Status commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
   /// out = H(q)^-1 tau at the last solve's q.

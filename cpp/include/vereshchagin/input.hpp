@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <kdl/frames.hpp>
 
+#include "vereshchagin/contact.hpp"
 #include "vereshchagin/friction_model.hpp"
 #include "vereshchagin/model.hpp"
 #include "vereshchagin/spatial.hpp"
@@ -85,6 +86,12 @@ struct SolveInput {
   /// Static friction, kinetic friction and joint limits (friction_solver.hpp); nullptr: none.
   /// Not owned: it must outlive the solve.
   const FrictionModel* friction = nullptr;
+  /// Point contacts (contact.hpp): supports and normal-force set-points on any segments. The
+  /// constraint columns of nu stay those of `constraints`; a set-point's normal reaction is part of
+  /// the command torques. Not combined with `friction` yet (Error::InvalidContact).
+  std::vector<PointContact> contacts;
+  /// Below this speed (m/s) a contact point is at rest along the normal, resp. not sliding.
+  double contact_velocity_tolerance = 1e-6;
   /// Physical gravity, base axes, m/s^2 (Earth with z up: (0, 0, -9.81)), and the base's own
   /// commanded spatial acceleration [linear; angular] (base axes, base origin; zero: a fixed
   /// base). The solver's root acceleration is base_acceleration - [gravity; 0].
@@ -106,10 +113,11 @@ struct SolveInput {
   Status addWrench(const FrameRef& frame, const Vector6& wrench);
   /// Constraint columns in all (the size of nu).
   int columns() const;
-  /// Zero f_ext and ff_torques, no constraints, frame wrenches or friction; keeps q, q_dot,
-  /// gravity, base_acceleration and all capacity.
+  /// Zero f_ext and ff_torques, no constraints, frame wrenches, contacts or friction; keeps q,
+  /// q_dot, gravity, base_acceleration, the contact velocity tolerance and all capacity.
   void clear();
-  /// Room for `blocks` constraint blocks and `wrenches` frame wrenches (allocates now, not later).
+  /// Room for `blocks` constraint blocks, `wrenches` frame wrenches and as many contacts
+  /// (allocates now, not later).
   void reserve(int blocks, int wrenches);
 
  private:

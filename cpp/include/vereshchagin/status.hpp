@@ -27,6 +27,8 @@ enum class Error : int {
   StateOutOfRange = -108,     ///< a state so large that round-off dominates
   InvalidFriction = -110,     ///< friction sizes or values
   NotConverged = -111,        ///< friction iteration bound exceeded, or an unbounded limit reaction
+  InvalidContact = -112,      ///< a contact's segment, point, normal, mu, facets or force set-point
+  NoContactSolution = -113,   ///< no contact forces meet the contact conditions (or none was found)
 };
 
 /// Short name of a code ("SizeMismatch", ...); "Unknown" for a number that is not one.

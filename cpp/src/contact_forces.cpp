@@ -1,0 +1,236 @@
+// The contact forces (contact_stage.hpp, steps 2-4): response columns of the unknown force
+// directions, the complementarity problem (acceleration level, polygonal Coulomb cones with
+// maximum dissipation), Lemke's pivoting with its certificate, the final solve and the statuses.
+//
+// Unknowns z and their complementary w, per contact role (a = the point's acceleration):
+//   kFull (a resting support with friction): z = (f_n, beta_1..beta_k, gamma), force
+//     f_n n + sum_j beta_j d_j, w = (n.a, gamma + d_j.a (j = 1..k), mu f_n - sum_j beta_j);
+//   kNormalOnly (a sliding or frictionless support, or in the sticking trial a resting one): z =
+//     f_n, force f_n dir (dir = n + mu d*, d* the vertex most opposed to the velocity), w = n.a;
+//   kTangentOnly (a resting set-point with friction): z = (beta_1..beta_k, gamma), force
+//     F n + sum_j beta_j d_j, w = (gamma + d_j.a, mu F - sum_j beta_j) (its normal is a column).
+// gamma > 0 means the point starts to slide: the force sits where it opposes a_t most.
+//
+// Which answer when several exist: a resting point with friction sticks whenever every such point
+// can (the sticking trial: tangential constraint columns, the normal forces by the convex
+// problem, every tangential force inside its polygon); otherwise the full problem's answer.
+#include <algorithm>
+#include <cmath>
+
+#include "contact_stage.hpp"
+#include "data_impl.hpp"
+#include "hd_core.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+namespace {
+
+constexpr int E_NO_SOLUTION = static_cast<int>(Error::NoContactSolution);
+
+double angle(int j, int facets) {
+  return 2.0 * M_PI * j / facets;
+}
+
+}  // namespace
+
+// The unknowns' force directions as wrench columns, their response, and the acceleration rows.
+void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
+  const int n = static_cast<int>(model_.nrOfJoints());
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& p = points_[k];
+    const PointContact& pc = in.contacts[k];
+    if (p.ncol == 0) continue;
+    // Columns and rows: kNormalOnly (dir; n), kFull (n, t1, t2), kTangentOnly (t1, t2).
+    const Vector3 cols[3] = {p.role == kNormalOnly ? p.dir : p.n, p.t1, p.t2};
+    const Vector3 rows[3] = {p.n, p.t1, p.t2};
+    const int first = p.role == kTangentOnly ? 1 : 0;
+    const KDL::Frame at(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)));
+    Vector6 bias;
+    (void)frameJacobian(model_, kin_, FrameRef{pc.segment, at}, jac_);
+    (void)frameBiasAcceleration(model_, kin_, FrameRef{pc.segment, at}, bias);
+    for (int c = 0; c < p.ncol; ++c) {
+      const Vector3& e = cols[first + c];
+      col_segment_(p.col + c) = pc.segment;
+      col_wrench_.col(p.col + c) << e, p.r.cross(e);
+      rows_jac_.row(p.row + c).head(n).noalias() = rows[first + c].transpose() * jac_.topRows<3>();
+      rows_bias_(p.row + c) = rows[first + c].dot(bias.head<3>());
+    }
+  }
+  auto dqdd = dqdd_.leftCols(ncol_);
+  (void)d.core.wrenchResponse(col_segment_.head(ncol_), col_wrench_.leftCols(ncol_), dqdd, nullptr);
+  const auto J = rows_jac_.topLeftCorner(nrow_, n);
+  acc_per_col_.topLeftCorner(nrow_, ncol_).noalias() = J * dqdd;
+  rows0_.head(nrow_).noalias() = J * d.core.res.qdd;
+  rows0_.head(nrow_) += rows_bias_.head(nrow_);
+}
+
+// M and q of the complementarity problem (see the top of this file).
+void ContactStage::assembleLcp(const SolveInput& in) {
+  auto coef = coef_.topLeftCorner(ncol_, nz_);  // column force per unit unknown
+  coef.setZero();
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& p = points_[k];
+    const int facets = in.contacts[k].facets;
+    if (p.role == kNormalOnly || p.role == kFull) coef(p.col, p.var) = 1.0;
+    if (p.role != kFull && p.role != kTangentOnly) continue;
+    const int beta0 = p.role == kFull ? p.var + 1 : p.var, t1 = p.role == kFull ? p.col + 1 : p.col;
+    for (int j = 0; j < facets; ++j) {
+      coef(t1, beta0 + j) = std::cos(angle(j, facets));
+      coef(t1 + 1, beta0 + j) = std::sin(angle(j, facets));
+    }
+  }
+  auto rz = rows_per_z_.topLeftCorner(nrow_, nz_);
+  rz.noalias() = acc_per_col_.topLeftCorner(nrow_, ncol_) * coef;
+  auto M = lcp_m_.topLeftCorner(nz_, nz_);
+  auto q = lcp_q_.head(nz_);
+  M.setZero();
+  q.setZero();
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& p = points_[k];
+    const PointContact& pc = in.contacts[k];
+    if (p.role == kNormalOnly || p.role == kFull) {  // n.a
+      M.row(p.var) = rz.row(p.row);
+      q(p.var) = rows0_(p.row);
+    }
+    if (p.role != kFull && p.role != kTangentOnly) continue;
+    const bool full = p.role == kFull;
+    const int beta0 = full ? p.var + 1 : p.var, gamma = beta0 + pc.facets, t1 = full ? p.row + 1 : p.row;
+    for (int j = 0; j < pc.facets; ++j) {  // gamma + d_j . a_t
+      const double cj = std::cos(angle(j, pc.facets)), sj = std::sin(angle(j, pc.facets));
+      M.row(beta0 + j) = cj * rz.row(t1) + sj * rz.row(t1 + 1);
+      M(beta0 + j, gamma) += 1.0;
+      q(beta0 + j) = cj * rows0_(t1) + sj * rows0_(t1 + 1);
+      M(gamma, beta0 + j) = -1.0;  // mu f_n - sum beta
+    }
+    if (full)
+      M(gamma, p.var) = pc.mu;
+    else
+      q(gamma) = pc.mu * pc.force;
+  }
+}
+
+// Lemke's pivoting, then the certificate: z >= 0, w = M z + q >= 0, z_i w_i = 0 (to round-off).
+int ContactStage::solveLcp(HdCore& c, bool convex) {
+  const auto M = lcp_m_.topLeftCorner(nz_, nz_);
+  const auto q = lcp_q_.head(nz_);
+  auto z = z_.head(nz_), w = w_.head(nz_);
+  int pivots = 0;
+  const int limit = 50 + 20 * nz_;
+  const Lemke::Result r = lemke_.solve(M, q, z, w, limit, pivots);
+  if (r == Lemke::kPivotLimit)
+    return c.fail(E_NO_SOLUTION, "contacts: the complementarity problem did not finish within %d pivots", limit);
+  if (r == Lemke::kRay)
+    return c.fail(E_NO_SOLUTION,
+                  convex ? "contacts: no contact forces meet the contact conditions (the constraints and the "
+                           "supports contradict each other)"
+                         : "contacts: no consistent contact forces were found (with friction at the supports the "
+                           "problem can have none: Painleve's paradox)");
+  const double scale = std::max({1.0, q.cwiseAbs().maxCoeff(), (M * z).cwiseAbs().maxCoeff()});
+  const double tol = 1e-9 * scale;
+  for (int i = 0; i < nz_; ++i)
+    if (w(i) < -tol || std::abs(w(i) * z(i)) > tol * std::max(1.0, std::abs(z(i))))
+      return c.fail(E_NO_SOLUTION, "contacts: the certificate of the contact forces failed at unknown %d", i);
+  return 0;
+}
+
+// The known forces plus those of z, into `forces`; the unknown parts added to work_'s wrenches.
+void ContactStage::applyForces(const SolveInput& in) {
+  const auto z = z_.head(nz_);
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& p = points_[k];
+    Vector3 f = Vector3::Zero();
+    for (int c = 0; c < p.ncol; ++c) f += coef_.row(p.col + c).head(nz_).dot(z) * col_wrench_.col(p.col + c).head<3>();
+    forces.col(k) = p.fixed + f;
+    if (p.ncol > 0 && !f.isZero(0.0))
+      work_.wrenches.push_back(
+          FrameWrench{in.contacts[k].segment, (Vector6() << f, Vector3::Zero()).finished(), in.contacts[k].point});
+  }
+}
+
+// The problem of the current layout on work_: base solve, response, complementarity, forces.
+int ContactStage::forcesOfLcp(DataImpl& d, const SolveInput& in, bool convex) {
+  if (int rc = runInput(d, work_)) return rc;
+  if (nz_ > 0) {
+    prepareColumns(d, in);
+    assembleLcp(in);
+    if (int rc = solveLcp(d.core, convex)) return rc;
+  }
+  applyForces(in);
+  return 0;
+}
+
+int ContactStage::trySticking(DataImpl& d, const SolveInput& in) {
+  layout(in, true);
+  buildWorkInput(in, true);
+  if (forcesOfLcp(d, in, true) != 0) return 0;  // no normal forces with every resting point held
+  if (int rc = runInput(d, work_)) return rc;   // with the normal forces: the tangential ones in nu
+  const auto nu = d.core.nu();
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& p = points_[k];
+    if (p.stick_col < 0) continue;
+    const PointContact& pc = in.contacts[k];
+    const Vector3 ft = -nu(p.stick_col) * p.t1 - nu(p.stick_col + 1) * p.t2;  // tau_cmd = -J^T alfa nu
+    const double fn = p.n.dot(forces.col(k)), apothem = pc.mu * fn * std::cos(M_PI / pc.facets);
+    for (int i = 0; i < pc.facets; ++i) {  // inside every edge (outward normals at (2i + 1) pi / k)
+      const double a = M_PI * (2 * i + 1) / pc.facets;
+      if ((std::cos(a) * p.t1 + std::sin(a) * p.t2).dot(ft) > apothem + 1e-12 * std::max(1.0, std::abs(fn))) return 0;
+    }
+    forces.col(k) += ft;
+  }
+  buildWorkInput(in, false);  // the final input: every force a wrench, no tangential columns
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Vector3 f = forces.col(k) - points_[k].fixed;
+    if (!f.isZero(0.0))
+      work_.wrenches.push_back(
+          FrameWrench{in.contacts[k].segment, (Vector6() << f, Vector3::Zero()).finished(), in.contacts[k].point});
+  }
+  if (int rc = runInput(d, work_)) return rc;
+  return 1;
+}
+
+void ContactStage::reportStatus(const SolveInput& in, bool stuck) {
+  bool convex = true;
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& p = points_[k];
+    const PointContact& pc = in.contacts[k];
+    const double fn = p.n.dot(forces.col(k));
+    ContactStatus s = ContactStatus::Sliding;
+    if (pc.isSupport() && fn <= 1e-12 * std::max(1.0, forces.col(k).norm()))
+      s = ContactStatus::Separating;
+    else if (stuck && p.stick_col >= 0)
+      s = ContactStatus::Sticking;
+    else if (p.role == kFull || p.role == kTangentOnly)
+      s = z_(p.var + p.nvar - 1) > 0.0 ? ContactStatus::Sliding : ContactStatus::Sticking;  // gamma
+    status[k] = s;
+    if ((p.kind == kTouching || p.kind == kSliding) && pc.mu > 0.0) convex = false;
+  }
+  outcome = points_.empty() ? ContactOutcome::None : convex ? ContactOutcome::Unique : ContactOutcome::Consistent;
+}
+
+int ContactStage::solve(DataImpl& d, const SolveInput& in) {
+  if (int rc = classify(d.core, in)) return rc;
+  bool stickable = false, convex = true;
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    stickable = stickable || points_[k].kind == kTouching || points_[k].kind == kSetPointRest;
+    convex = convex && !((points_[k].kind == kTouching || points_[k].kind == kSliding) && in.contacts[k].mu > 0.0);
+  }
+  if (stickable) {
+    const int rc = trySticking(d, in);
+    if (rc < 0) return rc;
+    if (rc == 1) {
+      reportStatus(in, true);
+      return 0;
+    }
+  }
+  layout(in, false);
+  buildWorkInput(in, false);
+  if (int rc = forcesOfLcp(d, in, convex)) return rc;
+  if (nz_ > 0)
+    if (int rc = runInput(d, work_)) return rc;
+  reportStatus(in, false);
+  return 0;
+}
+
+}  // namespace detail
+}  // namespace vereshchagin

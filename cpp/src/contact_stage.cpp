@@ -1,0 +1,197 @@
+// The contact stage (contact_stage.hpp): kinematics and classification of the contacts, the
+// base solve, the complementarity problem of the unknown contact forces, the final solve.
+#include "contact_stage.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "data_impl.hpp"
+#include "hd_core.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+namespace {
+
+constexpr int E_CONTACT = static_cast<int>(Error::InvalidContact);
+
+// t1 = unit(e x n) for the base axis e least aligned with n (the first on ties), t2 = n x t1.
+void tangents(const Vector3& n, Vector3& t1, Vector3& t2) {
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(n(k)) < std::abs(n(axis))) axis = k;
+  t1 = Vector3::Unit(axis).cross(n).normalized();
+  t2 = n.cross(t1);
+}
+
+double angle(int j, int facets) {
+  return 2.0 * M_PI * j / facets;
+}
+
+}  // namespace
+
+ContactStage::ContactStage(const Model& model) : model_(model), kin_(model), work_(model) {
+  jac_.resize(6, model.nrOfJoints());
+}
+
+int ContactStage::check(HdCore& c, const SolveInput& in) const {
+  for (std::size_t k = 0; k < in.contacts.size(); ++k) {
+    const PointContact& p = in.contacts[k];
+    if (p.segment < 0 || p.segment >= static_cast<int>(c.model.ns))
+      return c.fail(E_CONTACT, "contacts[%zu].segment = %d is out of range [0, %u)", k, p.segment, c.model.ns);
+    if (!p.point.allFinite() || !p.normal.allFinite())
+      return c.fail(E_CONTACT, "contacts[%zu]: point and normal must be finite", k);
+    if (std::abs(p.normal.norm() - 1.0) > 1e-6)
+      return c.fail(E_CONTACT, "contacts[%zu].normal must be a unit vector, its norm is %g", k, p.normal.norm());
+    if (!(std::isfinite(p.mu) && p.mu >= 0.0))
+      return c.fail(E_CONTACT, "contacts[%zu].mu must be finite and >= 0, got %g", k, p.mu);
+    if (p.facets < 3 || p.facets > 64)
+      return c.fail(E_CONTACT, "contacts[%zu].facets must be in 3 .. 64, got %d", k, p.facets);
+    if (!p.isSupport() && !(std::isfinite(p.force) && p.force >= 0.0))
+      return c.fail(E_CONTACT,
+                    "contacts[%zu].force (a normal-force set-point) must be finite and >= 0, or NaN for a support, "
+                    "got %g",
+                    k, p.force);
+  }
+  int extra = 0;  // a column per set-point, two more per point with friction (the sticking trial)
+  for (const PointContact& p : in.contacts) extra += (p.isSupport() ? 0 : 1) + (p.mu > 0.0 ? 2 : 0);
+  if (in.columns() + extra > c.mcap)
+    return c.fail(static_cast<int>(Error::TooManyConstraints),
+                  "%d constraint columns and %d more for the contacts (one per force set-point, two per point with "
+                  "friction): at most %d in all (SolverOptions::max_constraints)",
+                  in.columns(), extra, c.mcap);
+  if (!(std::isfinite(in.contact_velocity_tolerance) && in.contact_velocity_tolerance >= 0.0))
+    return c.fail(E_CONTACT, "contact_velocity_tolerance must be finite and >= 0, got %g",
+                  in.contact_velocity_tolerance);
+  if (in.friction != nullptr)
+    return c.fail(E_CONTACT, "contacts together with joint friction are not supported yet: solve without friction");
+  for (int k = 0; k < 3; ++k)
+    if (in.base_acceleration.vel(k) != 0.0 || in.base_acceleration.rot(k) != 0.0)
+      return c.fail(E_CONTACT, "contacts need a base at rest: base_acceleration must be zero");
+  return 0;
+}
+
+// Step 1: each contact's state at (q, qd) and the sizes of its unknowns, columns and rows.
+int ContactStage::classify(HdCore& c, const SolveInput& in) {
+  if (!forwardKinematics(model_, kin_, JointPositions(in.q), JointVelocities(in.q_dot)))
+    return c.fail(E_CONTACT, "contacts: the forward kinematics of the state failed");
+  const double tol = in.contact_velocity_tolerance;
+  points_.resize(in.contacts.size());
+  user_columns = in.columns();
+  for (std::size_t k = 0; k < in.contacts.size(); ++k) {
+    const PointContact& pc = in.contacts[k];
+    Point& p = points_[k];
+    KDL::Frame tip;
+    Vector6 twist;
+    (void)framePose(model_, kin_, FrameRef{pc.segment, KDL::Frame::Identity()}, tip);
+    const KDL::Vector point(pc.point(0), pc.point(1), pc.point(2)), r = tip.M * point;
+    (void)frameTwist(model_, kin_, FrameRef{pc.segment, KDL::Frame(point)}, twist);
+    p.r = Vector3(r.x(), r.y(), r.z());
+    p.v = twist.head<3>();
+    p.n = pc.normal.normalized();
+    tangents(p.n, p.t1, p.t2);
+    const double vn = p.n.dot(p.v);
+    const Vector3 vt = p.v - vn * p.n;
+    if (vt.norm() > tol) {  // the vertex most opposed to the tangential velocity (the first on ties)
+      double best = 0.0;
+      for (int j = 0; j < pc.facets; ++j) {
+        const Vector3 d = std::cos(angle(j, pc.facets)) * p.t1 + std::sin(angle(j, pc.facets)) * p.t2;
+        if (j == 0 || d.dot(vt) < best) best = d.dot(vt), p.slide_dir = d;
+      }
+    }
+    if (vt.norm() <= tol) p.slide_dir.setZero();
+    if (pc.isSupport()) {
+      if (vn < -tol)
+        return c.fail(E_CONTACT,
+                      "contacts[%zu] approaches its surface at %g m/s: an impact needs an impulse, not a force", k,
+                      -vn);
+      p.kind = vn > tol ? kSeparating : vt.norm() > tol || pc.mu == 0.0 ? kSliding : kTouching;
+    } else {
+      p.kind = vt.norm() > tol || pc.mu == 0.0 ? kSetPointSliding : kSetPointRest;
+    }
+  }
+  return 0;
+}
+
+void ContactStage::layout(const SolveInput& in, bool stick) {
+  nz_ = ncol_ = nrow_ = 0;
+  int stick_col = user_columns;
+  for (const Point& p : points_) stick_col += p.kind == kSetPointRest || p.kind == kSetPointSliding ? 1 : 0;
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    Point& p = points_[k];
+    const PointContact& pc = in.contacts[k];
+    p.fixed.setZero();
+    p.dir = p.n + pc.mu * p.slide_dir;
+    p.stick_col = -1;
+    const bool rest_friction = p.kind == kTouching || p.kind == kSetPointRest;
+    if (stick && rest_friction) {  // held tangentially by two columns
+      p.stick_col = stick_col;
+      stick_col += 2;
+    }
+    if (p.kind == kSetPointRest || p.kind == kSetPointSliding)
+      p.fixed = pc.force * (p.kind == kSetPointRest ? p.n : p.dir);
+    p.role = p.kind == kSliding || (stick && p.kind == kTouching) ? kNormalOnly
+             : p.kind == kTouching                                ? kFull
+             : p.kind == kSetPointRest && !stick                  ? kTangentOnly
+                                                                  : kNoUnknown;
+    p.nvar = p.role == kNormalOnly ? 1 : p.role == kFull ? pc.facets + 2 : p.role == kTangentOnly ? pc.facets + 1 : 0;
+    p.ncol = p.role == kNormalOnly ? 1 : p.role == kFull ? 3 : p.role == kTangentOnly ? 2 : 0;
+    p.nrow = p.ncol;
+    p.var = nz_, p.col = ncol_, p.row = nrow_;
+    nz_ += p.nvar, ncol_ += p.ncol, nrow_ += p.nrow;
+  }
+  reserve(static_cast<int>(in.contacts.size()), nz_, ncol_, nrow_);
+}
+
+void ContactStage::reserve(int contacts, int unknowns, int columns, int rows) {
+  const int n = static_cast<int>(model_.nrOfJoints());
+  status.resize(contacts);  // within its capacity after the first solve of this size
+  if (forces.cols() < contacts) forces.resize(3, contacts);
+  count = contacts;
+  if (rows_jac_.rows() < rows) rows_jac_.resize(rows, n), rows_bias_.resize(rows), rows0_.resize(rows);
+  if (col_wrench_.cols() < columns) {
+    col_wrench_.resize(6, columns);
+    col_segment_.resize(columns);
+    dqdd_.resize(n, columns);
+  }
+  if (acc_per_col_.rows() < rows || acc_per_col_.cols() < columns) acc_per_col_.resize(rows, columns);
+  if (coef_.rows() < columns || coef_.cols() < unknowns) coef_.resize(columns, unknowns);
+  if (rows_per_z_.rows() < rows || rows_per_z_.cols() < unknowns) rows_per_z_.resize(rows, unknowns);
+  if (lcp_m_.rows() < unknowns) {
+    lcp_m_.resize(unknowns, unknowns);
+    lcp_q_.resize(unknowns), z_.resize(unknowns), w_.resize(unknowns);
+  }
+  lemke_.reserve(unknowns);
+}
+
+// The input with a constraint column and a known wrench per force set-point and, for the sticking
+// trial, two tangential columns per resting point with friction (after all the set-points').
+void ContactStage::buildWorkInput(const SolveInput& in, bool stick) {
+  work_ = in;
+  work_.contacts.clear();
+  const auto column = [this](int segment, const Vector3& point, const Vector3& e) {
+    ConstraintBlock b;
+    b.segment = segment;
+    b.columns = 1;
+    b.alfa.col(0) << e, Vector3::Zero();  // the point's acceleration along e ...
+    b.point = point;
+    b.classical = true;  // ... held at zero (classical: the physical acceleration)
+    work_.constraints.push_back(b);
+  };
+  for (std::size_t k = 0; k < in.contacts.size(); ++k) {
+    const Point& p = points_[k];
+    const PointContact& pc = in.contacts[k];
+    if (p.kind != kSetPointRest && p.kind != kSetPointSliding) continue;
+    column(pc.segment, pc.point, p.n);
+    work_.wrenches.push_back(FrameWrench{pc.segment, (Vector6() << p.fixed, Vector3::Zero()).finished(), pc.point});
+  }
+  if (!stick) return;
+  for (std::size_t k = 0; k < in.contacts.size(); ++k) {
+    if (points_[k].stick_col < 0) continue;
+    column(in.contacts[k].segment, in.contacts[k].point, points_[k].t1);
+    column(in.contacts[k].segment, in.contacts[k].point, points_[k].t2);
+  }
+}
+
+}  // namespace detail
+}  // namespace vereshchagin

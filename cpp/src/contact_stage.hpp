@@ -1,0 +1,102 @@
+// The contact stage of solve() (input.contacts, contact.hpp), built in a Data at its first solve
+// with contacts. Per solve:
+//   1. the contact points' kinematics at (q, qd) (KinematicsData): each contact is separating,
+//      touching at rest, or sliding; a force set-point becomes a constraint column (zero normal
+//      acceleration, held by the motors) plus its normal force as a known wrench;
+//   2. the base solve of the input with those columns and wrenches;
+//   3. the contact forces: one wrench response column per unknown force direction
+//      (Data::wrenchResponseColumns, O(n) each) gives the affine map from the unknowns to the
+//      contact points' accelerations; the conditions (normal complementarity, the friction
+//      polygon with maximum dissipation) form a linear complementarity problem in the small space
+//      of the unknowns (the acceleration-level formulation of Stewart and Trinkle), solved exactly
+//      by Lemke's pivoting (lemke.hpp) and checked (the certificate);
+//   4. the final solve with the contact forces as wrenches: every result comes from it.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "vereshchagin/contact.hpp"
+#include "vereshchagin/input.hpp"
+#include "vereshchagin/kinematics.hpp"
+
+#include "lemke.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+struct DataImpl;
+class HdCore;
+
+class ContactStage {
+ public:
+  explicit ContactStage(const Model& model);
+
+  // The contacts of `in` (segments, points, normals, coefficients, set-points, and what they
+  // cannot be combined with); 0 or an error code with the core's message.
+  int check(HdCore& c, const SolveInput& in) const;
+  // Steps 1-4 above; 0 or an error code with the core's message.
+  int solve(DataImpl& d, const SolveInput& in);
+
+  Matrix3X forces;  // per contact (the first count columns), base axes, N: ON the robot BY the surface
+  int count = 0;    // contacts of the last solve
+  std::vector<ContactStatus> status;
+  ContactOutcome outcome = ContactOutcome::None;
+  int user_columns = 0;  // the input's own constraint columns (nu's size)
+
+ private:
+  // The contact's state at (q, qd); a frictionless point at rest counts as sliding (kSliding).
+  enum Kind : signed char { kSeparating, kTouching, kSliding, kSetPointRest, kSetPointSliding };
+  // Its unknowns in one complementarity problem: none, the normal force along `dir`, the full
+  // polygonal force (f_n, beta, gamma) or the tangential polygon of a set-point (beta, gamma).
+  enum Role : signed char { kNoUnknown, kNormalOnly, kFull, kTangentOnly };
+  struct Point {
+    Kind kind = kSeparating;
+    Role role = kNoUnknown;
+    Vector3 n, t1, t2, r, v;  // normal, tangents, point - tip origin, point velocity (base axes)
+    Vector3 slide_dir;        // sliding: the polygon vertex direction most opposed to v_t (else 0)
+    Vector3 dir;              // kNormalOnly: the force per unit normal force
+    Vector3 fixed;            // the known part of the force (set-points)
+    int var = 0, nvar = 0;    // its unknowns in z
+    int col = 0, ncol = 0;    // its response columns
+    int row = 0, nrow = 0;    // its acceleration rows
+    int stick_col = -1;       // the sticking trial: its first tangential constraint column in nu
+  };
+
+  int classify(HdCore& c, const SolveInput& in);
+  // Roles and sizes of one problem: the sticking trial (every resting point with friction held
+  // tangentially by two constraint columns) or the full polygonal problem.
+  void layout(const SolveInput& in, bool stick);
+  void buildWorkInput(const SolveInput& in, bool stick);
+  void prepareColumns(DataImpl& d, const SolveInput& in);
+  void assembleLcp(const SolveInput& in);
+  int solveLcp(HdCore& c, bool convex);
+  int forcesOfLcp(DataImpl& d, const SolveInput& in, bool convex);
+  void applyForces(const SolveInput& in);
+  // The sticking trial: 1 if every resting point with friction sticks (forces and the final solve
+  // done), 0 if not (fall back to the full problem), or an error code.
+  int trySticking(DataImpl& d, const SolveInput& in);
+  void reportStatus(const SolveInput& in, bool stuck);
+  void reserve(int contacts, int unknowns, int columns, int rows);
+
+  Model model_;
+  KinematicsData kin_;
+  SolveInput work_;  // the input with the set-point columns and the contact wrenches
+  Lemke lemke_;
+  std::vector<Point> points_;
+  Eigen::MatrixXd jac_;                 // 6 x n_joints: one contact point's Jacobian
+  Eigen::MatrixXd rows_jac_;            // rows x n_joints: acceleration rows per joint acceleration
+  Eigen::VectorXd rows_bias_;           // rows: their value at qdd = 0
+  Eigen::VectorXi col_segment_;         // columns: the segment of each force direction
+  Matrix6X col_wrench_;                 // columns: unit force direction as a wrench about the tip origin
+  Eigen::MatrixXd dqdd_;                // n_joints x columns: wrench response
+  Eigen::MatrixXd acc_per_col_;         // rows x columns: acceleration rows per unit column force
+  Eigen::MatrixXd coef_;                // columns x unknowns: column force per unit unknown
+  Eigen::MatrixXd lcp_m_, rows_per_z_;  // N x N; rows x N
+  Eigen::VectorXd lcp_q_, z_, w_, rows0_;
+  int nz_ = 0, ncol_ = 0, nrow_ = 0;
+};
+
+}  // namespace detail
+}  // namespace vereshchagin

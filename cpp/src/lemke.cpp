@@ -1,0 +1,114 @@
+// Lemke's complementary pivoting (lemke.hpp): the textbook scheme on an explicit tableau. The
+// artificial variable z0 enters at the most negative q; afterwards the complement of the variable
+// that just left enters, until z0 leaves (a solution) or a column has no positive entry (a ray).
+#include "lemke.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vereshchagin {
+namespace detail {
+
+void Lemke::reserve(int n) {
+  if (n <= capacity()) return;
+  tableau_.resize(n, 2 * n + 2);
+  basis_.resize(n);
+}
+
+// The leaving row for `entering`: the lexicographic minimum of (rhs, B^-1 row) / pivot entry over
+// the rows with a positive entry (B^-1 is the tableau's first n columns), which never cycles; the
+// artificial variable leaves whenever it ties for the minimum ratio. -1: no positive entry (a ray).
+int Lemke::ratioTest(int entering, int n, double tol) const {
+  const auto T = tableau_.topLeftCorner(n, 2 * n + 2);
+  const double col_max = T.col(entering).cwiseAbs().maxCoeff();
+  const double piv_tol = std::max(tol, 1e-11 * col_max);
+  int best = -1;
+  for (int i = 0; i < n; ++i) {
+    const double a = T(i, entering);
+    if (a <= piv_tol) continue;
+    if (best < 0) {
+      best = i;
+      continue;
+    }
+    const double b = T(best, entering);
+    const double ri = T(i, 2 * n + 1) / a, rb = T(best, 2 * n + 1) / b;
+    const double eps = 1e-12 * std::max({1.0, std::abs(ri), std::abs(rb)});
+    if (ri < rb - eps) {
+      best = i;
+      continue;
+    }
+    if (ri > rb + eps) continue;
+    if (basis_(i) == 2 * n) {  // z0 ties: let it leave
+      best = i;
+      continue;
+    }
+    if (basis_(best) == 2 * n) continue;
+    for (int k = 0; k < n; ++k) {  // lexicographic on B^-1
+      const double xi = T(i, k) / a, xb = T(best, k) / b;
+      if (xi < xb - 1e-12 * std::max({1.0, std::abs(xi), std::abs(xb)})) {
+        best = i;
+        break;
+      }
+      if (xi > xb + 1e-12 * std::max({1.0, std::abs(xi), std::abs(xb)})) break;
+    }
+  }
+  return best;
+}
+
+void Lemke::pivot(int row, int col, int n) {
+  auto T = tableau_.topLeftCorner(n, 2 * n + 2);
+  T.row(row) /= T(row, col);
+  for (int i = 0; i < n; ++i) {
+    if (i == row) continue;
+    const double f = T(i, col);
+    if (f != 0.0) T.row(i) -= f * T.row(row);
+  }
+  basis_(row) = col;
+}
+
+Lemke::Result Lemke::solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eigen::Ref<const Eigen::VectorXd>& q,
+                           Eigen::Ref<Eigen::VectorXd> z, Eigen::Ref<Eigen::VectorXd> w, int max_pivots, int& pivots) {
+  const int n = static_cast<int>(q.size());
+  pivots = 0;
+  z.setZero();
+  w = q;
+  if (n == 0 || q.minCoeff() >= 0.0) return kSolved;
+  auto T = tableau_.topLeftCorner(n, 2 * n + 2);
+  T.setZero();
+  T.leftCols(n).setIdentity();
+  T.middleCols(n, n) = -M;
+  T.col(2 * n).setConstant(-1.0);
+  T.col(2 * n + 1) = q;
+  for (int i = 0; i < n; ++i) basis_(i) = i;
+  const double scale = std::max({1.0, M.cwiseAbs().maxCoeff(), q.cwiseAbs().maxCoeff()});
+  const double tol = 1e-13 * scale;
+  int row;
+  q.minCoeff(&row);
+  pivot(row, 2 * n, n);  // z0 enters, the most negative w leaves
+  int leaving = row;     // the variable that left is w_row
+  for (pivots = 1; pivots <= max_pivots; ++pivots) {
+    const int entering = leaving < n ? leaving + n : leaving - n;  // its complement
+    const int best = ratioTest(entering, n, tol);
+    if (best < 0) return kRay;
+    leaving = basis_(best);
+    pivot(best, entering, n);
+    if (leaving == 2 * n) {  // z0 left: a complementary basis
+      w.setZero();
+      z.setZero();
+      for (int i = 0; i < n; ++i) {
+        const int v = basis_(i);
+        const double value = std::max(0.0, T(i, 2 * n + 1));
+        if (v < n)
+          w(v) = value;
+        else
+          z(v - n) = value;
+      }
+      w.noalias() = M * z + q;  // recomputed from z: the caller's certificate reads it
+      return kSolved;
+    }
+  }
+  return kPivotLimit;
+}
+
+}  // namespace detail
+}  // namespace vereshchagin

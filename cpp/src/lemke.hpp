@@ -1,0 +1,36 @@
+// Lemke's complementary pivoting for a small dense linear complementarity problem
+//     w = M z + q,  w >= 0,  z >= 0,  w^T z = 0,
+// with the covering vector of ones. Finitely many pivots: the lexicographic ratio test never
+// revisits a basis (ties go to the artificial variable first); max_pivots bounds them anyway. For M copositive-plus
+// (positive semi-definite, e.g. frictionless contacts) a secondary ray proves that the problem has no solution;
+// otherwise it only says none was found. Workspace sized by reserve(); solve() allocates nothing within it.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace vereshchagin {
+namespace detail {
+
+class Lemke {
+ public:
+  enum Result { kSolved = 0, kRay = 1, kPivotLimit = 2 };
+
+  // Room for problems of up to n variables (allocates).
+  void reserve(int n);
+  int capacity() const { return static_cast<int>(basis_.size()); }
+  // Solves the LCP of M (n x n) and q (n), n <= capacity(); z and w (n) receive the answer.
+  // tolerance: entries of a pivot column at or below it do not bound the ratio test (scaled by
+  // the problem's magnitude inside). pivots: the pivots made.
+  Result solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eigen::Ref<const Eigen::VectorXd>& q,
+               Eigen::Ref<Eigen::VectorXd> z, Eigen::Ref<Eigen::VectorXd> w, int max_pivots, int& pivots);
+
+ private:
+  int ratioTest(int entering, int n, double tol) const;
+  void pivot(int row, int col, int n);
+  // Tableau [I | -M | -e | q] over the variables w (0..n-1), z (n..2n-1), z0 (2n), rhs (2n+1).
+  Eigen::MatrixXd tableau_;
+  Eigen::VectorXi basis_;  // variable in the basis of each row
+};
+
+}  // namespace detail
+}  // namespace vereshchagin

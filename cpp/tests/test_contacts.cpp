@@ -1,0 +1,264 @@
+// Point contacts in solve() (contact.hpp) against a dense oracle built from the companions (mass
+// matrix, inverse dynamics, point Jacobians, tested against KDL and Pinocchio elsewhere):
+// Gauss's principle with unilateral constraints solved by enumerating which supports push
+// (frictionless), sticking points as bilateral point constraints, force set-points as a held
+// normal plus a known force; and, for every result, the replay identity
+//     H qdd = tau_ff - C qd - g + J_ext^T f_ext + tau_command + sum_c J_c^T f_c.
+// Random chains and trees at rest (every point touching), q random, tasks as classical set-points.
+#include <doctest/doctest.h>
+
+#include <Eigen/Dense>
+
+#include "random_chain.hpp"
+#include "random_tree.hpp"
+#include "vereshchagin/data.hpp"
+#include "vereshchagin/dynamics.hpp"
+
+using namespace vereshchagin;
+using testutil::RandomGen;
+
+namespace {
+
+// The dense problem: H, h = tau_ff - ID(q, qd, 0) (gravity, f_ext included), the task rows A x = b
+// and per contact its point Jacobian (3 x n) and bias acceleration (3).
+struct Dense {
+  Eigen::MatrixXd H, A;
+  Eigen::VectorXd h, b;
+  std::vector<Eigen::MatrixXd> J;
+  std::vector<Vector3> bias;
+};
+
+Dense dense(const Model& model, const SolveInput& in) {
+  const int n = static_cast<int>(model.nrOfJoints());
+  DynamicsData dyn(model);
+  KinematicsData kin(model);
+  Dense d;
+  d.H.resize(n, n);
+  d.h.resize(n);
+  REQUIRE(massMatrix(model, dyn, JointPositions(in.q), d.H));
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  REQUIRE(inverseDynamics(model, dyn, JointPositions(in.q), JointVelocities(in.q_dot), JointAccelerations(zero),
+                          in.f_ext, in.gravity, d.h));
+  d.h = in.ff_torques - d.h;
+  REQUIRE(forwardKinematics(model, kin, JointPositions(in.q), JointVelocities(in.q_dot)));
+  Eigen::MatrixXd J6(6, n);
+  Vector6 bias;
+  int m = in.columns();
+  d.A.resize(m, n);
+  d.b.resize(m);
+  int row = 0;
+  for (const ConstraintBlock& blk : in.constraints) {  // classical set-points (tests use only those)
+    const FrameRef at{blk.segment, KDL::Frame(KDL::Vector(blk.point(0), blk.point(1), blk.point(2)))};
+    REQUIRE(frameJacobian(model, kin, at, J6));
+    REQUIRE(frameBiasAcceleration(model, kin, at, bias));
+    for (int c = 0; c < blk.columns; ++c, ++row) {
+      d.A.row(row) = blk.alfa.col(c).transpose() * J6;
+      d.b(row) = blk.alfa.col(c).dot(blk.classical_acceleration - bias);
+    }
+  }
+  for (const PointContact& pc : in.contacts) {
+    const FrameRef at{pc.segment, KDL::Frame(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)))};
+    REQUIRE(frameJacobian(model, kin, at, J6));
+    REQUIRE(frameBiasAcceleration(model, kin, at, bias));
+    d.J.push_back(J6.topRows(3));
+    d.bias.push_back(bias.head<3>());
+  }
+  return d;
+}
+
+// Solves H x - A^T nu - C^T lam = h, A x = b, C x = e for x (and the multipliers).
+Eigen::VectorXd kkt(const Dense& d, const Eigen::MatrixXd& C, const Eigen::VectorXd& e, Eigen::VectorXd& lam) {
+  const int n = static_cast<int>(d.h.size()), m = static_cast<int>(d.b.size()), k = static_cast<int>(e.size());
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n + m + k, n + m + k);
+  Eigen::VectorXd r(n + m + k);
+  K.topLeftCorner(n, n) = d.H;
+  K.block(0, n, n, m) = -d.A.transpose();
+  K.block(0, n + m, n, k) = -C.transpose();
+  K.block(n, 0, m, n) = d.A;
+  K.block(n + m, 0, k, n) = C;
+  r << d.h, d.b, e;
+  const Eigen::VectorXd x = K.colPivHouseholderQr().solve(r);
+  lam = x.tail(k);
+  return x.head(n);
+}
+
+// The replay identity's residual, relative.
+double replay(const Model& model, const SolveInput& in, const Data& data) {
+  const Dense d = dense(model, in);
+  Eigen::VectorXd r = d.H * data.qdd() - d.h - data.commandTorques();
+  for (std::size_t c = 0; c < in.contacts.size(); ++c) r -= d.J[c].transpose() * data.contactForces().col(c);
+  return r.cwiseAbs().maxCoeff() / std::max(1.0, d.h.cwiseAbs().maxCoeff());
+}
+
+Model randomModel(RandomGen& g, bool tree, int n) {
+  testutil::TreeSpec spec;
+  spec.n_joints = n;
+  return tree ? Model(testutil::randomTree(g, spec)) : Model(g.chain(n));
+}
+
+SolveInput restingInput(RandomGen& g, const Model& model, int contacts, double mu, double force) {
+  const int n = static_cast<int>(model.nrOfJoints()), ns = static_cast<int>(model.nrOfSegments());
+  SolveInput in(model);
+  in.q = g.q(n).data;
+  in.q_dot.setZero();
+  in.ff_torques = g.torques(n).data;
+  for (int c = 0; c < contacts; ++c) {
+    PointContact pc;
+    pc.segment = g.integer(0, ns - 1);
+    pc.point = Vector3(g.uniform(-0.2, 0.2), g.uniform(-0.2, 0.2), g.uniform(-0.2, 0.2));
+    const KDL::Vector v = g.vector(-1.0, 1.0);
+    pc.normal = Vector3(v.x(), v.y(), v.z()).normalized();
+    pc.mu = mu;
+    pc.force = force;
+    in.contacts.push_back(pc);
+  }
+  return in;
+}
+
+}  // namespace
+
+TEST_CASE("frictionless supports equal the enumerated Gauss problem, chains and trees") {
+  RandomGen g(31);
+  double worst_qdd = 0.0, worst_force = 0.0, worst_replay = 0.0;
+  int pushing = 0;
+  for (int trial = 0; trial < 80; ++trial) {
+    const Model model = randomModel(g, trial % 2 == 1, g.integer(2, 9));
+    const int k = g.integer(1, std::min(4, static_cast<int>(model.nrOfJoints())));
+    SolveInput in = restingInput(g, model, k, 0.0, std::numeric_limits<double>::quiet_NaN());
+    Data data(model);
+    const Status s = solve(model, data, in);
+    REQUIRE_MESSAGE(s, "trial " << trial << ": " << std::string(s.message()));
+    CHECK(data.contactOutcome() == ContactOutcome::Unique);
+    const Dense d = dense(model, in);
+    // Enumerate the supports that push (the rest must separate).
+    int found = 0;
+    for (int mask = 0; mask < (1 << k); ++mask) {
+      const int a = __builtin_popcount(mask);
+      Eigen::MatrixXd C(a, model.nrOfJoints());
+      Eigen::VectorXd e(a), lam;
+      for (int c = 0, r = 0; c < k; ++c)
+        if (mask >> c & 1) {
+          C.row(r) = in.contacts[c].normal.transpose() * d.J[c];
+          e(r++) = -in.contacts[c].normal.dot(d.bias[c]);
+        }
+      const Eigen::VectorXd x = kkt(d, C, e, lam);
+      bool ok = a == 0 || lam.minCoeff() >= -1e-9;
+      for (int c = 0; c < k && ok; ++c)
+        if (!(mask >> c & 1)) ok = in.contacts[c].normal.dot(d.J[c] * x + d.bias[c]) >= -1e-9;
+      if (!ok) continue;
+      ++found;
+      worst_qdd = std::max(worst_qdd, (data.qdd() - x).cwiseAbs().maxCoeff() / std::max(1.0, x.cwiseAbs().maxCoeff()));
+      // The generalised contact force sum_c J_c^T f_c is unique (the forces themselves are not when
+      // the points' Jacobians are dependent): compare it, and each force's direction and sign.
+      Eigen::VectorXd gen_ours = Eigen::VectorXd::Zero(x.size()), gen_oracle = gen_ours;
+      for (int c = 0, r = 0; c < k; ++c) {
+        const double fn = (mask >> c & 1) ? lam(r++) : 0.0;
+        const Vector3 f = data.contactForces().col(c);
+        gen_ours += d.J[c].transpose() * f;
+        gen_oracle += d.J[c].transpose() * (fn * in.contacts[c].normal);
+        CHECK((f - in.contacts[c].normal.dot(f) * in.contacts[c].normal).norm() <= 1e-12 * std::max(1.0, f.norm()));
+        CHECK(in.contacts[c].normal.dot(f) >= 0.0);
+        pushing += fn > 1e-9;
+      }
+      worst_force = std::max(
+          worst_force, (gen_ours - gen_oracle).cwiseAbs().maxCoeff() / std::max(1.0, gen_oracle.cwiseAbs().maxCoeff()));
+      break;
+    }
+    CHECK_MESSAGE(found == 1, "trial " << trial << ": the enumeration found no consistent support set");
+    worst_replay = std::max(worst_replay, replay(model, in, data));
+  }
+  CHECK(worst_qdd <= 1e-9);
+  CHECK(worst_force <= 1e-9);
+  CHECK(worst_replay <= 1e-9);
+  CHECK(pushing > 20);
+  MESSAGE("worst: qdd " << worst_qdd << ", force " << worst_force << ", replay " << worst_replay << "; " << pushing
+                        << " pushing supports");
+}
+
+TEST_CASE("sticking points with friction equal bilateral point constraints") {
+  RandomGen g(47);
+  double worst = 0.0;
+  int sticking = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const Model model = randomModel(g, trial % 2 == 0, g.integer(4, 9));
+    SolveInput in = restingInput(g, model, 1, 2.0, std::numeric_limits<double>::quiet_NaN());
+    in.contacts[0].segment = static_cast<int>(model.nrOfSegments()) - 1;  // a chain's tip: a full-rank point
+    Data data(model);
+    REQUIRE(solve(model, data, in));
+    const Dense d = dense(model, in);
+    Eigen::VectorXd lam;
+    const Eigen::VectorXd x = kkt(d, d.J[0], -d.bias[0], lam);
+    // The bilateral answer must push and lie strictly inside the friction polygon (apothem mu cos(pi/4)).
+    const Vector3 n0 = in.contacts[0].normal;
+    const double fn = n0.dot(lam), ft = (lam - fn * n0).norm();
+    if (fn <= 1e-6 || ft >= 0.99 * 2.0 * std::cos(M_PI / 4) * fn) continue;
+    ++sticking;
+    CHECK(data.contactStatus()[0] == ContactStatus::Sticking);
+    CHECK(data.contactOutcome() == ContactOutcome::Consistent);
+    const double eq = (data.qdd() - x).cwiseAbs().maxCoeff() / std::max(1.0, x.cwiseAbs().maxCoeff());
+    // The generalised force J^T f is unique; the force itself only when J has rank 3.
+    const Eigen::VectorXd gen = d.J[0].transpose() * lam;
+    const double ef = (d.J[0].transpose() * data.contactForces().col(0) - gen).cwiseAbs().maxCoeff() /
+                      std::max(1.0, gen.cwiseAbs().maxCoeff());
+    if (eq > 1e-9 || ef > 1e-9)
+      MESSAGE("trial " << trial << " qdd err " << eq << " force " << data.contactForces().col(0).transpose() << " vs "
+                       << lam.transpose());
+    worst = std::max({worst, eq, ef});
+    CHECK(replay(model, in, data) <= 1e-9);
+  }
+  CHECK(sticking > 25);
+  CHECK(worst <= 1e-9);
+  MESSAGE("worst relative error " << worst << " over " << sticking << " sticking points");
+}
+
+TEST_CASE("a frictionless force set-point holds the normal and pushes with its force") {
+  RandomGen g(59);
+  double worst = 0.0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Model model = randomModel(g, trial % 2 == 0, g.integer(3, 8));
+    SolveInput in = restingInput(g, model, 1, 0.0, g.uniform(0.0, 20.0));
+    Data data(model);
+    const Status s = solve(model, data, in);
+    REQUIRE_MESSAGE(s, std::string(s.message()));
+    Dense d = dense(model, in);
+    const PointContact& pc = in.contacts[0];
+    d.h += d.J[0].transpose() * (pc.force * pc.normal);  // the surface's known push
+    Eigen::VectorXd lam;
+    const Eigen::VectorXd x =
+        kkt(d, pc.normal.transpose() * d.J[0], Eigen::VectorXd::Constant(1, -pc.normal.dot(d.bias[0])), lam);
+    worst = std::max(worst, (data.qdd() - x).cwiseAbs().maxCoeff() / std::max(1.0, x.cwiseAbs().maxCoeff()));
+    worst = std::max(worst, (data.contactForces().col(0) - pc.force * pc.normal).norm() / std::max(1.0, pc.force));
+    CHECK(data.nu().size() == 0);  // the set-point's column is not one of the input's
+    CHECK(replay(model, in, data) <= 1e-9);
+  }
+  CHECK(worst <= 1e-9);
+}
+
+TEST_CASE("contacts refuse invalid input with messages") {
+  RandomGen g(3);
+  const Model model(g.chain(4));
+  Data data(model);
+  SolveInput in(model);
+  PointContact pc;
+  pc.segment = 7;
+  in.contacts.push_back(pc);
+  Status s = solve(model, data, in);
+  CHECK(s.code() == Error::InvalidContact);
+  CHECK(std::string(s.message()).find("contacts[0].segment") != std::string::npos);
+  in.contacts[0].segment = 1;
+  in.contacts[0].normal = Vector3(0, 0, 2);
+  CHECK(solve(model, data, in).code() == Error::InvalidContact);
+  in.contacts[0].normal = Vector3::UnitZ();
+  in.contacts[0].mu = -1.0;
+  CHECK(solve(model, data, in).code() == Error::InvalidContact);
+  in.contacts[0].mu = 0.5;
+  in.contacts[0].facets = 2;
+  CHECK(solve(model, data, in).code() == Error::InvalidContact);
+  in.contacts[0].facets = 4;
+  REQUIRE(solve(model, data, in));
+  CHECK(data.contactForces().cols() == 1);
+  in.contacts.clear();
+  REQUIRE(solve(model, data, in));
+  CHECK(data.contactForces().cols() == 0);
+  CHECK(data.contactOutcome() == ContactOutcome::None);
+}
