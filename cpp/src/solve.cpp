@@ -165,7 +165,7 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
     c.message[0] = '\0';
     return Status();
   }
-  if (with_friction) return Status(static_cast<Error>(rc), d.friction_core->message_.data());
+  if (with_friction && !with_contacts) return Status(static_cast<Error>(rc), d.friction_core->message_.data());
   return d.status(rc);
 }
 
