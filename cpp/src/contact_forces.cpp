@@ -53,15 +53,15 @@ void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
       const Vector3& e = cols[first + c];
       col_segment_(p.col + c) = pc.segment;
       col_wrench_.col(p.col + c) << e, p.r.cross(e);
-      rows_jac_.row(p.row + c).head(n).noalias() = rows[first + c].transpose() * jac_.topRows<3>();
+      rows_jac_.col(p.row + c).head(n).noalias() = jac_.topRows<3>().transpose() * rows[first + c];
       rows_bias_(p.row + c) = rows[first + c].dot(bias.head<3>());
     }
   }
   auto dqdd = dqdd_.leftCols(ncol_);
   (void)d.core.wrenchResponse(col_segment_.head(ncol_), col_wrench_.leftCols(ncol_), dqdd, nullptr);
-  const auto J = rows_jac_.topLeftCorner(nrow_, n);
-  acc_per_col_.topLeftCorner(nrow_, ncol_).noalias() = J * dqdd;
-  rows0_.head(nrow_).noalias() = J * d.core.res.qdd;
+  const auto Jt = rows_jac_.topLeftCorner(n, nrow_);  // one column per row: no strided products
+  acc_per_col_.topLeftCorner(nrow_, ncol_).noalias() = Jt.transpose() * dqdd;
+  rows0_.head(nrow_).noalias() = Jt.transpose() * d.core.res.qdd;
   rows0_.head(nrow_) += rows_bias_.head(nrow_);
 }
 
@@ -126,7 +126,7 @@ int ContactStage::solveLcp(HdCore& c, bool convex) {
                            "supports contradict each other)"
                          : "contacts: no consistent contact forces were found (with friction at the supports the "
                            "problem can have none: Painleve's paradox)");
-  const double scale = std::max({1.0, q.cwiseAbs().maxCoeff(), (M * z).cwiseAbs().maxCoeff()});
+  const double scale = std::max({1.0, q.cwiseAbs().maxCoeff(), (w - q).cwiseAbs().maxCoeff()});  // w - q = M z
   const double tol = 1e-9 * scale;
   for (int i = 0; i < nz_; ++i)
     if (w(i) < -tol || std::abs(w(i) * z(i)) > tol * std::max(1.0, std::abs(z(i))))

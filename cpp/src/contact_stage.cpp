@@ -148,7 +148,7 @@ void ContactStage::reserve(int contacts, int unknowns, int columns, int rows) {
   status.resize(contacts);  // within its capacity after the first solve of this size
   if (forces.cols() < contacts) forces.resize(3, contacts);
   count = contacts;
-  if (rows_jac_.rows() < rows) rows_jac_.resize(rows, n), rows_bias_.resize(rows), rows0_.resize(rows);
+  if (rows_jac_.cols() < rows) rows_jac_.resize(n, rows), rows_bias_.resize(rows), rows0_.resize(rows);
   if (col_wrench_.cols() < columns) {
     col_wrench_.resize(6, columns);
     col_segment_.resize(columns);

@@ -86,7 +86,7 @@ class ContactStage {
   Lemke lemke_;
   std::vector<Point> points_;
   Eigen::MatrixXd jac_;                 // 6 x n_joints: one contact point's Jacobian
-  Eigen::MatrixXd rows_jac_;            // rows x n_joints: acceleration rows per joint acceleration
+  Eigen::MatrixXd rows_jac_;            // n_joints x rows: each acceleration row per joint acceleration
   Eigen::VectorXd rows_bias_;           // rows: their value at qdd = 0
   Eigen::VectorXi col_segment_;         // columns: the segment of each force direction
   Matrix6X col_wrench_;                 // columns: unit force direction as a wrench about the tip origin

@@ -57,7 +57,8 @@ int Lemke::ratioTest(int entering, int n, double tol) const {
 
 void Lemke::pivot(int row, int col, int n) {
   auto T = tableau_.topLeftCorner(n, 2 * n + 2);
-  T.row(row) /= T(row, col);
+  const double p = T(row, col);
+  T.row(row) /= p;
   for (int i = 0; i < n; ++i) {
     if (i == row) continue;
     const double f = T(i, col);
@@ -103,7 +104,8 @@ Lemke::Result Lemke::solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eig
         else
           z(v - n) = value;
       }
-      w.noalias() = M * z + q;  // recomputed from z: the caller's certificate reads it
+      w = q;  // recomputed from z (the caller's certificate reads it), without a temporary
+      w.noalias() += M * z;
       return kSolved;
     }
   }

@@ -3,7 +3,9 @@
 // operator new/delete and, on glibc, the malloc family, which Eigen uses). The test proves the
 // counters work by allocating on purpose in a counted region.
 #include <doctest/doctest.h>
+
 #include <kdl/chainhdsolver_vereshchagin.hpp>
+#include <limits>
 
 #include "alloc_counter.hpp"
 #include "random_chain.hpp"
@@ -13,6 +15,7 @@
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/friction_solver.hpp"
 #include "vereshchagin/kdl_compat.hpp"
+#include "vereshchagin/kinematics.hpp"
 #include "vereshchagin/tree_hd_solver.hpp"
 
 namespace {
@@ -370,4 +373,65 @@ TEST_CASE_FIXTURE(Fixture, "tree solves do not allocate") {
   CHECK_MESSAGE((a1.news == a0.news && a1.mallocs == a0.mallocs), "(model, data, input) solves allocated: operator new "
                                                                       << str(a1.news - a0.news) << ", malloc "
                                                                       << str(a1.mallocs - a0.mallocs));
+}
+
+TEST_CASE_FIXTURE(Fixture, "solves with contacts do not allocate once warm") {
+  // Supports with and without friction, a force set-point with friction, at rest and moving (so
+  // the sticking trial, the full complementarity problem and the separating and sliding paths all
+  // run), with a task on the last segment. The first solve of each size allocates the stage.
+  const vereshchagin::Model model(chain);
+  vereshchagin::Data data(model);
+  vereshchagin::SolveInput in(model);
+  in.constraints.reserve(4);
+  const auto contact = [&](int segment, double mu, double force) {
+    vereshchagin::PointContact pc;
+    pc.segment = segment;
+    pc.point = vereshchagin::Vector3(0.05, -0.02, 0.1);
+    pc.normal = vereshchagin::Vector3(0.3, 0.2, 1.0).normalized();
+    pc.mu = mu;
+    pc.force = force;
+    return pc;
+  };
+  const double support = std::numeric_limits<double>::quiet_NaN();
+  in.contacts = {contact(static_cast<int>(ns) - 1, 0.8, support), contact(3, 0.0, support), contact(5, 0.5, 4.0),
+                 contact(2, 0.6, support)};
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+  // Moving states: each normal perpendicular to its point's velocity (touching, sliding).
+  std::vector<std::vector<vereshchagin::Vector3>> sliding_normals(kSets);
+  vereshchagin::KinematicsData kin(model);
+  for (int s = 0; s < kSets; ++s) {
+    REQUIRE(vereshchagin::forwardKinematics(model, kin, vereshchagin::JointPositions(q[s].data),
+                                            vereshchagin::JointVelocities(qd[s].data)));
+    for (const vereshchagin::PointContact& pc : in.contacts) {
+      vereshchagin::Vector6 twist;
+      const KDL::Frame at(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)));
+      REQUIRE(vereshchagin::frameTwist(model, kin, vereshchagin::FrameRef{pc.segment, at}, twist));
+      const vereshchagin::Vector3 v = twist.head<3>();
+      sliding_normals[s].push_back(v.cross(vereshchagin::Vector3::UnitZ()).normalized());
+    }
+  }
+  const std::vector<vereshchagin::PointContact> resting = in.contacts;
+  double csum = 0.0;
+  int cfail = 0;
+  const auto run = [&](int s, bool moving, int columns) {
+    in.setState(vereshchagin::JointPositions(q[s].data), vereshchagin::JointVelocities(moving ? qd[s].data : rest));
+    for (std::size_t c = 0; c < in.contacts.size(); ++c)
+      in.contacts[c].normal = moving ? sliding_normals[s][c] : resting[c].normal;
+    in.ff_torques = ff[s].data;
+    in.constraints.clear();
+    if (columns > 0 && !in.addConstraint(static_cast<int>(ns) - 2, alfa_m[columns], beta[columns].data)) ++cfail;
+    const vereshchagin::Status st = vereshchagin::solve(model, data, in);
+    if (!st && st.code() != vereshchagin::Error::NoContactSolution) ++cfail;
+    if (st) csum += data.qdd()(0) + data.contactForces()(2, 0);
+  };
+  for (int s = 0; s < kSets; ++s)
+    for (int columns = 0; columns <= 2; ++columns) run(s, s % 2 == 1, columns);  // warm: every size once
+  const Counts c0 = now();
+  for (int it = 0; it < 300; ++it) run(it % kSets, it % 2 == 1, it % 3);
+  const Counts c1 = now();
+  CHECK_MESSAGE(cfail == 0, "contact solves failed: " << str(cfail));
+  CHECK_MESSAGE(std::isfinite(csum), "non-finite contact results");
+  CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "contact solves allocated: operator new "
+                                                                      << str(c1.news - c0.news) << ", malloc "
+                                                                      << str(c1.mallocs - c0.mallocs));
 }
