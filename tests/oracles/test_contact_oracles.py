@@ -31,6 +31,17 @@ def _pin_sticking_qdd(model, data, q, qd, tau, frame, point):
     return pin.constraintDynamics(model, data, q, qd, tau, [cm], [cd], pin.ProximalSettings(1e-14, 0.0, 1))
 
 
+def _resting_problem(rng, n, segments, contact):
+    """A random n-joint chain at rest with a random torque and one contact (``contact()``'s keys,
+    a random point) on each of ``segments``."""
+    rc = random_chain(rng, n, prismatic=False)
+    model, data = rc.model, rc.data()
+    q, _ = random_state(rng, rc)
+    tau = rng.normal(size=model.nv) * 3
+    specs = [dict(frame=rc.tip_frames[k], point=rng.normal(size=3) * 0.1, **contact()) for k in segments]
+    return contact_problem(model, data, pin_configuration(model, q), np.zeros(model.nv), tau, specs)
+
+
 @pytest.mark.parametrize("seed", range(8))
 def test_a_sticking_point_matches_pinocchio_constraint_dynamics(seed):
     rng = np.random.default_rng(seed)
@@ -51,15 +62,7 @@ def test_a_sticking_point_matches_pinocchio_constraint_dynamics(seed):
 @pytest.mark.parametrize("seed", range(8))
 def test_frictionless_enumeration_is_the_gauss_qp(seed):
     rng = np.random.default_rng(100 + seed)
-    rc = random_chain(rng, 7, prismatic=False)
-    model, data = rc.model, rc.data()
-    q, _ = random_state(rng, rc)
-    qp = pin_configuration(model, q)
-    tau = rng.normal(size=model.nv) * 3
-    specs = [
-        dict(frame=rc.tip_frames[k], point=rng.normal(size=3) * 0.1, normal=rng.normal(size=3), mu=0.0) for k in (3, 6)
-    ]
-    prob = contact_problem(model, data, qp, np.zeros(model.nv), tau, specs)
+    prob = _resting_problem(rng, 7, (3, 6), lambda: dict(normal=rng.normal(size=3), mu=0.0))
     sols = enumerate_modes(prob)
     assert len(sols) == 1  # frictionless: the accelerations are unique
     x = frictionless_qp(prob)
@@ -69,15 +72,7 @@ def test_frictionless_enumeration_is_the_gauss_qp(seed):
 @pytest.mark.parametrize("seed", range(6))
 def test_frictional_solutions_meet_their_conditions(seed):
     rng = np.random.default_rng(200 + seed)
-    rc = random_chain(rng, 6, prismatic=False)
-    model, data = rc.model, rc.data()
-    q, _ = random_state(rng, rc)
-    qp = pin_configuration(model, q)
-    tau = rng.normal(size=model.nv) * 3
-    specs = [
-        dict(frame=rc.tip_frames[k], point=rng.normal(size=3) * 0.1, normal=[0, 0, 1], mu=0.5, facets=4) for k in (2, 5)
-    ]
-    prob = contact_problem(model, data, qp, np.zeros(model.nv), tau, specs)
+    prob = _resting_problem(rng, 6, (2, 5), lambda: dict(normal=[0, 0, 1], mu=0.5, facets=4))
     sols = enumerate_modes(prob)
     assert sols, "no consistent mode (a Painleve case): pick another seed"
     for sol in sols:
