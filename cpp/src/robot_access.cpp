@@ -70,6 +70,17 @@ std::string nameList(const std::vector<std::string>& names) {
   return out;
 }
 
+std::string indexRangeMessage(const std::string& what, const std::string& value, int n) {
+  return what + " index " + value + " out of range for " + std::to_string(n) + " " + what + "s (valid " +
+         std::to_string(-n) + " .. " + std::to_string(n - 1) +
+         (what == "segment" ? "; the base is addressed by its name only)" : ")");
+}
+
+std::string indexTypeMessage(const std::string& what, const std::string& type_name) {
+  const char* named_by = what == "segment" ? "a str (segment or link name)" : "a str";
+  return "a " + what + " is named by " + named_by + " or an int index, got " + type_name;
+}
+
 Status findFrame(const RobotChain& robot, const std::string& name, FrameRef& out, std::string& message) {
   return findFrameOrSay(robot, name, out, message);
 }

@@ -145,6 +145,18 @@ void setRecordTuples(const RecordTuples& tuples, RobotRecord& record) {
   for (const auto& [link, segment, frame] : tuples.links) record.links.push_back({link, segment, frame});
 }
 
+std::vector<SegmentTuple> withoutParents(const std::vector<std::pair<SegmentTuple, long long>>& segments) {
+  std::vector<SegmentTuple> out;
+  for (const auto& s : segments) out.push_back(s.first);
+  return out;
+}
+
+std::vector<std::pair<SegmentTuple, long long>> withUnusedParents(const std::vector<SegmentTuple>& segments) {
+  std::vector<std::pair<SegmentTuple, long long>> out;
+  for (const SegmentTuple& s : segments) out.emplace_back(s, -1);
+  return out;
+}
+
 RobotRecord robotRecord(const RobotChain& robot) {
   RobotRecord r;
   r.root_link = robot.root_link;

@@ -65,6 +65,16 @@ TEST_CASE("lookups by name name what exists when they fail") {
   CHECK(vereshchagin::nameList(many).find("'n12'") == std::string::npos);
 }
 
+TEST_CASE("index messages name the valid range and what names an item") {
+  CHECK(vereshchagin::indexRangeMessage("segment", "9", 7) ==
+        "segment index 9 out of range for 7 segments (valid -7 .. 6; the base is addressed by its name only)");
+  CHECK(vereshchagin::indexRangeMessage("joint", "-8", 7) ==
+        "joint index -8 out of range for 7 joints (valid -7 .. 6)");
+  CHECK(vereshchagin::indexTypeMessage("segment", "float") ==
+        "a segment is named by a str (segment or link name) or an int index, got float");
+  CHECK(vereshchagin::indexTypeMessage("joint", "list") == "a joint is named by a str or an int index, got list");
+}
+
 TEST_CASE("rotor inertia is set per joint and refused when negative") {
   for (int tree_or_chain = 0; tree_or_chain < 2; ++tree_or_chain) {
     vereshchagin::RobotTree tree = robotfixture::tree();

@@ -108,3 +108,16 @@ TEST_CASE("robotFromRecord refuses crafted records naming the record") {
         "Tree state: segment 1: parent index is out of range (-1 .. 0)");
   CHECK(refusal(true, [](R& r) { r.segments[2].name = "arm"; }) == "Tree state: segment 'arm' cannot be added");
 }
+
+TEST_CASE("a chain's segment tuples drop and regain the unused parent index") {
+  const vereshchagin::RobotRecord chain = vereshchagin::robotRecord(robotfixture::chain());
+  const vereshchagin::RecordTuples tuples = vereshchagin::recordTuples(chain);
+  const std::vector<vereshchagin::SegmentTuple> bare = vereshchagin::withoutParents(tuples.segments);
+  REQUIRE(bare.size() == tuples.segments.size());
+  CHECK(bare[1] == tuples.segments[1].first);
+  const auto back = vereshchagin::withUnusedParents(bare);
+  REQUIRE(back.size() == bare.size());
+  CHECK(back[1].first == bare[1]);
+  CHECK(back[1].second == -1);
+  CHECK(vereshchagin::withoutParents(back) == bare);
+}

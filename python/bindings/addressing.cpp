@@ -1,29 +1,27 @@
 // The shared addressing rule of Chain and Tree (addressing.hpp).
 #include "addressing.hpp"
 
+#include "vereshchagin/robot_access.hpp"
+
 namespace vsbind {
 
 namespace {
 
-// The int value of an index argument, or raises naming the valid range (an int beyond the C range
-// is out of range like any other) or, for a non-int, what names a `what`.
-int indexInRange(PyObject* which, int n, const std::string& label, const std::string& what, const char* named_by) {
+// The int value of an index argument, or raises with robot_access.hpp's messages: the valid range
+// (an int beyond the C range is out of range like any other) or, for a non-int, what names a `what`.
+int indexInRange(PyObject* which, int n, const std::string& label, const std::string& what) {
   if (PyBool_Check(which) || !PyIndex_Check(which))
-    raise(label + ": a " + what + " is named by " + named_by + " or an int index, got " +
-          std::string(py::str(py::type::of(py::handle(which)).attr("__name__"))));
+    raise(label + ": " +
+          vereshchagin::indexTypeMessage(what, py::str(py::type::of(py::handle(which)).attr("__name__"))));
   const std::optional<long long> v = intWithin(which, -n, n - 1);
-  if (!v)
-    raise(label + ": " + what + " index " + py::str(which).cast<std::string>() + " out of range for " +
-          std::to_string(n) + " " + what + "s (valid " + std::to_string(-n) + " .. " + std::to_string(n - 1) +
-          (what == "segment" ? "; the base is addressed by its name only)" : ")"));
+  if (!v) raise(label + ": " + vereshchagin::indexRangeMessage(what, py::str(which), n));
   return static_cast<int>(*v < 0 ? *v + n : *v);
 }
 
 }  // namespace
 
 FrameTarget Addressable::resolveTarget(PyObject* which, const std::string& label) const {
-  if (!PyUnicode_Check(which))
-    return {indexInRange(which, segmentCount(), label, "segment", "a str (segment or link name)")};
+  if (!PyUnicode_Check(which)) return {indexInRange(which, segmentCount(), label, "segment")};
   vereshchagin::FrameRef ref;
   std::string message;
   if (!frameByName(py::handle(which).cast<std::string>(), ref, message)) raise(label + ": " + message);
@@ -42,8 +40,7 @@ FrameTarget Addressable::resolveMoving(PyObject* which, const std::string& label
 }
 
 int Addressable::resolveJoint(PyObject* which, const std::string& label) const {
-  if (!PyUnicode_Check(which))
-    return indexInRange(which, static_cast<int>(jointInfos().size()), label, "joint", "a str");
+  if (!PyUnicode_Check(which)) return indexInRange(which, static_cast<int>(jointInfos().size()), label, "joint");
   int index = -1;
   std::string message;
   if (!jointByName(py::handle(which).cast<std::string>(), index, message)) raise(label + ": " + message);

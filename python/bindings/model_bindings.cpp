@@ -8,12 +8,12 @@
 #include "model_class.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg, the F64View helpers
 #include "vereshchagin/robot_edit.hpp"
+#include "vereshchagin/robot_state.hpp"  // the joint records
 
 namespace vsbind {
 
 namespace {
 
-using vereshchagin::JointInfo;
 using vereshchagin::JointSpec;
 
 py::array array(const double* p, std::size_t n) {
@@ -25,36 +25,20 @@ py::array array(const std::vector<double>& v) {
   return array(v.data(), v.size());
 }
 
-// A property of every joint (in q order) or link: a float64 array of doubles, or a list.
-template <class M, class T, class Item>
-auto each(T Item::*field) {
-  return [field](const M& m) {
-    std::vector<T> v;
-    if constexpr (std::is_same_v<Item, JointInfo>)
-      for (const JointInfo& j : m.robot.joints) v.push_back(j.*field);
-    else
-      for (const Item& l : m.robot.links) v.push_back(l.*field);
-    if constexpr (std::is_same_v<T, double>)
-      return array(v);
-    else
-      return v;
-  };
-}
-
-// Sizes, names, the base, notes, joint data, masses, rotor inertia, the indices, pickle and
-// copies (repr: vereshchagin/_models.py); the docstring of Chain.lower is DOCS["Chain.lower"].
+// Sizes, names, the base, notes, joint records, masses, rotor inertia, the indices, pickle and
+// copies (repr and the joint properties: vereshchagin/_models.py); the docstring of Chain.n_joints
+// is DOCS["Chain.n_joints"].
 template <class M>
 py::class_<M> bindModel(py::module_& mod, const char* name) {
   py::class_<M> cls(mod, name, doc(name));
   const auto docOf = [prefix = std::string(name) + "."](const char* member) { return doc(prefix + member); };
   const auto prop = [&](const char* member, auto get) { cls.def_property_readonly(member, get, docOf(member)); };
-  const char* names[] = {"lower", "upper", "velocity_limit", "effort_limit", "friction", "damping"};
-  double JointInfo::*fields[] = {&JointInfo::lower,        &JointInfo::upper,    &JointInfo::velocity_limit,
-                                 &JointInfo::effort_limit, &JointInfo::friction, &JointInfo::damping};
-  for (int k = 0; k < 6; ++k) prop(names[k], each<M>(fields[k]));
-  prop("joint_names", each<M>(&JointInfo::name));
-  prop("joint_types", each<M>(&JointInfo::type));
-  prop("link_names", each<M>(&vereshchagin::LinkPlacement::link));
+  prop("_joints", [](const M& m) { return vereshchagin::recordTuples(vereshchagin::robotRecord(m.robot)).joints; });
+  prop("link_names", [](const M& m) {
+    std::vector<std::string> names;
+    for (const vereshchagin::LinkPlacement& l : m.robot.links) names.push_back(l.link);
+    return names;
+  });
   prop("n_joints", [](const M& m) { return vereshchagin::jointCount(m.robot); });
   prop("n_segments", &M::segmentCount);
   prop("segment_names", [](const M& m) { return vereshchagin::segmentNames(m.robot); });
@@ -171,11 +155,7 @@ void bindTree(py::module_& mod) {
   const auto fromUrdf = [](O source, O root, const std::string& inertia_check) {
     return modelFromUrdf<PyTree>(source, root.is_none() ? "" : root.cast<std::string>(), "", inertia_check);
   };
-  const auto parent = [](const PyTree& t) {
-    py::array_t<std::int64_t> a(static_cast<py::ssize_t>(t.robot.parent.size()));
-    std::copy(t.robot.parent.begin(), t.robot.parent.end(), a.mutable_data());
-    return a;
-  };
+  const auto parent = [](const PyTree& t) { return py::array_t<std::int64_t>(py::cast(t.robot.parent)); };
   const auto chain = [](const PyTree& t, O tip) {
     PyChain c;
     c.robot = vereshchagin::pathChain(t.robot, t.resolveMoving(tip.ptr(), "tip").segment);

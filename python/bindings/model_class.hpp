@@ -52,14 +52,8 @@ struct PyModel : CompanionModel {
 using PyChain = PyModel<vereshchagin::RobotChain>;
 using PyTree = PyModel<vereshchagin::RobotTree>;
 
-// Pickle states (model_state.cpp). Chain: (1, segments, joints, links, root_link, notes,
-// inertia_check); Tree: (1, root_link, [(segment, parent)], joints, links, notes, inertia_check).
-// A segment: (name, joint name, joint type, origin, axis, rotor inertia, damping, stiffness, tip
-// frame (12), the 13 stored inertia doubles), restored bit for bit; a joint: (name, type, lower,
-// upper, velocity_limit, effort_limit, friction, damping, segment); a link: (name, segment, frame
-// (12)); lists hold the records, the vectors of 3, 12 and 13 doubles are lists (any sequence
-// loads). States of six entries (no inertia_check) load as 'physical'. Crafted states raise
-// SolverError naming the record ("Chain state: ...", "Tree state: ...").
+// Pickle states (model_state.cpp; their layout: vereshchagin/_models.py's module docstring).
+// Crafted states raise SolverError naming the record ("Chain state: ...", "Tree state: ...").
 template <class Model>
 py::tuple modelState(const Model& model);
 template <class Model>

@@ -18,26 +18,22 @@ template <bool tree>
 using Segments =
     std::vector<std::conditional_t<tree, std::pair<vereshchagin::SegmentTuple, long long>, vereshchagin::SegmentTuple>>;
 
-// The records of a state (model_class.hpp gives both layouts); a malformed entry raises naming `what`.
+// The records of a state (layouts: vereshchagin/_models.py); a malformed entry raises naming `what`.
 template <bool tree>
 RobotRecord recordFrom(const py::tuple& state, const std::string& what) {
   RobotRecord r;
   RecordTuples t;
-  Segments<tree> segments;
   try {
-    segments = state[tree ? 2 : 1].template cast<Segments<tree>>();
+    if constexpr (tree)
+      t.segments = state[2].template cast<Segments<tree>>();
+    else
+      t.segments = vereshchagin::withUnusedParents(state[1].template cast<Segments<tree>>());
     t.joints = state[tree ? 3 : 2].template cast<std::vector<vereshchagin::JointTuple>>();
     t.links = state[tree ? 4 : 3].template cast<std::vector<vereshchagin::LinkTuple>>();
     r.root_link = state[tree ? 1 : 4].template cast<std::string>();
     r.notes = state[5].template cast<std::vector<std::string>>();
   } catch (const py::cast_error&) {
     raise(what + ": malformed records (segments, joints and links must be lists of tuples of the pickled layout)");
-  }
-  for (const auto& s : segments) {
-    if constexpr (tree)
-      t.segments.push_back(s);
-    else
-      t.segments.emplace_back(s, -1);  // a chain's parent field is unused
   }
   vereshchagin::setRecordTuples(t, r);
   return r;
@@ -50,16 +46,11 @@ py::tuple modelState(const Model& model) {
   constexpr bool tree = std::is_same_v<Model, PyTree>;
   const RobotRecord r = vereshchagin::robotRecord(model.robot);
   const RecordTuples t = vereshchagin::recordTuples(r);
-  Segments<tree> segments;
-  for (const auto& s : t.segments) {
-    if constexpr (tree)
-      segments.push_back(s);
-    else
-      segments.push_back(s.first);
-  }
   const char* check = vereshchagin::inertiaCheckName(model.inertia_check);
-  if (tree) return py::make_tuple(1, r.root_link, segments, t.joints, t.links, r.notes, check);
-  return py::make_tuple(1, segments, t.joints, t.links, r.root_link, r.notes, check);
+  if constexpr (tree)
+    return py::make_tuple(1, r.root_link, t.segments, t.joints, t.links, r.notes, check);
+  else
+    return py::make_tuple(1, vereshchagin::withoutParents(t.segments), t.joints, t.links, r.root_link, r.notes, check);
 }
 
 template <class Model>

@@ -11,7 +11,7 @@ namespace vsbind {
 
 namespace {
 
-enum View { kQdd, kTau, kNu, kLinkAcc, kFriction, kLimit, kStatus };
+enum View { kQdd, kTau, kNu, kLinkAcc, kFriction, kLimit, kStatus, kData };  // kData: the whole buffer
 
 // Every numeric output lives in `data` (allocated with the object: one allocation per solve).
 // Array fields are views of it whose base is the result; they are not cached (a cache would be a
@@ -59,23 +59,25 @@ PyObject* allocate(const ResultLayout& layout) {
 Py_ssize_t offsetOf(const ResultLayout& l, int which) {
   const Py_ssize_t nj = l.nj, link = 6 * (l.ns + 1);
   const Py_ssize_t offsets[] = {0, nj, 2 * nj, 2 * nj + l.m, 2 * nj + l.m + link, 3 * nj + l.m + link};
-  return which < kStatus ? offsets[which] : 4 * nj + l.m + link;
+  return which == kData ? 0 : which < kStatus ? offsets[which] : 4 * nj + l.m + link;
 }
 
-// Field `which` (closure) as a view into the result's data whose base is the result.
+// Field `which` (closure) as a view into the result's data whose base is the result (kData: all of
+// it as doubles, read-only: the pickle state's bytes, vereshchagin/_results.py).
 PyObject* getView(PyObject* o, void* closure) {
   ResultObject* r = self(o);
   const int which = static_cast<int>(reinterpret_cast<intptr_t>(closure));
   const ResultLayout& l = r->layout;
-  if (which >= kFriction && !l.friction) Py_RETURN_NONE;
-  const Py_ssize_t dims[2] = {which == kNu ? l.m : which == kLinkAcc ? l.ns + 1 : l.nj, 6};
+  if (which >= kFriction && which <= kStatus && !l.friction) Py_RETURN_NONE;
+  const Py_ssize_t n = which == kNu ? l.m : which == kData ? bufferDoubles(l) : l.nj;
+  const Py_ssize_t dims[2] = {which == kLinkAcc ? l.ns + 1 : n, 6};
   const auto& api = py::detail::npy_api::get();
-  constexpr int flags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_ |
-                        py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  constexpr int flags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_;
+  const int writeable = which == kData ? 0 : py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   const int type = which == kStatus ? py::detail::npy_api::NPY_INT_ : py::detail::npy_api::NPY_DOUBLE_;
   PyObject* v =
       api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(type), which == kLinkAcc ? 2 : 1, dims,
-                                nullptr, r->data + offsetOf(l, which), flags, nullptr);
+                                nullptr, r->data + offsetOf(l, which), flags | writeable, nullptr);
   if (v == nullptr) return nullptr;
   Py_INCREF(o);
   if (api.PyArray_SetBaseObject_(v, o) != 0) Py_CLEAR(v);
@@ -115,19 +117,8 @@ PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, closure(kQdd)},
                           {"gauss_value", getScalar, nullptr, nullptr, closure(2)},
                           {"iterations", getScalar, nullptr, nullptr, closure(3)},
                           {"_segment_layout", getSegments, nullptr, nullptr, nullptr},
+                          {"_data", getView, nullptr, nullptr, closure(kData)},
                           {nullptr, nullptr, nullptr, nullptr, nullptr}};
-
-// The pickle state (n_joints, n_segments, m, friction, smin, gauss, rank, iterations, data bytes,
-// keys, starts, counts), the last three None without constraints= keys.
-py::tuple resultState(const py::handle& o) {
-  if (Py_TYPE(o.ptr()) != g_type) raise("expected a SolveResult");
-  const ResultObject* r = self(o.ptr());
-  const ResultLayout& l = r->layout;
-  const auto seg = [r](int k) { return py::reinterpret_borrow<py::object>(r->segments[k] ? r->segments[k] : Py_None); };
-  const py::bytes data(reinterpret_cast<const char*>(r->data), sizeof(double) * bufferDoubles(l));
-  return py::make_tuple(l.nj, l.ns, l.m, static_cast<int>(l.friction), r->smin, r->gauss, r->rank, r->iterations, data,
-                        seg(0), seg(1), seg(2));
-}
 
 // A result from the entries of a state that vereshchagin/_results.py checked; the sizes and the
 // data length are checked again here, before anything is allocated.
@@ -163,7 +154,6 @@ void bindResultType(py::module_& mod) {
   if (type == nullptr) throw py::error_already_set();
   g_type = reinterpret_cast<PyTypeObject*>(type);
   mod.add_object("SolveResult", py::reinterpret_borrow<py::object>(type));
-  mod.def("_result_state", &resultState, doc("_core._result_state"));
   mod.def("_result_from_parts", &resultFromParts, doc("_core._result_from_parts"));
 }
 

@@ -335,6 +335,8 @@ int
     In ``0 .. n_joints - 1``.
 """
 
+_SHARED["_joints"] = r"""list of tuple: every moving joint in q order as (name, type, lower, upper, velocity_limit, effort_limit, friction, damping, segment index); vereshchagin/_models.py's joint properties read it."""
+
 _SHARED["segment_masses"] = r"""ndarray (n_segments,): mass of each segment's rigid body (merged links included), kg."""
 
 for _model in ("Chain", "Tree"):
@@ -648,7 +650,5 @@ DOCS["SolveResult.segment_nu"] = r"""dict or None: ``{key: nu_i}`` for each ``co
 
 DOCS["_core._beta_for"] = r"""task.beta_for's arithmetic (vereshchagin/task.hpp); None for inputs task.py checks itself."""
 
-
-DOCS["_core._result_state"] = r"""A SolveResult's pickle state (vereshchagin/_results.py restores it)."""
 
 DOCS["_core._result_from_parts"] = r"""A SolveResult from the entries of a state vereshchagin/_results.py checked."""

@@ -1,8 +1,39 @@
-"""Python-side members of the compiled Chain and Tree (``python/bindings/model_bindings.cpp``): their repr."""
+"""Python-side members of the compiled Chain and Tree (``python/bindings/model_bindings.cpp``).
+
+Their repr, and the joint properties (``joint_names``, ``joint_types``, ``lower``, ``upper``,
+``velocity_limit``, ``effort_limit``, ``friction``, ``damping``) read from the compiled
+``_joints`` records: one (name, type, lower, upper, velocity_limit, effort_limit, friction,
+damping, segment) tuple per moving joint, in q order.
+
+Their pickle states (``__getstate__``, ``__setstate__``: ``python/bindings/model_state.cpp``) are
+Chain: ``(1, segments, joints, links, root_link, notes, inertia_check)``; Tree: ``(1, root_link,
+[(segment, parent)], joints, links, notes, inertia_check)``. A segment: ``(name, joint name, joint
+type, origin, axis, rotor inertia, damping, stiffness, tip frame (12), the 13 stored inertia
+doubles)``, restored bit for bit; a joint: ``(name, type, lower, upper, velocity_limit,
+effort_limit, friction, damping, segment)``; a link: ``(name, segment, frame (12))``; lists hold
+the records, the vectors of 3, 12 and 13 doubles are lists (any sequence loads). States of six
+entries (no inertia_check) load as 'physical'.
+"""
 
 from __future__ import annotations
 
+import numpy as np
+
 from ._core import Chain, Tree
+from ._docstrings import DOCS
+
+# The joint properties in the order of the fields of a ``_joints`` record; the first two are lists
+# of str, the others float64 arrays of shape (n_joints,).
+_JOINT_FIELDS = (
+    "joint_names",
+    "joint_types",
+    "lower",
+    "upper",
+    "velocity_limit",
+    "effort_limit",
+    "friction",
+    "damping",
+)
 
 
 def _chain_repr(self: Chain) -> str:
@@ -15,6 +46,19 @@ def _tree_repr(self: Tree) -> str:
     return f"<vereshchagin.Tree with {self.n_segments} segments, {self.n_joints} joints, base '{self.root_link}'>"
 
 
+def _joint_property(model: str, field: int) -> property:
+    """The property of field ``field`` of every joint record of a ``model`` ("Chain" or "Tree")."""
+
+    def get(self):
+        values = [record[field] for record in self._joints]
+        return values if field < 2 else np.array(values, dtype=np.float64)
+
+    return property(get, doc=DOCS[f"{model}.{_JOINT_FIELDS[field]}"])
+
+
 # setattr because a type checker rejects assigning to a declared method.
 setattr(Chain, "__repr__", _chain_repr)  # noqa: B010
 setattr(Tree, "__repr__", _tree_repr)  # noqa: B010
+for _cls in (Chain, Tree):
+    for _field, _name in enumerate(_JOINT_FIELDS):
+        setattr(_cls, _name, _joint_property(_cls.__name__, _field))

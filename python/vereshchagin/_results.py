@@ -2,14 +2,14 @@
 
 The compiled ``_core.SolveResult`` keeps only the storage, its array views and the solve path's
 fast access (``python/bindings/result_type.cpp``). Its pickle state is the 12-tuple of
-``_core._result_state``: ``(n_joints, n_segments, m, friction, smallest_singular_value,
-gauss_value, constraint_rank, iterations, data, keys, starts, counts)``. A state is checked here
+``_result_state``: ``(n_joints, n_segments, m, friction, smallest_singular_value, gauss_value,
+constraint_rank, iterations, data, keys, starts, counts)``. A state is checked here
 (crafted states raise ``ValueError``) before ``_core._result_from_parts`` allocates a result.
 """
 
 from __future__ import annotations
 
-from ._core import SolveResult, _result_from_parts, _result_state
+from ._core import SolveResult, _result_from_parts
 from ._docstrings import DOCS
 
 _MAX_SIZE = 1 << 24  # joints or segments of a result
@@ -78,8 +78,18 @@ def _result_from_state(*state) -> SolveResult:
     return _result_from_parts(sizes, (rank, state[4], state[5], iterations), state[8], state[9:])
 
 
+def _result_state(self: SolveResult) -> tuple:
+    """The pickle state (see the module docstring): the layout, the scalars as stored (0 where a
+    solve without friction reports None), the storage's bytes (``_data``) and the segment layout."""
+    gauss, iterations = self.gauss_value, self.iterations
+    layout = self._segment_layout or (None, None, None)
+    sizes = (len(self.qdd), len(self.link_acc) - 1, len(self.nu), int(self.friction_torque is not None))
+    scalars = (self.smallest_singular_value, 0.0 if gauss is None else gauss, self.constraint_rank)
+    return (*sizes, *scalars, 0 if iterations is None else iterations, self._data.tobytes(), *layout)
+
+
 def _reduce(self: SolveResult):
-    """Pickle support: the state of ``_core._result_state``, restored by ``_result_from_state``."""
+    """Pickle support: the state of ``_result_state``, restored by ``_result_from_state``."""
     return _result_from_state, _result_state(self)
 
 

@@ -94,6 +94,16 @@ Status findJoint(const RobotChain& robot, const std::string& name, int& index, s
 /// The same on a tree.
 Status findJoint(const RobotTree& robot, const std::string& name, int& index, std::string& message);
 
+/// The message of an int index that addresses none of `n` items of kind `what` ("segment" or
+/// "joint"; `value` as the caller printed it): "segment index 9 out of range for 7 segments (valid
+/// -7 .. 6; the base is addressed by its name only)", or for joints "joint index 9 out of range for
+/// 7 joints (valid -7 .. 6)".
+std::string indexRangeMessage(const std::string& what, const std::string& value, int n);
+/// The message of an index argument that is neither a name nor an int (`type_name`: its type's
+/// name): "a segment is named by a str (segment or link name) or an int index, got float", or for
+/// joints "a joint is named by a str or an int index, got float".
+std::string indexTypeMessage(const std::string& what, const std::string& type_name);
+
 /// The serial chain from the tree's base to segment `tip` (0 <= tip < segmentCount): that path's
 /// segments, their joints and the links placed on them or on the base, the base's root_link, the
 /// tree's note about its root link and a note naming how many segments were left out.

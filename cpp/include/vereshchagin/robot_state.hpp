@@ -80,6 +80,13 @@ RecordTuples recordTuples(const RobotRecord& record);
 /// here: robotFromRecord checks the result).
 void setRecordTuples(const RecordTuples& tuples, RobotRecord& record);
 
+/// A chain's pickle state holds its segments without parent indices: the SegmentTuple of each of
+/// `segments`, in order.
+std::vector<SegmentTuple> withoutParents(const std::vector<std::pair<SegmentTuple, long long>>& segments);
+/// The inverse of withoutParents: each of `segments` with parent index -1 (a chain's parent field
+/// is unused; robotFromRecord ignores it for a chain).
+std::vector<std::pair<SegmentTuple, long long>> withUnusedParents(const std::vector<SegmentTuple>& segments);
+
 /// The records of a chain (SegmentRecord::parent = i - 1) and of a tree.
 RobotRecord robotRecord(const RobotChain& robot);
 RobotRecord robotRecord(const RobotTree& robot);  ///< see robotRecord(const RobotChain&)
