@@ -220,7 +220,7 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
     if (rc < 0) return rc;
     if (rc == 1) {
       reportStatus(in, true);
-      return 0;
+      return leastEffort(d, in);
     }
   }
   layout(in, false);
@@ -229,7 +229,7 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   if (nz_ > 0)
     if (int rc = runInput(d, work_)) return rc;
   reportStatus(in, false);
-  return 0;
+  return leastEffort(d, in);
 }
 
 }  // namespace detail

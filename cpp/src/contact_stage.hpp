@@ -78,6 +78,11 @@ class ContactStage {
   // done), 0 if not (fall back to the full problem), or an error code.
   int trySticking(DataImpl& d, const SolveInput& in);
   void reportStatus(const SolveInput& in, bool stuck);
+  // Least motor effort among the force distributions that keep qdd (contact_effort.cpp): 0 or an
+  // error code of the final sweep.
+  int leastEffort(DataImpl& d, const SolveInput& in);
+  int effortCoordinates(const SolveInput& in, const Eigen::VectorXd& qdd);
+  void reserveEffort(int coordinates, int rows, int columns);
   void reserve(int contacts, int unknowns, int columns, int rows);
 
   Model model_;
@@ -96,6 +101,15 @@ class ContactStage {
   Eigen::MatrixXd lcp_m_, rows_per_z_;  // N x N; rows x N
   Eigen::VectorXd lcp_q_, z_, w_, rows0_;
   int nz_ = 0, ncol_ = 0, nrow_ = 0;
+  // Least effort (contact_effort.cpp): per free force coordinate its direction, contact, value,
+  // wrench and responses; the validity rows in the coordinates; the programme's matrices.
+  ConvexQp qp_;
+  Matrix3X eff_dir_;
+  Eigen::VectorXi eff_contact_, eff_seg_;
+  Eigen::VectorXd eff_x_, eff_c_, eff_dx_, eff_r_, eff_rhs_;
+  Matrix6X eff_wrench_;
+  Eigen::MatrixXd eff_dqdd_, eff_dnu_, eff_dtau_, eff_gtg_, eff_l_, eff_q_, eff_rows_, eff_r_all_;
+  int eff_k_ = 0;
 };
 
 }  // namespace detail

@@ -73,7 +73,9 @@ Lemke::Result Lemke::solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eig
   pivots = 0;
   z.setZero();
   w = q;
-  if (n == 0 || q.minCoeff() >= 0.0) return kSolved;
+  const double scale = std::max({1.0, M.cwiseAbs().maxCoeff(), q.cwiseAbs().maxCoeff()});
+  const double tol = 1e-13 * scale;
+  if (n == 0 || q.minCoeff() >= -tol) return kSolved;  // z = 0 (w = q, non-negative to round-off)
   auto T = tableau_.topLeftCorner(n, 2 * n + 2);
   T.setZero();
   T.leftCols(n).setIdentity();
@@ -81,8 +83,6 @@ Lemke::Result Lemke::solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eig
   T.col(2 * n).setConstant(-1.0);
   T.col(2 * n + 1) = q;
   for (int i = 0; i < n; ++i) basis_(i) = i;
-  const double scale = std::max({1.0, M.cwiseAbs().maxCoeff(), q.cwiseAbs().maxCoeff()});
-  const double tol = 1e-13 * scale;
   int row;
   q.minCoeff(&row);
   pivot(row, 2 * n, n);  // z0 enters, the most negative w leaves
@@ -110,6 +110,37 @@ Lemke::Result Lemke::solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eig
     }
   }
   return kPivotLimit;
+}
+
+void ConvexQp::reserve(int p, int k) {
+  const int n = 2 * p + k;
+  if (m_.rows() < n) {
+    m_.resize(n, n);
+    q_.resize(n), z_.resize(n), w_.resize(n);
+  }
+  lemke_.reserve(n);
+}
+
+Lemke::Result ConvexQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& Q, const Eigen::Ref<const Eigen::VectorXd>& c,
+                              const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
+                              Eigen::Ref<Eigen::VectorXd> x, int max_pivots) {
+  const int p = static_cast<int>(c.size()), k = static_cast<int>(r.size()), n = 2 * p + k;
+  auto M = m_.topLeftCorner(n, n);
+  M.setZero();
+  M.topLeftCorner(p, p) = Q;
+  M.block(0, p, p, p) = -Q;
+  M.block(p, 0, p, p) = -Q;
+  M.block(p, p, p, p) = Q;
+  M.block(0, 2 * p, p, k) = -R.transpose();
+  M.block(p, 2 * p, p, k) = R.transpose();
+  M.block(2 * p, 0, k, p) = R;
+  M.block(2 * p, p, k, p) = -R;
+  auto q = q_.head(n);
+  q << c, -c, -r;
+  int pivots = 0;
+  const Lemke::Result result = lemke_.solve(M, q, z_.head(n), w_.head(n), max_pivots, pivots);
+  if (result == Lemke::kSolved) x = z_.head(p) - z_.segment(p, p);
+  return result;
 }
 
 }  // namespace detail

@@ -32,5 +32,24 @@ class Lemke {
   Eigen::VectorXi basis_;  // variable in the basis of each row
 };
 
+// A small convex quadratic programme on Lemke's pivoting:
+//     min 1/2 x^T Q x + c^T x   subject to   R x >= r   (x free; equalities as two rows),
+// Q positive semi-definite (p x p), R (k x p). Its optimality conditions are the LCP of the
+// bisymmetric, positive semi-definite matrix [[Q, -Q, -R^T], [-Q, Q, R^T], [R, -R, 0]] in
+// (x+, x-, multipliers), x = x+ - x-, which Lemke's pivoting solves whenever the programme is
+// feasible and bounded. Workspace by reserve(p, k); solve() allocates nothing within it.
+class ConvexQp {
+ public:
+  void reserve(int p, int k);
+  Lemke::Result solve(const Eigen::Ref<const Eigen::MatrixXd>& Q, const Eigen::Ref<const Eigen::VectorXd>& c,
+                      const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
+                      Eigen::Ref<Eigen::VectorXd> x, int max_pivots);
+
+ private:
+  Lemke lemke_;
+  Eigen::MatrixXd m_;
+  Eigen::VectorXd q_, z_, w_;
+};
+
 }  // namespace detail
 }  // namespace vereshchagin

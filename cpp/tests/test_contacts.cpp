@@ -13,6 +13,7 @@
 #include "random_tree.hpp"
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/dynamics.hpp"
+#include "vereshchagin/kinematics.hpp"
 
 using namespace vereshchagin;
 using testutil::RandomGen;
@@ -261,4 +262,73 @@ TEST_CASE("contacts refuse invalid input with messages") {
   REQUIRE(solve(model, data, in));
   CHECK(data.contactForces().cols() == 0);
   CHECK(data.contactOutcome() == ContactOutcome::None);
+}
+
+namespace {
+
+// A planar arm of three 1 kg links about y (KDL): 0.4 m, 0.4 m, and the tool 0.1 m beyond the
+// wrist (the third link's centre of mass 0.2 m beyond it).
+KDL::Chain planarArm() {
+  KDL::Chain chain;
+  const KDL::RigidBodyInertia link(1.0, KDL::Vector(0.2, 0, 0), KDL::RotationalInertia(0.001, 0.015, 0.015));
+  chain.addSegment(KDL::Segment("l1", KDL::Joint("j1", KDL::Joint::RotY), KDL::Frame(KDL::Vector(0.4, 0, 0)), link));
+  chain.addSegment(KDL::Segment("l2", KDL::Joint("j2", KDL::Joint::RotY), KDL::Frame(KDL::Vector(0.4, 0, 0)), link));
+  chain.addSegment(KDL::Segment("l3", KDL::Joint("j3", KDL::Joint::RotY), KDL::Frame(KDL::Vector(0.1, 0, 0)), link));
+  return chain;
+}
+
+}  // namespace
+
+TEST_CASE("a support under a direction the task also holds carries the load (least motor effort)") {
+  // The arm stands still, its tool held in x, z and pitch (3 columns: no motion left). A support
+  // at the elbow (the tip of l1, mu = 0.5) is redundant with the task: any valid support force
+  // leaves qdd = 0, and the solve takes the one of least ||tau_command||. Oracle: with qdd = 0,
+  // tau_command = tau_free - J_e^T f (tau_free: the command without the support), minimised over
+  // f_z >= 0, |f_x| <= mu f_z (the 4-facet polygon's edges in the arm's plane) by hand.
+  const Model model(planarArm());
+  Data data(model);
+  SolveInput in(model);
+  Eigen::VectorXd q(3), qd = Eigen::VectorXd::Zero(3);
+  q << 0.6, -0.6, -0.6;
+  in.setState(JointPositions(q), JointVelocities(qd));
+  Eigen::MatrixXd alfa = Eigen::MatrixXd::Zero(6, 3);
+  alfa(0, 0) = alfa(2, 1) = alfa(4, 2) = 1.0;
+  REQUIRE(in.addConstraint(2, alfa, Eigen::VectorXd::Zero(3)));
+  in.constraints[0].classical = true;
+  REQUIRE(solve(model, data, in));
+  const Eigen::VectorXd tau_free = data.commandTorques();
+  PointContact elbow;
+  elbow.segment = 0;
+  elbow.normal = Vector3::UnitZ();
+  elbow.mu = 0.5;
+  in.contacts.push_back(elbow);
+  const Status s = solve(model, data, in);
+  REQUIRE_MESSAGE(s, std::string(s.message()));
+  const Vector3 f = data.contactForces().col(0);
+  CHECK(data.qdd().cwiseAbs().maxCoeff() <= 1e-9);
+  // The oracle: least squares in (f_x, f_z), projected onto the cone's edges if outside.
+  KinematicsData kin(model);
+  REQUIRE(forwardKinematics(model, kin, JointPositions(q), JointVelocities(qd)));
+  Eigen::MatrixXd J6(6, 3);
+  REQUIRE(frameJacobian(model, kin, FrameRef{0, KDL::Frame::Identity()}, J6));
+  Eigen::MatrixXd B(3, 2);
+  B << J6.row(0).transpose(), J6.row(2).transpose();  // columns: f_x, f_z
+  Eigen::Vector2d best(0.0, 0.0);
+  double best_cost = tau_free.squaredNorm();
+  const auto consider = [&](const Eigen::Vector2d& x) {
+    if (x(1) < 0.0 || std::abs(x(0)) > 0.5 * x(1) + 1e-12) return;
+    const double cost = (tau_free - B * x).squaredNorm();
+    if (cost < best_cost) best_cost = cost, best = x;
+  };
+  consider(B.colPivHouseholderQr().solve(tau_free));
+  for (const double side : {-1.0, 1.0}) {  // on an edge: f_x = side mu f_z
+    const Eigen::Vector3d b = B.col(0) * side * 0.5 + B.col(1);
+    consider(Eigen::Vector2d(side * 0.5, 1.0) * std::max(0.0, b.dot(tau_free) / b.squaredNorm()));
+  }
+  CHECK(f.z() > 1.0);
+  CHECK(std::abs(f.x() - best(0)) <= 1e-9 * std::max(1.0, best.norm()));
+  CHECK(std::abs(f.z() - best(1)) <= 1e-9 * std::max(1.0, best.norm()));
+  CHECK((data.commandTorques() - (tau_free - B * best)).cwiseAbs().maxCoeff() <= 1e-9 * tau_free.norm());
+  MESSAGE("support force " << f.transpose() << " N; oracle " << best.transpose() << "; command "
+                           << data.commandTorques().transpose() << " N m (free " << tau_free.transpose() << ")");
 }

@@ -1,0 +1,192 @@
+// Who carries the load when the accelerations do not say (contact_stage.hpp): once the contact
+// forces are found, every force distribution that leaves qdd unchanged and meets the contact
+// conditions is as valid (redundant contacts, or a contact whose direction a task constraint also
+// holds). The solve takes the one of least motor effort: the smallest ||tau_command||^2 (the
+// motors' torques: the task's constraint forces and the set-points' reactions), so that surfaces
+// carry what they can and the motors only the rest. A small convex programme in the contact forces'
+// free coordinates (lemke.hpp, ConvexQp); skipped when the response columns of those coordinates
+// are independent (the forces are then unique).
+#include <algorithm>
+#include <cmath>
+
+#include "contact_stage.hpp"
+#include "data_impl.hpp"
+#include "dense_small.hpp"
+#include "hd_core.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+namespace {
+
+double angle(int j, int facets) {
+  return 2.0 * M_PI * j / facets;
+}
+
+}  // namespace
+
+// The free coordinates of the solved forces: their directions, the validity rows in them, and
+// their current values (x*). Returns the number of coordinates.
+int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd& qdd) {
+  int p = 0, k = 0;
+  const auto addDir = [&](int contact, const Vector3& e) {
+    eff_dir_.col(p) = e;
+    eff_contact_(p) = contact;
+    eff_x_(p) = e.dot(forces.col(contact));
+    return p++;
+  };
+  const auto addRow = [&](double rhs) {
+    eff_r_(k) = rhs;
+    eff_rows_.row(k).head(eff_dir_.cols()).setZero();
+    return k++;
+  };
+  for (std::size_t c = 0; c < points_.size(); ++c) {
+    const Point& pt = points_[c];
+    const PointContact& pc = in.contacts[c];
+    const Vector3 f = forces.col(c);
+    const double fn = pt.n.dot(f);
+    const int ci = static_cast<int>(c);
+    // The point's acceleration in the solved motion: a support whose normal acceleration is not
+    // zero leaves its surface (no force); one at rest with zero tangential acceleration may stick.
+    const KDL::Frame at(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)));
+    Vector6 bias;
+    (void)frameJacobian(model_, kin_, FrameRef{pc.segment, at}, jac_);
+    (void)frameBiasAcceleration(model_, kin_, FrameRef{pc.segment, at}, bias);
+    const Vector3 a = jac_.topRows<3>() * qdd + bias.head<3>();
+    const double an = pt.n.dot(a), a_tol = 1e-9 * std::max(1.0, a.norm());
+    const Vector3 at_ = a - an * pt.n;
+    const bool resting = pt.kind == kTouching || pt.kind == kSetPointRest;
+    const bool sticking = resting && pc.mu > 0.0 && at_.norm() <= a_tol;
+    if (pc.isSupport()) {
+      if (pt.kind == kSeparating || an > a_tol) continue;
+      // Frictionless or sliding: the force keeps its direction (at rest: opposing a_t).
+      Vector3 e = pt.n;
+      if (!sticking && pc.mu > 0.0) {
+        const Vector3 slide = pt.kind == kSliding ? pt.v - pt.n.dot(pt.v) * pt.n : at_;
+        double best = 0.0;
+        for (int j = 0; j < pc.facets; ++j) {
+          const Vector3 d = std::cos(angle(j, pc.facets)) * pt.t1 + std::sin(angle(j, pc.facets)) * pt.t2;
+          if (j == 0 || d.dot(slide) < best) best = d.dot(slide), e = pt.n + pc.mu * d;
+        }
+        if (fn > 0.0) e = f / fn;  // the direction found (a vertex or an edge of the polygon)
+      }
+      const int xn = addDir(ci, e);
+      eff_x_(xn) = fn;
+      eff_rows_(addRow(0.0), xn) = 1.0;  // f_n >= 0
+      if (!sticking) continue;
+      const int x1 = addDir(ci, pt.t1), x2 = addDir(ci, pt.t2);
+      for (int i = 0; i < pc.facets; ++i) {  // inside every edge of mu f_n conv{d_j}
+        const double ang = M_PI * (2 * i + 1) / pc.facets;
+        const int row = addRow(0.0);
+        eff_rows_(row, xn) = pc.mu * std::cos(M_PI / pc.facets);
+        eff_rows_(row, x1) = -std::cos(ang);
+        eff_rows_(row, x2) = -std::sin(ang);
+      }
+    } else if (sticking) {  // a set-point's tangential force, inside mu F conv{d_j}
+      const int x1 = addDir(ci, pt.t1), x2 = addDir(ci, pt.t2);
+      for (int i = 0; i < pc.facets; ++i) {
+        const double ang = M_PI * (2 * i + 1) / pc.facets;
+        const int row = addRow(-pc.mu * pc.force * std::cos(M_PI / pc.facets));
+        eff_rows_(row, x1) = -std::cos(ang);
+        eff_rows_(row, x2) = -std::sin(ang);
+      }
+    }
+  }
+  eff_k_ = k;
+  return p;
+}
+
+int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
+  HdCore& c = d.core;
+  const int n = static_cast<int>(model_.nrOfJoints()), m = c.res.m;
+  int k_max = 0;
+  for (const PointContact& pc : in.contacts) k_max += 1 + pc.facets;
+  reserveEffort(3 * static_cast<int>(in.contacts.size()), k_max, m);
+  const int p = effortCoordinates(in, c.res.qdd);
+  if (p == 0 || m == 0) return 0;  // no motor columns: nothing to trade
+  for (int i = 0; i < p; ++i) {
+    const int ci = eff_contact_(i);
+    const Vector3 e = eff_dir_.col(i);
+    eff_seg_(i) = in.contacts[ci].segment;
+    eff_wrench_.col(i) << e, points_[ci].r.cross(e);
+  }
+  auto G = eff_dqdd_.topLeftCorner(n, p);
+  auto N = eff_dnu_.topLeftCorner(m, p);
+  Eigen::Ref<Eigen::MatrixXd> dnu(N);
+  if (c.wrenchResponse(eff_seg_.head(p), eff_wrench_.leftCols(p), G, &dnu) != 0) return 0;
+  // Unique forces when G has independent columns (certified Cholesky of G^T G).
+  auto GtG = eff_gtg_.topLeftCorner(p, p);
+  GtG.noalias() = G.transpose() * G;
+  const double scale = std::max(1e-300, GtG.diagonal().maxCoeff());
+  if (choleskyCertified(GtG, eff_l_, 1e-10 * scale)) return 0;
+  // min 1/2 ||tau* + T dx||^2 subject to G dx = 0 (qdd kept) and the validity rows at x* + dx.
+  const int k = eff_k_, rows = 2 * n + k;
+  auto R = eff_r_all_.topLeftCorner(rows, p);
+  auto r = eff_rhs_.head(rows);
+  R.topRows(n) = G;
+  R.middleRows(n, n) = -G;
+  R.bottomRows(k) = eff_rows_.topLeftCorner(k, p);
+  const double tol = 1e-12 * std::max(1.0, G.cwiseAbs().maxCoeff());
+  r.head(2 * n).setConstant(-tol);  // G dx = 0 to round-off
+  r.tail(k) = eff_r_.head(k) - eff_rows_.topLeftCorner(k, p) * eff_x_.head(p);
+  // tau_cmd is linear in nu: its change per coordinate, column by column.
+  auto T = eff_dtau_.topLeftCorner(n, p);
+  for (int i = 0; i < p; ++i)
+    if (c.commandTorquesOf(N.col(i), T.col(i)) != 0) return 0;
+  auto Q = eff_q_.topLeftCorner(p, p);
+  Q.noalias() = T.transpose() * T;
+  auto lin = eff_c_.head(p);
+  lin.noalias() = T.transpose() * c.res.tau_cmd;
+  auto dx = eff_dx_.head(p);
+  if (qp_.solve(Q, lin, R, r, dx, 100 + 40 * rows) != Lemke::kSolved) return 0;  // keep the forces found
+  eff_x_.head(p) += dx;
+  for (int i = 0; i < p; ++i)  // the forces from their coordinates
+    if (in.contacts[eff_contact_(i)].isSupport()) forces.col(eff_contact_(i)).setZero();
+  for (int i = 0; i < p; ++i) {
+    const int ci = eff_contact_(i);
+    if (!in.contacts[ci].isSupport() && i > 0 && eff_contact_(i - 1) == ci) continue;  // set-point: both at once
+    if (!in.contacts[ci].isSupport()) {
+      forces.col(ci) = points_[ci].fixed + eff_x_(i) * eff_dir_.col(i) + eff_x_(i + 1) * eff_dir_.col(i + 1);
+      continue;
+    }
+    forces.col(ci) += eff_x_(i) * eff_dir_.col(i);
+  }
+  buildWorkInput(in, false);
+  for (std::size_t ci = 0; ci < points_.size(); ++ci) {
+    const Vector3 f = forces.col(ci) - points_[ci].fixed;
+    if (!f.isZero(0.0))
+      work_.wrenches.push_back(
+          FrameWrench{in.contacts[ci].segment, (Vector6() << f, Vector3::Zero()).finished(), in.contacts[ci].point});
+  }
+  if (const int rc = runInput(d, work_)) return rc;
+  for (std::size_t ci = 0; ci < points_.size(); ++ci)  // a support left without force
+    if (in.contacts[ci].isSupport() && !(points_[ci].n.dot(forces.col(ci)) > 0.0))
+      status[ci] = ContactStatus::Separating;
+  return 0;
+}
+
+void ContactStage::reserveEffort(int p, int k, int m) {
+  const int n = static_cast<int>(model_.nrOfJoints());
+  if (eff_dir_.cols() < p) {
+    eff_dir_.resize(3, p);
+    eff_contact_.resize(p), eff_x_.resize(p), eff_seg_.resize(p), eff_c_.resize(p), eff_dx_.resize(p);
+    eff_wrench_.resize(6, p);
+    eff_gtg_.resize(p, p), eff_l_.resize(p, p), eff_q_.resize(p, p);
+    eff_dqdd_.resize(n, p);
+    eff_dtau_.resize(n, p);
+  }
+  if (eff_rows_.rows() < k || eff_rows_.cols() < eff_dir_.cols()) {
+    eff_rows_.resize(k, eff_dir_.cols());
+    eff_r_.resize(k);
+  }
+  if (eff_dnu_.rows() < m || eff_dnu_.cols() < eff_dir_.cols()) eff_dnu_.resize(std::max(m, 1), eff_dir_.cols());
+  const int rows = 2 * n + static_cast<int>(eff_rows_.rows());
+  if (eff_r_all_.rows() < rows || eff_r_all_.cols() < eff_dir_.cols()) {
+    eff_r_all_.resize(rows, eff_dir_.cols());
+    eff_rhs_.resize(rows);
+  }
+  qp_.reserve(static_cast<int>(eff_dir_.cols()), rows);
+}
+
+}  // namespace detail
+}  // namespace vereshchagin
