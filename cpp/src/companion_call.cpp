@@ -4,6 +4,7 @@
 #include "vereshchagin/companion_call.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "dynamics_impl.hpp"
 
@@ -22,6 +23,17 @@ Eigen::Map<const JointRows> rows(const ArrayArg& a, long n) {
 
 long rowCount(const ArrayArg& a) {
   return a.ndim == 2 ? a.shape[0] : 1;
+}
+
+// The flat index of the first Inf or NaN of `a`, -1 if none: first a scan without early exit
+// (|x| <= DBL_MAX fails for both), which vectorizes, since every call's arguments pass it.
+long firstNonfinite(const ArrayArg& a) {
+  const long size = a.data ? a.size() : 0;
+  bool finite = true;
+  for (long i = 0; i < size; ++i) finite &= std::abs(a.data[i]) <= std::numeric_limits<double>::max();
+  for (long i = 0; !finite; ++i)
+    if (!std::isfinite(a.data[i])) return i;
+  return -1;
 }
 
 bool hasShape(const ArrayArg& a, long rows, long cols) {
@@ -110,9 +122,8 @@ Status checkCompanionArg(KinematicsData& kdata, const CompanionCall& call, Compa
   } else if (!hasShape(a, -1, k.nj) && !(state_rows && a.ndim == 2 && a.shape[1] == k.nj)) {
     return k.fail(Error::SizeMismatch, "%s must have shape (%d,), got %s", name, k.nj, a.shapeString().c_str());
   }
-  for (long i = 0, size = a.data ? a.size() : 0; i < size; ++i)
-    if (!std::isfinite(a.data[i]))
-      return k.fail(Error::NonfiniteInput, "%s contains NaN or Inf (flat index %ld)", name, i);
+  if (const long i = firstNonfinite(a); i >= 0)
+    return k.fail(Error::NonfiniteInput, "%s contains NaN or Inf (flat index %ld)", name, i);
   return Status();
 }
 

@@ -8,7 +8,6 @@
 #include <pybind11/pybind11.h>
 
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -49,12 +48,6 @@ inline std::optional<long long> intWithin(PyObject* obj, long long lo, long long
   const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
   if (overflow != 0 || v < lo || v > hi) return std::nullopt;
   return v;
-}
-
-inline std::string fmtDouble(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 // A real scalar (Python int or float, numpy scalar, 0-d array); bool, str, bytes, None and

@@ -17,28 +17,53 @@ void check(const vs::Status& s) {
   if (!s) raise(s.message());
 }
 
+// gravity as a list or tuple of three Python floats, read into g without numpy (false: anything
+// else, converted by asF64). Its values are checked with the other arguments'.
+bool floatTriple(PyObject* obj, double g[3]) {
+  if ((!PyList_CheckExact(obj) && !PyTuple_CheckExact(obj)) || PySequence_Fast_GET_SIZE(obj) != 3) return false;
+  PyObject** x = PySequence_Fast_ITEMS(obj);
+  for (int k = 0; k < 3; ++k) {
+    if (!PyFloat_CheckExact(x[k])) return false;
+    g[k] = PyFloat_AS_DOUBLE(x[k]);
+  }
+  return true;
+}
+
+// An f_ext dict {segment or link: wrench (6,), moment about that frame's origin}: the call's frame
+// wrenches.
+void frameWrenches(const CompanionModel& m, vs::CompanionCall& call, const py::handle& f_ext) {
+  call.frame_wrenches_given = true;
+  for (const auto& item : f_ext.cast<py::dict>()) {
+    const std::string label = "f_ext[" + py::repr(item.first).cast<std::string>() + "]";
+    const FrameTarget t = m.resolveMoving(item.first.ptr(), label);
+    const F64View w = vectorView(item.second.ptr(), label.c_str(), 6);
+    call.frame_wrenches.push_back({{t.segment, t.link_in_tip}, Eigen::Map<const vs::Vector6>(w.data)});
+  }
+}
+
 // Companion `kind` of m on its Python arguments in vs::CompanionArg order (q, qd, qdd, gravity,
 // f_ext; an empty handle where it takes none, f_ext None for no wrenches), each converted and
-// checked in turn. An f_ext dict {segment or link: wrench (6,), moment about that frame's origin}
-// becomes the call's frame wrenches.
+// checked in turn; float64 arrays are viewed in place, converted copies live in `keep`.
 py::array run(const CompanionModel& m, K kind, std::array<py::handle, 5> args, const FrameTarget& frame = {}) {
   vs::DynamicsData& d = m.companions();  // kd: its kinematics, where every message lives
   vs::KinematicsData& kd = d.kinematics();
   vs::CompanionCall call{kind, {}, {frame.segment, frame.link_in_tip}};
-  F64View views[5];
+  py::object keep[5];
+  double g[3];
   for (int k = 0; k < 5; ++k) {
-    if (!args[k] || (k == 4 && args[k].is_none())) continue;
-    if (k == 4 && PyDict_Check(args[k].ptr())) {
-      call.frame_wrenches_given = true;
-      for (const auto& item : args[k].cast<py::dict>()) {
-        const std::string label = "f_ext[" + py::repr(item.first).cast<std::string>() + "]";
-        const FrameTarget t = m.resolveMoving(item.first.ptr(), label);
-        const F64View w = vectorView(item.second.ptr(), label.c_str(), 6);
-        call.frame_wrenches.push_back({{t.segment, t.link_in_tip}, Eigen::Map<const vs::Vector6>(w.data)});
-      }
+    PyObject* obj = args[k].ptr();
+    if (obj == nullptr || (k == 4 && obj == Py_None)) continue;
+    if (k == 4 && PyDict_Check(obj)) {
+      frameWrenches(m, call, args[k]);
       continue;
     }
-    call.args[k] = views[k] = asF64(args[k].ptr(), vs::companionArgName(static_cast<vs::CompanionArg>(k)));
+    if (k == 3 && floatTriple(obj, g)) {
+      call.args[3] = vs::ArrayArg{g, 1, {3, 0, 0}};
+    } else {
+      F64View v = asF64(obj, vs::companionArgName(static_cast<vs::CompanionArg>(k)));
+      call.args[k] = v;
+      keep[k] = std::move(v.keep);
+    }
     check(vs::checkCompanionArg(kd, call, static_cast<vs::CompanionArg>(k)));
   }
   int ndim = 0;
