@@ -153,25 +153,8 @@ void bindSolver(py::module_& mod) {
       .def_readonly("n_joints", &PySolver::nj, doc("_core.Solver.n_joints"))
       .def_readonly("n_segments", &PySolver::ns, doc("_core.Solver.n_segments"))
       .def_property_readonly("model", &PySolver::model, doc("_core.Solver.model"));
-  for (const bool tree : {false, true}) {  // solver.chain, solver.tree: the model if it is one
-    const std::string name = tree ? "tree" : "chain";
-    cls.def_property_readonly(
-        name.c_str(),
-        [tree](const PySolver& s) {
-          if (s.isTree() != tree)
-            raise(std::string("this Solver is for a ") + (tree ? "Chain: use solver.chain" : "Tree: use solver.tree") +
-                  " (or solver.model)");
-          return s.model();
-        },
-        doc("_core.Solver." + name));
-  }
   cls.def_property_readonly("inertia_check", &PySolver::inertiaCheck, doc("_core.Solver.inertia_check"))
-      .def(py::pickle([](const PySolver& s) { return s.getState(); },
-                      [](const py::tuple& t) {
-                        if (t.size() != 5 && t.size() != 6) raise("Solver state must have 5 or 6 entries");
-                        return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4],
-                                                          t.size() == 6 ? py::object(t[5]) : py::none());
-                      }));
+      .def("_state", &PySolver::getState, doc("_core.Solver._state"));
   for (PyMethodDef& def : g_fast_defs) {
     def.ml_doc = doc("_core.Solver." + std::string(def.ml_name));
     addFastMethod(cls, &def);
