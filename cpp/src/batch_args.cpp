@@ -3,6 +3,7 @@
 #include "vereshchagin/batch_args.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace vereshchagin {
 
@@ -26,7 +27,42 @@ std::string shapeMessage(const char* name, const ArrayArg& a, int ndim, const lo
          (hint == ShapeHint::None ? ", got " : "") + a.shapeString();
 }
 
+// A joint limit vector: (n,), no NaN, into `out` (sized n); nullptr leaves `out` as it is.
+std::string limitFrom(const ArrayArg* a, const char* name, long n, Eigen::VectorXd& out) {
+  if (a == nullptr) return {};
+  if (a->ndim != 1 || a->shape[0] != n)
+    return std::string(name) + " must have shape (" + std::to_string(n) + ",), got " + a->shapeString();
+  for (long j = 0; j < n; ++j) {
+    if (std::isnan(a->data[j])) return std::string(name) + " contains NaN";
+    out(j) = a->data[j];
+  }
+  return {};
+}
+
 }  // namespace
+
+std::string frictionFromArrays(FrictionModel& out, long n, const ArrayArg& static_friction, const ArrayArg* kinetic,
+                               double velocity_tolerance, const ArrayArg* lower, const ArrayArg* upper,
+                               double limit_tolerance) {
+  using MapV = Eigen::Map<const Eigen::VectorXd>;
+  if (std::string why = vectorMessage(static_friction, "friction.static", n); !why.empty()) return why;
+  out.static_friction = MapV(static_friction.data, n);
+  out.kinetic_friction.resize(0);
+  if (kinetic != nullptr) {
+    if (std::string why = vectorMessage(*kinetic, "friction.kinetic", n); !why.empty()) return why;
+    out.kinetic_friction = MapV(kinetic->data, n);
+  }
+  out.velocity_tolerance = velocity_tolerance;
+  out.lower.resize(0);
+  out.upper.resize(0);
+  if (lower == nullptr && upper == nullptr) return {};
+  out.lower = Eigen::VectorXd::Constant(n, -std::numeric_limits<double>::infinity());
+  out.upper = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  if (std::string why = limitFrom(lower, "friction.lower", n, out.lower); !why.empty()) return why;
+  if (std::string why = limitFrom(upper, "friction.upper", n, out.upper); !why.empty()) return why;
+  out.limit_tolerance = limit_tolerance;
+  return {};
+}
 
 void BatchArgs::start(bool batch, const Model& model) {
   batch_ = batch;

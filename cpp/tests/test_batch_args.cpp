@@ -1,8 +1,10 @@
 // BatchArgs (batch_args.hpp): arrays checked into the rows of a BatchInput, shared or with a batch
 // axis, and the messages the Python package reports for shapes, non-finite values, batch sizes,
-// constraint columns per segment and repeated frames.
+// constraint columns per segment and repeated frames, and the arrays of a friction model.
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -96,4 +98,24 @@ TEST_CASE("a classical set-point is (6,) and finite") {
   acc[3] = 0.0;
   CHECK(args.setPoint(&a, true, "") == "");
   CHECK(args.input.blocks.back().classical.data == acc.data());
+}
+
+TEST_CASE("friction arrays: shapes, NaN in limits, one-sided limits") {
+  FrictionModel fm;
+  const std::vector<double> f(3, 0.5), two(2, 0.5), lower{-1.0, -std::numeric_limits<double>::infinity(), 0.0};
+  CHECK(frictionFromArrays(fm, 3, array(two, {2}), nullptr, 1e-6, nullptr, nullptr, 0.0) ==
+        "friction.static must have shape (3,), got (2,)");
+  const ArrayArg lo = array(lower, {3});
+  CHECK(frictionFromArrays(fm, 3, array(f, {3}), nullptr, 1e-5, &lo, nullptr, 1e-3) == "");
+  CHECK(fm.kinetic_friction.size() == 0);
+  CHECK(fm.velocity_tolerance == 1e-5);
+  CHECK(fm.lower(0) == -1.0);
+  CHECK(fm.upper(2) == std::numeric_limits<double>::infinity());
+  CHECK(fm.limit_tolerance == 1e-3);
+  std::vector<double> bad = lower;
+  bad[1] = std::nan("");
+  const ArrayArg up = array(bad, {3});
+  CHECK(frictionFromArrays(fm, 3, array(f, {3}), nullptr, 1e-6, nullptr, &up, 0.0) == "friction.upper contains NaN");
+  CHECK(frictionFromArrays(fm, 3, array(f, {3}), nullptr, 1e-6, nullptr, nullptr, 0.0) == "");
+  CHECK(fm.lower.size() == 0);
 }

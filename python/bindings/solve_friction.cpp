@@ -1,9 +1,8 @@
-// friction= of Solver.solve and solve_batch (FrictionArg, py_solver.hpp): shapes checked with the
-// Python names (friction.static, friction.kinetic, friction.lower / upper, ...), values by
-// vereshchagin::solve with the same names; a vereshchagin.Friction is parsed once and reused while
-// its attributes are the same objects.
-#include <limits>
-
+// friction= of Solver.solve and solve_batch (FrictionArg, py_solver.hpp): the attributes viewed as
+// arrays, their shapes checked by vereshchagin::frictionFromArrays with the Python names
+// (friction.static, friction.kinetic, friction.lower / upper), values by vereshchagin::solve with
+// the same names; a vereshchagin.Friction is parsed once and reused while its attributes are the
+// same objects.
 #include "py_solver.hpp"
 
 namespace vsbind {
@@ -24,16 +23,8 @@ PyObject* instanceDict(PyObject* obj) {
   return dict == nullptr ? nullptr : *dict;
 }
 
-// friction.lower / friction.upper: (nj,), no NaN (infinite: no limit); None leaves `out` as is.
-void limitArg(const py::object& obj, const char* name, unsigned int nj, Eigen::VectorXd& out) {
-  if (obj.is_none()) return;
-  const F64View a = asF64(obj.ptr(), name);
-  if (a.ndim != 1 || a.shape[0] != static_cast<py::ssize_t>(nj))
-    raise(std::string(name) + " must have shape (" + std::to_string(nj) + ",), got " + a.shapeString());
-  for (unsigned int j = 0; j < nj; ++j) {
-    if (std::isnan(a.data[j])) raise(std::string(name) + " contains NaN");
-    out(j) = a.data[j];
-  }
+void check(const std::string& why) {
+  if (!why.empty()) raise(why);
 }
 
 double scalarAttr(PyObject* fr, const char* attr, const char* name, double fallback) {
@@ -78,24 +69,18 @@ const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned in
   }
   vereshchagin::FrictionModel& fm = cacheable ? cache_ : scratch;
   if (cacheable) cache_key_ = py::object();  // invalid until parsed
-  using MapV = Eigen::Map<const Eigen::VectorXd>;
-  fm.static_friction = MapV(vectorView(static_obj.ptr(), "friction.static", nj).data, nj);
   const py::object none = py::none(), kin = py::getattr(obj, "kinetic", none), lower = py::getattr(obj, "lower", none),
                    upper = py::getattr(obj, "upper", none);
-  fm.kinetic_friction.resize(0);
-  if (!kin.is_none()) fm.kinetic_friction = MapV(vectorView(kin.ptr(), "friction.kinetic", nj).data, nj);
-  fm.velocity_tolerance = scalarAttr(obj, "velocity_tolerance", "friction.velocity_tolerance",
-                                     vereshchagin::FrictionModel().velocity_tolerance);
-  fm.lower.resize(0);
-  fm.upper.resize(0);
-  if (!lower.is_none() || !upper.is_none()) {
-    fm.lower = Eigen::VectorXd::Constant(nj, -std::numeric_limits<double>::infinity());
-    fm.upper = Eigen::VectorXd::Constant(nj, std::numeric_limits<double>::infinity());
-    limitArg(lower, "friction.lower", nj, fm.lower);
-    limitArg(upper, "friction.upper", nj, fm.upper);
-    fm.limit_tolerance =
-        scalarAttr(obj, "limit_tolerance", "friction.limit_tolerance", vereshchagin::FrictionModel().limit_tolerance);
-  }
+  const bool limits = !lower.is_none() || !upper.is_none();
+  auto view = [](const py::object& o, const char* name) { return o.is_none() ? F64View() : asF64(o.ptr(), name); };
+  const F64View st = asF64(static_obj.ptr(), "friction.static"), kv = view(kin, "friction.kinetic"),
+                lo = view(lower, "friction.lower"), up = view(upper, "friction.upper");
+  const vereshchagin::FrictionModel defaults;
+  const double vt = scalarAttr(obj, "velocity_tolerance", "friction.velocity_tolerance", defaults.velocity_tolerance);
+  const double lt =
+      limits ? scalarAttr(obj, "limit_tolerance", "friction.limit_tolerance", defaults.limit_tolerance) : 0.0;
+  check(vereshchagin::frictionFromArrays(fm, nj, st, kin.is_none() ? nullptr : &kv, vt, lower.is_none() ? nullptr : &lo,
+                                         upper.is_none() ? nullptr : &up, lt));
   PyObject* dict = cacheable ? instanceDict(obj) : nullptr;
   if (dict == nullptr) return &fm;  // not cached
   for (int k = 0; k < 6; ++k) cache_attrs_[k] = py::reinterpret_borrow<py::object>(PyDict_GetItem(dict, attrName(k)));

@@ -11,6 +11,7 @@
 
 #include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/batch.hpp"
+#include "vereshchagin/friction_model.hpp"
 #include "vereshchagin/model.hpp"
 
 namespace vereshchagin {
@@ -21,6 +22,17 @@ enum class ShapeHint {
   Alpha,  ///< alpha's: shape "(6, m)", its columns are unit wrenches, (6,) is one column
   FExt,   ///< f_ext's: one row [force; moment] per segment, or a dict {segment: wrench}
 };
+
+/// The arrays of a friction model (the attributes of the Python package's Friction), checked into
+/// `out` for n joints. static_friction: (n,), finite (N m or N). kinetic: (n,), finite, or nullptr
+/// (out.kinetic_friction empty: equal to static). lower, upper: (n,) without NaN (+-infinity: no
+/// limit; rad or m); both nullptr: no limits (out.lower, out.upper empty; out.limit_tolerance kept),
+/// one nullptr: no limit on that side. Tolerances are stored as given. Messages: "friction.static
+/// must have shape (n,), got (...)" (vectorMessage's), "friction.lower contains NaN"; the values'
+/// signs and order are solve()'s to check.
+std::string frictionFromArrays(FrictionModel& out, long n, const ArrayArg& static_friction, const ArrayArg* kinetic,
+                               double velocity_tolerance, const ArrayArg* lower, const ArrayArg* upper,
+                               double limit_tolerance);
 
 /// Builds a BatchInput from row-major arrays, checking each as it is added (see the top of this
 /// file). Every method returns "" on success, else the message; after a message the input is
