@@ -1,6 +1,6 @@
 // The Python Solver: one parser for the arguments of solve() and solve_batch() (SolveArgs, with
 // friction in FrictionArg) into a vereshchagin::BatchInput, one BatchWorkspace per thread, and
-// PySolver itself. solve_args.cpp: the parser; solve_friction.cpp: friction=; solve_run.cpp:
+// PySolver itself. solve_args.cpp: the parser (friction= too); solve_run.cpp:
 // solve(), solve_batch() and the benchmark hooks; solver_core.cpp: setup and state;
 // solver_bindings.cpp: the Python methods.
 #pragma once
