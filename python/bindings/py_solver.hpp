@@ -30,7 +30,7 @@ inline constexpr long kMaxBatchThreads = 256;
 
 // friction=: None/False, True (the model's values), a vereshchagin.Friction (parsed once and
 // reused while its attributes are the same objects: its arrays cannot be written) or any object
-// with the same attributes. Shapes are checked here, values by vereshchagin::solve.
+// with the same attributes. Shapes: vereshchagin::frictionFromArrays; values: vereshchagin::solve.
 class FrictionArg {
  public:
   void setModelValues(const std::vector<vereshchagin::JointInfo>& joints);

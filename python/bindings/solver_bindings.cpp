@@ -18,7 +18,6 @@ constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "ta
 constexpr int kNumSolveParams = sizeof(kSolveParams) / sizeof(kSolveParams[0]);
 static_assert(kNumSolveParams == kNumSolveArgs, "solve()'s parameters are SolveArgs::parse's arguments");
 PyObject* g_solve_names[kNumSolveParams + 1];  // interned, then "threads"
-PyObject* g_solver_error = nullptr;
 
 // Fills `slots` (solve()'s parameters) from positional and keyword arguments; raises TypeError
 // like Python functions.
@@ -63,21 +62,16 @@ PySolver& solverOf(PyObject* self) {
   return *static_cast<PySolver*>(value);
 }
 
-// Runs `body`, turning C++ exceptions into Python ones (SolverError for our messages).
+// Runs `body`, turning C++ exceptions into Python ones with the module's translators, as pybind11's
+// own dispatch does (SolverError for our messages).
 template <typename Body>
 PyObject* guarded(Body&& body) {
   try {
     return body().release().ptr();
-  } catch (const SolverError& e) {
-    PyErr_SetString(g_solver_error, e.what());
   } catch (py::error_already_set& e) {
     e.restore();
-  } catch (const py::builtin_exception& e) {
-    e.set_error();
-  } catch (const std::bad_alloc&) {
-    PyErr_NoMemory();
-  } catch (const std::exception& e) {
-    PyErr_SetString(PyExc_RuntimeError, e.what());
+  } catch (...) {
+    py::detail::try_translate_exceptions();
   }
   return nullptr;
 }
@@ -137,7 +131,6 @@ py::object solvePybind(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_f
 }  // namespace
 
 void bindSolver(py::module_& mod) {
-  g_solver_error = mod.attr("SolverError").ptr();
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
   g_solve_names[kNumSolveParams] = PyUnicode_InternFromString("threads");
 
