@@ -76,7 +76,7 @@ void BatchArgs::start(bool batch, const Model& model) {
   columns = 0;
   first_.clear();
   segment_cols_.clear();
-  frames_.clear();
+  n_frames_ = 0;
 }
 
 std::string BatchArgs::batchAxis(long n, const char* name, const std::string& shape) {
@@ -122,28 +122,32 @@ std::string BatchArgs::vector(StridedRows& out, const char* name, ArrayArg a, lo
 }
 
 std::string BatchArgs::frame(int segment, const Vector3& point, const std::string& label) {
-  for (const KeyedFrame& f : frames_)
-    if (f.segment == segment && f.point == point)
-      return label + ": the same frame as " + f.label + " (one entry per frame: put all its columns in one alpha)";
-  frames_.push_back(KeyedFrame{segment, point, label});
+  for (std::size_t k = 0; k < n_frames_; ++k)
+    if (frames_[k].segment == segment && frames_[k].point == point)
+      return label + ": the same frame as " + frames_[k].label +
+             " (one entry per frame: put all its columns in one alpha)";
+  if (n_frames_ == frames_.size()) frames_.emplace_back();
+  KeyedFrame& f = frames_[n_frames_++];
+  f.segment = segment;
+  f.point = point;
+  f.label.assign(label);  // reuses the string's storage
   return {};
 }
 
-std::string BatchArgs::block(int segment, ArrayArg alpha, const std::string& label) {
-  const std::string name = label.empty() ? "alpha" : label + " alpha";
+std::string BatchArgs::block(int segment, ArrayArg alpha, const char* name) {
   if (alpha.ndim == 1 && alpha.shape[0] == 6) {  // one column
     alpha.ndim = 2;
     alpha.shape[1] = 1;
   }
   const long m = alpha.ndim >= 2 ? alpha.shape[alpha.ndim - 1] : -1, shape[2] = {6, m};
-  if (m > 6) return name + " has " + std::to_string(m) + " columns; at most 6 constraints per segment";
+  if (m > 6) return std::string(name) + " has " + std::to_string(m) + " columns; at most 6 constraints per segment";
   BlockRows& blk = input.blocks.emplace_back();
   blk.segment = segment;
   blk.columns = static_cast<int>(m);
-  return rows(blk.alpha, name.c_str(), alpha, 2, shape, ShapeHint::Alpha);
+  return rows(blk.alpha, name, alpha, 2, shape, ShapeHint::Alpha);
 }
 
-std::string BatchArgs::setPoint(const ArrayArg* a, bool classical, const std::string& label) {
+std::string BatchArgs::setPoint(const ArrayArg* a, bool classical, const char* name, const std::string& label) {
   BlockRows& blk = input.blocks.back();
   if (classical) {  // task.py's wording: Task.solve passes its a_desired here
     for (long k = 0; k < a->size(); ++k)
@@ -153,16 +157,14 @@ std::string BatchArgs::setPoint(const ArrayArg* a, bool classical, const std::st
     if (std::string why = rows(blk.classical, "a_desired", *a, 1, &six); !why.empty()) return why;
   } else {
     if (a == nullptr) return "beta is required when alpha is given (shape (" + std::to_string(blk.columns) + ",))";
-    const std::string name = label.empty() ? "beta" : label + " beta";
-    if (std::string why = vector(blk.beta, name.c_str(), *a, blk.columns, true); !why.empty()) return why;
+    if (std::string why = vector(blk.beta, name, *a, blk.columns, true); !why.empty()) return why;
   }
   columns += blk.columns;
   if (label.empty()) return {};  // the end segment's alpha: counted with the first keyed block
   if (segment_cols_.empty()) {
     segment_cols_.assign(model_->nrOfSegments(), 0);
     const BlockRows& first = input.blocks.front();
-    if (input.blocks.size() > 1 && first.segment >= 0 && frames_.size() == 1)
-      segment_cols_[first.segment] = first.columns;
+    if (input.blocks.size() > 1 && first.segment >= 0 && n_frames_ == 1) segment_cols_[first.segment] = first.columns;
   }
   segment_cols_[blk.segment] += blk.columns;
   if (segment_cols_[blk.segment] > 6)

@@ -67,16 +67,16 @@ TEST_CASE("blocks: columns, set-points, columns per segment and one entry per fr
   BatchArgs args;
   args.start(false, model);
   const std::vector<double> alpha(6 * 4, 0.0), beta(4, 0.0), seven(6 * 7, 0.0);
-  CHECK(args.block(2, array(seven, {6, 7}), "") == "alpha has 7 columns; at most 6 constraints per segment");
+  CHECK(args.block(2, array(seven, {6, 7}), "alpha") == "alpha has 7 columns; at most 6 constraints per segment");
   args.start(false, model);
-  CHECK(args.block(2, array(alpha, {6, 4}), "") == "");
-  CHECK(args.setPoint(nullptr, false, "") == "beta is required when alpha is given (shape (4,))");
+  CHECK(args.block(2, array(alpha, {6, 4}), "alpha") == "");
+  CHECK(args.setPoint(nullptr, false, "beta", "") == "beta is required when alpha is given (shape (4,))");
   const ArrayArg b = array(beta, {4});
-  CHECK(args.setPoint(&b, false, "") == "");
+  CHECK(args.setPoint(&b, false, "beta", "") == "");
   CHECK(args.columns == 4);
   CHECK(args.frame(2, Vector3(0.0, 0.0, 0.1), "constraints['a']") == "");
-  CHECK(args.block(2, array(alpha, {6, 4}), "constraints['a']") == "");
-  const std::string why = args.setPoint(&b, false, "constraints['a']");
+  CHECK(args.block(2, array(alpha, {6, 4}), "constraints['a'] alpha") == "");
+  const std::string why = args.setPoint(&b, false, "constraints['a'] beta", "constraints['a']");
   CHECK(contains(why, "constraints['a']: more than 6 constraint columns on segment '"));
   CHECK(contains(why, "(alpha and every key on it count)"));
   CHECK(args.frame(2, Vector3(0.0, 0.0, 0.1), "constraints[-1]") ==
@@ -90,13 +90,13 @@ TEST_CASE("a classical set-point is (6,) and finite") {
   BatchArgs args;
   args.start(false, model);
   std::vector<double> alpha(6, 0.0), acc(6, 0.0);
-  CHECK(args.block(1, array(alpha, {6}), "") == "");  // (6,): one column
+  CHECK(args.block(1, array(alpha, {6}), "alpha") == "");  // (6,): one column
   CHECK(args.input.blocks.back().columns == 1);
   acc[3] = std::nan("");
   const ArrayArg a = array(acc, {6});
-  CHECK(args.setPoint(&a, true, "") == "a_desired must be finite (no NaN or Inf), flat index 3");
+  CHECK(args.setPoint(&a, true, "a_desired", "") == "a_desired must be finite (no NaN or Inf), flat index 3");
   acc[3] = 0.0;
-  CHECK(args.setPoint(&a, true, "") == "");
+  CHECK(args.setPoint(&a, true, "a_desired", "") == "");
   CHECK(args.input.blocks.back().classical.data == acc.data());
 }
 

@@ -69,13 +69,15 @@ Rows SolveArgs::vector(PyObject* obj, const char* name, py::ssize_t n, bool scal
 // A block of alpha and its set-point, beta or (classical) a_desired (label: "" for solve's alpha,
 // else "constraints[key]").
 void SolveArgs::addBlock(int segment, PyObject* alpha, PyObject* set_point, const std::string& label, bool classical) {
-  F64View a = asF64(alpha, label.empty() ? "alpha" : (label + " alpha").c_str());
-  check(block(segment, a, label));
+  const std::string an = label.empty() ? "" : label + " alpha", bn = label.empty() ? "" : label + " beta";
+  const char* a_name = label.empty() ? "alpha" : an.c_str();
+  const char* sp_name = classical ? "a_desired" : label.empty() ? "beta" : bn.c_str();
+  F64View a = asF64(alpha, a_name);
+  check(block(segment, a, a_name));
   keep(a);
   F64View sp;
-  if (set_point != nullptr)
-    sp = asF64(set_point, classical ? "a_desired" : label.empty() ? "beta" : (label + " beta").c_str());
-  check(setPoint(set_point ? &sp : nullptr, classical, label));
+  if (set_point != nullptr) sp = asF64(set_point, sp_name);
+  check(setPoint(set_point ? &sp : nullptr, classical, sp_name, label));
   keep(sp);
 }
 

@@ -69,16 +69,17 @@ class BatchArgs {
   std::string frame(int segment, const Vector3& point, const std::string& label);
 
   /// Appends a block on `segment` (segment order; -1: see BlockRows) with `alpha` (6, m) per row,
-  /// m <= 6 ((6,): one column). label: "" for the end segment's alpha (named "alpha"), else the
-  /// key ("constraints[2]", its alpha named "constraints[2] alpha"). Its set-point: setPoint().
-  std::string block(int segment, ArrayArg alpha, const std::string& label);
+  /// m <= 6 ((6,): one column), named `name` in messages ("alpha", "constraints[2] alpha"). Its
+  /// set-point: setPoint().
+  std::string block(int segment, ArrayArg alpha, const char* name);
 
-  /// The set-point of the block block() appended: beta (m,) per row (nullptr: not given, which is
-  /// refused: "beta is required when alpha is given (shape (m,))"; for m = 1 also a scalar or
-  /// (B,)), or with classical = true `a` is the frame's classical acceleration (6,) per row, named
-  /// "a_desired". Counts the block's columns; a keyed block (label not "") may not bring its
-  /// segment's columns (the end segment's alpha included) beyond 6.
-  std::string setPoint(const ArrayArg* a, bool classical, const std::string& label);
+  /// The set-point of the block block() appended: beta (m,) per row, named `name` (nullptr: not
+  /// given, which is refused: "beta is required when alpha is given (shape (m,))"; for m = 1 also
+  /// a scalar or (B,)), or with classical = true `a` is the frame's classical acceleration (6,) per
+  /// row, named "a_desired". Counts the block's columns; a keyed block (`label`, e.g.
+  /// "constraints[2]", not "") may not bring its segment's columns (the end segment's alpha
+  /// included) beyond 6.
+  std::string setPoint(const ArrayArg* a, bool classical, const char* name, const std::string& label);
 
   /// Whether start() allowed a leading batch axis.
   bool batched() const { return batch_; }
@@ -96,7 +97,8 @@ class BatchArgs {
   const Model* model_ = nullptr;
   std::string first_;               // the argument that set the batch size, and its shape
   std::vector<int> segment_cols_;   // constraint columns per segment (sized at the first keyed block)
-  std::vector<KeyedFrame> frames_;  // the frames of the keyed blocks
+  std::vector<KeyedFrame> frames_;  // the frames of the keyed blocks: the first n_frames_ (storage reused)
+  std::size_t n_frames_ = 0;
 };
 
 }  // namespace vereshchagin
