@@ -1,6 +1,8 @@
 // solveBatch (batch.hpp): the rows of a BatchInput in contiguous chunks over threads, one Data
-// per thread, the lowest failing row reported.
+// per thread, the lowest failing row reported; secondsPerSolve, the benchmark of one row.
 #include <algorithm>
+#include <chrono>
+#include <limits>
 #include <system_error>
 #include <thread>
 
@@ -58,6 +60,27 @@ BatchFailure solveBatch(const Model& model, const BatchInput& input, const Batch
       return BatchFailure{B - 1, "batch row " + std::to_string(B - 1) + ": " + s.message()};
   }
   return BatchFailure{};
+}
+
+double secondsPerSolve(const Model& model, const BatchInput& input, BatchWorkspace& w, long reps) {
+  const Eigen::Index n = model.nrOfJoints(), ns = model.nrOfSegments();
+  const int columns = input.columns();
+  const bool friction = input.frictionOf(0) != nullptr;
+  Eigen::VectorXd qdd(n), tau(n), nu(std::max(columns, 1)), fr(n), lim(n);
+  Eigen::Matrix<double, 6, Eigen::Dynamic> acc(6, ns + 1);
+  std::vector<int> status(n);
+  int rank, iterations;
+  double smin, gauss;
+  const BatchOutput out{qdd.data(), tau.data(), nu.data(),     acc.data(), &smin, &rank, friction ? fr.data() : nullptr,
+                        lim.data(), &gauss,     status.data(), &iterations};
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long k = 0; k < reps; ++k) {
+    input.fillRow(0, w.input);
+    if (!solve(model, w.data, w.input)) return std::numeric_limits<double>::quiet_NaN();
+    out.write(0, w.data, columns, friction);
+  }
+  const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
+  return dt.count() / static_cast<double>(reps);
 }
 
 }  // namespace vereshchagin

@@ -4,6 +4,7 @@
 // package reports (pass-through weights, column capacity, friction values).
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -158,4 +159,24 @@ TEST_CASE("solve() checks weights, capacity and friction values with the Python 
   fm.upper = -Eigen::VectorXd::Ones(3);
   CHECK(message().find("friction.lower[0] and friction.upper[0]") == 0);
   CHECK(message().find("got 1 > -1") != std::string::npos);
+}
+
+TEST_CASE("secondsPerSolve times row 0 and leaves its state, NaN when it fails") {
+  RandomGen g(9);
+  const Model model(g.chain(4));
+  const int n = 4, ns = static_cast<int>(model.nrOfSegments());
+  Rows rows(n, ns, 2, g);
+  BatchWorkspace w(model, SolverOptions(), KDL::Vector(0, 0, -9.81));
+  const double seconds = secondsPerSolve(model, rows.input, w, 3);
+  CHECK(std::isfinite(seconds));
+  CHECK(seconds > 0.0);
+  Outputs timed(n, ns, 1), single(n, ns, 1);
+  REQUIRE(timed.out().write(0, w.data, 1, false));
+  BatchWorkspace fresh(model, SolverOptions(), KDL::Vector(0, 0, -9.81));
+  rows.input.fillRow(0, fresh.input);
+  REQUIRE(solve(model, fresh.data, fresh.input).ok());
+  REQUIRE(single.out().write(0, fresh.data, 1, false));
+  CHECK(timed.qdd == single.qdd);
+  rows.q[1] = std::nan("");
+  CHECK(std::isnan(secondsPerSolve(model, rows.input, w, 2)));
 }

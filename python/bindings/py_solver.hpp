@@ -1,6 +1,6 @@
 // The Python Solver: one parser for the arguments of solve() and solve_batch() (SolveArgs, with
 // friction in FrictionArg) into a vereshchagin::BatchInput, one BatchWorkspace per thread, and
-// PySolver itself. solve_args.cpp: the parser; solve_friction.cpp: friction=; solve_run.cpp:
+// PySolver itself. solve_args.cpp: the parser (friction= too); solve_run.cpp:
 // solve(), solve_batch() and the benchmark hooks; solver_core.cpp: setup and state;
 // solver_bindings.cpp: the Python methods.
 #pragma once
@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "vereshchagin/batch.hpp"
+#include "vereshchagin/batch_args.hpp"
 
 #include "common.hpp"
 #include "model_class.hpp"
@@ -30,7 +30,7 @@ inline constexpr long kMaxBatchThreads = 256;
 
 // friction=: None/False, True (the model's values), a vereshchagin.Friction (parsed once and
 // reused while its attributes are the same objects: its arrays cannot be written) or any object
-// with the same attributes. Shapes are checked here, values by vereshchagin::solve.
+// with the same attributes. Shapes: vereshchagin::frictionFromArrays; values: vereshchagin::solve.
 class FrictionArg {
  public:
   void setModelValues(const std::vector<vereshchagin::JointInfo>& joints);
@@ -44,38 +44,30 @@ class FrictionArg {
 };
 
 // The arguments of one solve (1 row, no batch axis accepted) or of a batch (B rows, each argument
-// shared or with a leading batch axis) as a BatchInput, shapes checked with messages naming the
-// argument (values: by vereshchagin::solve, for each row).
-class SolveArgs {
+// shared or with a leading batch axis) as a BatchInput, shapes checked by BatchArgs with messages
+// naming the argument (values: by vereshchagin::solve, for each row).
+class SolveArgs : public vereshchagin::BatchArgs {
  public:
   // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
   // tau_ff_pass_through, (out: not read), a_desired (nullptr or None: not given).
   void parse(class PySolver& s, PyObject* const* args, bool batch);
 
-  vereshchagin::BatchInput input;
-  int columns = 0;  // constraint columns of every row (the size of nu)
   bool any_friction = false;
   std::vector<py::object> keys;     // constraints= keys: input.blocks[blocks.size() - keys.size() + k]
   std::vector<py::ssize_t> starts;  // their first column in nu
 
  private:
-  enum Hint { kNoHint, kAlphaHint, kFExtHint };  // what a shape message adds
-  Rows arg(const char* name, F64View v, int ndim, const py::ssize_t* shape, Hint hint = kNoHint);
+  const double* keep(F64View& v);  // keeps v's converted copy (if any) alive with the rows
   Rows vector(PyObject* obj, const char* name, py::ssize_t n, bool scalar_ok = false);
-  void batchAxis(py::ssize_t n, const char* name, const std::string& shape);
-  void addBlock(int segment, PyObject* alpha, PyObject* beta, const std::string& label, PyObject* classical = nullptr);
+  void addBlock(int segment, PyObject* alpha, PyObject* set_point, const std::string& label, bool classical = false);
   void parseFExt(PyObject* obj);
   void parseConstraints(PyObject* obj);
   void parseFriction(FrictionArg& parser, PyObject* obj);
 
-  bool batch_ = false;
   unsigned int nj_ = 0, ns_ = 0;
   const Addressable* addressing_ = nullptr;
-  std::string first_;                             // the argument that set the batch size, and its shape
-  std::vector<KDL::Vector> frames_;               // the frame of each constraints= entry (one entry per frame)
-  std::vector<int> segment_cols_;                 // constraint columns per segment
-  std::vector<py::object> keep_;                  // converted copies the rows point into
-  vereshchagin::FrictionModel friction_scratch_;  // a friction= that is not cached
+  std::vector<py::object> keep_;                              // converted copies the rows point into
+  vereshchagin::FrictionModel friction_scratch_;              // a friction= that is not cached
   std::vector<vereshchagin::FrictionModel> friction_models_;  // friction= per row
 };
 
@@ -103,6 +95,7 @@ class PySolver {
   py::tuple getState() const;
   py::object model() const { return tree_ ? py::cast(*tree_) : py::cast(*chain_); }
   bool isTree() const { return tree_ != nullptr; }
+  const vereshchagin::Model& cppModel() const { return cpp_model_; }
   std::string inertiaCheck() const { return vereshchagin::inertiaCheckName(options_.inertia_check); }
 
   // Holds the solver for one call. Waits with the GIL released while another thread holds it;

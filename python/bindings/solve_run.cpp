@@ -2,8 +2,6 @@
 // hooks (_solve_dict, _time_cpp) and Solver.solve_batch (vereshchagin::solveBatch over one
 // workspace per thread), each on the arguments SolveArgs parsed.
 #include <algorithm>
-#include <chrono>
-#include <limits>
 
 #include "py_solver.hpp"
 #include "result_type.hpp"
@@ -12,18 +10,7 @@ namespace vsbind {
 
 using namespace pybind11::literals;
 
-namespace {
-
 constexpr const char* kOverflow = "the results overflow: gauss_value is beyond the double range";
-
-// Row 0 of `a` on `w`: vereshchagin::solve's message on failure, else nullptr.
-const char* solveRow(const vereshchagin::Model& m, const SolveArgs& a, vereshchagin::BatchWorkspace& w) {
-  a.input.fillRow(0, w.input);
-  const vereshchagin::Status s = vereshchagin::solve(m, w.data, w.input);
-  return s ? nullptr : s.message();
-}
-
-}  // namespace
 
 void PySolver::solveArgs(PyObject* const* args, bool frictionless) {
   last_state_ = false;
@@ -32,7 +19,10 @@ void PySolver::solveArgs(PyObject* const* args, bool frictionless) {
   const char* failure;
   {
     py::gil_scoped_release release;
-    failure = solveRow(cpp_model_, args_, *workspaces_[0]);
+    vereshchagin::BatchWorkspace& w = *workspaces_[0];
+    args_.input.fillRow(0, w.input);
+    const vereshchagin::Status st = vereshchagin::solve(cpp_model_, w.data, w.input);
+    failure = st ? nullptr : st.message();
   }
   if (failure) raise(failure);
   last_state_ = true;
@@ -81,22 +71,8 @@ double PySolver::timeCpp(PyObject* const* args, long reps) {
   Lock lk(*this);
   SolveArgs a;
   a.parse(*this, args, /*batch=*/false);
-  Eigen::VectorXd qdd(nj), tau(nj), nu(std::max(a.columns, 1)), fr(nj), lim(nj);
-  Eigen::Matrix<double, 6, Eigen::Dynamic> acc(6, ns + 1);
-  std::vector<int> status(nj);
-  int rank, iters;
-  double smin, gauss;
-  const vereshchagin::BatchOutput o{
-      qdd.data(), tau.data(), nu.data(),     acc.data(), &smin, &rank, a.any_friction ? fr.data() : nullptr,
-      lim.data(), &gauss,     status.data(), &iters};
   py::gil_scoped_release release;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long k = 0; k < reps; ++k) {
-    if (solveRow(cpp_model_, a, *workspaces_[0])) return std::numeric_limits<double>::quiet_NaN();
-    o.write(0, workspaces_[0]->data, a.columns, a.any_friction);
-  }
-  const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
-  return dt.count() / static_cast<double>(reps);
+  return vereshchagin::secondsPerSolve(cpp_model_, a.input, *workspaces_[0], reps);
 }
 
 py::dict PySolver::solveBatch(PyObject* const* args, const py::object& threads_obj) {

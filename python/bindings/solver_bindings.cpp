@@ -1,6 +1,8 @@
-// Solver's Python methods: solve() and _time_cpp() as METH_FASTCALL entry points (keyword names
-// matched against interned strings), the rest through pybind11.
+// Solver's Python methods: solve(), solve_batch() and the benchmark hooks as METH_FASTCALL entry
+// points (keyword names matched against interned strings), the rest through pybind11.
 #include <pybind11/stl.h>
+
+#include <algorithm>
 
 #include "py_solver.hpp"
 
@@ -8,18 +10,23 @@ namespace vsbind {
 
 namespace {
 
+// solve()'s parameters; solve_batch() has `threads` in place of `out`.
 // clang-format off
 constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
                                         "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired"};
 // clang-format on
 constexpr int kNumSolveParams = sizeof(kSolveParams) / sizeof(kSolveParams[0]);
 static_assert(kNumSolveParams == kNumSolveArgs, "solve()'s parameters are SolveArgs::parse's arguments");
-PyObject* g_solve_names[kNumSolveParams];
-PyObject* g_solver_error = nullptr;
+PyObject* g_solve_names[kNumSolveParams + 1];  // interned, then "threads"
 
 // Fills `slots` (solve()'s parameters) from positional and keyword arguments; raises TypeError
 // like Python functions.
-void bindArguments(const char* fname, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames, PyObject** slots) {
+// `batch`: solve_batch's parameters.
+void bindArguments(const char* fname, bool batch, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames,
+                   PyObject** slots) {
+  PyObject* names[kNumSolveParams];
+  std::copy(g_solve_names, g_solve_names + kNumSolveParams, names);
+  if (batch) names[kOutArg] = g_solve_names[kNumSolveParams];
   if (nargs > kNumSolveParams)
     throw py::type_error(std::string(fname) + "() takes at most " + std::to_string(kNumSolveParams) +
                          " positional arguments (" + std::to_string(nargs) + " given)");
@@ -28,14 +35,15 @@ void bindArguments(const char* fname, PyObject* const* args, Py_ssize_t nargs, P
     PyObject* name = PyTuple_GET_ITEM(kwnames, k);
     int slot = -1;
     for (int s = 0; s < kNumSolveParams && slot < 0; ++s)
-      if (name == g_solve_names[s]) slot = s;
+      if (name == names[s]) slot = s;
     for (int s = 0; s < kNumSolveParams && slot < 0; ++s)
-      if (PyUnicode_Compare(name, g_solve_names[s]) == 0) slot = s;
+      if (PyUnicode_Compare(name, names[s]) == 0) slot = s;
     if (slot < 0)
       throw py::type_error(std::string(fname) + "() got an unexpected keyword argument '" +
                            py::handle(name).cast<std::string>() + "'");
     if (slots[slot] != nullptr)
-      throw py::type_error(std::string(fname) + "() got multiple values for argument '" + kSolveParams[slot] + "'");
+      throw py::type_error(std::string(fname) + "() got multiple values for argument '" +
+                           py::handle(names[slot]).cast<std::string>() + "'");
     slots[slot] = args[nargs + k];
   }
 }
@@ -54,31 +62,27 @@ PySolver& solverOf(PyObject* self) {
   return *static_cast<PySolver*>(value);
 }
 
-// Runs `body`, turning C++ exceptions into Python ones (SolverError for our messages).
+// Runs `body`, turning C++ exceptions into Python ones with the module's translators, as pybind11's
+// own dispatch does (SolverError for our messages).
 template <typename Body>
 PyObject* guarded(Body&& body) {
   try {
     return body().release().ptr();
-  } catch (const SolverError& e) {
-    PyErr_SetString(g_solver_error, e.what());
   } catch (py::error_already_set& e) {
     e.restore();
-  } catch (const py::builtin_exception& e) {
-    e.set_error();
-  } catch (const std::bad_alloc&) {
-    PyErr_NoMemory();
-  } catch (const std::exception& e) {
-    PyErr_SetString(PyExc_RuntimeError, e.what());
+  } catch (...) {
+    py::detail::try_translate_exceptions();
   }
   return nullptr;
 }
 
-enum Entry { kSolve, kTimeCpp, kSolveDict };
-constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict"};
+enum Entry { kSolve, kTimeCpp, kSolveDict, kSolveBatch };
+constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict", "solve_batch"};
 
 // The METH_FASTCALL methods: solve(q, qd, ...); _time_cpp(reps, q, qd, ...): seconds per C++
 // solve (outputs read as solve() reads them), for benchmarks that compare the Python call with
-// the C++ work in the same process; _solve_dict(q, qd, ...): solve() returning a dict of arrays.
+// the C++ work in the same process; _solve_dict(q, qd, ...): solve() returning a dict of arrays;
+// solve_batch(q, qd, ..., threads, a_desired): a dict of the batch's arrays (solver.py wraps it).
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
@@ -89,9 +93,11 @@ PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyO
       ++args, --nargs;
     }
     PyObject* a[kNumSolveParams] = {};
-    bindArguments(kEntryNames[kind], args, nargs, kwnames, a);
+    bindArguments(kEntryNames[kind], kind == kSolveBatch, args, nargs, kwnames, a);
     if (kind == kTimeCpp) return py::float_(solverOf(self).timeCpp(a, reps));
     if (kind == kSolveDict) return solverOf(self).solveDict(a);
+    if (kind == kSolveBatch)
+      return solverOf(self).solveBatch(a, py::reinterpret_borrow<py::object>(a[kOutArg] ? a[kOutArg] : Py_None));
     return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg]);
   });
 }
@@ -102,7 +108,7 @@ PyMethodDef fastDef() {  // the doc is set in bindSolver()
           METH_FASTCALL | METH_KEYWORDS, nullptr};
 }
 
-PyMethodDef g_fast_defs[] = {fastDef<kSolve>(), fastDef<kTimeCpp>(), fastDef<kSolveDict>()};
+PyMethodDef g_fast_defs[] = {fastDef<kSolve>(), fastDef<kTimeCpp>(), fastDef<kSolveDict>(), fastDef<kSolveBatch>()};
 
 void addFastMethod(py::handle cls, PyMethodDef* def) {
   PyObject* descr = PyDescr_NewMethod(reinterpret_cast<PyTypeObject*>(cls.ptr()), def);
@@ -112,35 +118,21 @@ void addFastMethod(py::handle cls, PyMethodDef* def) {
 
 using O = const py::object&;
 
-// solve_batch (`last`: threads) and _solve_pybind (`last`: out, the benchmark of the fast call's
-// gain) bound the plain pybind11 way: named arguments with defaults.
-template <bool kBatch>
-auto namedSolve(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_ff, O friction, O constraints, O f_pass,
-                O t_pass, O last, O a_desired) {
-  PyObject* const out = kBatch ? nullptr : last.ptr();  // solve_batch has no out
-  PyObject* a[kNumSolveParams] = {q.ptr(),      qd.ptr(),       alpha.ptr(),       beta.ptr(),   f_ext.ptr(),
-                                  tau_ff.ptr(), friction.ptr(), constraints.ptr(), f_pass.ptr(), t_pass.ptr(),
-                                  out,          a_desired.ptr()};
-  if constexpr (kBatch)
-    return s.solveBatch(a, last);
-  else
-    return s.solve(a, last.is_none() ? nullptr : last.ptr());
-}
-
-template <bool kBatch, typename... Last>
-void defNamedSolve(py::class_<PySolver>& cls, const char* name, const Last&... last) {
-  const py::object none = py::none();
-  cls.def(name, &namedSolve<kBatch>, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,
-          py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
-          py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, last...,
-          py::arg("a_desired") = none, doc("_core.Solver." + std::string(name)));
+// _solve_pybind: solve() bound the plain pybind11 way (named arguments with defaults), the
+// benchmark of the fast call's gain.
+py::object solvePybind(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_ff, O friction, O constraints, O f_pass,
+                       O t_pass, O out, O a_desired) {
+  PyObject* a[kNumSolveParams] = {q.ptr(),      qd.ptr(),     alpha.ptr(),    beta.ptr(),
+                                  f_ext.ptr(),  tau_ff.ptr(), friction.ptr(), constraints.ptr(),
+                                  f_pass.ptr(), t_pass.ptr(), out.ptr(),      a_desired.ptr()};
+  return s.solve(a, out.is_none() ? nullptr : out.ptr());
 }
 
 }  // namespace
 
 void bindSolver(py::module_& mod) {
-  g_solver_error = mod.attr("SolverError").ptr();
   for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
+  g_solve_names[kNumSolveParams] = PyUnicode_InternFromString("threads");
 
   py::class_<PySolver> cls(mod, "Solver", doc("_core.Solver"));
   cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
@@ -154,31 +146,17 @@ void bindSolver(py::module_& mod) {
       .def_readonly("n_joints", &PySolver::nj, doc("_core.Solver.n_joints"))
       .def_readonly("n_segments", &PySolver::ns, doc("_core.Solver.n_segments"))
       .def_property_readonly("model", &PySolver::model, doc("_core.Solver.model"));
-  for (const bool tree : {false, true}) {  // solver.chain, solver.tree: the model if it is one
-    const std::string name = tree ? "tree" : "chain";
-    cls.def_property_readonly(
-        name.c_str(),
-        [tree](const PySolver& s) {
-          if (s.isTree() != tree)
-            raise(std::string("this Solver is for a ") + (tree ? "Chain: use solver.chain" : "Tree: use solver.tree") +
-                  " (or solver.model)");
-          return s.model();
-        },
-        doc("_core.Solver." + name));
-  }
   cls.def_property_readonly("inertia_check", &PySolver::inertiaCheck, doc("_core.Solver.inertia_check"))
-      .def(py::pickle([](const PySolver& s) { return s.getState(); },
-                      [](const py::tuple& t) {
-                        if (t.size() != 5 && t.size() != 6) raise("Solver state must have 5 or 6 entries");
-                        return std::make_unique<PySolver>(t[0], t[1], t[2], t[3], t[4],
-                                                          t.size() == 6 ? py::object(t[5]) : py::none());
-                      }));
+      .def("_state", &PySolver::getState, doc("_core.Solver._state"));
   for (PyMethodDef& def : g_fast_defs) {
     def.ml_doc = doc("_core.Solver." + std::string(def.ml_name));
     addFastMethod(cls, &def);
   }
-  defNamedSolve<true>(cls, "solve_batch", py::arg("threads") = 1);
-  defNamedSolve<false>(cls, "_solve_pybind", py::arg("out") = py::none());
+  const py::object none = py::none();
+  cls.def("_solve_pybind", &solvePybind, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,
+          py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
+          py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, py::arg("out") = none,
+          py::arg("a_desired") = none, doc("_core.Solver._solve_pybind"));
 }
 
 }  // namespace vsbind

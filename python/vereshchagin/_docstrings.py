@@ -585,9 +585,7 @@ DOCS["_core.Solver.n_segments"] = r"""Number of segments (moving and fixed-joint
 
 DOCS["_core.Solver.model"] = r"""A copy of the solver's Chain or Tree."""
 
-DOCS["_core.Solver.chain"] = r"""A copy of the solver's Chain (SolverError for a Tree solver)."""
-
-DOCS["_core.Solver.tree"] = r"""A copy of the solver's Tree (SolverError for a Chain solver)."""
+DOCS["_core.Solver._state"] = r"""(model, gravity, rcond, damping, inertia_check, max_constraints): the constructor's arguments that rebuild this solver (pickling; see Solver.__reduce__)."""
 
 DOCS["_core.Solver.inertia_check"] = r"""str: 'physical' or 'joint_space' (see Solver)."""
 

@@ -180,6 +180,39 @@ class Solver(_core.Solver):
         segment_nu = {key: out["nu"][:, start : start + count] for key, start, count in layout}
         return BatchResult(**out, segment_nu=segment_nu or None)
 
+    @property
+    def chain(self) -> _core.Chain:
+        """A copy of the solver's Chain.
+
+        Raises
+        ------
+        SolverError
+            The solver is for a :class:`Tree` (use ``solver.tree`` or ``solver.model``).
+        """
+        model = self.model
+        if isinstance(model, _core.Tree):
+            raise _core.SolverError("this Solver is for a Tree: use solver.tree (or solver.model)")
+        return model
+
+    @property
+    def tree(self) -> _core.Tree:
+        """A copy of the solver's Tree.
+
+        Raises
+        ------
+        SolverError
+            The solver is for a :class:`Chain` (use ``solver.chain`` or ``solver.model``).
+        """
+        model = self.model
+        if not isinstance(model, _core.Tree):
+            raise _core.SolverError("this Solver is for a Chain: use solver.chain (or solver.model)")
+        return model
+
+    def __reduce__(self):
+        # Rebuilt through the constructor from its arguments (model, gravity, rcond, damping,
+        # inertia_check, max_constraints), so copies and unpickled solvers are checked as new ones.
+        return (type(self), self._state())
+
     def response_columns(self, joints, hold_sticking=True):
         """Affine response of the last solve to unit feed-forward joint torques.
 

@@ -117,4 +117,10 @@ struct BatchFailure {
 BatchFailure solveBatch(const Model& model, const BatchInput& input, const BatchOutput& out,
                         const std::vector<BatchWorkspace*>& workspaces);
 
+/// Seconds per solve of row 0 of `input` on `w` (steady clock, averaged over `reps` >= 1 solves),
+/// each followed by the copy of its results that BatchOutput::write makes (into buffers of its
+/// own, allocated once before the clock starts): the C++ cost of one solve as a caller sees it,
+/// for benchmarks. NaN if a solve fails.
+double secondsPerSolve(const Model& model, const BatchInput& input, BatchWorkspace& w, long reps);
+
 }  // namespace vereshchagin
