@@ -29,6 +29,36 @@ bool floatTriple(PyObject* obj, double g[3]) {
   return true;
 }
 
+// q as a native float64 vector of n finite values, viewed in place (the common call), or nullptr:
+// the generic path then converts and checks it with its messages.
+const double* plainJoints(PyObject* obj, py::ssize_t n) {
+  using api = py::detail::npy_api;
+  if (!api::get().PyArray_Check_(obj)) return nullptr;
+  const auto* arr = py::detail::array_proxy(obj);
+  const auto* descr = py::detail::array_descriptor_proxy(arr->descr);
+  constexpr int need = api::NPY_ARRAY_C_CONTIGUOUS_ | api::NPY_ARRAY_ALIGNED_;
+  if (descr->type_num != api::NPY_DOUBLE_ || descr->byteorder == '>' || (arr->flags & need) != need || arr->nd != 1 ||
+      arr->dimensions[0] != n)
+    return nullptr;
+  const double* p = reinterpret_cast<const double*>(arr->data);
+  for (py::ssize_t k = 0; k < n; ++k)
+    if (!std::isfinite(p[k])) return nullptr;
+  return p;
+}
+
+// mass_matrix and gravity_torques on a plain q straight into the library (no argument table);
+// anything else, or a failure (its message), through run().
+template <typename Call>
+py::object direct(const CompanionModel& m, PyObject* q_obj, std::initializer_list<py::ssize_t> shape, Call call) {
+  vs::DynamicsData& d = m.companions();
+  const py::ssize_t n = static_cast<py::ssize_t>(d.model().nrOfJoints());
+  const double* q = plainJoints(q_obj, n);
+  if (q == nullptr) return py::object();  // null: the generic path
+  py::array out = newDoubles(shape);
+  if (!call(d, vs::JointPositions(Eigen::Map<const Eigen::VectorXd>(q, n)), doubles(out), n)) return py::object();
+  return std::move(out);
+}
+
 // An f_ext dict {segment or link: wrench (6,), moment about that frame's origin}: the call's frame
 // wrenches.
 void frameWrenches(const CompanionModel& m, vs::CompanionCall& call, const py::handle& f_ext) {
@@ -106,8 +136,28 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
   const auto twist = [frame](const M& m, O q, O qd, O s) { return run(m, K::Twist, {q, qd}, frame(m, s)); };
   const auto jdot = [frame](const M& m, O q, O qd, O s) { return run(m, K::JacobianDotTimesQd, {q, qd}, frame(m, s)); };
   const auto id = [](const M& m, O q, O qd, O qdd, O f, O g) { return run(m, K::InverseDynamics, {q, qd, qdd, g, f}); };
-  const auto mass = [](const M& m, O q) { return run(m, K::MassMatrix, {q}); };
-  const auto grav = [](const M& m, O q, O g) { return run(m, K::GravityTorques, {q, {}, {}, g}); };
+  const auto mass = [](const M& m, O q) {
+    const auto h = [](vs::DynamicsData& d, const vs::JointPositions& jq, double* out, py::ssize_t n) {
+      return vs::massMatrix(d.model(), d, jq, Eigen::Map<Eigen::MatrixXd>(out, n, n)).ok();
+    };
+    const py::ssize_t n = static_cast<py::ssize_t>(m.companions().model().nrOfJoints());
+    py::object out = direct(m, q.ptr(), {n, n}, h);
+    return out ? out : py::object(run(m, K::MassMatrix, {q}));
+  };
+  const auto grav = [](const M& m, O q, O g) {
+    double gv[3];
+    const double* gp = plainJoints(g.ptr(), 3);
+    const bool plain_g = floatTriple(g.ptr(), gv) ? std::isfinite(gv[0] + gv[1] + gv[2])
+                         : gp != nullptr          ? (std::copy_n(gp, 3, gv), true)
+                                                  : false;
+    const auto tau = [&gv](vs::DynamicsData& d, const vs::JointPositions& jq, double* out, py::ssize_t n) {
+      const KDL::Vector gravity(gv[0], gv[1], gv[2]);
+      return vs::gravityTorques(d.model(), d, jq, gravity, Eigen::Map<Eigen::VectorXd>(out, n)).ok();
+    };
+    const py::ssize_t n = static_cast<py::ssize_t>(m.companions().model().nrOfJoints());
+    py::object out = plain_g ? direct(m, q.ptr(), {n}, tau) : py::object();
+    return out ? out : py::object(run(m, K::GravityTorques, {q, {}, {}, g}));
+  };
   const auto coriolis = [](const M& m, O q, O qd) { return run(m, K::CoriolisTorques, {q, qd}); };
   const auto fk_all = [](const M& m, O q) { return run(m, K::FkAll, {q}); };
   cls.def("fk", fk, py::arg("q"), segment, key("fk"))
