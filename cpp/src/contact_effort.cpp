@@ -17,14 +17,6 @@
 namespace vereshchagin {
 namespace detail {
 
-namespace {
-
-double angle(int j, int facets) {
-  return 2.0 * M_PI * j / facets;
-}
-
-}  // namespace
-
 // The free coordinates of the solved forces: their directions, the validity rows in them, and
 // their current values (x*). Returns the number of coordinates.
 int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd& qdd) {
@@ -41,34 +33,29 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
     return k++;
   };
   for (std::size_t c = 0; c < points_.size(); ++c) {
-    const Point& pt = points_[c];
+    Point& pt = points_[c];
     const PointContact& pc = in.contacts[c];
     const Vector3 f = forces.col(c);
     const double fn = pt.n.dot(f);
     const int ci = static_cast<int>(c);
     // The point's acceleration in the solved motion: a support whose normal acceleration is not
     // zero leaves its surface (no force); one at rest with zero tangential acceleration may stick.
-    const KDL::Frame at(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)));
     Vector6 bias;
-    (void)frameJacobian(model_, kin_, FrameRef{pc.segment, at}, jac_);
-    (void)frameBiasAcceleration(model_, kin_, FrameRef{pc.segment, at}, bias);
+    pointKinematics(pc, bias);
     const Vector3 a = jac_.topRows<3>() * qdd + bias.head<3>();
     const double an = pt.n.dot(a), a_tol = 1e-9 * std::max(1.0, a.norm());
     const Vector3 at_ = a - an * pt.n;
     const bool resting = pt.kind == kTouching || pt.kind == kSetPointRest;
     const bool sticking = resting && pc.mu > 0.0 && at_.norm() <= a_tol;
+    pt.held = sticking;
     if (pc.isSupport()) {
       if (pt.kind == kSeparating || an > a_tol) continue;
       // Frictionless or sliding: the force keeps its direction (at rest: opposing a_t).
       Vector3 e = pt.n;
       if (!sticking && pc.mu > 0.0) {
         const Vector3 slide = pt.kind == kSliding ? pt.v - pt.n.dot(pt.v) * pt.n : at_;
-        double best = 0.0;
-        for (int j = 0; j < pc.facets; ++j) {
-          const Vector3 d = std::cos(angle(j, pc.facets)) * pt.t1 + std::sin(angle(j, pc.facets)) * pt.t2;
-          if (j == 0 || d.dot(slide) < best) best = d.dot(slide), e = pt.n + pc.mu * d;
-        }
-        if (fn > 0.0) e = f / fn;  // the direction found (a vertex or an edge of the polygon)
+        e = fn > 0.0 ? Vector3(f / fn)
+                     : Vector3(pt.n + pc.mu * mostOpposed(pt, slide, pc.facets));  // found, or a vertex
       }
       const int xn = addDir(ci, e);
       eff_x_(xn) = fn;
@@ -76,19 +63,19 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
       if (!sticking) continue;
       const int x1 = addDir(ci, pt.t1), x2 = addDir(ci, pt.t2);
       for (int i = 0; i < pc.facets; ++i) {  // inside every edge of mu f_n conv{d_j}
-        const double ang = M_PI * (2 * i + 1) / pc.facets;
+        const Eigen::Vector2d e_i = edgeCoords(i, pc.facets);
         const int row = addRow(0.0);
         eff_rows_(row, xn) = pc.mu * std::cos(M_PI / pc.facets);
-        eff_rows_(row, x1) = -std::cos(ang);
-        eff_rows_(row, x2) = -std::sin(ang);
+        eff_rows_(row, x1) = -e_i(0);
+        eff_rows_(row, x2) = -e_i(1);
       }
     } else if (sticking) {  // a set-point's tangential force, inside mu F conv{d_j}
       const int x1 = addDir(ci, pt.t1), x2 = addDir(ci, pt.t2);
       for (int i = 0; i < pc.facets; ++i) {
-        const double ang = M_PI * (2 * i + 1) / pc.facets;
+        const Eigen::Vector2d e_i = edgeCoords(i, pc.facets);
         const int row = addRow(-pc.mu * pc.force * std::cos(M_PI / pc.facets));
-        eff_rows_(row, x1) = -std::cos(ang);
-        eff_rows_(row, x2) = -std::sin(ang);
+        eff_rows_(row, x1) = -e_i(0);
+        eff_rows_(row, x2) = -e_i(1);
       }
     }
   }
@@ -140,28 +127,17 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   auto dx = eff_dx_.head(p);
   if (qp_.solve(Q, lin, R, r, dx, 100 + 40 * rows) != Lemke::kSolved) return 0;  // keep the forces found
   eff_x_.head(p) += dx;
-  for (int i = 0; i < p; ++i)  // the forces from their coordinates
-    if (in.contacts[eff_contact_(i)].isSupport()) forces.col(eff_contact_(i)).setZero();
-  for (int i = 0; i < p; ++i) {
+  for (int i = 0; i < p; ++i) forces.col(eff_contact_(i)) = points_[eff_contact_(i)].fixed;  // known part
+  for (int i = 0; i < p; ++i) forces.col(eff_contact_(i)) += eff_x_(i) * eff_dir_.col(i);
+  if (const int rc = solveWithForces(d, in)) return rc;
+  for (int i = 0; i < p; ++i) {  // the supports' statuses with their new forces
     const int ci = eff_contact_(i);
-    if (!in.contacts[ci].isSupport() && i > 0 && eff_contact_(i - 1) == ci) continue;  // set-point: both at once
-    if (!in.contacts[ci].isSupport()) {
-      forces.col(ci) = points_[ci].fixed + eff_x_(i) * eff_dir_.col(i) + eff_x_(i + 1) * eff_dir_.col(i + 1);
-      continue;
-    }
-    forces.col(ci) += eff_x_(i) * eff_dir_.col(i);
-  }
-  buildWorkInput(in, false);
-  for (std::size_t ci = 0; ci < points_.size(); ++ci) {
-    const Vector3 f = forces.col(ci) - points_[ci].fixed;
-    if (!f.isZero(0.0))
-      work_.wrenches.push_back(
-          FrameWrench{in.contacts[ci].segment, (Vector6() << f, Vector3::Zero()).finished(), in.contacts[ci].point});
-  }
-  if (const int rc = runInput(d, work_)) return rc;
-  for (std::size_t ci = 0; ci < points_.size(); ++ci)  // a support left without force
-    if (in.contacts[ci].isSupport() && !(points_[ci].n.dot(forces.col(ci)) > 0.0))
+    if (!in.contacts[ci].isSupport()) continue;
+    if (!pushes(points_[ci], forces.col(ci)))
       status[ci] = ContactStatus::Separating;
+    else if (status[ci] == ContactStatus::Separating)  // touching, now carrying
+      status[ci] = points_[ci].held ? ContactStatus::Sticking : ContactStatus::Sliding;
+  }
   return 0;
 }
 

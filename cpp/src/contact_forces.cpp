@@ -28,10 +28,6 @@ namespace {
 
 constexpr int E_NO_SOLUTION = static_cast<int>(Error::NoContactSolution);
 
-double angle(int j, int facets) {
-  return 2.0 * M_PI * j / facets;
-}
-
 }  // namespace
 
 // The unknowns' force directions as wrench columns, their response, and the acceleration rows.
@@ -45,10 +41,8 @@ void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
     const Vector3 cols[3] = {p.role == kNormalOnly ? p.dir : p.n, p.t1, p.t2};
     const Vector3 rows[3] = {p.n, p.t1, p.t2};
     const int first = p.role == kTangentOnly ? 1 : 0;
-    const KDL::Frame at(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)));
     Vector6 bias;
-    (void)frameJacobian(model_, kin_, FrameRef{pc.segment, at}, jac_);
-    (void)frameBiasAcceleration(model_, kin_, FrameRef{pc.segment, at}, bias);
+    pointKinematics(pc, bias);
     for (int c = 0; c < p.ncol; ++c) {
       const Vector3& e = cols[first + c];
       col_segment_(p.col + c) = pc.segment;
@@ -75,9 +69,10 @@ void ContactStage::assembleLcp(const SolveInput& in) {
     if (p.role == kNormalOnly || p.role == kFull) coef(p.col, p.var) = 1.0;
     if (p.role != kFull && p.role != kTangentOnly) continue;
     const int beta0 = p.role == kFull ? p.var + 1 : p.var, t1 = p.role == kFull ? p.col + 1 : p.col;
-    for (int j = 0; j < facets; ++j) {
-      coef(t1, beta0 + j) = std::cos(angle(j, facets));
-      coef(t1 + 1, beta0 + j) = std::sin(angle(j, facets));
+    for (int j = 0; j < facets; ++j) {  // d_j in the (t1, t2) columns
+      const Eigen::Vector2d d = vertexCoords(j, facets);
+      coef(t1, beta0 + j) = d(0);
+      coef(t1 + 1, beta0 + j) = d(1);
     }
   }
   auto rz = rows_per_z_.topLeftCorner(nrow_, nz_);
@@ -97,7 +92,8 @@ void ContactStage::assembleLcp(const SolveInput& in) {
     const bool full = p.role == kFull;
     const int beta0 = full ? p.var + 1 : p.var, gamma = beta0 + pc.facets, t1 = full ? p.row + 1 : p.row;
     for (int j = 0; j < pc.facets; ++j) {  // gamma + d_j . a_t
-      const double cj = std::cos(angle(j, pc.facets)), sj = std::sin(angle(j, pc.facets));
+      const Eigen::Vector2d d = vertexCoords(j, pc.facets);
+      const double cj = d(0), sj = d(1);
       M.row(beta0 + j) = cj * rz.row(t1) + sj * rz.row(t1 + 1);
       M(beta0 + j, gamma) += 1.0;
       q(beta0 + j) = cj * rows0_(t1) + sj * rows0_(t1 + 1);
@@ -142,9 +138,7 @@ void ContactStage::applyForces(const SolveInput& in) {
     Vector3 f = Vector3::Zero();
     for (int c = 0; c < p.ncol; ++c) f += coef_.row(p.col + c).head(nz_).dot(z) * col_wrench_.col(p.col + c).head<3>();
     forces.col(k) = p.fixed + f;
-    if (p.ncol > 0 && !f.isZero(0.0))
-      work_.wrenches.push_back(
-          FrameWrench{in.contacts[k].segment, (Vector6() << f, Vector3::Zero()).finished(), in.contacts[k].point});
+    if (p.ncol > 0 && !f.isZero(0.0)) addForce(in.contacts[k], f);
   }
 }
 
@@ -172,49 +166,35 @@ int ContactStage::trySticking(DataImpl& d, const SolveInput& in) {
     const PointContact& pc = in.contacts[k];
     const Vector3 ft = -nu(p.stick_col) * p.t1 - nu(p.stick_col + 1) * p.t2;  // tau_cmd = -J^T alfa nu
     const double fn = p.n.dot(forces.col(k)), apothem = pc.mu * fn * std::cos(M_PI / pc.facets);
-    for (int i = 0; i < pc.facets; ++i) {  // inside every edge (outward normals at (2i + 1) pi / k)
-      const double a = M_PI * (2 * i + 1) / pc.facets;
-      if ((std::cos(a) * p.t1 + std::sin(a) * p.t2).dot(ft) > apothem + 1e-12 * std::max(1.0, std::abs(fn))) return 0;
-    }
+    for (int i = 0; i < pc.facets; ++i)  // inside every edge of the polygon
+      if (edgeNormal(p, i, pc.facets).dot(ft) > apothem + 1e-12 * std::max(1.0, std::abs(fn))) return 0;
     forces.col(k) += ft;
   }
-  buildWorkInput(in, false);  // the final input: every force a wrench, no tangential columns
-  for (std::size_t k = 0; k < points_.size(); ++k) {
-    const Vector3 f = forces.col(k) - points_[k].fixed;
-    if (!f.isZero(0.0))
-      work_.wrenches.push_back(
-          FrameWrench{in.contacts[k].segment, (Vector6() << f, Vector3::Zero()).finished(), in.contacts[k].point});
-  }
-  if (int rc = runInput(d, work_)) return rc;
+  if (int rc = solveWithForces(d, in)) return rc;  // the final sweep: no tangential columns
   return 1;
 }
 
 void ContactStage::reportStatus(const SolveInput& in, bool stuck) {
-  bool convex = true;
   for (std::size_t k = 0; k < points_.size(); ++k) {
     const Point& p = points_[k];
-    const PointContact& pc = in.contacts[k];
-    const double fn = p.n.dot(forces.col(k));
     ContactStatus s = ContactStatus::Sliding;
-    if (pc.isSupport() && fn <= 1e-12 * std::max(1.0, forces.col(k).norm()))
+    if (in.contacts[k].isSupport() && !pushes(p, forces.col(k)))
       s = ContactStatus::Separating;
     else if (stuck && p.stick_col >= 0)
       s = ContactStatus::Sticking;
     else if (p.role == kFull || p.role == kTangentOnly)
       s = z_(p.var + p.nvar - 1) > 0.0 ? ContactStatus::Sliding : ContactStatus::Sticking;  // gamma
     status[k] = s;
-    if ((p.kind == kTouching || p.kind == kSliding) && pc.mu > 0.0) convex = false;
   }
-  outcome = points_.empty() ? ContactOutcome::None : convex ? ContactOutcome::Unique : ContactOutcome::Consistent;
+  outcome = points_.empty()     ? ContactOutcome::None
+            : convexProblem(in) ? ContactOutcome::Unique
+                                : ContactOutcome::Consistent;
 }
 
 int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   if (int rc = classify(d.core, in)) return rc;
-  bool stickable = false, convex = true;
-  for (std::size_t k = 0; k < points_.size(); ++k) {
-    stickable = stickable || points_[k].kind == kTouching || points_[k].kind == kSetPointRest;
-    convex = convex && !((points_[k].kind == kTouching || points_[k].kind == kSliding) && in.contacts[k].mu > 0.0);
-  }
+  bool stickable = false;
+  for (const Point& p : points_) stickable = stickable || p.kind == kTouching || p.kind == kSetPointRest;
   if (stickable) {
     const int rc = trySticking(d, in);
     if (rc < 0) return rc;
@@ -225,7 +205,7 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   }
   layout(in, false);
   buildWorkInput(in, false);
-  if (int rc = forcesOfLcp(d, in, convex)) return rc;
+  if (int rc = forcesOfLcp(d, in, convexProblem(in))) return rc;
   if (nz_ > 0)
     if (int rc = runInput(d, work_)) return rc;
   reportStatus(in, false);

@@ -24,11 +24,61 @@ void tangents(const Vector3& n, Vector3& t1, Vector3& t2) {
   t2 = n.cross(t1);
 }
 
-double angle(int j, int facets) {
-  return 2.0 * M_PI * j / facets;
+}  // namespace
+
+Eigen::Vector2d ContactStage::vertexCoords(int j, int facets) {
+  const double a = 2.0 * M_PI * j / facets;
+  return Eigen::Vector2d(std::cos(a), std::sin(a));
 }
 
-}  // namespace
+Eigen::Vector2d ContactStage::edgeCoords(int i, int facets) {
+  const double a = M_PI * (2 * i + 1) / facets;
+  return Eigen::Vector2d(std::cos(a), std::sin(a));
+}
+
+Vector3 ContactStage::vertex(const Point& p, int j, int facets) {
+  const Eigen::Vector2d d = vertexCoords(j, facets);
+  return d(0) * p.t1 + d(1) * p.t2;
+}
+
+Vector3 ContactStage::mostOpposed(const Point& p, const Vector3& v, int facets) {
+  Vector3 best = vertex(p, 0, facets);
+  for (int j = 1; j < facets; ++j)
+    if (const Vector3 d = vertex(p, j, facets); d.dot(v) < best.dot(v)) best = d;
+  return best;
+}
+
+Vector3 ContactStage::edgeNormal(const Point& p, int i, int facets) {
+  const Eigen::Vector2d e = edgeCoords(i, facets);
+  return e(0) * p.t1 + e(1) * p.t2;
+}
+
+bool ContactStage::pushes(const Point& p, const Vector3& f) {
+  return p.n.dot(f) > 1e-12 * std::max(1.0, f.norm());
+}
+
+bool ContactStage::convexProblem(const SolveInput& in) const {
+  for (std::size_t k = 0; k < points_.size(); ++k)
+    if ((points_[k].kind == kTouching || points_[k].kind == kSliding) && in.contacts[k].mu > 0.0) return false;
+  return true;
+}
+
+void ContactStage::pointKinematics(const PointContact& pc, Vector6& bias) {
+  const FrameRef at{pc.segment, KDL::Frame(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)))};
+  (void)frameJacobian(model_, kin_, at, jac_);
+  (void)frameBiasAcceleration(model_, kin_, at, bias);
+}
+
+void ContactStage::addForce(const PointContact& pc, const Vector3& f) {
+  work_.wrenches.push_back(FrameWrench{pc.segment, (Vector6() << f, Vector3::Zero()).finished(), pc.point});
+}
+
+int ContactStage::solveWithForces(DataImpl& d, const SolveInput& in) {
+  buildWorkInput(in, false);  // the set-points' columns and known forces
+  for (std::size_t k = 0; k < points_.size(); ++k)
+    if (const Vector3 f = forces.col(k) - points_[k].fixed; !f.isZero(0.0)) addForce(in.contacts[k], f);
+  return runInput(d, work_);
+}
 
 ContactStage::ContactStage(const Model& model) : model_(model), kin_(model), work_(model) {
   jac_.resize(6, model.nrOfJoints());
@@ -92,14 +142,8 @@ int ContactStage::classify(HdCore& c, const SolveInput& in) {
     tangents(p.n, p.t1, p.t2);
     const double vn = p.n.dot(p.v);
     const Vector3 vt = p.v - vn * p.n;
-    if (vt.norm() > tol) {  // the vertex most opposed to the tangential velocity (the first on ties)
-      double best = 0.0;
-      for (int j = 0; j < pc.facets; ++j) {
-        const Vector3 d = std::cos(angle(j, pc.facets)) * p.t1 + std::sin(angle(j, pc.facets)) * p.t2;
-        if (j == 0 || d.dot(vt) < best) best = d.dot(vt), p.slide_dir = d;
-      }
-    }
-    if (vt.norm() <= tol) p.slide_dir.setZero();
+    // Sliding: the vertex most opposed to the tangential velocity.
+    p.slide_dir = vt.norm() > tol ? mostOpposed(p, vt, pc.facets) : Vector3::Zero();
     if (pc.isSupport()) {
       if (vn < -tol)
         return c.fail(E_CONTACT,
@@ -183,7 +227,7 @@ void ContactStage::buildWorkInput(const SolveInput& in, bool stick) {
     const PointContact& pc = in.contacts[k];
     if (p.kind != kSetPointRest && p.kind != kSetPointSliding) continue;
     column(pc.segment, pc.point, p.n);
-    work_.wrenches.push_back(FrameWrench{pc.segment, (Vector6() << p.fixed, Vector3::Zero()).finished(), pc.point});
+    addForce(pc, p.fixed);
   }
   if (!stick) return;
   for (std::size_t k = 0; k < in.contacts.size(); ++k) {

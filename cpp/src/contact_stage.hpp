@@ -62,7 +62,28 @@ class ContactStage {
     int col = 0, ncol = 0;    // its response columns
     int row = 0, nrow = 0;    // its acceleration rows
     int stick_col = -1;       // the sticking trial: its first tangential constraint column in nu
+    bool held = false;        // least effort: it sticks, its force free inside its polygon
   };
+
+  // The polygon of a point with `facets` facets: vertex direction d_j, the vertex most opposed to
+  // `v` (the first on ties), the outward normal of edge i (at (2 i + 1) pi / facets; the polygon
+  // mu f_n conv{d_j} lies where e_i . f_t <= mu f_n cos(pi / facets)).
+  static Eigen::Vector2d vertexCoords(int j, int facets);  // d_j in (t1, t2): cos, sin of 2 pi j / facets
+  static Eigen::Vector2d edgeCoords(int i, int facets);    // e_i in (t1, t2)
+  static Vector3 vertex(const Point& p, int j, int facets);
+  static Vector3 mostOpposed(const Point& p, const Vector3& v, int facets);
+  static Vector3 edgeNormal(const Point& p, int i, int facets);
+  // A support's force pushes (f_n above round-off), i.e. it does not separate.
+  static bool pushes(const Point& p, const Vector3& f);
+  // No touching support has friction: the accelerations are unique (ContactOutcome::Unique).
+  bool convexProblem(const SolveInput& in) const;
+  // jac_ and `bias` of the contact point (linear rows 0..2: its velocity Jacobian and classical
+  // acceleration at qdd = 0, base axes), from kin_ at the solve's state.
+  void pointKinematics(const PointContact& pc, Vector6& bias);
+  // A force on the contact point as one more wrench of work_.
+  void addForce(const PointContact& pc, const Vector3& f);
+  // The final sweep: the input with every contact force (`forces`) as a wrench.
+  int solveWithForces(DataImpl& d, const SolveInput& in);
 
   int classify(HdCore& c, const SolveInput& in);
   // Roles and sizes of one problem: the sticking trial (every resting point with friction held
