@@ -78,18 +78,28 @@ struct F64View : vereshchagin::ArrayArg {
   py::object keep;
 };
 
+// `obj` as a numpy array of native float64, C-contiguous and aligned, with at most 3 dimensions
+// (viewed in place without conversion), or nullptr.
+inline const py::detail::PyArray_Proxy* nativeF64(PyObject* obj) {
+  namespace d = py::detail;
+  constexpr int need = d::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | d::npy_api::NPY_ARRAY_ALIGNED_;
+  if (!d::npy_api::get().PyArray_Check_(obj)) return nullptr;
+  const auto* arr = d::array_proxy(obj);
+  const auto* descr = d::array_descriptor_proxy(arr->descr);
+  const bool native = arr->nd <= 3 && (arr->flags & need) == need && descr->type_num == d::npy_api::NPY_DOUBLE_ &&
+                      descr->byteorder != '>';
+  return native ? arr : nullptr;
+}
+
 // Views `obj` as float64. Integer and floating arrays (and nested sequences of numbers) are
 // accepted; bool, complex, string, object and other dtypes raise naming `name`. Values are not
 // checked here (see requireFiniteView).
 inline F64View asF64(PyObject* obj, const char* name) {
   namespace d = py::detail;
-  constexpr int need = d::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | d::npy_api::NPY_ARRAY_ALIGNED_;
   const auto& api = d::npy_api::get();
-  const auto* arr = api.PyArray_Check_(obj) ? d::array_proxy(obj) : nullptr;
-  const auto* descr = arr ? d::array_descriptor_proxy(arr->descr) : nullptr;
+  const auto* arr = nativeF64(obj);
   F64View v;
-  if (!arr || arr->nd > 3 || (arr->flags & need) != need || descr->type_num != d::npy_api::NPY_DOUBLE_ ||
-      descr->byteorder == '>') {
+  if (!arr) {
     if (obj == Py_None) raise(std::string(name) + " must be a real array, got None");
     if (PyBool_Check(obj)) raise(std::string(name) + " must be a real number or array, got bool");
     // PyArray_FromAny keeps the error of a failed conversion (py::array::ensure clears it).

@@ -32,14 +32,8 @@ bool floatTriple(PyObject* obj, double g[3]) {
 // q as a native float64 vector of n finite values, viewed in place (the common call), or nullptr:
 // the generic path then converts and checks it with its messages.
 const double* plainJoints(PyObject* obj, py::ssize_t n) {
-  using api = py::detail::npy_api;
-  if (!api::get().PyArray_Check_(obj)) return nullptr;
-  const auto* arr = py::detail::array_proxy(obj);
-  const auto* descr = py::detail::array_descriptor_proxy(arr->descr);
-  constexpr int need = api::NPY_ARRAY_C_CONTIGUOUS_ | api::NPY_ARRAY_ALIGNED_;
-  if (descr->type_num != api::NPY_DOUBLE_ || descr->byteorder == '>' || (arr->flags & need) != need || arr->nd != 1 ||
-      arr->dimensions[0] != n)
-    return nullptr;
+  const auto* arr = nativeF64(obj);
+  if (arr == nullptr || arr->nd != 1 || arr->dimensions[0] != n) return nullptr;
   const double* p = reinterpret_cast<const double*>(arr->data);
   for (py::ssize_t k = 0; k < n; ++k)
     if (!std::isfinite(p[k])) return nullptr;
