@@ -120,12 +120,17 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   auto T = eff_dtau_.topLeftCorner(n, p);
   for (int i = 0; i < p; ++i)
     if (c.commandTorquesOf(N.col(i), T.col(i)) != 0) return 0;
-  auto Q = eff_q_.topLeftCorner(p, p);
-  Q.noalias() = T.transpose() * T;
-  auto lin = eff_c_.head(p);
-  lin.noalias() = T.transpose() * c.res.tau_cmd;
+  // Then the least contact forces: 1/2 sum_c ||f_c||^2, f_c = fixed_c + sum_i x_i e_i over its
+  // coordinates (their Gram matrix per contact; the gradient at x* is e_i . f_c).
+  auto P = eff_q_.topLeftCorner(p, p);
+  auto pv = eff_c_.head(p);
+  for (int i = 0; i < p; ++i) {
+    for (int j = 0; j < p; ++j)
+      P(i, j) = eff_contact_(i) == eff_contact_(j) ? eff_dir_.col(i).dot(eff_dir_.col(j)) : 0.0;
+    pv(i) = eff_dir_.col(i).dot(forces.col(eff_contact_(i)));
+  }
   auto dx = eff_dx_.head(p);
-  if (qp_.solve(Q, lin, R, r, dx, 100 + 40 * rows) != Lemke::kSolved) return 0;  // keep the forces found
+  if (lqp_.solve(T, c.res.tau_cmd, P, pv, R, r, dx) != Lemke::kSolved) return 0;  // keep the forces found
   eff_x_.head(p) += dx;
   for (int i = 0; i < p; ++i) forces.col(eff_contact_(i)) = points_[eff_contact_(i)].fixed;  // known part
   for (int i = 0; i < p; ++i) forces.col(eff_contact_(i)) += eff_x_(i) * eff_dir_.col(i);
@@ -161,7 +166,7 @@ void ContactStage::reserveEffort(int p, int k, int m) {
     eff_r_all_.resize(rows, eff_dir_.cols());
     eff_rhs_.resize(rows);
   }
-  qp_.reserve(static_cast<int>(eff_dir_.cols()), rows);
+  lqp_.reserve(static_cast<int>(eff_dir_.cols()), rows, n);
 }
 
 }  // namespace detail

@@ -175,6 +175,8 @@ int ContactStage::trySticking(DataImpl& d, const SolveInput& in) {
 }
 
 void ContactStage::reportStatus(const SolveInput& in, bool stuck) {
+  // gamma (an acceleration) above round-off of the problem's accelerations: starts to slide.
+  const double gamma_tol = stuck || nz_ == 0 ? 0.0 : 1e-9 * std::max(1.0, lcp_q_.head(nz_).cwiseAbs().maxCoeff());
   for (std::size_t k = 0; k < points_.size(); ++k) {
     const Point& p = points_[k];
     ContactStatus s = ContactStatus::Sliding;
@@ -183,7 +185,7 @@ void ContactStage::reportStatus(const SolveInput& in, bool stuck) {
     else if (stuck && p.stick_col >= 0)
       s = ContactStatus::Sticking;
     else if (p.role == kFull || p.role == kTangentOnly)
-      s = z_(p.var + p.nvar - 1) > 0.0 ? ContactStatus::Sliding : ContactStatus::Sticking;  // gamma
+      s = z_(p.var + p.nvar - 1) > gamma_tol ? ContactStatus::Sliding : ContactStatus::Sticking;  // gamma
     status[k] = s;
   }
   outcome = points_.empty()     ? ContactOutcome::None
@@ -193,6 +195,7 @@ void ContactStage::reportStatus(const SolveInput& in, bool stuck) {
 
 int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   if (int rc = classify(d.core, in)) return rc;
+  if (const int rc = tryAllActive(d, in); rc != 0) return rc < 0 ? rc : 0;
   bool stickable = false;
   for (const Point& p : points_) stickable = stickable || p.kind == kTouching || p.kind == kSetPointRest;
   if (stickable) {

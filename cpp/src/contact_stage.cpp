@@ -103,11 +103,11 @@ int ContactStage::check(HdCore& c, const SolveInput& in) const {
                     "got %g",
                     k, p.force);
   }
-  int extra = 0;  // a column per set-point, two more per point with friction (the sticking trial)
-  for (const PointContact& p : in.contacts) extra += (p.isSupport() ? 0 : 1) + (p.mu > 0.0 ? 2 : 0);
+  int extra = 0;  // a column per contact, two more per point with friction (the sticking trial)
+  for (const PointContact& p : in.contacts) extra += 1 + (p.mu > 0.0 ? 2 : 0);
   if (in.columns() + extra > c.mcap)
     return c.fail(static_cast<int>(Error::TooManyConstraints),
-                  "%d constraint columns and %d more for the contacts (one per force set-point, two per point with "
+                  "%d constraint columns and %d more for the contacts (one per contact, two more per point with "
                   "friction): at most %d in all (SolverOptions::max_constraints)",
                   in.columns(), extra, c.mcap);
   if (!(std::isfinite(in.contact_velocity_tolerance) && in.contact_velocity_tolerance >= 0.0))

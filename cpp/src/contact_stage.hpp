@@ -1,5 +1,8 @@
 // The contact stage of solve() (input.contacts, contact.hpp), built in a Data at its first solve
 // with contacts. Per solve:
+//   0. the all-active guess (contact_active.cpp): when every touching support held and every
+//      resting point with friction stuck is consistent and its forces are unique, that is the
+//      answer (one solve with the contacts as constraint columns, then step 4);
 //   1. the contact points' kinematics at (q, qd) (KinematicsData): each contact is separating,
 //      touching at rest, or sliding; a force set-point becomes a constraint column (zero normal
 //      acceleration, held by the motors) plus its normal force as a known wrench;
@@ -62,6 +65,8 @@ class ContactStage {
     int col = 0, ncol = 0;    // its response columns
     int row = 0, nrow = 0;    // its acceleration rows
     int stick_col = -1;       // the sticking trial: its first tangential constraint column in nu
+    int normal_col = -1;      // the all-active guess: a support's normal column in nu
+    bool dropped = false;     // the all-active guess: a support left out (it separates)
     bool held = false;        // least effort: it sticks, its force free inside its polygon
   };
 
@@ -99,6 +104,16 @@ class ContactStage {
   // done), 0 if not (fall back to the full problem), or an error code.
   int trySticking(DataImpl& d, const SolveInput& in);
   void reportStatus(const SolveInput& in, bool stuck);
+  // The all-active guess (contact_active.cpp): 1 if it holds (forces, final sweep and statuses
+  // done), 0 if not (go on with the general method), or an error code of the final sweep.
+  int tryAllActive(DataImpl& d, const SolveInput& in);
+  void buildActiveInput(const SolveInput& in);
+  int activeForces(const SolveInput& in, const Eigen::Ref<const Eigen::VectorXd>& nu);
+  bool droppedSeparate(const SolveInput& in, const Eigen::VectorXd& qdd);
+  bool heldPointsStill(const SolveInput& in, const Eigen::VectorXd& qdd);
+  int activeRows(const SolveInput& in, int dn);
+  int redundantGuess(DataImpl& d, const SolveInput& in);
+  void reserveActive(int m, int rows);
   // Least motor effort among the force distributions that keep qdd (contact_effort.cpp): 0 or an
   // error code of the final sweep.
   int leastEffort(DataImpl& d, const SolveInput& in);
@@ -125,12 +140,17 @@ class ContactStage {
   // Least effort (contact_effort.cpp): per free force coordinate its direction, contact, value,
   // wrench and responses; the validity rows in the coordinates; the programme's matrices.
   ConvexQp qp_;
+  LexicographicQp lqp_;  // least effort, then least contact force
   Matrix3X eff_dir_;
   Eigen::VectorXi eff_contact_, eff_seg_;
   Eigen::VectorXd eff_x_, eff_c_, eff_dx_, eff_r_, eff_rhs_;
   Matrix6X eff_wrench_;
   Eigen::MatrixXd eff_dqdd_, eff_dnu_, eff_dtau_, eff_gtg_, eff_l_, eff_q_, eff_rows_, eff_r_all_;
   int eff_k_ = 0;
+  // The all-active guess with redundant columns (contact_active.cpp): K's null directions, the
+  // multipliers, the motors' torques per direction, the programme in the null coordinates.
+  Eigen::MatrixXd act_null_, act_cmd_, act_q_, act_r_;
+  Eigen::VectorXd act_nu_, act_masked_, act_tau_, act_lin_, act_y_, act_rhs_;
 };
 
 }  // namespace detail

@@ -235,6 +235,11 @@ class HdCore {
   int wrenchResponse(const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& wrenches,
                      Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd>* dnu);
   int commandTorquesOf(const Eigen::Ref<const Eigen::VectorXd>& nu, Eigen::Ref<Eigen::VectorXd> tau_cmd);
+  // After a solve on the several-segment path whose coupling matrix K was rank-deficient under the
+  // truncated pseudo-inverse (res.rank < res.m): K's null directions (the truncated eigenvectors)
+  // into out's first columns (res.m rows, caller's column order), multiplier changes that change
+  // no joint torque and so no motion. Returns their number, or -1 on any other path.
+  int nullMultipliers(Eigen::Ref<Eigen::MatrixXd> out) const;
   // Validates weights (messages of HdSolver::setPassThrough) into `out`; 0 or an error code.
   int setPassThrough(const Eigen::Ref<const Eigen::VectorXd>& f_ext_pass_through,
                      const Eigen::Ref<const Eigen::VectorXd>& ff_pass_through, PassThroughWeights& out);

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dense_small.hpp"
+
 namespace vereshchagin {
 namespace detail {
 
@@ -141,6 +143,61 @@ Lemke::Result ConvexQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& Q, const 
   const Lemke::Result result = lemke_.solve(M, q, z_.head(n), w_.head(n), max_pivots, pivots);
   if (result == Lemke::kSolved) x = z_.head(p) - z_.segment(p, p);
   return result;
+}
+
+void LexicographicQp::reserve(int p, int k, int n) {
+  (void)n;
+  if (q_.rows() < p) {
+    q_.resize(p, p), v_.resize(p, p), z_.resize(p, p), q2_.resize(p, p);
+    c_.resize(p), w_.resize(p), c2_.resize(p);
+  }
+  if (rz_.rows() < k || rz_.cols() < q_.cols()) {
+    rz_.resize(k, q_.cols());
+    r2_.resize(k);
+  }
+  qp_.reserve(static_cast<int>(q_.cols()), static_cast<int>(rz_.rows()));
+}
+
+Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
+                                     const Eigen::Ref<const Eigen::VectorXd>& t,
+                                     const Eigen::Ref<const Eigen::MatrixXd>& P,
+                                     const Eigen::Ref<const Eigen::VectorXd>& pv,
+                                     const Eigen::Ref<const Eigen::MatrixXd>& R,
+                                     const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> x) {
+  const int p = static_cast<int>(C.cols()), k = static_cast<int>(r.size());
+  auto Q = q_.topLeftCorner(p, p);
+  Q.noalias() = C.transpose() * C;
+  auto c = c_.head(p);
+  c.noalias() = C.transpose() * t;
+  const int limit = 100 + 40 * (2 * p + k);
+  if (const Lemke::Result res = qp_.solve(Q, c, R, r, x, limit); res != Lemke::kSolved) return res;
+  // C's null space: the eigenvectors of C^T C at (relatively) zero eigenvalues.
+  auto V = v_.topLeftCorner(p, p);
+  jacobiEigen(Q, V);  // Q becomes diagonal
+  const double cut = 1e-12 * std::max(1e-300, Q.diagonal().cwiseAbs().maxCoeff());
+  int d = 0;
+  for (int j = 0; j < p; ++j)
+    if (Q(j, j) <= cut) z_.col(d++).head(p) = V.col(j);
+  if (d == 0) return Lemke::kSolved;
+  const auto Z = z_.topLeftCorner(p, d);
+  auto PZ = v_.topLeftCorner(p, d);  // V is no longer needed
+  PZ.noalias() = P * Z;
+  auto Q2 = q2_.topLeftCorner(d, d);
+  Q2.noalias() = Z.transpose() * PZ;
+  auto grad = w_.head(p);  // the second objective's gradient at x1
+  grad.noalias() = P * x;
+  grad += pv;
+  auto c2 = c2_.head(d);
+  c2.noalias() = Z.transpose() * grad;
+  auto RZ = rz_.topLeftCorner(k, d);
+  RZ.noalias() = R * Z;
+  auto r2 = r2_.head(k);
+  r2 = r;
+  r2.noalias() -= R * x;
+  auto w = w_.head(d);
+  if (qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved) return Lemke::kSolved;  // keep x1
+  x.noalias() += Z * w;
+  return Lemke::kSolved;
 }
 
 }  // namespace detail

@@ -236,6 +236,20 @@ void HdCore::factorizeCouplingGeneral() {
                                        options.damping);
 }
 
+int HdCore::nullMultipliers(Eigen::Ref<Eigen::MatrixXd> out) const {
+  if (!res.general || ws.use_cholesky || res.rank >= res.m ||
+      options.policy != SingularityPolicy::TruncatedPseudoInverse)
+    return -1;
+  const CouplingGeneral& g = ws.general;
+  int d = 0;
+  for (int j = 0; j < res.m; ++j) {
+    if (g.invg(j) != 0.0) continue;  // a kept eigenvalue
+    for (int s = 0; s < res.m; ++s) out(g.order(s), d) = g.vg(s, j);
+    ++d;
+  }
+  return d;
+}
+
 // Cholesky factor of K into cholg's diagonal blocks (their lower triangles; nothing reads the
 // rest) and the certificate that every eigenvalue is above the truncation threshold:
 // lambda_min(K) >= 1 / ||L^-1||_F^2 > rcond kappa (kappa >= lambda_max(K)). False if a block is

@@ -282,9 +282,12 @@ KDL::Chain planarArm() {
 TEST_CASE("a support under a direction the task also holds carries the load (least motor effort)") {
   // The arm stands still, its tool held in x, z and pitch (3 columns: no motion left). A support
   // at the elbow (the tip of l1, mu = 0.5) is redundant with the task: any valid support force
-  // leaves qdd = 0, and the solve takes the one of least ||tau_command||. Oracle: with qdd = 0,
-  // tau_command = tau_free - J_e^T f (tau_free: the command without the support), minimised over
-  // f_z >= 0, |f_x| <= mu f_z (the 4-facet polygon's edges in the arm's plane) by hand.
+  // leaves qdd = 0, and the solve takes the one of least ||tau_command||, then of least ||f||.
+  // Oracle: with qdd = 0, tau_command = tau_free - J_e^T f (tau_free: the command without the
+  // support). The elbow moves with joint 1 only, so the least command zeroes its first entry along
+  // the line b . (f_x, f_z) = tau_free(0) (b: the elbow's x and z rows of joint 1); the least force
+  // on that line inside f_z >= 0, |f_x| <= mu f_z (the 4-facet polygon's vertices in the arm's
+  // plane) is the line's point nearest the origin, or the nearer of its crossings with the edges.
   const Model model(planarArm());
   Data data(model);
   SolveInput in(model);
@@ -313,17 +316,17 @@ TEST_CASE("a support under a direction the task also holds carries the load (lea
   REQUIRE(frameJacobian(model, kin, FrameRef{0, KDL::Frame::Identity()}, J6));
   Eigen::MatrixXd B(3, 2);
   B << J6.row(0).transpose(), J6.row(2).transpose();  // columns: f_x, f_z
-  Eigen::Vector2d best(0.0, 0.0);
-  double best_cost = tau_free.squaredNorm();
-  const auto consider = [&](const Eigen::Vector2d& x) {
-    if (x(1) < 0.0 || std::abs(x(0)) > 0.5 * x(1) + 1e-12) return;
-    const double cost = (tau_free - B * x).squaredNorm();
-    if (cost < best_cost) best_cost = cost, best = x;
-  };
-  consider(B.colPivHouseholderQr().solve(tau_free));
-  for (const double side : {-1.0, 1.0}) {  // on an edge: f_x = side mu f_z
-    const Eigen::Vector3d b = B.col(0) * side * 0.5 + B.col(1);
-    consider(Eigen::Vector2d(side * 0.5, 1.0) * std::max(0.0, b.dot(tau_free) / b.squaredNorm()));
+  const Eigen::Vector2d b = B.row(0).transpose();
+  const double tau1 = tau_free(0);
+  REQUIRE(B.bottomRows(2).cwiseAbs().maxCoeff() == 0.0);  // joints 2 and 3 do not move the elbow
+  Eigen::Vector2d best = b * tau1 / b.squaredNorm();      // the nearest point of the line
+  if (std::abs(best(0)) > 0.5 * best(1)) {
+    double best_norm = std::numeric_limits<double>::infinity();
+    for (const double side : {-1.0, 1.0}) {  // crossing the edge f_x = side mu f_z
+      const Eigen::Vector2d edge(side * 0.5, 1.0);
+      const double s = tau1 / b.dot(edge);
+      if (s > 0.0 && (s * edge).norm() < best_norm) best = s * edge, best_norm = (s * edge).norm();
+    }
   }
   CHECK(f.z() > 1.0);
   CHECK(std::abs(f.x() - best(0)) <= 1e-9 * std::max(1.0, best.norm()));
