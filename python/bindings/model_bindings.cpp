@@ -21,8 +21,9 @@ py::array array(const std::vector<double>& v) {
   return py::array_t<double>(py::cast(v));
 }
 
-// _state: a model's StateRecords to its state, _records: back; _urdf_text: from_urdf's source.
-py::object layout(const char* function) {
+// A function of vereshchagin/_models.py: _state (a model's StateRecords to its state), _records
+// (back) or _urdf_text (from_urdf's source as a str).
+py::object pyModels(const char* function) {
   return py::module_::import("vereshchagin._models").attr(function);
 }
 
@@ -31,7 +32,7 @@ py::object layout(const char* function) {
 template <class M>
 M modelFromState(const py::tuple& state) {
   const std::string what = std::is_same_v<M, PyTree> ? "Tree state" : "Chain state";
-  const py::tuple records = layout("_records")(state, what);  // (StateRecords, inertia_check)
+  const py::tuple records = pyModels("_records")(state, what);  // (StateRecords, inertia_check)
   vereshchagin::StateRecords r;
   try {
     r = records[0].cast<vereshchagin::StateRecords>();
@@ -51,7 +52,7 @@ template <class M>
 M modelFromUrdf(O source, const std::string& root, const std::string& tip, const std::string& inertia_check) {
   M model;
   model.inertia_check = inertiaCheckArg(inertia_check, "");
-  const std::string text = layout("_urdf_text")(source).cast<std::string>();  // raises for another source
+  const std::string text = pyModels("_urdf_text")(source).cast<std::string>();  // raises for another source
   std::string message;
   if (!vereshchagin::loadUrdf(text, root, tip, {model.inertia_check}, model.robot, message)) raise(message);
   return model;
@@ -81,7 +82,7 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
   };
   const auto rotorInertia = [](const M& m) { return array(vereshchagin::rotorInertia(m.robot)); };
   const auto state = [](O self) {
-    return py::tuple(layout("_state")(self, vereshchagin::stateRecords(self.cast<const M&>().robot)));
+    return py::tuple(pyModels("_state")(self, vereshchagin::stateRecords(self.cast<const M&>().robot)));
   };
   const auto segmentIndex = [](const M& m, O which) { return m.resolveMoving(which.ptr(), "segment_index").segment; };
   const auto jointIndex = [](const M& m, O which) { return m.resolveJoint(which.ptr(), "joint_index"); };

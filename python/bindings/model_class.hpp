@@ -26,10 +26,10 @@ struct FrameTarget {
 };
 
 // What every Python call on a Chain or Tree shares: the one addressing rule of frames and joints
-// (names and int indices, negative from the end, looked up by robot_access.hpp,
-// messages starting with the caller's `label`), the inertia check the model was built with, and
-// the companions' (fk, jacobian, ...) Model, built at their first call and kept until the robot
-// changes (add_segment, rotor_inertia). Callers hold the GIL.
+// (names, looked up by robot_access.hpp, and int indices, negative from the end; messages start
+// with the caller's `label`), the inertia check the model was built with, and the companions'
+// (fk, jacobian, ...) Model with its workspace, built at their first call and kept until the
+// robot changes (add_segment, rotor_inertia). Callers hold the GIL.
 class CompanionModel {
  public:
   virtual ~CompanionModel() = default;
