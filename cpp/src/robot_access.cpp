@@ -94,18 +94,6 @@ Status findJoint(const RobotTree& robot, const std::string& name, int& index, st
   return findJointOrSay(robot, name, index, message);
 }
 
-int RobotRef::segmentCount() const {
-  return tree_ ? vereshchagin::segmentCount(*tree_) : vereshchagin::segmentCount(*chain_);
-}
-const std::vector<JointInfo>& RobotRef::joints() const {
-  return tree_ ? tree_->joints : chain_->joints;
-}
-Status RobotRef::findFrame(const std::string& name, FrameRef& out, std::string& message) const {
-  return tree_ ? findFrameOrSay(*tree_, name, out, message) : findFrameOrSay(*chain_, name, out, message);
-}
-Status RobotRef::findJoint(const std::string& name, int& index, std::string& message) const {
-  return tree_ ? findJointOrSay(*tree_, name, index, message) : findJointOrSay(*chain_, name, index, message);
-}
 Model RobotRef::model(const ModelOptions& options) const {
   return tree_ ? Model(*tree_, options) : Model(*chain_, options);
 }

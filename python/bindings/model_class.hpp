@@ -36,7 +36,7 @@ class CompanionModel {
   virtual vereshchagin::RobotRef names() const = 0;  // the robot, for lookups and the companions
 
   // Any frame: segment, merged link, base link (segment -1) or index.
-  FrameTarget resolveTarget(PyObject* which, const std::string& label) const {
+  [[gnu::noinline]] FrameTarget resolveTarget(PyObject* which, const std::string& label) const {
     if (!PyUnicode_Check(which)) return {indexInRange(which, names().segmentCount(), label, "segment")};
     vereshchagin::FrameRef ref;
     std::string message;

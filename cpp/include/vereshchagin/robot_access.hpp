@@ -130,12 +130,19 @@ class RobotRef {
  public:
   RobotRef(const RobotChain& chain) : chain_(&chain) {}  ///< a view of `chain` (implicit)
   RobotRef(const RobotTree& tree) : tree_(&tree) {}      ///< a view of `tree` (implicit)
-  int segmentCount() const;                              ///< the number of segments (the base excluded)
-  const std::vector<JointInfo>& joints() const;          ///< the moving joints, q order
+  /// The number of segments (the base excluded).
+  int segmentCount() const { return tree_ ? vereshchagin::segmentCount(*tree_) : vereshchagin::segmentCount(*chain_); }
+  const std::vector<JointInfo>& joints() const { return tree_ ? tree_->joints : chain_->joints; }  ///< q order
   /// findFrame on the robot, with its message.
-  Status findFrame(const std::string& name, FrameRef& out, std::string& message) const;
+  Status findFrame(const std::string& name, FrameRef& out, std::string& message) const {
+    return tree_ ? vereshchagin::findFrame(*tree_, name, out, message)
+                 : vereshchagin::findFrame(*chain_, name, out, message);
+  }
   /// findJoint on the robot, with its message (`index`: q order).
-  Status findJoint(const std::string& name, int& index, std::string& message) const;
+  Status findJoint(const std::string& name, int& index, std::string& message) const {
+    return tree_ ? vereshchagin::findJoint(*tree_, name, index, message)
+                 : vereshchagin::findJoint(*chain_, name, index, message);
+  }
   /// Model(robot, options): its segments in the robot's segment order (a tree's: robot_tree.hpp).
   Model model(const ModelOptions& options) const;
 
