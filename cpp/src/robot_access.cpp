@@ -94,6 +94,10 @@ Status findJoint(const RobotTree& robot, const std::string& name, int& index, st
   return findJointOrSay(robot, name, index, message);
 }
 
+Model RobotRef::model(const ModelOptions& options) const {
+  return tree_ ? Model(*tree_, options) : Model(*chain_, options);
+}
+
 int segmentCount(const RobotChain& robot) {
   return static_cast<int>(robot.chain.getNrOfSegments());
 }

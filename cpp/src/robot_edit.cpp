@@ -132,6 +132,17 @@ const char* jointTypeName(KDL::Joint::JointType type) {
   }
 }
 
+Status inertiaFromArray(const ArrayArg& a, const std::string& name, Eigen::Matrix3d& out, std::string& message) {
+  if (a.ndim != 2 || a.shape[0] != 3 || a.shape[1] != 3) {
+    message = name + " must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + a.shapeString();
+    return Status(Error::SizeMismatch, message.c_str());
+  }
+  if (message = nonfiniteMessage(a, name.c_str()); !message.empty())
+    return Status(Error::NonfiniteInput, message.c_str());
+  out = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.data);
+  return Status();
+}
+
 Status addSegment(RobotChain& robot, const SegmentSpec& spec, InertiaCheck check, std::string& message) {
   const std::string jname = spec.joint_name.empty() ? spec.name + "_joint" : spec.joint_name;
   message = segmentFault(robot, spec, jname, check);

@@ -224,4 +224,37 @@ Status robotFromRecord(const RobotRecord& record, RobotTree& out, std::string& m
   return Status();
 }
 
+namespace {
+
+template <class Robot>
+StateRecords stateOf(const Robot& robot) {
+  const RobotRecord r = robotRecord(robot);
+  RecordTuples t = recordTuples(r);
+  return {r.root_link, std::move(t.segments), std::move(t.joints), std::move(t.links), r.notes};
+}
+
+template <class Robot>
+Status fromState(const StateRecords& records, Robot& out, std::string& message) {
+  RobotRecord r;
+  r.root_link = std::get<0>(records);
+  r.notes = std::get<4>(records);
+  setRecordTuples({std::get<1>(records), std::get<2>(records), std::get<3>(records)}, r);
+  return robotFromRecord(r, out, message);
+}
+
+}  // namespace
+
+StateRecords stateRecords(const RobotChain& robot) {
+  return stateOf(robot);
+}
+StateRecords stateRecords(const RobotTree& robot) {
+  return stateOf(robot);
+}
+Status robotFromState(const StateRecords& records, RobotChain& out, std::string& message) {
+  return fromState(records, out, message);
+}
+Status robotFromState(const StateRecords& records, RobotTree& out, std::string& message) {
+  return fromState(records, out, message);
+}
+
 }  // namespace vereshchagin

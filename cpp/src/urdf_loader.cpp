@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <utility>
 
 #include <urdf_model/model.h>
 
@@ -209,6 +210,17 @@ UrdfResult chainFromUrdf(const std::string& source, const std::string& root, con
   UrdfResult r;
   r.message = "URDF source is neither XML text nor a readable file: '" + source + "'";
   return r;
+}
+
+Status loadUrdf(const std::string& source, const std::string& root, const std::string& tip, const UrdfOptions& options,
+                RobotChain& out, std::string& message) {
+  auto r = chainFromUrdf(source, root, tip, options);
+  if (!r.ok) {
+    message = std::move(r.message);
+    return Status(Error::InvalidModel, message.c_str());
+  }
+  out = std::move(r.robot);
+  return Status();
 }
 
 }  // namespace vereshchagin

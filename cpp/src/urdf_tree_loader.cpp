@@ -1,6 +1,7 @@
 // URDF -> RobotTree. See urdf_loader.hpp for the frame conventions and the segment order.
 #include <algorithm>
 #include <fstream>
+#include <utility>
 
 #include <urdf_model/model.h>
 
@@ -209,6 +210,17 @@ UrdfTreeResult treeFromUrdf(const std::string& source, const std::string& root, 
   UrdfTreeResult r;
   r.message = "URDF source is neither XML text nor a readable file: '" + source + "'";
   return r;
+}
+
+Status loadUrdf(const std::string& source, const std::string& root, const std::string& /*tip*/,
+                const UrdfOptions& options, RobotTree& out, std::string& message) {
+  auto r = treeFromUrdf(source, root, options);
+  if (!r.ok) {
+    message = std::move(r.message);
+    return Status(Error::InvalidModel, message.c_str());
+  }
+  out = std::move(r.robot);
+  return Status();
 }
 
 }  // namespace vereshchagin

@@ -123,3 +123,46 @@ TEST_CASE("pathChain is the chain loader's chain of the same path") {
   REQUIRE(!path.notes.empty());
   CHECK(path.notes.back() == "extracted from a tree: the 1 segments off the path to 'finger' are left out");
 }
+
+TEST_CASE("RobotRef reads a chain and a tree as the functions above do") {
+  const vereshchagin::RobotTree tree = robotfixture::tree();
+  const vereshchagin::RobotChain chain = robotfixture::chain();
+  const vereshchagin::RobotRef t(tree), c(chain);
+  CHECK(t.segmentCount() == 3);
+  CHECK(c.segmentCount() == 2);
+  CHECK(&t.joints() == &tree.joints);
+  CHECK(&c.joints() == &chain.joints);
+  CHECK(vereshchagin::linkNames(tree).size() == tree.links.size());
+  vereshchagin::FrameRef ref;
+  std::string message;
+  CHECK(t.findFrame("finger", ref, message));
+  CHECK(ref.segment == 1);
+  CHECK_FALSE(c.findFrame("nowhere", ref, message));
+  CHECK(message.find("no segment or link named 'nowhere'") == 0);
+  int index = -1;
+  CHECK(t.findJoint("j_slider", index, message));
+  CHECK(index == 2);
+  CHECK_FALSE(c.findJoint("j_slider", index, message));
+  CHECK(message.find("no joint named 'j_slider'") == 0);
+  // A tree's Model orders its segments as the RobotTree does (the Python Tree relies on it).
+  const vereshchagin::Model model = t.model(vereshchagin::ModelOptions{});
+  REQUIRE(model.status());
+  CHECK(model.segmentNames() == tree.segment_names);
+  CHECK(c.model(vereshchagin::ModelOptions{}).nrOfSegments() == 2);
+}
+
+TEST_CASE("rotor inertia from an array checks its shape first") {
+  vereshchagin::RobotChain chain = robotfixture::chain();
+  const double values[3] = {0.1, 0.2, 0.3};
+  vereshchagin::ArrayArg a;
+  a.data = values;
+  a.ndim = 1;
+  a.shape[0] = 3;
+  std::string message;
+  CHECK(vereshchagin::setRotorInertia(chain, a, message).code() == vereshchagin::Error::SizeMismatch);
+  CHECK(message == "rotor_inertia must have shape (2,), got (3,)");
+  CHECK(vereshchagin::rotorInertia(chain) == vereshchagin::rotorInertia(robotfixture::chain()));
+  a.shape[0] = 2;
+  REQUIRE(vereshchagin::setRotorInertia(chain, a, message));
+  CHECK(vereshchagin::rotorInertia(chain) == std::vector<double>{0.1, 0.2});
+}

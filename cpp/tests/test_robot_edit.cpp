@@ -2,6 +2,7 @@
 // unchanged on failure, and segmentSpec reading a segment back (inertia about the centre of mass
 // by the parallel-axis theorem, against the inertia given), plus the joint helpers and their
 // messages.
+#include <cmath>
 #include <string>
 
 #include <doctest/doctest.h>
@@ -139,4 +140,30 @@ TEST_CASE("joint names with messages and joints as Python expressions") {
   CHECK(vereshchagin::jointExpression(j) == "Joint.revolute(axis=[0, 0, 1], origin=[0.5, 0, 0])");
   REQUIRE(vereshchagin::axisJoint(KDL::Joint::TransAxis, {1, 0, 0}, {}, j));
   CHECK(vereshchagin::jointExpression(j) == "Joint.prismatic(axis=[1, 0, 0], origin=[0, 0, 0])");
+}
+
+TEST_CASE("inertiaFromArray reads a 3x3 row-major array, or names its shape or first non-finite value") {
+  const double values[9] = {0.05, 0.001, 0.002, 0.001, 0.04, 0.003, 0.002, 0.003, 0.03};
+  vereshchagin::ArrayArg a;
+  a.data = values;
+  a.ndim = 2;
+  a.shape[0] = a.shape[1] = 3;
+  Eigen::Matrix3d out = Eigen::Matrix3d::Zero();
+  std::string message;
+  REQUIRE(vereshchagin::inertiaFromArray(a, "inertia", out, message));
+  CHECK(out(0, 1) == 0.001);
+  CHECK(out(1, 2) == 0.003);
+  a.ndim = 1;
+  a.shape[0] = 9;
+  CHECK(vereshchagin::inertiaFromArray(a, "segment 'x': inertia", out, message).code() ==
+        vereshchagin::Error::SizeMismatch);
+  CHECK(message ==
+        "segment 'x': inertia must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape (9,)");
+  const double bad[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, std::nan("")};
+  a.data = bad;
+  a.ndim = 2;
+  a.shape[0] = 3;
+  CHECK(vereshchagin::inertiaFromArray(a, "inertia", out, message).code() == vereshchagin::Error::NonfiniteInput);
+  CHECK(message.find("inertia contains NaN or Inf") == 0);
+  CHECK(out(0, 1) == 0.001);  // unchanged
 }

@@ -121,3 +121,20 @@ TEST_CASE("a chain's segment tuples drop and regain the unused parent index") {
   CHECK(back[1].second == -1);
   CHECK(vereshchagin::withoutParents(back) == bare);
 }
+
+TEST_CASE("state records round-trip a chain and a tree, and are refused as records are") {
+  const vereshchagin::RobotTree tree = robotfixture::tree();
+  const vereshchagin::RobotChain chain = robotfixture::chain();
+  vereshchagin::RobotTree t;
+  vereshchagin::RobotChain c;
+  std::string message;
+  REQUIRE(vereshchagin::robotFromState(vereshchagin::stateRecords(tree), t, message));
+  REQUIRE(vereshchagin::robotFromState(vereshchagin::stateRecords(chain), c, message));
+  CHECK(sameRecords(vereshchagin::robotRecord(t), vereshchagin::robotRecord(tree)));
+  CHECK(sameRecords(vereshchagin::robotRecord(c), vereshchagin::robotRecord(chain)));
+  CHECK(std::get<0>(vereshchagin::stateRecords(tree)) == tree.root_link);
+  vereshchagin::StateRecords bad = vereshchagin::stateRecords(chain);
+  std::get<1>(bad).pop_back();  // one segment fewer than joint records
+  CHECK_FALSE(vereshchagin::robotFromState(bad, c, message));
+  CHECK(message.rfind("Chain state", 0) == 0);
+}

@@ -248,3 +248,17 @@ TEST_CASE("a heavy root link is noted: the fixed base leaves its mass out") {
 }
 
 }  // namespace
+
+TEST_CASE("loadUrdf loads a chain or a tree into place, or says why and leaves it") {
+  vereshchagin::RobotChain chain;
+  vereshchagin::RobotTree tree;
+  std::string message;
+  REQUIRE(vereshchagin::loadUrdf(kArm, "", "", {}, chain, message));
+  CHECK(chain.chain.getNrOfSegments() == vereshchagin::chainFromUrdf(kArm).robot.chain.getNrOfSegments());
+  REQUIRE(vereshchagin::loadUrdf(kArm, "", "ignored for a tree", {}, tree, message));
+  CHECK(tree.segment_names.size() == vereshchagin::treeFromUrdf(kArm).robot.segment_names.size());
+  const vereshchagin::Status s = vereshchagin::loadUrdf("/no/such/robot.urdf", "", "", {}, chain, message);
+  CHECK(s.code() == vereshchagin::Error::InvalidModel);
+  CHECK(message.find("neither XML text nor a readable file") != std::string::npos);
+  CHECK(chain.chain.getNrOfSegments() > 0);  // unchanged
+}

@@ -1,14 +1,15 @@
 // vereshchagin.Chain, vereshchagin.Tree and vereshchagin.Joint: what Chain and Tree share bound
 // once (bindModel), then the members only one of them has. Conversion and argument messages only:
-// the C++ library reads, checks and edits the robots (robot_access.hpp, robot_edit.hpp); pickle
-// states and from_urdf are model_state.cpp's.
+// the C++ library reads, checks, edits and records the robots (robot_access.hpp, robot_edit.hpp,
+// robot_state.hpp); vereshchagin/_models.py lays out the pickle states.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "model_class.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg, the F64View helpers
 #include "vereshchagin/robot_edit.hpp"
-#include "vereshchagin/robot_state.hpp"  // the joint records
+#include "vereshchagin/robot_state.hpp"
+#include "vereshchagin/urdf_loader.hpp"
 
 namespace vsbind {
 
@@ -16,31 +17,58 @@ namespace {
 
 using vereshchagin::JointSpec;
 
-py::array array(const double* p, std::size_t n) {
-  py::array a = newDoubles({static_cast<py::ssize_t>(n)});
-  std::copy(p, p + n, doubles(a));
-  return a;
-}
 py::array array(const std::vector<double>& v) {
-  return array(v.data(), v.size());
+  return py::array_t<double>(py::cast(v));
 }
 
-// Sizes, names, the base, notes, joint records, masses, rotor inertia, the indices, pickle and
-// copies (repr and the joint properties: vereshchagin/_models.py); the docstring of Chain.n_joints
-// is DOCS["Chain.n_joints"].
+// A function of vereshchagin/_models.py: _state (a model's StateRecords to its state), _records
+// (back) or _urdf_text (from_urdf's source as a str).
+py::object pyModels(const char* function) {
+  return py::module_::import("vereshchagin._models").attr(function);
+}
+
+// A pickle state (layouts: vereshchagin/_models.py) back to a model. _records raises "<what>:
+// unknown format", a malformed entry raises here, a bad record in the library ("Chain state: ...").
+template <class M>
+M modelFromState(const py::tuple& state) {
+  const std::string what = std::is_same_v<M, PyTree> ? "Tree state" : "Chain state";
+  const py::tuple records = pyModels("_records")(state, what);  // (StateRecords, inertia_check)
+  vereshchagin::StateRecords r;
+  try {
+    r = records[0].cast<vereshchagin::StateRecords>();
+  } catch (const py::cast_error&) {
+    raise(what + ": malformed records (segments, joints and links must be lists of tuples of the pickled layout)");
+  }
+  M model;
+  std::string message;
+  if (!vereshchagin::robotFromState(r, model.robot, message)) raise(message);
+  model.inertia_check = inertiaCheckArg(records[1].cast<std::string>(), what + ": ");
+  return model;
+}
+
+// Chain.from_urdf / Tree.from_urdf: `source` is URDF XML text (str holding '<') or a readable file
+// path (str or os.PathLike); `tip` is unused for a Tree. Raises SolverError otherwise.
+template <class M>
+M modelFromUrdf(O source, const std::string& root, const std::string& tip, const std::string& inertia_check) {
+  M model;
+  model.inertia_check = inertiaCheckArg(inertia_check, "");
+  const std::string text = pyModels("_urdf_text")(source).cast<std::string>();  // raises for another source
+  std::string message;
+  if (!vereshchagin::loadUrdf(text, root, tip, {model.inertia_check}, model.robot, message)) raise(message);
+  return model;
+}
+
+// Sizes, names, the base, notes, joint records, masses, rotor inertia, indices, pickle and copies
+// (repr, joint properties: vereshchagin/_models.py); Chain.n_joints's docstring: DOCS["Chain.n_joints"].
 template <class M>
 py::class_<M> bindModel(py::module_& mod, const char* name) {
   py::class_<M> cls(mod, name, doc(name));
   const auto docOf = [prefix = std::string(name) + "."](const char* member) { return doc(prefix + member); };
   const auto prop = [&](const char* member, auto get) { cls.def_property_readonly(member, get, docOf(member)); };
   prop("_joints", [](const M& m) { return vereshchagin::recordTuples(vereshchagin::robotRecord(m.robot)).joints; });
-  prop("link_names", [](const M& m) {
-    std::vector<std::string> names;
-    for (const vereshchagin::LinkPlacement& l : m.robot.links) names.push_back(l.link);
-    return names;
-  });
+  prop("link_names", [](const M& m) { return vereshchagin::linkNames(m.robot); });
   prop("n_joints", [](const M& m) { return vereshchagin::jointCount(m.robot); });
-  prop("n_segments", &M::segmentCount);
+  prop("n_segments", [](const M& m) { return vereshchagin::segmentCount(m.robot); });
   prop("segment_names", [](const M& m) { return vereshchagin::segmentNames(m.robot); });
   prop("root_link", [](const M& m) { return m.robot.root_link; });
   prop("notes", [](const M& m) { return m.robot.notes; });
@@ -48,22 +76,22 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
   prop("segment_masses", [](const M& m) { return array(vereshchagin::segmentMasses(m.robot)); });
   // rotor_inertia: one per joint in q order; the setter (shape (n_joints,), >= 0) rebuilds the robot.
   const auto setRotorInertia = [](M& m, O values) {
-    const F64View v = vectorView(values.ptr(), "rotor_inertia", static_cast<py::ssize_t>(m.robot.joints.size()));
     std::string message;
-    if (!vereshchagin::setRotorInertia(m.robot, std::vector<double>(v.data, v.data + v.size()), message))
-      raise(message);
+    if (!vereshchagin::setRotorInertia(m.robot, asF64(values.ptr(), "rotor_inertia"), message)) raise(message);
     m.invalidateCompanions();
   };
   const auto rotorInertia = [](const M& m) { return array(vereshchagin::rotorInertia(m.robot)); };
+  const auto state = [](O self) {
+    return py::tuple(pyModels("_state")(self, vereshchagin::stateRecords(self.cast<const M&>().robot)));
+  };
+  const auto segmentIndex = [](const M& m, O which) { return m.resolveMoving(which.ptr(), "segment_index").segment; };
+  const auto jointIndex = [](const M& m, O which) { return m.resolveJoint(which.ptr(), "joint_index"); };
+  const auto copy = [](const M& m) { return m; };
   cls.def_property("rotor_inertia", rotorInertia, setRotorInertia, docOf("rotor_inertia"))
-      .def(
-          "segment_index", [](const M& m, O which) { return m.resolveMoving(which.ptr(), "segment_index").segment; },
-          py::arg("name"), docOf("segment_index"))
-      .def(
-          "joint_index", [](const M& m, O which) { return m.resolveJoint(which.ptr(), "joint_index"); },
-          py::arg("name"), docOf("joint_index"))
-      .def(py::pickle(&modelState<M>, &modelFromState<M>))
-      .def("__copy__", [](const M& m) { return m; })
+      .def("segment_index", segmentIndex, py::arg("name"), docOf("segment_index"))
+      .def("joint_index", jointIndex, py::arg("name"), docOf("joint_index"))
+      .def(py::pickle(state, &modelFromState<M>))
+      .def("__copy__", copy)
       .def(
           "__deepcopy__", [](const M& m, const py::dict&) { return m; }, py::arg("memo"));
   return cls;
@@ -86,15 +114,6 @@ JointSpec jointArg(O joint) {
   return j;
 }
 
-Eigen::Matrix3d inertiaArg(O inertia, const std::string& name) {
-  if (inertia.is_none()) return Eigen::Matrix3d::Zero();
-  const F64View v = asF64(inertia.ptr(), name.c_str());
-  if (v.ndim != 2 || v.shape[0] != 3 || v.shape[1] != 3)
-    raise(name + " must be a 3x3 matrix (about the centre of mass, tip-frame axes), got shape " + v.shapeString());
-  requireFiniteView(v, name.c_str());
-  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(v.data);
-}
-
 void addSegment(PyChain& c, const std::string& name, O joint, O tip, O mass, O com, O inertia, O rotor,
                 const std::string& joint_name, const std::string& inertia_check) {
   const std::string where = "segment '" + name + "': ";  // every message names segment and argument
@@ -107,8 +126,10 @@ void addSegment(PyChain& c, const std::string& name, O joint, O tip, O mass, O c
   spec.joint = jointArg(joint);
   if (!tip.is_none()) spec.tip = frameFrom4x4(tip, (where + "tip").c_str());
   if (!com.is_none()) spec.com = vec3(com, (where + "com").c_str());
-  spec.inertia = inertiaArg(inertia, where + "inertia");
   std::string message;
+  if (!inertia.is_none() && !vereshchagin::inertiaFromArray(asF64(inertia.ptr(), (where + "inertia").c_str()),
+                                                            where + "inertia", spec.inertia, message))
+    raise(message);
   if (!vereshchagin::addSegment(c.robot, spec, check, message)) raise(message);
   c.invalidateCompanions();
   if (check == vereshchagin::InertiaCheck::JointSpace) c.inertia_check = check;
@@ -117,15 +138,15 @@ void addSegment(PyChain& c, const std::string& name, O joint, O tip, O mass, O c
 py::dict segmentSpec(const PyChain& c, O which) {
   const int segment = c.resolveMoving(which.ptr(), "segment").segment;
   const vereshchagin::SegmentSpec s = vereshchagin::segmentSpec(vereshchagin::segmentAt(c.robot, segment));
+  const auto vec = [](const KDL::Vector& v) { return array({v.x(), v.y(), v.z()}); };
   py::array tip = newDoubles({4, 4});
   for (int k = 0; k < 16; ++k) doubles(tip)[k] = s.tip(k / 4, k % 4);
-  return py::dict(
-      py::arg("name") = s.name, py::arg("joint_type") = vereshchagin::jointTypeName(s.joint.type),
-      py::arg("axis") = s.joint.type == KDL::Joint::Fixed ? py::object(py::none()) : array(s.joint.axis.data, 3),
-      py::arg("origin") = array(s.joint.origin.data, 3), py::arg("joint_name") = s.joint_name, py::arg("tip") = tip,
-      py::arg("mass") = s.mass, py::arg("com") = array(s.com.data, 3),
-      py::arg("inertia") = py::cast(Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(s.inertia)),
-      py::arg("rotor_inertia") = s.rotor_inertia);
+  return py::dict(py::arg("name") = s.name, py::arg("joint_type") = vereshchagin::jointTypeName(s.joint.type),
+                  py::arg("axis") = s.joint.type == KDL::Joint::Fixed ? py::object(py::none()) : vec(s.joint.axis),
+                  py::arg("origin") = vec(s.joint.origin), py::arg("joint_name") = s.joint_name, py::arg("tip") = tip,
+                  py::arg("mass") = s.mass, py::arg("com") = vec(s.com),
+                  py::arg("inertia") = py::cast(Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(s.inertia)),
+                  py::arg("rotor_inertia") = s.rotor_inertia);
 }
 
 }  // namespace
@@ -136,10 +157,8 @@ void bindChain(py::module_& mod) {
     joint.def_static(
         name, [type = type](O axis, O origin) { return axisJointArg(type, axis, origin); }, py::arg("axis"),
         py::arg("origin") = py::none(), doc(std::string("Joint.") + name));
-  joint
-      .def_static(
-          "fixed", [] { return JointSpec(); }, doc("Joint.fixed"))
-      .def("__repr__", &vereshchagin::jointExpression);
+  const auto fixed = [] { return JointSpec(); };
+  joint.def_static("fixed", fixed, doc("Joint.fixed")).def("__repr__", &vereshchagin::jointExpression);
   bindModel<PyChain>(mod, "Chain")
       .def(py::init<>())
       .def("add_segment", &addSegment, doc("Chain.add_segment"), py::arg("name"), py::arg("joint"),

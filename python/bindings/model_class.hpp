@@ -1,68 +1,102 @@
-// The Python Chain and Tree as one template over the C++ robot (RobotChain / RobotTree) and the
-// inertia check it was built with. Names and frames are resolved by addressing.hpp, the
-// companions' C++ model is built on demand (companions.hpp); the domain logic is the C++
-// library's (robot_access.hpp, robot_edit.hpp, robot_state.hpp).
+// The Python Chain and Tree: one template over the C++ robot (RobotChain / RobotTree) on what every
+// Python call on a model shares (CompanionModel). The domain logic is the C++ library's
+// (robot_access.hpp, robot_edit.hpp, robot_state.hpp).
 #pragma once
 
+#include <memory>
+#include <optional>
 #include <string>
-#include <type_traits>
 #include <vector>
 
+#include "vereshchagin/dynamics.hpp"
 #include "vereshchagin/inertia_check.hpp"
-#include "vereshchagin/model.hpp"
 #include "vereshchagin/robot_access.hpp"
 
-#include "addressing.hpp"
 #include "common.hpp"
-#include "companions.hpp"
 
 namespace vsbind {
 
 using O = const py::object&;  // a Python argument
 
-template <class Robot>
-struct PyModel : CompanionModel {
-  Robot robot;
+// A frame resolved to a segment (-1: the base) and the frame's pose in that segment's tip frame.
+struct FrameTarget {
+  int segment = -1;
+  KDL::Frame link_in_tip = KDL::Frame::Identity();
+  bool merged = false;  // a merged link away from the tip: moments must be moved
+};
+
+// What every Python call on a Chain or Tree shares: the one addressing rule of frames and joints
+// (names, looked up by robot_access.hpp, and int indices, negative from the end; messages start
+// with the caller's `label`), the inertia check the model was built with, and the companions'
+// (fk, jacobian, ...) Model with its workspace, built at their first call and kept until the
+// robot changes (add_segment, rotor_inertia). Callers hold the GIL.
+class CompanionModel {
+ public:
+  virtual ~CompanionModel() = default;
+  virtual vereshchagin::RobotRef names() const = 0;  // the robot, for lookups and the companions
+
+  // Any frame: segment, merged link, base link (segment -1) or index.
+  [[gnu::noinline]] FrameTarget resolveTarget(PyObject* which, const std::string& label) const {
+    if (!PyUnicode_Check(which)) return {indexInRange(which, names().segmentCount(), label, "segment")};
+    vereshchagin::FrameRef ref;
+    std::string message;
+    if (!names().findFrame(py::handle(which).cast<std::string>(), ref, message)) raise(label + ": " + message);
+    return {ref.segment, ref.in_tip, ref.segment >= 0 && ref.in_tip.p.Norm() != 0.0};  // -1: the base or on it
+  }
+  // The same for calls that need a moving segment: the base raises.
+  FrameTarget resolveMoving(PyObject* which, const std::string& label) const {
+    const FrameTarget t = resolveTarget(which, label);
+    if (t.segment < 0)
+      raise(label + ": '" + py::str(which).cast<std::string>() + "' is (part of) the fixed base, not a moving segment");
+    return t;
+  }
+  // resolveTarget, with None meaning the last segment (the default of Chain.fk, jacobian, ...).
+  FrameTarget resolveOptional(const py::object& which, const std::string& label) const {
+    return which.is_none() ? FrameTarget{names().segmentCount() - 1} : resolveTarget(which.ptr(), label);
+  }
+  // Joint index from a joint name or an int index (negative from the end).
+  int resolveJoint(PyObject* which, const std::string& label) const {
+    if (!PyUnicode_Check(which)) return indexInRange(which, static_cast<int>(jointInfos().size()), label, "joint");
+    int index = -1;
+    std::string message;
+    if (!names().findJoint(py::handle(which).cast<std::string>(), index, message)) raise(label + ": " + message);
+    return index;
+  }
+  const std::vector<vereshchagin::JointInfo>& jointInfos() const { return names().joints(); }
+
+  vereshchagin::DynamicsData& companions() const {  // built at first use
+    if (!cache_) cache_ = std::make_shared<vereshchagin::DynamicsData>(names().model({inertia_check}));
+    return *cache_;
+  }
+  void invalidateCompanions() { cache_.reset(); }  // the robot changed
+
   // The inertia check the model was built with: JointSpace once any part of it was accepted only
   // by that check (from_urdf or add_segment with inertia_check='joint_space'). A Solver uses it
   // unless told otherwise.
   vereshchagin::InertiaCheck inertia_check = vereshchagin::InertiaCheck::Physical;
 
-  int segmentCount() const override { return vereshchagin::segmentCount(robot); }
-  const std::string& segmentName(int index) const override { return vereshchagin::segmentName(robot, index); }
-  const std::vector<vereshchagin::JointInfo>& jointInfos() const override { return robot.joints; }
+ private:
+  // The int value of an index argument, or raises with robot_access.hpp's messages: the valid range
+  // (an int beyond the C range is out of range like any other) or, for a non-int, what names a `what`.
+  static int indexInRange(PyObject* which, int n, const std::string& label, const std::string& what) {
+    if (PyBool_Check(which) || !PyIndex_Check(which))
+      raise(label + ": " +
+            vereshchagin::indexTypeMessage(what, py::str(py::type::of(py::handle(which)).attr("__name__"))));
+    const std::optional<long long> v = intWithin(which, -n, n - 1);
+    if (!v) raise(label + ": " + vereshchagin::indexRangeMessage(what, py::str(which), n));
+    return static_cast<int>(*v < 0 ? *v + n : *v);
+  }
+  mutable std::shared_ptr<vereshchagin::DynamicsData> cache_;  // its model(): the one built
+};
+using Addressable = CompanionModel;  // what the solver's argument parser reads of a model
 
- protected:
-  Status frameByName(const std::string& name, vereshchagin::FrameRef& out, std::string& message) const override {
-    return vereshchagin::findFrame(robot, name, out, message);
-  }
-  Status jointByName(const std::string& name, int& index, std::string& message) const override {
-    return vereshchagin::findJoint(robot, name, index, message);
-  }
-  // A tree's Model must order its segments as the PyTree does (the preorder of the KDL::Tree).
-  vereshchagin::Model buildModel() const override {
-    vereshchagin::Model model(robot, vereshchagin::ModelOptions{inertia_check});
-    if constexpr (std::is_same_v<Robot, vereshchagin::RobotTree>)
-      if (model.segmentNames() != robot.segment_names)
-        raise("internal error: the tree's C++ model orders its segments differently");
-    return model;
-  }
+template <class Robot>
+struct PyModel : CompanionModel {
+  Robot robot;
+  vereshchagin::RobotRef names() const override { return robot; }
 };
 
 using PyChain = PyModel<vereshchagin::RobotChain>;
 using PyTree = PyModel<vereshchagin::RobotTree>;
-
-// Pickle states (model_state.cpp; their layout: vereshchagin/_models.py's module docstring).
-// Crafted states raise SolverError naming the record ("Chain state: ...", "Tree state: ...").
-template <class Model>
-py::tuple modelState(const Model& model);
-template <class Model>
-Model modelFromState(const py::tuple& state);
-
-// Chain.from_urdf / Tree.from_urdf: `source` is URDF XML text (str holding '<') or a readable file
-// path (str or os.PathLike); `tip` is unused for a Tree. Raises SolverError otherwise.
-template <class Model>
-Model modelFromUrdf(const py::object& source, const std::string& root, const std::string& tip,
-                    const std::string& inertia_check);
 
 }  // namespace vsbind

@@ -5,7 +5,8 @@ Their repr, and the joint properties (``joint_names``, ``joint_types``, ``lower`
 ``_joints`` records: one (name, type, lower, upper, velocity_limit, effort_limit, friction,
 damping, segment) tuple per moving joint, in q order.
 
-Their pickle states (``__getstate__``, ``__setstate__``: ``python/bindings/model_state.cpp``) are
+Their pickle states (``__getstate__``, ``__setstate__``: ``python/bindings/model_state.cpp``, which
+calls ``_state`` and ``_records`` below for the layout; the C++ library checks the records) are
 Chain: ``(1, segments, joints, links, root_link, notes, inertia_check)``; Tree: ``(1, root_link,
 [(segment, parent)], joints, links, notes, inertia_check)``. A segment: ``(name, joint name, joint
 type, origin, axis, rotor inertia, damping, stiffness, tip frame (12), the 13 stored inertia
@@ -17,9 +18,12 @@ entries (no inertia_check) load as 'physical'.
 
 from __future__ import annotations
 
+import os
+from collections.abc import Sequence
+
 import numpy as np
 
-from ._core import Chain, Tree
+from ._core import Chain, SolverError, Tree
 from ._docstrings import DOCS
 
 # The joint properties in the order of the fields of a ``_joints`` record; the first two are lists
@@ -34,6 +38,64 @@ _JOINT_FIELDS = (
     "friction",
     "damping",
 )
+
+
+def _state(model: Chain | Tree, records: tuple) -> tuple:
+    """The pickle state of ``model`` from the C++ library's records of it.
+
+    Parameters
+    ----------
+    model : Chain or Tree
+        The model (its type picks the layout; its ``inertia_check`` ends the state).
+    records : tuple
+        ``(root_link, [(segment, parent)], joints, links, notes)`` (``robot_state.hpp``'s
+        ``StateRecords``; a chain's parent indices are dropped).
+    """
+    root, segments, joints, links, notes = records
+    if isinstance(model, Tree):
+        return (1, root, segments, joints, links, notes, model.inertia_check)
+    return (1, [segment for segment, _ in segments], joints, links, root, notes, model.inertia_check)
+
+
+def _records(state: tuple, what: str) -> tuple:
+    """The inverse of ``_state``: ``(records, inertia_check)`` of a Chain or Tree state.
+
+    Parameters
+    ----------
+    state : tuple
+        A state of either layout (``what`` says which), of six entries (no inertia_check: loads
+        as 'physical') or seven.
+    what : str
+        "Chain state" or "Tree state": the start of every message.
+
+    Raises
+    ------
+    SolverError
+        "<what>: unknown format" for another length or version; the entries themselves are
+        checked by the caller (``model_state.cpp``) and the C++ library.
+    """
+    if len(state) not in (6, 7) or not isinstance(state[0], int) or state[0] != 1:
+        raise SolverError(f"{what}: unknown format")
+    check = state[6] if len(state) == 7 else "physical"
+    if what == "Tree state":
+        return (state[1], state[2], state[3], state[4], state[5]), check
+    segments = state[1]
+    if isinstance(segments, Sequence) and not isinstance(segments, (str, bytes)):
+        segments = [(segment, -1) for segment in segments]  # a chain's parent index is unused
+    return (state[4], segments, state[2], state[3], state[5]), check
+
+
+def _urdf_text(source) -> str:
+    """``from_urdf``'s ``source`` (URDF XML text or a file path: str or os.PathLike) as a str.
+
+    Raises
+    ------
+    SolverError
+        For any other type.
+    """
+    if not isinstance(source, str) and not hasattr(source, "__fspath__"):
+        raise SolverError("source must be URDF XML text or a file path")
+    return str(os.fspath(source))
 
 
 def _chain_repr(self: Chain) -> str:

@@ -10,6 +10,7 @@
 
 #include <kdl/segment.hpp>
 
+#include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/model.hpp"  // FrameRef
 #include "vereshchagin/robot_chain.hpp"
 #include "vereshchagin/robot_tree.hpp"
@@ -54,6 +55,16 @@ std::vector<double> rotorInertia(const Robot& robot) {
 Status setRotorInertia(RobotChain& robot, const std::vector<double>& values, std::string& message);
 /// The same for a tree: rebuilds its KDL::Tree in segment order (joint numbering unchanged).
 Status setRotorInertia(RobotTree& robot, const std::vector<double>& values, std::string& message);
+
+/// setRotorInertia from an array as a caller hands it over (array_arg.hpp). Checks its shape
+/// first: Error::SizeMismatch with vectorMessage's "rotor_inertia must have shape (7,), got (6,)"
+/// (or its non-finite message) in `message`, `robot` unchanged.
+template <class Robot>
+Status setRotorInertia(Robot& robot, const ArrayArg& values, std::string& message) {
+  message = vectorMessage(values, "rotor_inertia", static_cast<long>(robot.joints.size()));
+  if (!message.empty()) return Status(Error::SizeMismatch, message.c_str());
+  return setRotorInertia(robot, std::vector<double>(values.data, values.data + values.size()), message);
+}
 
 /// A frame by name: a segment (its tip frame), a link merged into a segment (its pose in that
 /// segment's tip frame) or the base (root_link, segment -1); segments first, then links, then the
@@ -103,6 +114,42 @@ std::string indexRangeMessage(const std::string& what, const std::string& value,
 /// name): "a segment is named by a str (segment or link name) or an int index, got float", or for
 /// joints "a joint is named by a str or an int index, got float".
 std::string indexTypeMessage(const std::string& what, const std::string& type_name);
+
+/// The names of every link of the description, in RobotChain::links / RobotTree::links order.
+template <class Robot>
+std::vector<std::string> linkNames(const Robot& robot) {
+  std::vector<std::string> out;
+  for (const LinkPlacement& l : robot.links) out.push_back(l.link);
+  return out;
+}
+
+/// A chain or a tree, for code that reads either without knowing which (the Python Chain and
+/// Tree's name lookups): each member calls the function of the same name above on the robot it
+/// views. It holds a pointer: use it only while that robot lives (it is built per call, cheaply).
+class RobotRef {
+ public:
+  RobotRef(const RobotChain& chain) : chain_(&chain) {}  ///< a view of `chain` (implicit)
+  RobotRef(const RobotTree& tree) : tree_(&tree) {}      ///< a view of `tree` (implicit)
+  /// The number of segments (the base excluded).
+  int segmentCount() const { return tree_ ? vereshchagin::segmentCount(*tree_) : vereshchagin::segmentCount(*chain_); }
+  const std::vector<JointInfo>& joints() const { return tree_ ? tree_->joints : chain_->joints; }  ///< q order
+  /// findFrame on the robot, with its message.
+  Status findFrame(const std::string& name, FrameRef& out, std::string& message) const {
+    return tree_ ? vereshchagin::findFrame(*tree_, name, out, message)
+                 : vereshchagin::findFrame(*chain_, name, out, message);
+  }
+  /// findJoint on the robot, with its message (`index`: q order).
+  Status findJoint(const std::string& name, int& index, std::string& message) const {
+    return tree_ ? vereshchagin::findJoint(*tree_, name, index, message)
+                 : vereshchagin::findJoint(*chain_, name, index, message);
+  }
+  /// Model(robot, options): its segments in the robot's segment order (a tree's: robot_tree.hpp).
+  Model model(const ModelOptions& options) const;
+
+ private:
+  const RobotChain* chain_ = nullptr;
+  const RobotTree* tree_ = nullptr;
+};
 
 /// The serial chain from the tree's base to segment `tip` (0 <= tip < segmentCount): that path's
 /// segments, their joints and the links placed on them or on the base, the base's root_link, the

@@ -15,6 +15,7 @@
 #include <kdl/joint.hpp>
 #include <kdl/segment.hpp>
 
+#include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/robot_chain.hpp"
 #include "vereshchagin/status.hpp"
@@ -64,6 +65,12 @@ struct SegmentSpec {
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  ///< about the centre of mass, tip-frame axes, kg m^2
   double rotor_inertia = 0.0;                         ///< reflected to the joint, >= 0; 0 for a fixed joint
 };
+
+/// SegmentSpec::inertia from an array as a caller hands it over: 3x3, row-major, finite values.
+/// On failure `out` is unchanged and `message` holds "<name> must be a 3x3 matrix (about the centre
+/// of mass, tip-frame axes), got shape (3,)" (Error::SizeMismatch) or nonfiniteMessage's
+/// (Error::NonfiniteInput).
+Status inertiaFromArray(const ArrayArg& a, const std::string& name, Eigen::Matrix3d& out, std::string& message);
 
 /// Appends `spec` to the end of `robot` (its chain, one link placement, and a JointInfo of type
 /// "continuous" or "prismatic" for a moving joint). Checks first, and leaves `robot` unchanged on

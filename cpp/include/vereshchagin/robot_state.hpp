@@ -87,6 +87,20 @@ std::vector<SegmentTuple> withoutParents(const std::vector<std::pair<SegmentTupl
 /// is unused; robotFromRecord ignores it for a chain).
 std::vector<std::pair<SegmentTuple, long long>> withUnusedParents(const std::vector<SegmentTuple>& segments);
 
+/// A whole robot as the Python pickle states hold it, whichever the robot: root_link, each
+/// segment with its parent index (a chain's: unused), the joints (q order), the links and the
+/// notes (vereshchagin/_models.py lays them out as a Chain's or a Tree's state).
+using StateRecords = std::tuple<std::string, std::vector<std::pair<SegmentTuple, long long>>, std::vector<JointTuple>,
+                                std::vector<LinkTuple>, std::vector<std::string>>;
+
+/// The StateRecords of `robot`, bit for bit (robotRecord, then recordTuples).
+StateRecords stateRecords(const RobotChain& robot);
+StateRecords stateRecords(const RobotTree& robot);  ///< see stateRecords(const RobotChain&)
+/// robotFromRecord of `records` (setRecordTuples, then every check and message of robotFromRecord).
+Status robotFromState(const StateRecords& records, RobotChain& out, std::string& message);
+/// The same for a tree (robotFromRecord's tree checks and "Tree state: " messages).
+Status robotFromState(const StateRecords& records, RobotTree& out, std::string& message);
+
 /// The records of a chain (SegmentRecord::parent = i - 1) and of a tree.
 RobotRecord robotRecord(const RobotChain& robot);
 RobotRecord robotRecord(const RobotTree& robot);  ///< see robotRecord(const RobotChain&)

@@ -48,6 +48,7 @@
 #include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/robot_chain.hpp"
 #include "vereshchagin/robot_tree.hpp"
+#include "vereshchagin/status.hpp"
 
 namespace vereshchagin {
 
@@ -98,5 +99,13 @@ UrdfTreeResult treeFromUrdfFile(const std::string& path, const std::string& root
 /// The same from URDF XML text or a file path, told apart as chainFromUrdf does.
 UrdfTreeResult treeFromUrdf(const std::string& source, const std::string& root = "",
                             const UrdfOptions& options = UrdfOptions());
+
+/// chainFromUrdf(source, root, tip, options) into `out`, moved. On failure Error::InvalidModel
+/// with the result's message in `message`, and `out` unchanged.
+Status loadUrdf(const std::string& source, const std::string& root, const std::string& tip, const UrdfOptions& options,
+                RobotChain& out, std::string& message);
+/// treeFromUrdf(source, root, options) into `out` (`tip` is unused), as the chain's.
+Status loadUrdf(const std::string& source, const std::string& root, const std::string& tip, const UrdfOptions& options,
+                RobotTree& out, std::string& message);
 
 }  // namespace vereshchagin
