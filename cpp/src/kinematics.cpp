@@ -2,7 +2,6 @@
 // in the base frame (kinematics_impl.hpp).
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "kdl_convert.hpp"
 #include "kinematics_impl.hpp"
@@ -40,12 +39,21 @@ KinSegment makeSegment(const KDL::Segment& s, int joint, int parent) {
   k.k = w / k.w_norm;
   k.kxv = k.k.cross(v) / k.w_norm;
   k.kv = k.k.dot(v);
+  const Matrix3 K = skew(k.k);
+  const Vector3 d = k.X0.p - k.kxv;
+  k.KR = K * k.X0.R;
+  k.KKR = K * k.KR;
+  k.Kd = K * d;
+  k.KKd = K * k.Kd;
   return k;
 }
 
 // The screw motion E = exp(q [S_r]) of a joint, applied to X0: for a revolute joint E.R is the
-// rotation by theta = |w_r| q about k (Rodrigues) and E.p = (I - E.R) (k x v_r) / |w_r| + k (k . v_r) q;
-// for a prismatic one E = (I, v_r q).
+// rotation by theta = |w_r| q about k, E = I + sin(theta) K + (1 - cos(theta)) K K with K = [k]x
+// (Rodrigues), and E.p = (I - E.R) (k x v_r) / |w_r| + k (k . v_r) q; so tip(q) = E X0 has
+// R = X0.R + sin K X0.R + (1 - cos) K K X0.R and p = X0.p + sin K d + (1 - cos) K K d + k (k . v_r) q
+// with d = X0.p - k x v_r / |w_r|, K X0.R, K K X0.R, K d, K K d constants of the segment. For a
+// prismatic joint E = (I, v_r q).
 void jointPose(const KinSegment& s, double q, Matrix3& R, Vector3& p) {
   if (s.kind == JointKind::Prismatic) {
     R = s.X0.R;
@@ -54,14 +62,8 @@ void jointPose(const KinSegment& s, double q, Matrix3& R, Vector3& p) {
   }
   const double theta = s.w_norm * q;
   const double sn = std::sin(theta), c1 = 1.0 - std::cos(theta);
-  const Vector3& k = s.k;
-  Matrix3 E;  // I + sin K + (1 - cos) K K, K = [k]x, K K = k k^T - I
-  E << 1.0 - c1 * (k.y() * k.y() + k.z() * k.z()), c1 * k.x() * k.y() - sn * k.z(), c1 * k.x() * k.z() + sn * k.y(),
-      c1 * k.x() * k.y() + sn * k.z(), 1.0 - c1 * (k.x() * k.x() + k.z() * k.z()), c1 * k.y() * k.z() - sn * k.x(),
-      c1 * k.x() * k.z() - sn * k.y(), c1 * k.y() * k.z() + sn * k.x(), 1.0 - c1 * (k.x() * k.x() + k.y() * k.y());
-  R.noalias() = E * s.X0.R;
-  p.noalias() = E * (s.X0.p - s.kxv);
-  p += s.kxv + k * (s.kv * q);
+  R = s.X0.R + sn * s.KR + c1 * s.KKR;
+  p = s.X0.p + sn * s.Kd + c1 * s.KKd + s.k * (s.kv * q);
 }
 
 }  // namespace
@@ -91,14 +93,21 @@ Status KinematicsImpl::checkModel(const Model& m) {
 }
 
 Status KinematicsImpl::checkResult(const Eigen::Ref<const Eigen::MatrixXd>& out) {
-  // |x| <= DBL_MAX is false for Inf and NaN; no early exit, so that the loop vectorizes (Eigen's
-  // allFinite on a strided Ref costs several times more, on every companion call).
-  bool finite = true;
-  for (Eigen::Index c = 0; c < out.cols(); ++c) {
-    const double* x = out.col(c).data();
-    for (Eigen::Index r = 0; r < out.rows(); ++r) finite &= std::abs(x[r]) <= std::numeric_limits<double>::max();
+  // x - x is 0 for a finite x and NaN for Inf and NaN, and NaN stays in a sum: four independent
+  // sums without early exit, which the compiler vectorizes (Eigen's allFinite on a strided Ref
+  // costs several times more, on every companion call). A contiguous result is one column.
+  double sums[4] = {0.0, 0.0, 0.0, 0.0};
+  const bool contiguous = out.outerStride() == out.rows();
+  for (Eigen::Index c = 0; c < (contiguous ? 1 : out.cols()); ++c) {
+    const double* x = out.data() + c * out.outerStride();
+    const Eigen::Index n = contiguous ? out.size() : out.rows();
+    Eigen::Index r = 0;
+    for (; r + 4 <= n; r += 4)
+      for (int l = 0; l < 4; ++l) sums[l] += x[r + l] - x[r + l];
+    for (; r < n; ++r) sums[0] += x[r] - x[r];
   }
-  if (!finite) return fail(Error::NonfiniteResult, "the result overflows the double range");
+  if (std::isnan(sums[0] + sums[1] + sums[2] + sums[3]))
+    return fail(Error::NonfiniteResult, "the result overflows the double range");
   return Status();
 }
 

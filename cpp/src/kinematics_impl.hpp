@@ -25,6 +25,9 @@ struct KinSegment {
   Vector3 kxv = Vector3::Zero();  // k x v_r / |w_r| (revolute)
   double w_norm = 0.0;            // |w_r|
   double kv = 0.0;                // k . v_r (revolute: the screw's pitch term, zero for KDL joints)
+  // Revolute: K = [k]x applied once and twice to X0.R and to d = X0.p - kxv (kinematics.cpp's jointPose).
+  Matrix3 KR = Matrix3::Zero(), KKR = Matrix3::Zero();
+  Vector3 Kd = Vector3::Zero(), KKd = Vector3::Zero();
   JointKind kind = JointKind::Fixed;
   int joint = -1, parent = -1;
   double rotor = 0.0;  // KDL::Joint::getInertia()

@@ -67,6 +67,17 @@ TEST_CASE("array arguments print their shapes and name what is wrong with them")
   CHECK(vs::vectorMessage(array(v, {1}), "x", 1).empty());
 }
 
+TEST_CASE("arguments that are no real array are named with why") {
+  CHECK(vs::notArrayMessage("q", true) == "q must be a real array, got None");
+  CHECK(vs::notArrayMessage("q", false) == "q must be a real number or array, got bool");
+  CHECK(vs::unconvertedMessage("q", "list", "") == "q must be a real array (numbers of equal-length rows), got list");
+  CHECK(vs::unconvertedMessage("q", "list", "ValueError: ragged") ==
+        "q must be a real array (numbers of equal-length rows), got list (its conversion raised ValueError: ragged)");
+  CHECK(vs::dtypeMessage("q", 'c', "complex128", 1) == "q must hold real numbers (int or float), got dtype complex128");
+  CHECK(vs::dtypeMessage("q", 'f', "float32", 4) == "q has 4 dimensions; at most 3 are meaningful");
+  CHECK(vs::dtypeMessage("q", 'u', "uint8", 3).empty());
+}
+
 TEST_CASE("companion arguments are checked in order with the Python messages") {
   Arm arm;
   const std::vector<double> short_q(static_cast<std::size_t>(arm.n - 1), 0.0), rows(2 * arm.n, 0.0);

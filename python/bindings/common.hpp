@@ -1,7 +1,7 @@
 // The conversion vocabulary of the bindings: the exception type, the docstrings, and checked numpy
-// conversions whose messages name the offending argument. Float64 C-contiguous inputs are viewed
-// in place (one type check and a few field reads through numpy's C API table that pybind11 already
-// loads), anything else is converted once with a dtype check; outputs come from PyArray_NewFromDescr.
+// conversions whose messages (array_arg.hpp's) name the offending argument. Float64 C-contiguous
+// inputs are viewed in place (a type check and a few field reads through numpy's C API table that
+// pybind11 already loads), anything else is converted once; outputs come from PyArray_NewFromDescr.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -50,6 +50,10 @@ inline std::optional<long long> intWithin(PyObject* obj, long long lo, long long
   return v;
 }
 
+inline std::string typeName(PyObject* obj) {
+  return py::str(py::type::of(py::handle(obj)).attr("__name__"));
+}
+
 // A real scalar (Python int or float, numpy scalar, 0-d array); bool, str, bytes, None and
 // anything without __float__ raise.
 inline double scalarArg(const py::handle& obj, const char* name) {
@@ -58,18 +62,9 @@ inline double scalarArg(const py::handle& obj, const char* name) {
   const py::object f = py::reinterpret_steal<py::object>(refused ? nullptr : PyNumber_Float(o));
   if (!f) {
     PyErr_Clear();
-    raise(std::string(name) + " must be a real number, got " +
-          std::string(py::str(py::type::of(obj).attr("__name__"))));
+    raise(std::string(name) + " must be a real number, got " + typeName(o));
   }
   return PyFloat_AsDouble(f.ptr());
-}
-
-// " (its conversion raised Type: message)" for the pending Python error, cleared (or "" if none).
-inline std::string pendingErrorNote() {
-  if (!PyErr_Occurred()) return "";
-  py::error_already_set e;  // fetches and clears it
-  const std::string type = py::str(e.type().attr("__name__"));
-  return " (its conversion raised " + type + ": " + std::string(py::str(e.value())) + ")";
 }
 
 // A read-only view of a real array argument (data, ndim, shape, size(), shapeString()). `data`
@@ -78,41 +73,29 @@ struct F64View : vereshchagin::ArrayArg {
   py::object keep;
 };
 
-// `obj` as a numpy array of native float64, C-contiguous and aligned, with at most 3 dimensions
-// (viewed in place without conversion), or nullptr.
-inline const py::detail::PyArray_Proxy* nativeF64(PyObject* obj) {
-  namespace d = py::detail;
-  constexpr int need = d::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | d::npy_api::NPY_ARRAY_ALIGNED_;
-  if (!d::npy_api::get().PyArray_Check_(obj)) return nullptr;
-  const auto* arr = d::array_proxy(obj);
-  const auto* descr = d::array_descriptor_proxy(arr->descr);
-  const bool native = arr->nd <= 3 && (arr->flags & need) == need && descr->type_num == d::npy_api::NPY_DOUBLE_ &&
-                      descr->byteorder != '>';
-  return native ? arr : nullptr;
-}
-
-// Views `obj` as float64. Integer and floating arrays (and nested sequences of numbers) are
-// accepted; bool, complex, string, object and other dtypes raise naming `name`. Values are not
-// checked here (see requireFiniteView).
+// `obj` as numpy float64 with at most 3 dimensions. Native C-contiguous aligned float64 arrays are
+// viewed in place; integer and floating arrays (and nested sequences of numbers) are converted;
+// None, bool, complex, string, object and other dtypes raise naming `name` (a failed conversion
+// with its Python error). Values are not checked here (see requireFiniteView).
 inline F64View asF64(PyObject* obj, const char* name) {
   namespace d = py::detail;
   const auto& api = d::npy_api::get();
-  const auto* arr = nativeF64(obj);
+  constexpr int need = d::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | d::npy_api::NPY_ARRAY_ALIGNED_;
   F64View v;
-  if (!arr) {
-    if (obj == Py_None) raise(std::string(name) + " must be a real array, got None");
-    if (PyBool_Check(obj)) raise(std::string(name) + " must be a real number or array, got bool");
+  const auto* arr = api.PyArray_Check_(obj) ? d::array_proxy(obj) : nullptr;
+  const auto* descr = arr ? d::array_descriptor_proxy(arr->descr) : nullptr;
+  if (!arr || arr->nd > 3 || (arr->flags & need) != need || descr->type_num != d::npy_api::NPY_DOUBLE_ ||
+      descr->byteorder == '>') {
+    if (obj == Py_None || PyBool_Check(obj)) raise(vereshchagin::notArrayMessage(name, obj == Py_None));
     // PyArray_FromAny keeps the error of a failed conversion (py::array::ensure clears it).
     const py::array any = py::reinterpret_steal<py::array>(api.PyArray_FromAny_(obj, nullptr, 0, 0, 0, nullptr));
-    if (!any)
-      raise(std::string(name) + " must be a real array (numbers of equal-length rows), got " +
-            std::string(py::str(py::type::of(py::handle(obj)).attr("__name__"))) + pendingErrorNote());
-    const char kind = any.dtype().kind();
-    if (kind != 'f' && kind != 'i' && kind != 'u')
-      raise(std::string(name) + " must hold real numbers (int or float), got dtype " +
-            std::string(py::str(any.dtype())));
-    if (any.ndim() > 3)
-      raise(std::string(name) + " has " + std::to_string(any.ndim()) + " dimensions; at most 3 are meaningful");
+    if (!any) {
+      const py::error_already_set e;  // the conversion's own error (a NULL return sets one), cleared
+      raise(vereshchagin::unconvertedMessage(name, typeName(obj),
+                                             typeName(e.value().ptr()) + ": " + std::string(py::str(e.value()))));
+    }
+    const std::string why = vereshchagin::dtypeMessage(name, any.dtype().kind(), py::str(any.dtype()), any.ndim());
+    if (!why.empty()) raise(why);
     v.keep = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(any);  // a float64 copy
     if (!v.keep) {
       PyErr_Clear();

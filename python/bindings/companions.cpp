@@ -17,44 +17,20 @@ void check(const vs::Status& s) {
   if (!s) raise(s.message());
 }
 
-// gravity as a list or tuple of three Python floats, read into g without numpy (false: anything
-// else, converted by asF64). Its values are checked with the other arguments'.
-bool floatTriple(PyObject* obj, double g[3]) {
+// gravity as a list or tuple of three Python floats, read into g (storage) and viewed by `arg`
+// without numpy (false: anything else, converted by asF64). Values are checked with the others'.
+bool floatTriple(PyObject* obj, double g[3], vs::ArrayArg& arg) {
   if ((!PyList_CheckExact(obj) && !PyTuple_CheckExact(obj)) || PySequence_Fast_GET_SIZE(obj) != 3) return false;
   PyObject** x = PySequence_Fast_ITEMS(obj);
   for (int k = 0; k < 3; ++k) {
     if (!PyFloat_CheckExact(x[k])) return false;
     g[k] = PyFloat_AS_DOUBLE(x[k]);
   }
+  arg = vs::ArrayArg{g, 1, {3, 0, 0}};
   return true;
 }
 
-// q as a native float64 vector of n finite values, viewed in place (the common call), or nullptr:
-// the generic path then converts and checks it with its messages.
-const double* plainJoints(PyObject* obj, py::ssize_t n) {
-  const auto* arr = nativeF64(obj);
-  if (arr == nullptr || arr->nd != 1 || arr->dimensions[0] != n) return nullptr;
-  const double* p = reinterpret_cast<const double*>(arr->data);
-  for (py::ssize_t k = 0; k < n; ++k)
-    if (!std::isfinite(p[k])) return nullptr;
-  return p;
-}
-
-// mass_matrix and gravity_torques on a plain q straight into the library (no argument table);
-// anything else, or a failure (its message), through run().
-template <typename Call>
-py::object direct(const CompanionModel& m, PyObject* q_obj, std::initializer_list<py::ssize_t> shape, Call call) {
-  vs::DynamicsData& d = m.companions();
-  const py::ssize_t n = static_cast<py::ssize_t>(d.model().nrOfJoints());
-  const double* q = plainJoints(q_obj, n);
-  if (q == nullptr) return py::object();  // null: the generic path
-  py::array out = newDoubles(shape);
-  if (!call(d, vs::JointPositions(Eigen::Map<const Eigen::VectorXd>(q, n)), doubles(out), n)) return py::object();
-  return std::move(out);
-}
-
-// An f_ext dict {segment or link: wrench (6,), moment about that frame's origin}: the call's frame
-// wrenches.
+// An f_ext dict {segment or link: wrench (6,), moment about that frame's origin}: frame wrenches.
 void frameWrenches(const CompanionModel& m, vs::CompanionCall& call, const py::handle& f_ext) {
   call.frame_wrenches_given = true;
   for (const auto& item : f_ext.cast<py::dict>()) {
@@ -69,8 +45,7 @@ void frameWrenches(const CompanionModel& m, vs::CompanionCall& call, const py::h
 // f_ext; an empty handle where it takes none, f_ext None for no wrenches), each converted and
 // checked in turn; float64 arrays are viewed in place, converted copies live in `keep`.
 py::array run(const CompanionModel& m, K kind, std::array<py::handle, 5> args, const FrameTarget& frame = {}) {
-  vs::DynamicsData& d = m.companions();  // kd: its kinematics, where every message lives
-  vs::KinematicsData& kd = d.kinematics();
+  vs::DynamicsData& d = m.companions();  // d.kinematics() holds every message
   vs::CompanionCall call{kind, {}, {frame.segment, frame.link_in_tip}};
   py::object keep[5];
   double g[3];
@@ -78,21 +53,17 @@ py::array run(const CompanionModel& m, K kind, std::array<py::handle, 5> args, c
     PyObject* obj = args[k].ptr();
     if (obj == nullptr || (k == 4 && obj == Py_None)) continue;
     if (k == 4 && PyDict_Check(obj)) {
-      frameWrenches(m, call, args[k]);
-      continue;
-    }
-    if (k == 3 && floatTriple(obj, g)) {
-      call.args[3] = vs::ArrayArg{g, 1, {3, 0, 0}};
-    } else {
+      frameWrenches(m, call, args[k]);  // checked there; the f_ext rows stay none
+    } else if (k != 3 || !floatTriple(obj, g, call.args[3])) {
       F64View v = asF64(obj, vs::companionArgName(static_cast<vs::CompanionArg>(k)));
       call.args[k] = v;
       keep[k] = std::move(v.keep);
     }
-    check(vs::checkCompanionArg(kd, call, static_cast<vs::CompanionArg>(k)));
+    check(vs::checkCompanionArg(d.kinematics(), call, static_cast<vs::CompanionArg>(k)));
   }
   int ndim = 0;
   py::ssize_t shape[3];
-  check(vs::companionShape(kd, call, ndim, shape));
+  check(vs::companionShape(d.kinematics(), call, ndim, shape));
   py::array out = newArray(py::detail::npy_api::NPY_DOUBLE_, ndim, shape, /*fortran=*/kind == K::Jacobian);
   check(vs::callCompanion(d.model(), d, call, doubles(out)));
   return out;
@@ -130,28 +101,8 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
   const auto twist = [frame](const M& m, O q, O qd, O s) { return run(m, K::Twist, {q, qd}, frame(m, s)); };
   const auto jdot = [frame](const M& m, O q, O qd, O s) { return run(m, K::JacobianDotTimesQd, {q, qd}, frame(m, s)); };
   const auto id = [](const M& m, O q, O qd, O qdd, O f, O g) { return run(m, K::InverseDynamics, {q, qd, qdd, g, f}); };
-  const auto mass = [](const M& m, O q) {
-    const auto h = [](vs::DynamicsData& d, const vs::JointPositions& jq, double* out, py::ssize_t n) {
-      return vs::massMatrix(d.model(), d, jq, Eigen::Map<Eigen::MatrixXd>(out, n, n)).ok();
-    };
-    const py::ssize_t n = static_cast<py::ssize_t>(m.companions().model().nrOfJoints());
-    py::object out = direct(m, q.ptr(), {n, n}, h);
-    return out ? out : py::object(run(m, K::MassMatrix, {q}));
-  };
-  const auto grav = [](const M& m, O q, O g) {
-    double gv[3];
-    const double* gp = plainJoints(g.ptr(), 3);
-    const bool plain_g = floatTriple(g.ptr(), gv) ? std::isfinite(gv[0] + gv[1] + gv[2])
-                         : gp != nullptr          ? (std::copy_n(gp, 3, gv), true)
-                                                  : false;
-    const auto tau = [&gv](vs::DynamicsData& d, const vs::JointPositions& jq, double* out, py::ssize_t n) {
-      const KDL::Vector gravity(gv[0], gv[1], gv[2]);
-      return vs::gravityTorques(d.model(), d, jq, gravity, Eigen::Map<Eigen::VectorXd>(out, n)).ok();
-    };
-    const py::ssize_t n = static_cast<py::ssize_t>(m.companions().model().nrOfJoints());
-    py::object out = plain_g ? direct(m, q.ptr(), {n}, tau) : py::object();
-    return out ? out : py::object(run(m, K::GravityTorques, {q, {}, {}, g}));
-  };
+  const auto mass = [](const M& m, O q) { return run(m, K::MassMatrix, {q}); };
+  const auto grav = [](const M& m, O q, O g) { return run(m, K::GravityTorques, {q, {}, {}, g}); };
   const auto coriolis = [](const M& m, O q, O qd) { return run(m, K::CoriolisTorques, {q, qd}); };
   const auto fk_all = [](const M& m, O q) { return run(m, K::FkAll, {q}); };
   cls.def("fk", fk, py::arg("q"), segment, key("fk"))

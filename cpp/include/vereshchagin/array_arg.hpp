@@ -32,6 +32,20 @@ struct ArrayArg {
 /// first that is not (k counts in row-major order).
 std::string nonfiniteMessage(const ArrayArg& a, const char* name);
 
+/// Why a Python argument `name` that is None (none = true) or a bool cannot be an array:
+/// "<name> must be a real array, got None", "<name> must be a real number or array, got bool".
+std::string notArrayMessage(const char* name, bool none);
+
+/// Why `name` of Python type `type` could not be read as an array: "<name> must be a real array
+/// (numbers of equal-length rows), got <type>", then " (its conversion raised <note>)" unless
+/// `note` (the conversion's error, "Type: message") is empty.
+std::string unconvertedMessage(const char* name, const std::string& type, const std::string& note);
+
+/// "" for an array of numpy dtype kind 'f', 'i' or 'u' (`dtype`: its name) with at most 3
+/// dimensions, else why not: "<name> must hold real numbers (int or float), got dtype <dtype>",
+/// "<name> has <ndim> dimensions; at most 3 are meaningful".
+std::string dtypeMessage(const char* name, char kind, const std::string& dtype, int ndim);
+
 /// "" if `a` is a finite vector of shape (n,), else "<name> must have shape (n,), got <shape>" or
 /// nonfiniteMessage's.
 std::string vectorMessage(const ArrayArg& a, const char* name, long n);
