@@ -1,4 +1,4 @@
-// The companions of Chain and Tree (companions.hpp), bound on both by one template, and task.py's
+// The companions of Chain and Tree (model_class.hpp: CompanionModel), bound on both by one template, and task.py's
 // fast path _core._beta_for (task.hpp's betaShape, betaFromArrays). Each Python argument becomes an
 // array that the C++ library checks (companion_call.hpp) and computes on, into a numpy array of the
 // shape it reports. Conventions (the solver's): physical gravity, base axes; f_ext ON each segment.
