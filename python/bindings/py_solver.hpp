@@ -7,11 +7,9 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
-#include <string>
 #include <thread>
-#include <vector>
 
-#include "vereshchagin/batch_args.hpp"
+#include "vereshchagin/batch_args.hpp"  // also <string>, <vector>
 
 #include "common.hpp"
 #include "model_class.hpp"
@@ -21,12 +19,11 @@ namespace vsbind {
 // Positions in the argument array of SolveArgs::parse (solve()'s parameter order).
 inline constexpr int kOutArg = 10, kADesiredArg = 11, kNumSolveArgs = 12;
 
-// The arguments of one solve (1 row, no batch axis accepted) or of a batch (B rows, each argument
-// shared or with a leading batch axis) as a BatchInput, shapes checked by BatchArgs with messages
-// naming the argument (values: by vereshchagin::solve, for each row). friction=: None/False, True
-// (the model's values), a vereshchagin.Friction or any object with its attributes, read as the tuple
-// of vereshchagin/friction.py's _fields_of. A Friction caches it until an attribute is replaced and
-// its arrays cannot be written: while the tuple is the same, solve()'s SolveArgs reuses its parse.
+// The arguments of one solve (1 row, no batch axis) or of a batch (B rows, each argument shared or with a leading
+// batch axis) as a BatchInput, shapes checked by BatchArgs with messages naming the argument (values: by solve(), per
+// row). friction=: None/False, True (the model's values), a vereshchagin.Friction or any object with its attributes,
+// read as the tuple of vereshchagin/friction.py's _fields_of; a Friction caches it until an attribute is replaced and
+// its arrays cannot be written, so solve()'s SolveArgs reuses its parse while the tuple is the same.
 class SolveArgs : public vereshchagin::BatchArgs {
  public:
   // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,

@@ -1,8 +1,7 @@
-// The one parser of Solver.solve's and Solver.solve_batch's arguments (SolveArgs, py_solver.hpp):
-// Python objects are viewed as float64 arrays and handed to vereshchagin::BatchArgs, which checks
-// their shapes into rows with a stride of a BatchInput (0: shared by every row; solve() is the
-// one-row case that accepts no batch axis); keys are resolved here. friction=: the arrays of its
-// _fields tuple checked by vereshchagin::frictionFromArrays, values by vereshchagin::solve.
+// The one parser of Solver.solve's and solve_batch's arguments (SolveArgs, py_solver.hpp): Python objects viewed as
+// float64 arrays are handed to vereshchagin::BatchArgs, which checks their shapes into rows with a stride of a
+// BatchInput (0: shared by every row; solve() is the one-row case without a batch axis); keys are resolved here.
+// friction=: its _fields tuple's arrays checked by vereshchagin::frictionFromArrays, values by vereshchagin::solve.
 #include "py_solver.hpp"
 
 namespace vsbind {
