@@ -64,6 +64,28 @@ std::string frictionFromArrays(FrictionModel& out, long n, const ArrayArg& stati
   return {};
 }
 
+std::string endBlockArgs(bool alpha, bool beta, bool a_desired, bool tree) {
+  if (alpha && tree)
+    return "alpha and beta constrain a chain's last segment; a Tree has no last segment: pass constraints={segment or "
+           "link name: (alpha, beta)}";
+  if (alpha && beta && a_desired)
+    return "beta and a_desired given: a_desired (the tip's classical acceleration) replaces beta";
+  if (!alpha && (beta || a_desired)) return std::string(a_desired ? "a_desired" : "beta") + " given without alpha";
+  return {};
+}
+
+FrictionModel frictionOfJoints(const std::vector<JointInfo>& joints) {
+  const auto n = static_cast<Eigen::Index>(joints.size());
+  FrictionModel out;
+  out.static_friction = out.lower = out.upper = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    out.static_friction(k) = joints[k].friction;
+    out.lower(k) = joints[k].lower;
+    out.upper(k) = joints[k].upper;
+  }
+  return out;
+}
+
 void BatchArgs::start(bool batch, const Model& model) {
   batch_ = batch;
   model_ = &model;

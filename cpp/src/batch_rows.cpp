@@ -1,7 +1,9 @@
-// BatchInput and BatchOutput (batch.hpp): a row of strided inputs written into a SolveInput, and
-// a Data's results copied out as a row of row-major arrays.
+// BatchInput, BatchOutput and PackedRow (batch.hpp): a row of strided inputs written into a
+// SolveInput, a Data's results copied out as a row of row-major arrays, and one row's outputs
+// packed in one buffer.
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "vereshchagin/batch.hpp"
 
@@ -87,6 +89,16 @@ bool BatchOutput::write(std::ptrdiff_t b, const Data& d, int columns, bool with_
   gauss_value[b] = d.gaussValue();
   iterations[b] = d.iterations();
   return std::isfinite(gauss_value[b]);
+}
+
+std::string PackedRow::describe() const {
+  return "n_joints = " + std::to_string(n_joints) + ", n_segments = " + std::to_string(n_segments) +
+         ", m = " + std::to_string(m) + (friction ? " with" : " without") + " friction";
+}
+
+bool PackedRow::plausible() const {
+  constexpr long kMax = 1L << 24;
+  return n_joints >= 0 && n_segments >= 0 && m >= 0 && n_joints <= kMax && n_segments <= kMax && m <= 6 * n_segments;
 }
 
 BatchWorkspace::BatchWorkspace(const Model& model, const SolverOptions& options, const KDL::Vector& gravity)

@@ -180,3 +180,28 @@ TEST_CASE("secondsPerSolve times row 0 and leaves its state, NaN when it fails")
   rows.q[1] = std::nan("");
   CHECK(std::isnan(secondsPerSolve(model, rows.input, w, 2)));
 }
+
+TEST_CASE("PackedRow: offsets, length, description and the output it writes") {
+  const PackedRow plain{3, 2, 1, false}, fr{3, 2, 1, true};
+  CHECK(plain.offset(PackedRow::Nu) == 6);
+  CHECK(plain.offset(PackedRow::LinkAcc) == 7);
+  CHECK(plain.offset(PackedRow::End) == 7 + 18);
+  CHECK(fr.offset(PackedRow::Status) == 25 + 6);
+  CHECK(fr.offset(PackedRow::End) == 25 + 6 + 2);  // 3 int32 in 2 doubles
+  CHECK(fr.describe() == "n_joints = 3, n_segments = 2, m = 1 with friction");
+  CHECK(!(plain == fr));
+  CHECK(plain == PackedRow{3, 2, 1, false});
+  CHECK(fr.plausible());
+  CHECK(!PackedRow{3, 2, 13, false}.plausible());  // more than 6 columns per segment
+  CHECK(!PackedRow{-1, 2, 1, false}.plausible());
+  CHECK(!PackedRow{3, 1L << 25, 1, false}.plausible());
+  std::vector<double> buffer(static_cast<std::size_t>(fr.offset(PackedRow::End)));
+  double smin = 0.0, gauss = 0.0;
+  int rank = 0, iterations = 0;
+  const BatchOutput o = fr.output(buffer.data(), &smin, &rank, &gauss, &iterations);
+  CHECK(o.nu == buffer.data() + 6);
+  CHECK(reinterpret_cast<double*>(o.status) == buffer.data() + 31);
+  CHECK(o.gauss_value == &gauss);
+  CHECK(plain.output(buffer.data(), &smin, &rank, &gauss, &iterations).friction_torque == nullptr);
+  CHECK(plain.output(buffer.data(), &smin, &rank, &gauss, &iterations).limit_torque == nullptr);
+}

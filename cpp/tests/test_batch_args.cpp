@@ -119,3 +119,29 @@ TEST_CASE("friction arrays: shapes, NaN in limits, one-sided limits") {
   CHECK(frictionFromArrays(fm, 3, array(f, {3}), nullptr, 1e-6, nullptr, nullptr, 0.0) == "");
   CHECK(fm.lower.size() == 0);
 }
+
+TEST_CASE("friction of the joints: their static friction and limits") {
+  std::vector<JointInfo> joints(2);
+  joints[0].friction = 0.5;
+  joints[0].lower = -1.0;
+  joints[1].upper = 2.0;
+  const FrictionModel fm = frictionOfJoints(joints);
+  CHECK(fm.static_friction(0) == 0.5);
+  CHECK(fm.static_friction(1) == 0.0);
+  CHECK(fm.kinetic_friction.size() == 0);
+  CHECK(fm.lower(0) == -1.0);
+  CHECK(fm.lower(1) == -std::numeric_limits<double>::infinity());
+  CHECK(fm.upper(1) == 2.0);
+  CHECK(fm.velocity_tolerance == FrictionModel().velocity_tolerance);
+  CHECK(frictionOfJoints({}).static_friction.size() == 0);
+}
+
+TEST_CASE("end-segment arguments: alpha on a tree, beta with a_desired, a set-point without alpha") {
+  CHECK(endBlockArgs(false, false, false, true) == "");
+  CHECK(endBlockArgs(true, true, false, false) == "");
+  CHECK(endBlockArgs(true, false, true, false) == "");
+  CHECK(contains(endBlockArgs(true, true, false, true), "a Tree has no last segment"));
+  CHECK(contains(endBlockArgs(true, true, true, false), "beta and a_desired given"));
+  CHECK(endBlockArgs(false, true, false, false) == "beta given without alpha");
+  CHECK(endBlockArgs(false, true, true, false) == "a_desired given without alpha");
+}

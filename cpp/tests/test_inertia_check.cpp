@@ -7,7 +7,8 @@
 //    complementarity with KDL forward dynamics reproducing qdd;
 //  * a model whose joint-space inertia is positive definite at some configurations only: solves
 //    there (against KDL's H) and fails elsewhere with E_DEGENERATE_INERTIA naming the joint;
-//  * setOptions() switching the check rebuilds the model; the URDF loader's option likewise.
+//  * setOptions() switching the check rebuilds the model; the URDF loader's option likewise;
+//  * parseInertiaCheck: the Python spelling of the option, anything else refused with a message.
 #include <string>
 
 #include <doctest/doctest.h>
@@ -202,3 +203,15 @@ TEST_CASE("URDF loader option: physical and joint-space checks") {
 }
 
 }  // namespace
+
+TEST_CASE("parseInertiaCheck: the two spellings, anything else refused") {
+  vereshchagin::InertiaCheck c = vereshchagin::InertiaCheck::Physical;
+  CHECK(vereshchagin::parseInertiaCheck("joint_space", c).ok());
+  CHECK(c == vereshchagin::InertiaCheck::JointSpace);
+  CHECK(vereshchagin::parseInertiaCheck("physical", c).ok());
+  CHECK(c == vereshchagin::InertiaCheck::Physical);
+  const vereshchagin::Status s = vereshchagin::parseInertiaCheck("Physical", c);
+  CHECK(s.code() == vereshchagin::Error::InvalidOptions);
+  CHECK(std::string(s.message()).find("inertia_check must be 'physical'") == 0);
+  CHECK(c == vereshchagin::InertiaCheck::Physical);
+}

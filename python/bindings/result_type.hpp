@@ -5,31 +5,22 @@
 
 #include <pybind11/pybind11.h>
 
+#include "vereshchagin/batch.hpp"
+
 namespace vsbind {
 
 namespace py = pybind11;
 
-struct ResultLayout {
-  int nj = 0, ns = 0, m = 0;
-  bool friction = false;
-};
-
-// Where each output lives in the buffer (offsets in doubles).
-struct ResultPointers {
-  double *qdd, *tau_command, *nu, *link_acc, *friction_torque, *limit_torque;
-  int* status;
-};
-
-// Registers the type on `mod` (as SolveResult) and _result_state / _result_from_parts, the
-// storage side of pickling (vereshchagin/_results.py).
+// Registers the type on `mod` (as SolveResult) and _result_from_parts, the storage side of
+// pickling (vereshchagin/_results.py).
 void bindResultType(py::module_& mod);
 
 // A new result for `layout` (data uninitialised), or `out` after checking that it is a
 // SolveResult of the same layout (raises SolverError otherwise). Returns a new reference.
-py::object newResult(const ResultLayout& layout, PyObject* out);
-ResultPointers resultPointers(PyObject* result);
-// Scalars and the segment_nu layout: keys[k] owns nu[start_k:start_k + count_k].
-void setResultScalars(PyObject* result, int rank, double smin, double gauss, int iterations);
-void setSegmentLayout(PyObject* result, py::tuple keys, py::tuple starts, py::tuple counts);
+py::object newResult(const vereshchagin::PackedRow& layout, PyObject* out);
+// Where solve() writes its outputs into `result` (row 0; the friction ones nullptr without friction).
+vereshchagin::BatchOutput resultOutput(PyObject* result);
+// Sets segment_nu's layout, a (key, start, count) tuple per key (keys[k] owns nu[start:start + count]).
+void setSegmentLayout(PyObject* result, py::tuple layout);
 
 }  // namespace vsbind

@@ -1,20 +1,12 @@
-// The one parser of Solver.solve's and Solver.solve_batch's arguments (SolveArgs, py_solver.hpp):
-// Python objects are viewed as float64 arrays and handed to vereshchagin::BatchArgs, which checks
-// their shapes into rows with a stride of a BatchInput (0: shared by every row; solve() is the
-// one-row case that accepts no batch axis); keys are resolved here. friction= (FrictionArg): the
-// attributes viewed as arrays, checked by vereshchagin::frictionFromArrays with the Python names
-// (friction.static, ...), values by vereshchagin::solve; a vereshchagin.Friction is parsed once
-// and reused while its attributes are the same objects.
+// The one parser of Solver.solve's and solve_batch's arguments (SolveArgs, py_solver.hpp): Python objects viewed as
+// float64 arrays are handed to vereshchagin::BatchArgs, which checks their shapes into rows with a stride of a
+// BatchInput (0: shared by every row; solve() is the one-row case without a batch axis); keys are resolved here.
+// friction=: its _fields tuple's arrays checked by vereshchagin::frictionFromArrays, values by vereshchagin::solve.
 #include "py_solver.hpp"
 
 namespace vsbind {
 
 namespace {
-
-// Raised for alpha/beta (the end segment's constraint) on a tree solver.
-constexpr const char* kTreeAlpha =
-    "alpha and beta constrain a chain's last segment; a Tree has no last segment: pass constraints={segment or "
-    "link name: (alpha, beta)}";
 
 bool given(PyObject* obj) {
   return obj != nullptr && obj != Py_None;
@@ -24,45 +16,17 @@ void check(const std::string& why) {
   if (!why.empty()) raise(why);
 }
 
-std::string keyLabel(const char* what, PyObject* key) {
-  return std::string(what) + "[" + py::repr(key).cast<std::string>() + "]";
-}
-
-vereshchagin::Vector3 point(const KDL::Vector& p) {
-  return vereshchagin::Vector3(p.x(), p.y(), p.z());
-}
-
-// The attributes of a vereshchagin.Friction, in the order of FrictionArg::cache_attrs_ (interned).
-PyObject* attrName(int k) {
-  static const char* const text[6] = {"static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance"};
-  static PyObject* names[6] = {};
-  if (names[k] == nullptr) names[k] = PyUnicode_InternFromString(text[k]);
-  return names[k];
-}
-
-// The instance dict of a vereshchagin.Friction (a dataclass: its fields live there).
-PyObject* instanceDict(PyObject* obj) {
-  PyObject** dict = _PyObject_GetDictPtr(obj);
-  return dict == nullptr ? nullptr : *dict;
-}
-
-double scalarAttr(PyObject* fr, const char* attr, const char* name, double fallback) {
-  const py::object obj = py::getattr(fr, attr, py::none());
-  return obj.is_none() ? fallback : scalarArg(obj, name);
-}
-
 }  // namespace
 
-const double* SolveArgs::keep(F64View& v) {
-  if (v.keep) keep_.push_back(std::move(v.keep));
-  return v.data;
+F64View SolveArgs::view(PyObject* obj, const char* name) {
+  F64View v = asF64(obj, name);
+  if (v.keep) keep_.push_back(std::move(v.keep));  // v.data stays valid: keep_ holds the copy
+  return v;
 }
 
-Rows SolveArgs::vector(PyObject* obj, const char* name, py::ssize_t n, bool scalar_ok) {
-  F64View v = asF64(obj, name);
-  Rows r;
-  check(BatchArgs::vector(r, name, v, n, scalar_ok));
-  keep(v);
+vereshchagin::StridedRows SolveArgs::vector(PyObject* obj, const char* name, py::ssize_t n, bool scalar_ok) {
+  vereshchagin::StridedRows r;
+  check(BatchArgs::vector(r, name, view(obj, name), n, scalar_ok));
   return r;
 }
 
@@ -72,34 +36,28 @@ void SolveArgs::addBlock(int segment, PyObject* alpha, PyObject* set_point, cons
   const std::string an = label.empty() ? "" : label + " alpha", bn = label.empty() ? "" : label + " beta";
   const char* a_name = label.empty() ? "alpha" : an.c_str();
   const char* sp_name = classical ? "a_desired" : label.empty() ? "beta" : bn.c_str();
-  F64View a = asF64(alpha, a_name);
-  check(block(segment, a, a_name));
-  keep(a);
-  F64View sp;
-  if (set_point != nullptr) sp = asF64(set_point, sp_name);
+  check(block(segment, view(alpha, a_name), a_name));
+  const F64View sp = set_point ? view(set_point, sp_name) : F64View();
   check(setPoint(set_point ? &sp : nullptr, classical, sp_name, label));
-  keep(sp);
 }
 
 // f_ext: (n_segments, 6) rows [force, moment] (base axes, moment about each tip origin), or a
 // dict {segment or link: (6,) wrench}, the moment about that frame's origin.
 void SolveArgs::parseFExt(PyObject* obj) {
   if (!PyDict_Check(obj)) {
-    const long shape[2] = {ns_, 6};
-    F64View v = asF64(obj, "f_ext");
-    check(rows(input.f_ext, "f_ext", v, 2, shape, vereshchagin::ShapeHint::FExt));
-    keep(v);
+    const long shape[2] = {solver_->ns, 6};
+    check(rows(input.f_ext, "f_ext", view(obj, "f_ext"), 2, shape, vereshchagin::ShapeHint::FExt));
     return;
   }
   PyObject *key, *value;
   Py_ssize_t pos = 0;
   while (PyDict_Next(obj, &pos, &key, &value)) {
-    const std::string label = keyLabel("f_ext", key);
-    const FrameTarget t = addressing_->resolveMoving(key, label);
+    const std::string label = "f_ext[" + py::repr(key).cast<std::string>() + "]";
+    const FrameTarget t = solver_->addressing->resolveMoving(key, label);
     vereshchagin::WrenchRows& w = input.wrenches.emplace_back();
     w.segment = t.segment;
     w.on_frame = t.merged;
-    w.point = point(t.link_in_tip.p);
+    w.point = vereshchagin::Vector3(t.link_in_tip.p.data);
     w.wrench = vector(value, label.c_str(), 6);
   }
 }
@@ -110,79 +68,49 @@ void SolveArgs::parseConstraints(PyObject* obj) {
   PyObject *key, *value;
   Py_ssize_t pos = 0;
   while (PyDict_Next(obj, &pos, &key, &value)) {
-    const std::string label = keyLabel("constraints", key);
-    const FrameTarget t = addressing_->resolveMoving(key, label);
-    check(frame(t.segment, point(t.link_in_tip.p), label));
+    const std::string label = "constraints[" + py::repr(key).cast<std::string>() + "]";
+    const FrameTarget t = solver_->addressing->resolveMoving(key, label);
+    check(frame(t.segment, vereshchagin::Vector3(t.link_in_tip.p.data), label));
     if ((!PyTuple_Check(value) && !PyList_Check(value)) || PySequence_Fast_GET_SIZE(value) != 2)
       raise(label + " must be a pair (alpha " +
             (batched() ? "(6, m_i) or (B, 6, m_i), beta (m_i,) or (B, m_i))" : "(6, m_i), beta (m_i,))"));
-    keys.push_back(py::reinterpret_borrow<py::object>(key));
-    starts.push_back(columns);
+    const int start = columns;
     addBlock(t.segment, PySequence_Fast_GET_ITEM(value, 0), PySequence_Fast_GET_ITEM(value, 1), label);
-    if (t.merged) input.blocks.back().point = point(t.link_in_tip.p);
+    if (t.merged) input.blocks.back().point = vereshchagin::Vector3(t.link_in_tip.p.data);
+    layout.append(py::make_tuple(py::handle(key), start, input.blocks.back().columns));
   }
 }
 
-void FrictionArg::setModelValues(const std::vector<vereshchagin::JointInfo>& joints) {
-  const auto n = static_cast<Eigen::Index>(joints.size());
-  model_values_.static_friction = model_values_.lower = model_values_.upper = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    model_values_.static_friction(k) = joints[k].friction;
-    model_values_.lower(k) = joints[k].lower;
-    model_values_.upper(k) = joints[k].upper;
-  }
-}
-
-// True while the cached Friction still holds the very attribute objects it was parsed from. Its
-// arrays are read-only views of immutable bytes (friction.py), so the same objects mean the same
-// values; an attribute replaced (object.__setattr__) makes the next solve parse it again.
-bool FrictionArg::unchanged(PyObject* obj) const {
-  PyObject* dict = instanceDict(obj);
-  if (dict == nullptr) return false;
-  for (int k = 0; k < 6; ++k)
-    if (PyDict_GetItem(dict, attrName(k)) != cache_attrs_[k].ptr()) return false;
-  return true;
-}
-
-const vereshchagin::FrictionModel* FrictionArg::parse(PyObject* obj, unsigned int nj,
-                                                      vereshchagin::FrictionModel& scratch) {
-  if (obj == nullptr || obj == Py_None || PyBool_Check(obj)) return obj == Py_True ? &model_values_ : nullptr;
-  static py::object friction_type = py::module_::import("vereshchagin.friction").attr("Friction");
-  const bool cacheable = Py_TYPE(obj) == reinterpret_cast<PyTypeObject*>(friction_type.ptr());
-  if (cacheable && cache_key_.ptr() == obj && unchanged(obj)) return &cache_;
-  const py::object static_obj = py::reinterpret_steal<py::object>(PyObject_GetAttrString(obj, "static"));
-  if (!static_obj) {
-    if (!PyErr_ExceptionMatches(PyExc_AttributeError)) throw py::error_already_set();  // e.g. a property raised
-    PyErr_Clear();
-    raise("friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)");
-  }
+const vereshchagin::FrictionModel* SolveArgs::friction(PyObject* obj, vereshchagin::FrictionModel& scratch) {
+  if (obj == nullptr || obj == Py_None || PyBool_Check(obj)) return obj == Py_True ? &solver_->model_friction : nullptr;
+  static PyObject* const module = py::module_::import("vereshchagin.friction").release().ptr();
+  static PyObject* const type = py::object(py::handle(module).attr("Friction")).release().ptr();
+  static PyObject* const fields_name = PyUnicode_InternFromString("_fields");
+  const bool cacheable = Py_TYPE(obj) == reinterpret_cast<PyTypeObject*>(type);
+  const py::object f = cacheable ? py::reinterpret_steal<py::object>(PyObject_GetAttr(obj, fields_name))
+                                 : py::handle(module).attr("_friction_fields")(py::handle(obj));
+  if (!f) throw py::error_already_set();
+  if (cacheable && f.ptr() == cache_key_.ptr()) return &cache_;
+  if (!PyTuple_Check(f.ptr()) || PyTuple_GET_SIZE(f.ptr()) != 6) raise("friction._fields is not a tuple of 6");
   vereshchagin::FrictionModel& fm = cacheable ? cache_ : scratch;
   if (cacheable) cache_key_ = py::object();  // invalid until parsed
-  const py::object none = py::none(), kin = py::getattr(obj, "kinetic", none), lower = py::getattr(obj, "lower", none),
-                   upper = py::getattr(obj, "upper", none);
-  const bool limits = !lower.is_none() || !upper.is_none();
-  auto view = [](const py::object& o, const char* name) { return o.is_none() ? F64View() : asF64(o.ptr(), name); };
-  const F64View st = asF64(static_obj.ptr(), "friction.static"), kv = view(kin, "friction.kinetic"),
-                lo = view(lower, "friction.lower"), up = view(upper, "friction.upper");
-  const vereshchagin::FrictionModel defaults;
-  const double vt = scalarAttr(obj, "velocity_tolerance", "friction.velocity_tolerance", defaults.velocity_tolerance);
-  const double lt =
-      limits ? scalarAttr(obj, "limit_tolerance", "friction.limit_tolerance", defaults.limit_tolerance) : 0.0;
-  check(vereshchagin::frictionFromArrays(fm, nj, st, kin.is_none() ? nullptr : &kv, vt, lower.is_none() ? nullptr : &lo,
-                                         upper.is_none() ? nullptr : &up, lt));
-  PyObject* dict = cacheable ? instanceDict(obj) : nullptr;
-  if (dict == nullptr) return &fm;  // not cached
-  for (int k = 0; k < 6; ++k) cache_attrs_[k] = py::reinterpret_borrow<py::object>(PyDict_GetItem(dict, attrName(k)));
-  cache_key_ = py::reinterpret_borrow<py::object>(obj);
+  auto item = [&](int k) { return PyTuple_GET_ITEM(f.ptr(), k); };
+  auto view = [&](int k, const char* name) { return item(k) == Py_None ? F64View() : asF64(item(k), name); };
+  const F64View st = asF64(item(0), "friction.static"), kv = view(1, "friction.kinetic"),
+                lo = view(3, "friction.lower"), up = view(4, "friction.upper");
+  auto opt = [&](int k, const F64View& v) { return item(k) == Py_None ? nullptr : &v; };
+  check(vereshchagin::frictionFromArrays(fm, solver_->nj, st, opt(1, kv),
+                                         scalarArg(item(2), "friction.velocity_tolerance"), opt(3, lo), opt(4, up),
+                                         scalarArg(item(5), "friction.limit_tolerance")));
+  if (cacheable) cache_key_ = f;
   return &fm;
 }
 
 // friction: one for every row, or in a batch a list or tuple of one per row.
-void SolveArgs::parseFriction(FrictionArg& parser, PyObject* obj) {
-  input.friction.clear();
+void SolveArgs::parseFriction(PyObject* obj) {  // input.friction: cleared by start()
   any_friction = false;
   if (!batched() || !(PyList_Check(obj) || PyTuple_Check(obj))) {
-    if (const vereshchagin::FrictionModel* fm = parser.parse(obj, nj_, friction_scratch_)) input.friction.push_back(fm);
+    if (const vereshchagin::FrictionModel* fm = friction(obj, friction_scratch_)) input.friction.push_back(fm);
     any_friction = !input.friction.empty();
     return;
   }
@@ -192,10 +120,14 @@ void SolveArgs::parseFriction(FrictionArg& parser, PyObject* obj) {
   for (Py_ssize_t b = 0; b < n; ++b) {
     vereshchagin::FrictionModel& fm = friction_models_[b];
     const vereshchagin::FrictionModel* p = nullptr;
+    const auto row = [b] { return "friction[" + std::to_string(b) + "]: "; };
     try {
-      p = parser.parse(PySequence_Fast_GET_ITEM(obj, b), nj_, fm);
+      p = friction(PySequence_Fast_GET_ITEM(obj, b), fm);
     } catch (const SolverError& e) {
-      raise("friction[" + std::to_string(b) + "]: " + e.what());
+      raise(row() + e.what());
+    } catch (py::error_already_set& e) {  // vereshchagin/friction.py's SolverError
+      if (!e.matches(py::module_::import("vereshchagin._core").attr("SolverError"))) throw;
+      raise(row() + std::string(py::str(e.value())));
     }
     if (p != nullptr && p != &fm) fm = *p;  // the cache or the model's values: the next row may change them
     input.friction.push_back(p ? &fm : nullptr);
@@ -205,33 +137,23 @@ void SolveArgs::parseFriction(FrictionArg& parser, PyObject* obj) {
 
 void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   start(batch, s.cppModel());
-  nj_ = s.nj;
-  ns_ = s.ns;
-  addressing_ = s.addressing;
-  keys.clear();
-  starts.clear();
+  solver_ = &s;
+  if (!layout.empty()) PyList_SetSlice(layout.ptr(), 0, PY_SSIZE_T_MAX, nullptr);
   keep_.clear();
   if (a[0] == nullptr || a[1] == nullptr) raise("solve() needs q and qd");
-  input.q = vector(a[0], "q", nj_);
-  input.q_dot = vector(a[1], "qd", nj_);
-  PyObject* a_desired = given(a[kADesiredArg]) ? a[kADesiredArg] : nullptr;
+  input.q = vector(a[0], "q", solver_->nj);
+  input.q_dot = vector(a[1], "qd", solver_->nj);
+  const bool classical = given(a[kADesiredArg]);
+  check(vereshchagin::endBlockArgs(given(a[2]), given(a[3]), classical, s.isTree()));
   if (given(a[2])) {
-    if (s.isTree()) raise(kTreeAlpha);
-    if (a_desired && given(a[3]))
-      raise("beta and a_desired given: a_desired (the tip's classical acceleration) replaces beta");
-    addBlock(static_cast<int>(ns_) - 1, a[2],
-             a_desired     ? a_desired
-             : given(a[3]) ? a[3]
-                           : nullptr,
-             "", a_desired != nullptr);
+    PyObject* set_point = classical ? a[kADesiredArg] : given(a[3]) ? a[3] : nullptr;
+    addBlock(static_cast<int>(solver_->ns) - 1, a[2], set_point, "", classical);
     if (input.blocks.back().columns == 0) input.blocks.pop_back();  // no columns: nothing to constrain
-  } else if (given(a[3]) || a_desired) {
-    raise(std::string(a_desired ? "a_desired" : "beta") + " given without alpha");
   }
   if (given(a[4])) parseFExt(a[4]);
-  if (given(a[5])) input.ff_torques = vector(a[5], "tau_ff", nj_);
+  if (given(a[5])) input.ff_torques = vector(a[5], "tau_ff", solver_->nj);
   if (given(a[7])) parseConstraints(a[7]);
-  parseFriction(s.friction, a[6]);
+  parseFriction(a[6]);
   // Pass-through weights: one per constraint column (their range: checked by vereshchagin::solve).
   if (given(a[8])) input.f_ext_pass_through = vector(a[8], "f_ext_pass_through", columns, /*scalar_ok=*/true);
   if (given(a[9])) input.ff_pass_through = vector(a[9], "tau_ff_pass_through", columns, /*scalar_ok=*/true);

@@ -10,21 +10,18 @@ namespace vsbind {
 
 using namespace pybind11::literals;
 
-constexpr const char* kOverflow = "the results overflow: gauss_value is beyond the double range";
-
 void PySolver::solveArgs(PyObject* const* args, bool frictionless) {
   last_state_ = false;
   args_.parse(*this, args, /*batch=*/false);
   if (frictionless && args_.any_friction) raise("_solve_dict benchmarks the frictionless call: no friction");
-  const char* failure;
+  vereshchagin::Status st;
   {
     py::gil_scoped_release release;
     vereshchagin::BatchWorkspace& w = *workspaces_[0];
     args_.input.fillRow(0, w.input);
-    const vereshchagin::Status st = vereshchagin::solve(cpp_model_, w.data, w.input);
-    failure = st ? nullptr : st.message();
+    st = vereshchagin::solve(cpp_model_, w.data, w.input);
   }
-  if (failure) raise(failure);
+  if (!st) raise(st.message());
   last_state_ = true;
 }
 
@@ -32,25 +29,10 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out) {
   Lock lk(*this);
   solveArgs(args, false);
   const bool fr = args_.any_friction;
-  py::object r = newResult(ResultLayout{static_cast<int>(nj), static_cast<int>(ns), args_.columns, fr}, out);
-  const ResultPointers p = resultPointers(r.ptr());
-  int rank, iterations = 0;
-  double smin, gauss = 0.0;
-  const vereshchagin::BatchOutput o{
-      p.qdd,          p.tau_command, p.nu,     p.link_acc, &smin, &rank, fr ? p.friction_torque : nullptr,
-      p.limit_torque, &gauss,        p.status, &iterations};
-  if (!o.write(0, workspaces_[0]->data, args_.columns, fr)) raise(kOverflow);
-  setResultScalars(r.ptr(), rank, smin, gauss, iterations);
-  if (!args_.keys.empty()) {
-    const std::size_t nk = args_.keys.size(), first = args_.input.blocks.size() - nk;
-    py::tuple keys(nk), starts(nk), counts(nk);
-    for (std::size_t k = 0; k < nk; ++k) {
-      keys[k] = args_.keys[k];
-      starts[k] = args_.starts[k];
-      counts[k] = args_.input.blocks[first + k].columns;
-    }
-    setSegmentLayout(r.ptr(), keys, starts, counts);
-  }
+  py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr}, out);
+  if (!resultOutput(r.ptr()).write(0, workspaces_[0]->data, args_.columns, fr))
+    raise("the results overflow: gauss_value is beyond the double range");
+  if (!args_.layout.empty()) setSegmentLayout(r.ptr(), py::tuple(args_.layout));
   return r;
 }
 
@@ -75,36 +57,34 @@ double PySolver::timeCpp(PyObject* const* args, long reps) {
   return vereshchagin::secondsPerSolve(cpp_model_, a.input, *workspaces_[0], reps);
 }
 
-py::dict PySolver::solveBatch(PyObject* const* args, const py::object& threads_obj) {
+py::dict PySolver::solveBatch(PyObject* const* args, PyObject* threads_obj) {
   Lock lk(*this);
   last_state_ = false;  // until workspace 0 holds the last row's state
   SolveArgs a;
   a.parse(*this, args, /*batch=*/true);
   const py::ssize_t B = a.input.rows, n = nj, BF = a.any_friction ? B : 0;  // friction outputs: 0 rows without
-  long threads = 1;
-  if (!threads_obj.is_none())
-    threads = intOption(threads_obj, "threads", 0, kMaxBatchThreads, "", "(0: one per core)", true);
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  const long t = threads_obj && threads_obj != Py_None ? py::handle(threads_obj).cast<long>() : 1;  // solver.py checks
+  const long threads = std::clamp<long>(t == 0 ? std::thread::hardware_concurrency() : t, 1, 256);  // 0: one per core
   std::vector<vereshchagin::BatchWorkspace*> ws;
   for (long t = 0; t < std::min<long>(threads, std::max<py::ssize_t>(B, 1)); ++t) ws.push_back(&workspace(t));
-  py::dict out("qdd"_a = newDoubles({B, n}), "tau_command"_a = newDoubles({B, n}), "nu"_a = newDoubles({B, a.columns}),
-               "link_acc"_a = newDoubles({B, ns + 1, 6}), "constraint_rank"_a = newInts({B}),
-               "smallest_singular_value"_a = newDoubles({B}), "friction_torque"_a = newDoubles({BF, n}),
-               "limit_torque"_a = newDoubles({BF, n}), "status"_a = newInts({BF, n}),
-               "gauss_value"_a = newDoubles({BF}), "iterations"_a = newInts({BF}));
-  auto d = [&](const char* k) { return doubles(out[k].cast<py::array>()); };
-  auto i = [&](const char* k) { return ints(out[k].cast<py::array>()); };
-  const vereshchagin::BatchOutput o{d("qdd"),
-                                    d("tau_command"),
-                                    d("nu"),
-                                    d("link_acc"),
-                                    d("smallest_singular_value"),
-                                    i("constraint_rank"),
-                                    BF ? d("friction_torque") : nullptr,
-                                    d("limit_torque"),
-                                    d("gauss_value"),
-                                    i("status"),
-                                    i("iterations")};
+  vereshchagin::BatchOutput o;
+  py::dict out;
+  const auto put = [&](const char* key, py::array a) {
+    out[key] = a;
+    return a;
+  };
+  o.qdd = doubles(put("qdd", newDoubles({B, n})));
+  o.tau_command = doubles(put("tau_command", newDoubles({B, n})));
+  o.nu = doubles(put("nu", newDoubles({B, a.columns})));
+  o.link_acc = doubles(put("link_acc", newDoubles({B, ns + 1, 6})));
+  o.constraint_rank = ints(put("constraint_rank", newInts({B})));
+  o.smallest_singular_value = doubles(put("smallest_singular_value", newDoubles({B})));
+  double* friction = doubles(put("friction_torque", newDoubles({BF, n})));
+  o.friction_torque = BF ? friction : nullptr;
+  o.limit_torque = doubles(put("limit_torque", newDoubles({BF, n})));
+  o.status = ints(put("status", newInts({BF, n})));
+  o.gauss_value = doubles(put("gauss_value", newDoubles({BF})));
+  o.iterations = ints(put("iterations", newInts({BF})));
   vereshchagin::BatchFailure failure;
   {
     py::gil_scoped_release release;
@@ -114,11 +94,7 @@ py::dict PySolver::solveBatch(PyObject* const* args, const py::object& threads_o
   last_state_ = B > 0;
   // solver.py drops the friction outputs without friction and views nu per constraints= key.
   out["any_friction"] = a.any_friction;
-  py::list layout;
-  for (std::size_t k = 0; k < a.keys.size(); ++k)
-    layout.append(
-        py::make_tuple(a.keys[k], a.starts[k], a.input.blocks[a.input.blocks.size() - a.keys.size() + k].columns));
-  out["segment_nu"] = layout;
+  out["segment_nu"] = a.layout;
   return out;
 }
 

@@ -1,8 +1,7 @@
 // Solver's Python methods: solve(), solve_batch() and the benchmark hooks as METH_FASTCALL entry
 // points (keyword names matched against interned strings), the rest through pybind11.
+#include <pybind11/eigen.h>
 #include <pybind11/stl.h>
-
-#include <algorithm>
 
 #include "py_solver.hpp"
 
@@ -15,28 +14,23 @@ namespace {
 constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
                                         "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired"};
 // clang-format on
-constexpr int kNumSolveParams = sizeof(kSolveParams) / sizeof(kSolveParams[0]);
-static_assert(kNumSolveParams == kNumSolveArgs, "solve()'s parameters are SolveArgs::parse's arguments");
-PyObject* g_solve_names[kNumSolveParams + 1];  // interned, then "threads"
+static_assert(sizeof(kSolveParams) == kNumSolveArgs * sizeof(char*), "one name per SolveArgs::parse argument");
+PyObject* g_names[2][kNumSolveArgs];  // interned: solve()'s, solve_batch()'s
 
 // Fills `slots` (solve()'s parameters) from positional and keyword arguments; raises TypeError
-// like Python functions.
-// `batch`: solve_batch's parameters.
-void bindArguments(const char* fname, bool batch, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames,
-                   PyObject** slots) {
-  PyObject* names[kNumSolveParams];
-  std::copy(g_solve_names, g_solve_names + kNumSolveParams, names);
-  if (batch) names[kOutArg] = g_solve_names[kNumSolveParams];
-  if (nargs > kNumSolveParams)
-    throw py::type_error(std::string(fname) + "() takes at most " + std::to_string(kNumSolveParams) +
+// like Python functions. names: g_names[0] or g_names[1].
+void bindArguments(const char* fname, PyObject* const* names, PyObject* const* args, Py_ssize_t nargs,
+                   PyObject* kwnames, PyObject** slots) {
+  if (nargs > kNumSolveArgs)
+    throw py::type_error(std::string(fname) + "() takes at most " + std::to_string(kNumSolveArgs) +
                          " positional arguments (" + std::to_string(nargs) + " given)");
   for (Py_ssize_t k = 0; k < nargs; ++k) slots[k] = args[k];
   for (Py_ssize_t k = 0; kwnames != nullptr && k < PyTuple_GET_SIZE(kwnames); ++k) {
     PyObject* name = PyTuple_GET_ITEM(kwnames, k);
     int slot = -1;
-    for (int s = 0; s < kNumSolveParams && slot < 0; ++s)
+    for (int s = 0; s < kNumSolveArgs && slot < 0; ++s)
       if (name == names[s]) slot = s;
-    for (int s = 0; s < kNumSolveParams && slot < 0; ++s)
+    for (int s = 0; s < kNumSolveArgs && slot < 0; ++s)
       if (PyUnicode_Compare(name, names[s]) == 0) slot = s;
     if (slot < 0)
       throw py::type_error(std::string(fname) + "() got an unexpected keyword argument '" +
@@ -51,13 +45,7 @@ void bindArguments(const char* fname, bool batch, PyObject* const* args, Py_ssiz
 // The PySolver of a Solver instance (the method descriptor guarantees the type; a subclass whose
 // __init__ did not call the base one has no value yet).
 PySolver& solverOf(PyObject* self) {
-  auto* inst = reinterpret_cast<py::detail::instance*>(self);
-  void* value = nullptr;
-  if (inst->simple_layout) {
-    if (inst->simple_holder_constructed) value = inst->simple_value_holder[0];
-  } else {
-    value = inst->get_value_and_holder().value_ptr();
-  }
+  void* value = reinterpret_cast<py::detail::instance*>(self)->get_value_and_holder().value_ptr();
   if (value == nullptr) throw py::type_error("Solver.__init__ was not called on this instance");
   return *static_cast<PySolver*>(value);
 }
@@ -86,18 +74,14 @@ constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict", "sol
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
-    long reps = 0;
-    if (kind == kTimeCpp) {
-      if (nargs < 1) throw py::type_error("_time_cpp(reps, q, qd, ...) needs reps");
-      reps = py::handle(args[0]).cast<long>();
-      ++args, --nargs;
-    }
-    PyObject* a[kNumSolveParams] = {};
-    bindArguments(kEntryNames[kind], kind == kSolveBatch, args, nargs, kwnames, a);
+    if (kind == kTimeCpp && nargs < 1) throw py::type_error("_time_cpp(reps, q, qd, ...) needs reps");
+    const long reps = kind == kTimeCpp ? py::handle(args[0]).cast<long>() : 0;
+    const int first = kind == kTimeCpp ? 1 : 0;  // _time_cpp's solve arguments follow reps
+    PyObject* a[kNumSolveArgs] = {};
+    bindArguments(kEntryNames[kind], g_names[kind == kSolveBatch], args + first, nargs - first, kwnames, a);
     if (kind == kTimeCpp) return py::float_(solverOf(self).timeCpp(a, reps));
     if (kind == kSolveDict) return solverOf(self).solveDict(a);
-    if (kind == kSolveBatch)
-      return solverOf(self).solveBatch(a, py::reinterpret_borrow<py::object>(a[kOutArg] ? a[kOutArg] : Py_None));
+    if (kind == kSolveBatch) return solverOf(self).solveBatch(a, a[kOutArg]);
     return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg]);
   });
 }
@@ -110,35 +94,29 @@ PyMethodDef fastDef() {  // the doc is set in bindSolver()
 
 PyMethodDef g_fast_defs[] = {fastDef<kSolve>(), fastDef<kTimeCpp>(), fastDef<kSolveDict>(), fastDef<kSolveBatch>()};
 
-void addFastMethod(py::handle cls, PyMethodDef* def) {
-  PyObject* descr = PyDescr_NewMethod(reinterpret_cast<PyTypeObject*>(cls.ptr()), def);
-  if (descr == nullptr || PyObject_SetAttrString(cls.ptr(), def->ml_name, descr) != 0) throw py::error_already_set();
-  Py_DECREF(descr);
-}
-
 using O = const py::object&;
 
 // _solve_pybind: solve() bound the plain pybind11 way (named arguments with defaults), the
 // benchmark of the fast call's gain.
 py::object solvePybind(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_ff, O friction, O constraints, O f_pass,
                        O t_pass, O out, O a_desired) {
-  PyObject* a[kNumSolveParams] = {q.ptr(),      qd.ptr(),     alpha.ptr(),    beta.ptr(),
-                                  f_ext.ptr(),  tau_ff.ptr(), friction.ptr(), constraints.ptr(),
-                                  f_pass.ptr(), t_pass.ptr(), out.ptr(),      a_desired.ptr()};
+  PyObject* a[kNumSolveArgs] = {q.ptr(),      qd.ptr(),     alpha.ptr(),    beta.ptr(),
+                                f_ext.ptr(),  tau_ff.ptr(), friction.ptr(), constraints.ptr(),
+                                f_pass.ptr(), t_pass.ptr(), out.ptr(),      a_desired.ptr()};
   return s.solve(a, out.is_none() ? nullptr : out.ptr());
 }
 
 }  // namespace
 
 void bindSolver(py::module_& mod) {
-  for (int k = 0; k < kNumSolveParams; ++k) g_solve_names[k] = PyUnicode_InternFromString(kSolveParams[k]);
-  g_solve_names[kNumSolveParams] = PyUnicode_InternFromString("threads");
+  for (int k = 0; k < kNumSolveArgs; ++k) {
+    g_names[0][k] = PyUnicode_InternFromString(kSolveParams[k]);
+    g_names[1][k] = PyUnicode_InternFromString(k == kOutArg ? "threads" : kSolveParams[k]);
+  }
 
   py::class_<PySolver> cls(mod, "Solver", doc("_core.Solver"));
-  cls.def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
-                   const py::object&>(),
-          py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81}, py::arg("rcond") = 1e-12,
-          py::arg("damping") = py::none(), py::arg("inertia_check") = py::none(),
+  cls.def(py::init<O, O, O, O, O, O>(), py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81},
+          py::arg("rcond") = 1e-12, py::arg("damping") = py::none(), py::arg("inertia_check") = py::none(),
           py::arg("max_constraints") = py::none())
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            doc("_core.Solver.response_columns"))
@@ -146,11 +124,12 @@ void bindSolver(py::module_& mod) {
       .def_readonly("n_joints", &PySolver::nj, doc("_core.Solver.n_joints"))
       .def_readonly("n_segments", &PySolver::ns, doc("_core.Solver.n_segments"))
       .def_property_readonly("model", &PySolver::model, doc("_core.Solver.model"));
-  cls.def_property_readonly("inertia_check", &PySolver::inertiaCheck, doc("_core.Solver.inertia_check"))
-      .def("_state", &PySolver::getState, doc("_core.Solver._state"));
+  cls.def_property_readonly("inertia_check", &PySolver::inertiaCheck, doc("_core.Solver.inertia_check"));
   for (PyMethodDef& def : g_fast_defs) {
     def.ml_doc = doc("_core.Solver." + std::string(def.ml_name));
-    addFastMethod(cls, &def);
+    PyObject* descr = PyDescr_NewMethod(reinterpret_cast<PyTypeObject*>(cls.ptr()), &def);
+    if (descr == nullptr) throw py::error_already_set();
+    cls.attr(def.ml_name) = py::reinterpret_steal<py::object>(descr);
   }
   const py::object none = py::none();
   cls.def("_solve_pybind", &solvePybind, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,

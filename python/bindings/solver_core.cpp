@@ -1,55 +1,33 @@
 // The Python Solver's setup and state: construction (model, options, workspace 0), the lock with
-// re-entry detection, gravity, response_columns() around workspace 0's last solve, pickling state.
+// re-entry detection, gravity, response_columns() around workspace 0's last solve.
 #include "py_solver.hpp"
 
 namespace vsbind {
 
-long intOption(const py::object& obj, const char* name, long lo, long hi, const char* bound, const char* hint,
-               bool with_type) {
-  if (PyBool_Check(obj.ptr()) || !PyIndex_Check(obj.ptr()))
-    raise(std::string(name) + " must be an int" + bound + " " + hint + ", got " +
-          (with_type ? std::string(Py_TYPE(obj.ptr())->tp_name) + " " : "") + py::repr(obj).cast<std::string>());
-  const std::optional<long long> v = intWithin(obj.ptr(), lo, hi);
-  if (!v)
-    raise(std::string(name) + " must be in " + std::to_string(lo) + " .. " + std::to_string(hi) + " " + hint +
-          ", got " + py::str(obj).cast<std::string>());
-  return static_cast<long>(*v);
-}
-
 vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where) {
-  if (value == "physical") return vereshchagin::InertiaCheck::Physical;
-  if (value == "joint_space") return vereshchagin::InertiaCheck::JointSpace;
-  raise(where +
-        "inertia_check must be 'physical' (every body a rigid body) or 'joint_space' (identified models: "
-        "any symmetric inertia, H(q) positive definite at each solve), got '" +
-        value + "'");
+  vereshchagin::InertiaCheck check = vereshchagin::InertiaCheck::Physical;
+  if (const vereshchagin::Status s = vereshchagin::parseInertiaCheck(value, check); !s)
+    raise(where + s.message() + ", got '" + value + "'");
+  return check;
 }
 
 PySolver::PySolver(const py::object& model, const py::object& gravity, const py::object& rcond,
-                   const py::object& damping, const py::object& inertia_check, const py::object& max_constraints)
-    : damping_arg_(damping) {
-  if (py::isinstance<PyChain>(model)) {
-    chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
-    addressing = chain_.get();
-  } else if (py::isinstance<PyTree>(model)) {
+                   const py::object& damping, const py::object& inertia_check, const py::object& max_constraints) {
+  if (py::isinstance<PyTree>(model)) {
     tree_ = std::make_unique<PyTree>(model.cast<const PyTree&>());
     addressing = tree_.get();
-  } else {
-    throw py::type_error("Solver(model): model must be a vereshchagin.Chain or vereshchagin.Tree, got " +
-                         std::string(Py_TYPE(model.ptr())->tp_name));
+  } else {  // a Chain (solver.py refuses other types)
+    chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
+    addressing = chain_.get();
   }
   options_.rcond = scalarArg(rcond, "rcond");
-  if (inertia_check.is_none())  // the check the model was built with
-    options_.inertia_check = tree_ ? tree_->inertia_check : chain_->inertia_check;
-  else
-    options_.inertia_check = inertiaCheckArg(py::str(inertia_check).cast<std::string>(), "");
+  // solver.py passes the check the model was built with for None.
+  options_.inertia_check = inertiaCheckArg(py::str(inertia_check).cast<std::string>(), "");
   if (!damping.is_none()) {
     options_.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
     options_.damping = scalarArg(damping, "damping");
   }
-  if (!max_constraints.is_none())
-    options_.max_constraints = static_cast<int>(
-        intOption(max_constraints, "max_constraints", 1, 1 << 24, " >= 1", "(None: the default)", false));
+  if (!max_constraints.is_none()) options_.max_constraints = max_constraints.cast<int>();  // checked by solver.py
   gravity_ = vec3(gravity, "gravity");
   const vereshchagin::ModelOptions model_options{options_.inertia_check};
   cpp_model_ = tree_ ? vereshchagin::Model(tree_->robot.tree, tree_->robot.root_link, model_options)
@@ -59,7 +37,7 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
   if (const vereshchagin::Status s = workspace(0).data.status(); !s) raise(invalid + std::string(s.message()));
   nj = cpp_model_.nrOfJoints();
   ns = cpp_model_.nrOfSegments();
-  friction.setModelValues(addressing->jointInfos());
+  model_friction = vereshchagin::frictionOfJoints(addressing->jointInfos());
 }
 
 PySolver::Lock::Lock(PySolver& s) : s_(s) {
@@ -87,42 +65,24 @@ void PySolver::setGravity(const py::object& gravity) {
   for (auto& w : workspaces_) w->input.gravity = g;
 }
 
-py::array PySolver::gravity() const {
-  py::array g = newDoubles({3});
-  for (int k = 0; k < 3; ++k) doubles(g)[k] = gravity_(k);
-  return g;
-}
-
-py::tuple PySolver::responseColumns(const std::vector<int>& joints, bool hold_sticking) {
-  const Eigen::VectorXi requested =
-      Eigen::Map<const Eigen::VectorXi>(joints.data(), static_cast<Eigen::Index>(joints.size()));
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> PySolver::responseColumns(const Eigen::VectorXi& joints,
+                                                                      bool hold_sticking) {
   Lock lk(*this);
   if (!last_state_)
     raise(
         "response_columns() linearises around the last successful solve() (or the last row of solve_batch()): "
         "call solve() at the state first");
   vereshchagin::Data& data = workspaces_[0]->data;
-  const Eigen::Index k = requested.size();
-  Eigen::MatrixXd dq(nj, k), dt(nj, k);
+  std::pair<Eigen::MatrixXd, Eigen::MatrixXd> cols{Eigen::MatrixXd(nj, joints.size()),
+                                                   Eigen::MatrixXd(nj, joints.size())};
   vereshchagin::Status rc;
   {
     py::gil_scoped_release release;
-    rc = hold_sticking ? data.responseColumnsHoldingSticking(requested, dq, dt)
-                       : data.responseColumns(requested, dq, dt);
+    rc = hold_sticking ? data.responseColumnsHoldingSticking(joints, cols.first, cols.second)
+                       : data.responseColumns(joints, cols.first, cols.second);
   }
   if (!rc) raise(rc.message());
-  auto toNumpy = [&](const Eigen::MatrixXd& M) {
-    py::array a = newDoubles({static_cast<py::ssize_t>(nj), static_cast<py::ssize_t>(k)});
-    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(doubles(a), nj, k) = M;
-    return a;
-  };
-  return py::make_tuple(toNumpy(dq), toNumpy(dt));
-}
-
-py::tuple PySolver::getState() const {
-  return py::make_tuple(model(), gravity(), options_.rcond, damping_arg_,
-                        vereshchagin::inertiaCheckName(options_.inertia_check),
-                        options_.max_constraints > 0 ? py::object(py::int_(options_.max_constraints)) : py::none());
+  return cols;
 }
 
 }  // namespace vsbind

@@ -585,7 +585,6 @@ DOCS["_core.Solver.n_segments"] = r"""Number of segments (moving and fixed-joint
 
 DOCS["_core.Solver.model"] = r"""A copy of the solver's Chain or Tree."""
 
-DOCS["_core.Solver._state"] = r"""(model, gravity, rcond, damping, inertia_check, max_constraints): the constructor's arguments that rebuild this solver (pickling; see Solver.__reduce__)."""
 
 DOCS["_core.Solver.inertia_check"] = r"""str: 'physical' or 'joint_space' (see Solver)."""
 

@@ -3,8 +3,9 @@
 The compiled ``_core.SolveResult`` keeps only the storage, its array views and the solve path's
 fast access (``python/bindings/result_type.cpp``). Its pickle state is the 12-tuple of
 ``_result_state``: ``(n_joints, n_segments, m, friction, smallest_singular_value, gauss_value,
-constraint_rank, iterations, data, keys, starts, counts)``. A state is checked here
-(crafted states raise ``ValueError``) before ``_core._result_from_parts`` allocates a result.
+constraint_rank, iterations, data, keys, starts, counts)``; the compiled type holds the segment
+layout as one tuple of ``(key, start, count)`` triples. A state is checked here (crafted states
+raise ``ValueError``) before ``_core._result_from_parts`` allocates a result.
 """
 
 from __future__ import annotations
@@ -73,16 +74,19 @@ def _result_from_state(*state) -> SolveResult:
         raise ValueError("SolveResult state: smin and gauss must be floats")
     if not isinstance(state[8], bytes):
         raise ValueError("SolveResult state: data must be bytes")
+    layout = None
     if state[9] is not None:
         _check_segment_layout(state[9], state[10], state[11], sizes[2])
-    return _result_from_parts(sizes, (rank, state[4], state[5], iterations), state[8], state[9:])
+        layout = tuple(zip(state[9], state[10], state[11]))
+    return _result_from_parts(sizes, (rank, state[4], state[5], iterations), state[8], layout)
 
 
 def _result_state(self: SolveResult) -> tuple:
     """The pickle state (see the module docstring): the layout, the scalars as stored (0 where a
     solve without friction reports None), the storage's bytes (``_data``) and the segment layout."""
     gauss, iterations = self.gauss_value, self.iterations
-    layout = self._segment_layout or (None, None, None)
+    triples = self._segment_layout
+    layout = (None, None, None) if triples is None else tuple(zip(*triples))
     sizes = (len(self.qdd), len(self.link_acc) - 1, len(self.nu), int(self.friction_torque is not None))
     scalars = (self.smallest_singular_value, 0.0 if gauss is None else gauss, self.constraint_rank)
     return (*sizes, *scalars, 0 if iterations is None else iterations, self._data.tobytes(), *layout)
@@ -109,7 +113,7 @@ def _segment_nu(self: SolveResult):
     if layout is None:
         return None
     nu = self.nu
-    return {key: nu[start : start + count] for key, start, count in zip(*layout)}
+    return {key: nu[start : start + count] for key, start, count in layout}
 
 
 def _repr(self: SolveResult) -> str:

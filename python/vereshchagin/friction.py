@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Optional
 
 import numpy as np
@@ -30,6 +31,88 @@ def _frozen_vector(value, name: str, allow_inf: bool = False) -> Optional[np.nda
     return np.frombuffer(a.tobytes(), dtype=np.float64)
 
 
+def _real(value, name: str) -> float:
+    """``value`` as a float (its range is the solve's to check).
+
+    Raises
+    ------
+    SolverError
+        ``value`` is a bool, str, bytes or None, or has no float value.
+    """
+    if not isinstance(value, (bool, str, bytes)) and value is not None:
+        try:
+            return float(value)
+        except Exception:  # any failing __float__ counts as "not a real number"
+            pass
+    raise SolverError(f"friction.{name} must be a real number, got {type(value).__name__}")
+
+
+def _fields_of(static, kinetic, velocity_tolerance, lower, upper, limit_tolerance) -> tuple:
+    """What a solver reads of a friction model: ``(static, kinetic, velocity_tolerance, lower,
+    upper, limit_tolerance)``, the arrays as given (the solver checks their shapes and values),
+    the tolerances as floats: None gives the default, and without limits ``limit_tolerance`` is
+    not read (0.0).
+
+    Raises
+    ------
+    SolverError
+        A tolerance that is not a real number.
+    """
+    limits = lower is not None or upper is not None
+    vt = 1e-6 if velocity_tolerance is None else _real(velocity_tolerance, "velocity_tolerance")
+    lt = 1e-9 if limit_tolerance is None else _real(limit_tolerance, "limit_tolerance")
+    return (static, kinetic, vt, lower, upper, lt if limits else 0.0)
+
+
+def _friction_fields(obj) -> tuple:
+    """``_fields_of`` any ``friction=`` object: a Friction's (cached) or the attributes of any object
+    that has ``static`` (``kinetic``, ``velocity_tolerance``, ``lower``, ``upper`` and
+    ``limit_tolerance`` are optional). The solvers call it for objects that are not exactly a Friction.
+
+    Raises
+    ------
+    SolverError
+        ``obj`` has no ``static`` attribute, or a tolerance is not a real number.
+    """
+    if isinstance(obj, Friction):
+        return obj._fields
+    try:
+        static = obj.static
+    except AttributeError:
+        raise SolverError(
+            "friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)"
+        ) from None
+    rest = [getattr(obj, name, None) for name in ("kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance")]
+    return _fields_of(static, *rest)
+
+
+class _Field(property):
+    """A field of Friction, kept in the instance dict. Setting it (the constructor, or
+    ``object.__setattr__`` past the frozen guard) drops the cached ``_fields``, so that the next
+    solve reads the new value; a solver reuses what it parsed while ``_fields`` is the same tuple.
+    A property, as which type checkers and documentation tools see it; on the class it is the
+    field's default, as the dataclass had it (no default: no class attribute)."""
+
+    def __init__(self, name: str, default):
+        def get(obj):
+            return obj.__dict__.get(name, default)
+
+        def put(obj, value) -> None:
+            obj.__dict__[name] = value
+            obj.__dict__.pop("_fields", None)
+
+        super().__init__(get, put)
+        self.name = name
+        self.default = default
+
+    def __get__(self, obj, owner=None):
+        if obj is not None:
+            return super().__get__(obj, owner)
+        if self.default is _Field:
+            raise AttributeError(self.name)
+        return self.default
+
+
 @dataclass(frozen=True)
 class Friction:
     """Per-joint friction for ``Solver.solve(..., friction=Friction(...))``.
@@ -37,7 +120,7 @@ class Friction:
     Immutable: the arrays are stored as float64 copies that cannot be written (views of immutable
     bytes: ``flags.writeable`` cannot be switched back on), so a solver may reuse a parsed
     ``Friction`` across calls (pass the same object in a control loop). A solver reparses it if
-    an attribute was replaced.
+    an attribute was replaced (``object.__setattr__``).
 
     Parameters
     ----------
@@ -75,9 +158,22 @@ class Friction:
         object.__setattr__(self, "lower", _frozen_vector(self.lower, "lower", allow_inf=True))
         object.__setattr__(self, "upper", _frozen_vector(self.upper, "upper", allow_inf=True))
 
+    @cached_property
+    def _fields(self) -> tuple:
+        """What solvers read (``_fields_of``), cached until a field is replaced."""
+        return _fields_of(
+            self.static, self.kinetic, self.velocity_tolerance, self.lower, self.upper, self.limit_tolerance
+        )
+
     def __reduce__(self):
         # Rebuilt through the constructor, so copies and unpickled objects stay read-only.
         return (
             Friction,
             (self.static, self.kinetic, self.velocity_tolerance, self.lower, self.upper, self.limit_tolerance),
         )
+
+
+# The fields become _Field descriptors once the dataclass has made its methods (whose defaults stay
+# those above).
+for _name in ("static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance"):
+    setattr(Friction, _name, _Field(_name, Friction.__dict__.get(_name, _Field)))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Optional
@@ -9,6 +10,28 @@ from typing import Optional
 import numpy as np
 
 from . import _core
+
+# The most threads solve_batch starts (threads= beyond it is refused): each costs an OS thread and
+# a workspace (a solver's Data), and no machine gains from more.
+_MAX_BATCH_THREADS = 256
+
+
+def _int_option(value, name: str, lo: int, hi: int, bound: str, hint: str, with_type: bool) -> int:
+    """``value`` as an int in ``lo .. hi`` (an int or anything with ``__index__``, not a bool).
+
+    Raises
+    ------
+    SolverError
+        "<name> must be an int<bound> <hint>, got [type] repr" or "<name> must be in lo .. hi
+        <hint>, got value"; a failing ``__index__`` raises its own error.
+    """
+    if isinstance(value, bool) or not hasattr(type(value), "__index__"):
+        kind = f"{type(value).__name__} " if with_type else ""
+        raise _core.SolverError(f"{name} must be an int{bound} {hint}, got {kind}{value!r}")
+    index = operator.index(value)
+    if not lo <= index <= hi:
+        raise _core.SolverError(f"{name} must be in {lo} .. {hi} {hint}, got {value}")
+    return index
 
 
 @dataclass(frozen=True)
@@ -105,6 +128,21 @@ class Solver(_core.Solver):
     solving.
     """
 
+    def __init__(
+        self, model, gravity=(0.0, 0.0, -9.81), rcond=1e-12, damping=None, inertia_check=None, max_constraints=None
+    ):
+        if not isinstance(model, (_core.Chain, _core.Tree)):
+            kind = type(model).__name__
+            raise TypeError(f"Solver(model): model must be a vereshchagin.Chain or vereshchagin.Tree, got {kind}")
+        if max_constraints is not None:
+            max_constraints = _int_option(
+                max_constraints, "max_constraints", 1, 1 << 24, " >= 1", "(None: the default)", False
+            )
+        if inertia_check is None:  # the check the model was built with
+            inertia_check = model.inertia_check
+        super().__init__(model, gravity, rcond, damping, inertia_check, max_constraints)
+        self._options = (float(rcond), damping, max_constraints)  # what __reduce__ needs besides the properties
+
     def solve_batch(
         self,
         q,
@@ -159,6 +197,7 @@ class Solver(_core.Solver):
             ``threads`` that is not an int in 0 .. 256, or the first failing row
             (``"batch row 3: ..."``).
         """
+        threads = _int_option(threads, "threads", 0, _MAX_BATCH_THREADS, "", "(0: one per core)", True)
         out = super().solve_batch(
             q,
             qd,
@@ -211,7 +250,8 @@ class Solver(_core.Solver):
     def __reduce__(self):
         # Rebuilt through the constructor from its arguments (model, gravity, rcond, damping,
         # inertia_check, max_constraints), so copies and unpickled solvers are checked as new ones.
-        return (type(self), self._state())
+        rcond, damping, max_constraints = self._options
+        return (type(self), (self.model, self.gravity, rcond, damping, self.inertia_check, max_constraints))
 
     def response_columns(self, joints, hold_sticking=True):
         """Affine response of the last solve to unit feed-forward joint torques.

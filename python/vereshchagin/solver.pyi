@@ -22,6 +22,15 @@ class BatchResult:
     segment_nu: Optional[dict] = None
 
 class Solver(_core.Solver):
+    def __init__(
+        self,
+        model: Union[_core.Chain, _core.Tree],
+        gravity: ArrayLike = ...,
+        rcond: float = 1e-12,
+        damping: Optional[float] = None,
+        inertia_check: Optional[str] = None,
+        max_constraints: Optional[int] = None,
+    ) -> None: ...
     def solve_batch(  # type: ignore[override]
         self,
         q: ArrayLike,

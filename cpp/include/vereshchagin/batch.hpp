@@ -93,6 +93,64 @@ struct BatchOutput {
   bool write(std::ptrdiff_t b, const Data& data, int columns, bool with_friction) const;
 };
 
+/// The outputs of one row packed in one buffer of doubles, in this order: qdd and tau_command
+/// (n_joints each), nu (m), link_acc ((n_segments + 1) x 6, row-major), then with friction
+/// friction_torque and limit_torque (n_joints each) and status (n_joints int32 values in
+/// ceil(n_joints / 2) doubles). The Python package's SolveResult stores its outputs (and pickles
+/// them) in this layout; the scalars live outside the buffer.
+struct PackedRow {
+  /// An output's place in the buffer (see offset()).
+  enum Field {
+    Qdd,             ///< joint accelerations (n_joints)
+    TauCommand,      ///< command torques (n_joints)
+    Nu,              ///< constraint magnitudes (m)
+    LinkAcc,         ///< link accelerations ((n_segments + 1) x 6)
+    FrictionTorque,  ///< friction torques (n_joints; with friction)
+    LimitTorque,     ///< joint-limit reactions (n_joints; with friction)
+    Status,          ///< JointStatus as int32 (n_joints; with friction)
+    End,             ///< the end of the buffer
+  };
+  long n_joints = 0;      ///< n
+  long n_segments = 0;    ///< segments of the model
+  long m = 0;             ///< constraint columns (the size of nu)
+  bool friction = false;  ///< whether the friction outputs are stored
+
+  /// The first double of `field` (End: the buffer's length; the friction fields: their place as
+  /// if stored). Inline, as output(): the solve path of the Python package calls them per solve.
+  std::ptrdiff_t offset(Field field) const {
+    const std::ptrdiff_t n = n_joints, link = 6 * (n_segments + 1), friction_start = 2 * n + m + link;
+    if (field <= LinkAcc) return field == Qdd ? 0 : field == TauCommand ? n : field == Nu ? 2 * n : 2 * n + m;
+    if (field != End) return friction_start + (field - FrictionTorque) * n;
+    return friction ? friction_start + 2 * n + (n + 1) / 2 : friction_start;
+  }
+  /// "n_joints = 7, n_segments = 8, m = 6 with friction" (or "without friction").
+  std::string describe() const;
+  /// Whether the sizes are ones a model can have (0 .. 2^24 joints and segments, 0 .. 6 columns per
+  /// segment): the check of a layout read from outside (an unpickled result) before it is allocated.
+  bool plausible() const;
+  /// Whether both describe the same layout.
+  bool operator==(const PackedRow& o) const {
+    return n_joints == o.n_joints && n_segments == o.n_segments && m == o.m && friction == o.friction;
+  }
+  /// A BatchOutput that writes row 0 into `buffer` (offset(End) doubles; the friction outputs
+  /// nullptr without friction) and the scalars (1 each) where the pointers point.
+  BatchOutput output(double* buffer, double* smallest_singular_value, int* constraint_rank, double* gauss_value,
+                     int* iterations) const {
+    double* const fr = friction ? buffer + offset(FrictionTorque) : nullptr;
+    return {buffer,
+            buffer + n_joints,
+            buffer + offset(Nu),
+            buffer + offset(LinkAcc),
+            smallest_singular_value,
+            constraint_rank,
+            fr,
+            fr ? fr + n_joints : nullptr,
+            gauss_value,
+            fr ? reinterpret_cast<int*>(fr + 2 * n_joints) : nullptr,
+            iterations};
+  }
+};
+
 /// A thread's workspace for solveBatch(): a Data and a SolveInput for one model.
 struct BatchWorkspace {
   /// Data(model, options), a SolveInput of the model with this gravity (m/s^2, base axes).

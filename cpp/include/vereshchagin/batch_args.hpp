@@ -13,6 +13,7 @@
 #include "vereshchagin/batch.hpp"
 #include "vereshchagin/friction_model.hpp"
 #include "vereshchagin/model.hpp"
+#include "vereshchagin/robot_chain.hpp"
 
 namespace vereshchagin {
 
@@ -33,6 +34,18 @@ enum class ShapeHint {
 std::string frictionFromArrays(FrictionModel& out, long n, const ArrayArg& static_friction, const ArrayArg* kinetic,
                                double velocity_tolerance, const ArrayArg* lower, const ArrayArg* upper,
                                double limit_tolerance);
+
+/// The friction model of `friction=True`: the joints' own static friction and position limits
+/// (JointInfo::friction, lower, upper: N m or N, rad or m), one entry per joint in joint order;
+/// kinetic friction equal to static, tolerances FrictionModel's defaults.
+FrictionModel frictionOfJoints(const std::vector<JointInfo>& joints);
+
+/// Checks which of solve()'s end-segment arguments are given (alpha: the (6, m) directions, beta:
+/// the set-point, a_desired: the tip's classical acceleration instead of beta) on a chain or, with
+/// tree = true, a tree, which has no last segment. Messages: "alpha and beta constrain a chain's
+/// last segment; a Tree has no last segment: pass constraints=...", "beta and a_desired given:
+/// ...", "beta given without alpha", "a_desired given without alpha".
+std::string endBlockArgs(bool alpha, bool beta, bool a_desired, bool tree);
 
 /// Builds a BatchInput from row-major arrays, checking each as it is added (see the top of this
 /// file). Every method returns "" on success, else the message; after a message the input is

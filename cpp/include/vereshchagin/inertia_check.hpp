@@ -3,6 +3,10 @@
 /// and the URDF loader (UrdfOptions).
 #pragma once
 
+#include <string>
+
+#include "vereshchagin/status.hpp"
+
 namespace vereshchagin {
 
 /// Which inertial parameters a model may have (see the top of this file).
@@ -31,6 +35,19 @@ enum class InertiaCheck {
 /// "physical" / "joint_space" (the Python spelling), for messages.
 inline const char* inertiaCheckName(InertiaCheck check) {
   return check == InertiaCheck::Physical ? "physical" : "joint_space";
+}
+
+/// Sets `out` from its Python spelling, "physical" or "joint_space". Any other `name` leaves `out`
+/// as it is and returns Error::InvalidOptions with the message "inertia_check must be 'physical'
+/// (...) or 'joint_space' (...)" (the caller appends the value it got).
+inline Status parseInertiaCheck(const std::string& name, InertiaCheck& out) {
+  if (name == "physical" || name == "joint_space") {
+    out = name == "physical" ? InertiaCheck::Physical : InertiaCheck::JointSpace;
+    return {};
+  }
+  return {Error::InvalidOptions,
+          "inertia_check must be 'physical' (every body a rigid body) or 'joint_space' (identified models: any "
+          "symmetric inertia, H(q) positive definite at each solve)"};
 }
 
 }  // namespace vereshchagin
