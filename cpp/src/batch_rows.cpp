@@ -40,6 +40,8 @@ void BatchInput::fillRow(std::ptrdiff_t b, SolveInput& in) const {
   }
   if (ff_torques.data) in.ff_torques = MapV(ff_torques.row(b), nj);
   in.friction = frictionOf(b);
+  in.contacts = contacts;  // within in.contacts' capacity after the first row
+  in.contact_velocity_tolerance = contact_velocity_tolerance;
   const double* f_pass = f_ext_pass_through.data ? f_ext_pass_through.row(b) : nullptr;
   const double* t_pass = ff_pass_through.data ? ff_pass_through.row(b) : nullptr;
   int col = 0;
@@ -74,6 +76,13 @@ bool BatchOutput::write(std::ptrdiff_t b, const Data& d, int columns, bool with_
   std::copy_n(d.linkAccelerations().data(), links, link_acc + b * links);
   constraint_rank[b] = d.constraintRank();
   smallest_singular_value[b] = d.smallestSingularValue();
+  if (contact_force != nullptr) {
+    const auto forces = d.contactForces();
+    const std::ptrdiff_t k = forces.cols();
+    for (std::ptrdiff_t c = 0; c < k; ++c) std::copy_n(forces.col(c).data(), 3, contact_force + 3 * (b * k + c));
+    for (std::ptrdiff_t c = 0; c < k; ++c) contact_status[b * k + c] = static_cast<int>(d.contactStatus()[c]);
+    contact_outcome[b] = static_cast<int>(d.contactOutcome());
+  }
   if (friction_torque == nullptr) return true;
   if (!with_friction) {
     std::fill_n(friction_torque + b * n, n, std::nan(""));
@@ -93,12 +102,14 @@ bool BatchOutput::write(std::ptrdiff_t b, const Data& d, int columns, bool with_
 
 std::string PackedRow::describe() const {
   return "n_joints = " + std::to_string(n_joints) + ", n_segments = " + std::to_string(n_segments) +
-         ", m = " + std::to_string(m) + (friction ? " with" : " without") + " friction";
+         ", m = " + std::to_string(m) + (friction ? " with" : " without") + " friction" +
+         (contacts > 0 ? ", " + std::to_string(contacts) + " contacts" : "");
 }
 
 bool PackedRow::plausible() const {
   constexpr long kMax = 1L << 24;
-  return n_joints >= 0 && n_segments >= 0 && m >= 0 && n_joints <= kMax && n_segments <= kMax && m <= 6 * n_segments;
+  return n_joints >= 0 && n_segments >= 0 && m >= 0 && n_joints <= kMax && n_segments <= kMax && m <= 6 * n_segments &&
+         contacts >= 0 && contacts <= kMax;
 }
 
 BatchWorkspace::BatchWorkspace(const Model& model, const SolverOptions& options, const KDL::Vector& gravity)

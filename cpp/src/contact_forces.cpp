@@ -170,6 +170,9 @@ int ContactStage::trySticking(DataImpl& d, const SolveInput& in) {
       if (edgeNormal(p, i, pc.facets).dot(ft) > apothem + 1e-12 * std::max(1.0, std::abs(fn))) return 0;
     forces.col(k) += ft;
   }
+  // Held columns that contradict the task (a task column along a held direction) are met only in
+  // the least-squares sense: the points must really stick.
+  if (!heldPointsStill(in, d.core.res.qdd)) return 0;
   if (int rc = solveWithForces(d, in)) return rc;  // the final sweep: no tangential columns
   return 1;
 }

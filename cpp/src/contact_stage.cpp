@@ -167,6 +167,7 @@ void ContactStage::layout(const SolveInput& in, bool stick) {
     p.fixed.setZero();
     p.dir = p.n + pc.mu * p.slide_dir;
     p.stick_col = -1;
+    p.normal_col = -1;  // the all-active guess's only
     const bool rest_friction = p.kind == kTouching || p.kind == kSetPointRest;
     if (stick && rest_friction) {  // held tangentially by two columns
       p.stick_col = stick_col;

@@ -197,11 +197,25 @@ TEST_CASE("PackedRow: offsets, length, description and the output it writes") {
   CHECK(!PackedRow{3, 1L << 25, 1, false}.plausible());
   std::vector<double> buffer(static_cast<std::size_t>(fr.offset(PackedRow::End)));
   double smin = 0.0, gauss = 0.0;
-  int rank = 0, iterations = 0;
-  const BatchOutput o = fr.output(buffer.data(), &smin, &rank, &gauss, &iterations);
+  int rank = 0, iterations = 0, outcome = 0;
+  const BatchOutput o = fr.output(buffer.data(), &smin, &rank, &gauss, &iterations, &outcome);
   CHECK(o.nu == buffer.data() + 6);
   CHECK(reinterpret_cast<double*>(o.status) == buffer.data() + 31);
   CHECK(o.gauss_value == &gauss);
-  CHECK(plain.output(buffer.data(), &smin, &rank, &gauss, &iterations).friction_torque == nullptr);
-  CHECK(plain.output(buffer.data(), &smin, &rank, &gauss, &iterations).limit_torque == nullptr);
+  CHECK(o.contact_force == nullptr);
+  CHECK(plain.output(buffer.data(), &smin, &rank, &gauss, &iterations, &outcome).friction_torque == nullptr);
+  CHECK(plain.output(buffer.data(), &smin, &rank, &gauss, &iterations, &outcome).limit_torque == nullptr);
+  // Contacts after the friction outputs: 3 doubles of force each, then their statuses as int32.
+  const PackedRow ct{3, 2, 1, true, 3};
+  CHECK(ct.offset(PackedRow::ContactForce) == fr.offset(PackedRow::End));
+  CHECK(ct.offset(PackedRow::ContactStatus) == fr.offset(PackedRow::End) + 9);
+  CHECK(ct.offset(PackedRow::End) == fr.offset(PackedRow::End) + 9 + 2);
+  CHECK(ct.describe() == "n_joints = 3, n_segments = 2, m = 1 with friction, 3 contacts");
+  CHECK(!(ct == fr));
+  CHECK(!PackedRow{3, 2, 1, false, -1}.plausible());
+  std::vector<double> contact_buffer(static_cast<std::size_t>(ct.offset(PackedRow::End)));
+  const BatchOutput oc = ct.output(contact_buffer.data(), &smin, &rank, &gauss, &iterations, &outcome);
+  CHECK(oc.contact_force == contact_buffer.data() + ct.offset(PackedRow::ContactForce));
+  CHECK(reinterpret_cast<double*>(oc.contact_status) == contact_buffer.data() + ct.offset(PackedRow::ContactStatus));
+  CHECK(oc.contact_outcome == &outcome);
 }

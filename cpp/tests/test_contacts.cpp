@@ -335,3 +335,33 @@ TEST_CASE("a support under a direction the task also holds carries the load (lea
   MESSAGE("support force " << f.transpose() << " N; oracle " << best.transpose() << "; command "
                            << data.commandTorques().transpose() << " N m (free " << tau_free.transpose() << ")");
 }
+
+TEST_CASE("a force set-point the task drags along slides, its friction at the opposing vertex") {
+  // The planar arm's tool presses down on a table with 5 N (mu = 0.4) while the task accelerates
+  // it along x at 0.5 m/s^2 from rest: the point starts to slide, so Coulomb's law with maximum
+  // dissipation puts the friction at mu F against the motion, (-2, 0, 5) N in all. (The task's
+  // column along x contradicts a sticking trial's tangential column there: the solve must see
+  // that the point does not stick.)
+  const Model model(planarArm());
+  Data data(model);
+  SolveInput in(model);
+  Eigen::VectorXd q(3), qd = Eigen::VectorXd::Zero(3);
+  q << 0.6, -1.2, 0.3;
+  in.setState(JointPositions(q), JointVelocities(qd));
+  Eigen::MatrixXd alfa = Eigen::MatrixXd::Zero(6, 1);
+  alfa(0, 0) = 1.0;
+  REQUIRE(in.addConstraint(2, alfa, Eigen::VectorXd::Zero(1)));
+  in.constraints[0].classical = true;
+  in.constraints[0].classical_acceleration(0) = 0.5;
+  PointContact tool;
+  tool.segment = 2;
+  tool.normal = Vector3::UnitZ();
+  tool.mu = 0.4;
+  tool.force = 5.0;
+  in.contacts.push_back(tool);
+  const Status s = solve(model, data, in);
+  REQUIRE_MESSAGE(s, std::string(s.message()));
+  CHECK(data.contactStatus()[0] == ContactStatus::Sliding);
+  CHECK((data.contactForces().col(0) - Vector3(-2.0, 0.0, 5.0)).norm() <= 1e-12);
+  CHECK(replay(model, in, data) <= 1e-12);
+}

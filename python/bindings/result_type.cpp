@@ -21,7 +21,7 @@ using Row = vereshchagin::PackedRow;
 struct ResultObject {
   PyObject_VAR_HEAD PyObject* segments;  // segment_nu's layout: a (key, start, count) tuple per key, or NULL
   Row layout;
-  int rank, iterations;
+  int rank, iterations, contact_outcome;
   double smin, gauss;
   double data[1];  // layout.offset(Row::End) entries
 };
@@ -44,7 +44,7 @@ PyObject* allocate(const Row& layout) {
   if (r == nullptr) throw py::error_already_set();
   r->segments = nullptr;
   r->layout = layout;
-  r->rank = r->iterations = 0;
+  r->rank = r->iterations = r->contact_outcome = 0;
   r->smin = r->gauss = 0.0;
   return reinterpret_cast<PyObject*>(r);
 }
@@ -56,15 +56,21 @@ PyObject* getView(PyObject* o, void* closure) {
   const auto which = static_cast<Row::Field>(reinterpret_cast<intptr_t>(closure));
   const Row& l = r->layout;
   if (which >= Row::FrictionTorque && which <= Row::Status && !l.friction) Py_RETURN_NONE;
-  const Py_ssize_t n = which == Row::Nu ? l.m : which == Row::End ? l.offset(Row::End) : l.n_joints;
-  const Py_ssize_t dims[2] = {which == Row::LinkAcc ? l.n_segments + 1 : n, 6};
+  const bool contact = which == Row::ContactForce || which == Row::ContactStatus;
+  const Py_ssize_t n = which == Row::Nu    ? l.m
+                       : which == Row::End ? l.offset(Row::End)
+                       : contact           ? l.contacts
+                                           : l.n_joints;
+  const bool matrix = which == Row::LinkAcc || which == Row::ContactForce;  // (rows, 6) and (contacts, 3)
+  const Py_ssize_t dims[2] = {which == Row::LinkAcc ? l.n_segments + 1 : n, which == Row::LinkAcc ? 6 : 3};
   const auto& api = py::detail::npy_api::get();
   constexpr int flags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_;
   const int writeable = which == Row::End ? 0 : py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  const int type = which == Row::Status ? py::detail::npy_api::NPY_INT_ : py::detail::npy_api::NPY_DOUBLE_;
-  PyObject* v = api.PyArray_NewFromDescr_(
-      api.PyArray_Type_, api.PyArray_DescrFromType_(type), which == Row::LinkAcc ? 2 : 1, dims, nullptr,
-      r->data + (which == Row::End ? 0 : l.offset(which)), flags | writeable, nullptr);
+  const bool ints = which == Row::Status || which == Row::ContactStatus;
+  const int type = ints ? py::detail::npy_api::NPY_INT_ : py::detail::npy_api::NPY_DOUBLE_;
+  PyObject* v =
+      api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(type), matrix ? 2 : 1, dims, nullptr,
+                                r->data + (which == Row::End ? 0 : l.offset(which)), flags | writeable, nullptr);
   if (v == nullptr) return nullptr;
   Py_INCREF(o);
   if (api.PyArray_SetBaseObject_(v, o) != 0) Py_CLEAR(v);
@@ -72,11 +78,13 @@ PyObject* getView(PyObject* o, void* closure) {
 }
 
 // Scalar `which` (closure): 0 rank, 1 smin, 2 gauss, 3 iterations (2 and 3: None without friction),
-// 4 the (key, start, count) triples of segment_nu or None (vereshchagin/_results.py makes the dict).
+// 4 the (key, start, count) triples of segment_nu or None (vereshchagin/_results.py makes the dict),
+// 5 the ContactOutcome code.
 PyObject* getScalar(PyObject* o, void* closure) {
   const ResultObject* r = self(o);
   const intptr_t which = reinterpret_cast<intptr_t>(closure);
   if (which == 4) return py::handle(r->segments ? r->segments : Py_None).inc_ref().ptr();
+  if (which == 5) return PyLong_FromLong(r->contact_outcome);
   if (which >= 2 && !r->layout.friction) Py_RETURN_NONE;
   if (which == 0 || which == 3) return PyLong_FromLong(which == 0 ? r->rank : r->iterations);
   return PyFloat_FromDouble(which == 1 ? r->smin : r->gauss);
@@ -98,14 +106,18 @@ PyGetSetDef g_getset[] = {{"qdd", getView, nullptr, nullptr, closure(Row::Qdd)},
                           {"status", getView, nullptr, nullptr, closure(Row::Status)},
                           {"gauss_value", getScalar, nullptr, nullptr, closure(2)},
                           {"iterations", getScalar, nullptr, nullptr, closure(3)},
+                          {"contact_force", getView, nullptr, nullptr, closure(Row::ContactForce)},
+                          {"contact_status", getView, nullptr, nullptr, closure(Row::ContactStatus)},
                           {"_segment_layout", getScalar, nullptr, nullptr, closure(4)},
+                          {"_contact_outcome", getScalar, nullptr, nullptr, closure(5)},
                           {"_data", getView, nullptr, nullptr, closure(Row::End)},
                           {nullptr, nullptr, nullptr, nullptr, nullptr}};
 
 // A result from the entries of a state that vereshchagin/_results.py checked; the sizes and the
 // data length are checked again here, before anything is allocated.
-py::object resultFromParts(std::tuple<long, long, long, bool> sizes, std::tuple<int, double, double, int> scalars,
-                           const py::bytes& data, const py::object& layout) {
+py::object resultFromParts(std::tuple<long, long, long, bool, long> sizes,
+                           std::tuple<int, double, double, int, int> scalars, const py::bytes& data,
+                           const py::object& layout) {
   const Row l = std::apply([](auto... size) { return Row{size...}; }, sizes);
   if (!l.plausible()) raise("SolveResult state: sizes out of range");
   const std::string_view buf = data;
@@ -114,7 +126,7 @@ py::object resultFromParts(std::tuple<long, long, long, bool> sizes, std::tuple<
   py::object o = py::reinterpret_steal<py::object>(allocate(l));
   ResultObject* r = self(o.ptr());
   std::memcpy(r->data, buf.data(), buf.size());
-  std::tie(r->rank, r->smin, r->gauss, r->iterations) = scalars;
+  std::tie(r->rank, r->smin, r->gauss, r->iterations, r->contact_outcome) = scalars;
   if (!layout.is_none()) setSegmentLayout(o.ptr(), layout.cast<py::tuple>());
   return o;
 }
@@ -151,7 +163,8 @@ py::object newResult(const vereshchagin::PackedRow& layout, PyObject* out) {
 
 vereshchagin::BatchOutput resultOutput(PyObject* o) {
   ResultObject* r = self(o);
-  return r->layout.output(r->data, &r->smin, &r->rank, &r->gauss, &r->iterations);
+  r->contact_outcome = 0;  // written by a solve with contacts
+  return r->layout.output(r->data, &r->smin, &r->rank, &r->gauss, &r->iterations, &r->contact_outcome);
 }
 
 void setSegmentLayout(PyObject* o, py::tuple layout) {

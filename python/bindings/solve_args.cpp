@@ -135,6 +135,39 @@ void SolveArgs::parseFriction(PyObject* obj) {  // input.friction: cleared by st
   }
 }
 
+// contacts: a list or tuple of vereshchagin.Contact, every row's. Each holds its segment key and its
+// checked values as a read-only float64 array (vereshchagin/contacts.py): point (3, in the segment's
+// or link's frame), normal (3), mu, facets, force (NaN: a support).
+void SolveArgs::parseContacts(PyObject* obj) {
+  static PyObject* const type =
+      py::object(py::module_::import("vereshchagin.contacts").attr("Contact")).release().ptr();
+  static PyObject* const segment_name = PyUnicode_InternFromString("_segment");
+  static PyObject* const values_name = PyUnicode_InternFromString("_values");
+  if (!PyList_Check(obj) && !PyTuple_Check(obj)) raise("contacts must be a list of vereshchagin.Contact");
+  for (Py_ssize_t k = 0; k < PySequence_Fast_GET_SIZE(obj); ++k) {
+    PyObject* c = PySequence_Fast_GET_ITEM(obj, k);
+    const std::string label = "contacts[" + std::to_string(k) + "]";
+    if (!PyObject_TypeCheck(c, reinterpret_cast<PyTypeObject*>(type)))
+      raise(label + " must be a vereshchagin.Contact, got " + Py_TYPE(c)->tp_name);
+    const auto attr = [c](PyObject* name) {
+      py::object o = py::reinterpret_steal<py::object>(PyObject_GetAttr(c, name));
+      if (!o) throw py::error_already_set();
+      return o;
+    };
+    const FrameTarget t = solver_->addressing->resolveMoving(attr(segment_name).ptr(), label);
+    const F64View v = asF64(attr(values_name).ptr(), label.c_str());  // checked by Contact (force NaN: a support)
+    if (v.ndim != 1 || v.shape[0] != 9) raise(label + ": not a vereshchagin.Contact's values");
+    const KDL::Vector point = t.link_in_tip * KDL::Vector(v.data[0], v.data[1], v.data[2]);
+    vereshchagin::PointContact& pc = input.contacts.emplace_back();
+    pc.segment = t.segment;
+    pc.point = vereshchagin::Vector3(point.data);
+    pc.normal = vereshchagin::Vector3(v.data + 3);
+    pc.mu = v.data[6];
+    pc.facets = static_cast<int>(v.data[7]);
+    pc.force = v.data[8];
+  }
+}
+
 void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   start(batch, s.cppModel());
   solver_ = &s;
@@ -154,6 +187,8 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   if (given(a[5])) input.ff_torques = vector(a[5], "tau_ff", solver_->nj);
   if (given(a[7])) parseConstraints(a[7]);
   parseFriction(a[6]);
+  input.contacts.clear();
+  if (given(a[kContactsArg])) parseContacts(a[kContactsArg]);
   // Pass-through weights: one per constraint column (their range: checked by vereshchagin::solve).
   if (given(a[8])) input.f_ext_pass_through = vector(a[8], "f_ext_pass_through", columns, /*scalar_ok=*/true);
   if (given(a[9])) input.ff_pass_through = vector(a[9], "tau_ff_pass_through", columns, /*scalar_ok=*/true);

@@ -29,7 +29,8 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out) {
   Lock lk(*this);
   solveArgs(args, false);
   const bool fr = args_.any_friction;
-  py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr}, out);
+  const long k = static_cast<long>(args_.input.contacts.size());
+  py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr, k}, out);
   if (!resultOutput(r.ptr()).write(0, workspaces_[0]->data, args_.columns, fr))
     raise("the results overflow: gauss_value is beyond the double range");
   if (!args_.layout.empty()) setSegmentLayout(r.ptr(), py::tuple(args_.layout));
@@ -85,6 +86,10 @@ py::dict PySolver::solveBatch(PyObject* const* args, PyObject* threads_obj) {
   o.status = ints(put("status", newInts({BF, n})));
   o.gauss_value = doubles(put("gauss_value", newDoubles({BF})));
   o.iterations = ints(put("iterations", newInts({BF})));
+  const py::ssize_t k = static_cast<py::ssize_t>(a.input.contacts.size());
+  o.contact_force = doubles(put("contact_force", newDoubles({B, k, 3})));
+  o.contact_status = ints(put("contact_status", newInts({B, k})));
+  o.contact_outcome = ints(put("contact_outcome", newInts({B})));
   vereshchagin::BatchFailure failure;
   {
     py::gil_scoped_release release;

@@ -12,7 +12,7 @@ namespace {
 // solve()'s parameters; solve_batch() has `threads` in place of `out`.
 // clang-format off
 constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
-                                        "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired"};
+                                        "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired", "contacts"};
 // clang-format on
 static_assert(sizeof(kSolveParams) == kNumSolveArgs * sizeof(char*), "one name per SolveArgs::parse argument");
 PyObject* g_names[2][kNumSolveArgs];  // interned: solve()'s, solve_batch()'s
@@ -70,7 +70,7 @@ constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict", "sol
 // The METH_FASTCALL methods: solve(q, qd, ...); _time_cpp(reps, q, qd, ...): seconds per C++
 // solve (outputs read as solve() reads them), for benchmarks that compare the Python call with
 // the C++ work in the same process; _solve_dict(q, qd, ...): solve() returning a dict of arrays;
-// solve_batch(q, qd, ..., threads, a_desired): a dict of the batch's arrays (solver.py wraps it).
+// solve_batch(q, qd, ..., threads, a_desired, contacts): a dict of the batch's arrays (solver.py wraps it).
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
@@ -99,10 +99,10 @@ using O = const py::object&;
 // _solve_pybind: solve() bound the plain pybind11 way (named arguments with defaults), the
 // benchmark of the fast call's gain.
 py::object solvePybind(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_ff, O friction, O constraints, O f_pass,
-                       O t_pass, O out, O a_desired) {
-  PyObject* a[kNumSolveArgs] = {q.ptr(),      qd.ptr(),     alpha.ptr(),    beta.ptr(),
-                                f_ext.ptr(),  tau_ff.ptr(), friction.ptr(), constraints.ptr(),
-                                f_pass.ptr(), t_pass.ptr(), out.ptr(),      a_desired.ptr()};
+                       O t_pass, O out, O a_desired, O contacts) {
+  PyObject* a[kNumSolveArgs] = {q.ptr(),      qd.ptr(),        alpha.ptr(),       beta.ptr(),   f_ext.ptr(),
+                                tau_ff.ptr(), friction.ptr(),  constraints.ptr(), f_pass.ptr(), t_pass.ptr(),
+                                out.ptr(),    a_desired.ptr(), contacts.ptr()};
   return s.solve(a, out.is_none() ? nullptr : out.ptr());
 }
 
@@ -135,7 +135,7 @@ void bindSolver(py::module_& mod) {
   cls.def("_solve_pybind", &solvePybind, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,
           py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
           py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, py::arg("out") = none,
-          py::arg("a_desired") = none, doc("_core.Solver._solve_pybind"));
+          py::arg("a_desired") = none, py::arg("contacts") = none, doc("_core.Solver._solve_pybind"));
 }
 
 }  // namespace vsbind

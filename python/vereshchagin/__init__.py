@@ -10,6 +10,7 @@ feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL
 from ._core import Chain, Joint, SolveResult, SolverError, Tree
 from . import _models, _results, robots, task  # noqa: F401 (_models, _results: members in Python)
 from ._version import __version__ as __version__  # written once: CMakeLists.txt
+from .contacts import Contact, ContactOutcome, ContactStatus
 from .friction import Friction
 from .kdl_interop import chain_from_kdl as _chain_from_kdl, chain_to_kdl as _chain_to_kdl
 from .solver import BatchResult, Solver
@@ -39,6 +40,9 @@ setattr(Chain, "to_kdl", _to_kdl)  # noqa: B010
 __all__ = [
     "BatchResult",
     "Chain",
+    "Contact",
+    "ContactOutcome",
+    "ContactStatus",
     "Friction",
     "Joint",
     "SolveResult",

@@ -494,7 +494,7 @@ DOCS["Tree.fk_all"] = _fk_all(", in segment order")
 
 # ---- Solver (solver_bindings.cpp): the C++ core of vereshchagin.Solver (solver.py) ----
 
-DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None)
+DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -548,19 +548,28 @@ a_desired : array_like, shape (6,), optional
     ``beta = alpha.T @ [a_lin - omega x v - gravity; a_ang]`` itself, from the tip twist its own
     sweep computes at ``(q, qd)`` (what :func:`vereshchagin.task.beta_for` does, without the
     extra kinematics): ``a_desired = 0`` holds the tip still against gravity.
+contacts : list of Contact, optional
+    Point contacts (:class:`vereshchagin.Contact`): supports, whose normal force (>= 0) and
+    friction the solve finds exactly with the motion (a point may lift off), and force
+    set-points, which stay on their surface and push with a given normal force. The surfaces
+    supply the contact forces, the motors only ``tau_command``; where the forces are not unique,
+    the least motor effort, then the least contact force (docs: "Contacts"). Not together with
+    ``friction`` yet.
 
 Returns
 -------
 SolveResult
     ``qdd``, ``tau_command``, ``nu``, ``link_acc``, ``constraint_rank``,
     ``smallest_singular_value``; with friction also ``friction_torque``, ``limit_torque``,
-    ``status``, ``gauss_value``, ``iterations``; with ``constraints`` also ``segment_nu``.
+    ``status``, ``gauss_value``, ``iterations``; with ``constraints`` also ``segment_nu``; with
+    ``contacts`` ``contact_force``, ``contact_status``, ``contact_outcome``.
 
 Raises
 ------
 SolverError
     Wrong shapes or dtypes, NaN or Inf, unknown segment names, more than 6 columns on one
-    segment, invalid friction, or a solve that fails (the message says why).
+    segment, invalid friction or contacts, or a solve that fails (the message says why: e.g.
+    contacts whose conditions no forces meet).
 
 Notes
 -----
@@ -568,7 +577,7 @@ The GIL is released during the solve. One solver serialises concurrent calls; us
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
 """
 
-DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None)
+DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None, contacts=None)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 """
@@ -640,6 +649,17 @@ DOCS["SolveResult.status"] = r"""ndarray of int32, shape (n,) or None: 0 moving,
 DOCS["SolveResult.gauss_value"] = r"""float or None: Gauss' function at the optimum, ``Z0(qdd) + sum f_j |qdd_j|`` over resting joints."""
 
 DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max-min (bounded; see the docs)."""
+
+DOCS["SolveResult.contact_force"] = r"""ndarray, shape (k, 3): the force each contact's surface applies to the robot at its point, base axes, N.
+
+One row per entry of ``contacts`` (k = 0 without contacts); a set-point's normal force included.
+Replaying ``tau_ff + tau_command`` and these forces (``J_c^T f_c``) through any forward dynamics
+gives ``qdd``.
+"""
+
+DOCS["SolveResult.contact_status"] = r"""ndarray of int32, shape (k,): :class:`ContactStatus` codes, 0 separating, 1 sticking, 2 sliding."""
+
+DOCS["SolveResult.contact_outcome"] = r"""ContactOutcome: NONE (no contacts), UNIQUE (no touching support has friction: unique accelerations) or CONSISTENT (one consistent answer by the documented rule)."""
 
 DOCS["SolveResult.segment_nu"] = r"""dict or None: ``{key: nu_i}`` for each ``constraints`` key, views into ``nu``."""
 

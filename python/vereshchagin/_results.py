@@ -1,9 +1,10 @@
 """SolveResult's pickling, copies, ``segment_nu`` and repr, written in Python over the compiled type.
 
 The compiled ``_core.SolveResult`` keeps only the storage, its array views and the solve path's
-fast access (``python/bindings/result_type.cpp``). Its pickle state is the 12-tuple of
+fast access (``python/bindings/result_type.cpp``). Its pickle state is the 14-tuple of
 ``_result_state``: ``(n_joints, n_segments, m, friction, smallest_singular_value, gauss_value,
-constraint_rank, iterations, data, keys, starts, counts)``; the compiled type holds the segment
+constraint_rank, iterations, data, keys, starts, counts, contacts, contact_outcome)`` (states of
+12 entries, from before contacts, load with none); the compiled type holds the segment
 layout as one tuple of ``(key, start, count)`` triples. A state is checked here (crafted states
 raise ``ValueError``) before ``_core._result_from_parts`` allocates a result.
 """
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 from ._core import SolveResult, _result_from_parts
 from ._docstrings import DOCS
+from .contacts import ContactOutcome
 
 _MAX_SIZE = 1 << 24  # joints or segments of a result
 _INT_MAX = 2**31 - 1
@@ -63,11 +65,19 @@ def _result_from_state(*state) -> SolveResult:
         The state is malformed: wrong entry count, sizes out of range, data of the wrong length,
         a segment layout that does not fit ``nu``.
     """
-    if len(state) != 12:
-        raise ValueError("SolveResult state must have 12 entries")
+    if len(state) not in (12, 14):
+        raise ValueError("SolveResult state must have 14 entries (12 without contacts)")
     nj = _int(state[0], _MAX_SIZE, "n_joints")
     ns = _int(state[1], _MAX_SIZE, "n_segments")
-    sizes = (nj, ns, _int(state[2], 6 * ns, "m"), _int(state[3], 1, "the friction flag"))
+    contacts, outcome = state[12:] if len(state) == 14 else (0, 0)
+    sizes = (
+        nj,
+        ns,
+        _int(state[2], 6 * ns, "m"),
+        _int(state[3], 1, "the friction flag"),
+        _int(contacts, _MAX_SIZE, "contacts"),
+    )
+    outcome = _int(outcome, 2, "the contact outcome")
     rank = _int(state[6], _INT_MAX, "rank", -_INT_MAX)
     iterations = _int(state[7], _INT_MAX, "iterations", -_INT_MAX)
     if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in state[4:6]):
@@ -78,7 +88,7 @@ def _result_from_state(*state) -> SolveResult:
     if state[9] is not None:
         _check_segment_layout(state[9], state[10], state[11], sizes[2])
         layout = tuple(zip(state[9], state[10], state[11]))
-    return _result_from_parts(sizes, (rank, state[4], state[5], iterations), state[8], layout)
+    return _result_from_parts(sizes, (rank, state[4], state[5], iterations, outcome), state[8], layout)
 
 
 def _result_state(self: SolveResult) -> tuple:
@@ -89,7 +99,8 @@ def _result_state(self: SolveResult) -> tuple:
     layout = (None, None, None) if triples is None else tuple(zip(*triples))
     sizes = (len(self.qdd), len(self.link_acc) - 1, len(self.nu), int(self.friction_torque is not None))
     scalars = (self.smallest_singular_value, 0.0 if gauss is None else gauss, self.constraint_rank)
-    return (*sizes, *scalars, 0 if iterations is None else iterations, self._data.tobytes(), *layout)
+    contacts = (len(self.contact_status), self._contact_outcome)
+    return (*sizes, *scalars, 0 if iterations is None else iterations, self._data.tobytes(), *layout, *contacts)
 
 
 def _reduce(self: SolveResult):
@@ -116,6 +127,11 @@ def _segment_nu(self: SolveResult):
     return {key: nu[start : start + count] for key, start, count in layout}
 
 
+def _contact_outcome(self: SolveResult) -> ContactOutcome:
+    """How the contact forces were determined (``ContactOutcome.NONE`` without contacts)."""
+    return ContactOutcome(self._contact_outcome)
+
+
 def _repr(self: SolveResult) -> str:
     """``<vereshchagin.SolveResult n_joints=7 m=6 rank=6 friction>`` (" friction": a friction solve)."""
     friction = " friction" if self.friction_torque is not None else ""
@@ -130,5 +146,6 @@ for _name, _value in [
     ("__copy__", _copy),
     ("__deepcopy__", _deepcopy),
     ("segment_nu", property(_segment_nu, doc=DOCS["SolveResult.segment_nu"])),
+    ("contact_outcome", property(_contact_outcome, doc=DOCS["SolveResult.contact_outcome"])),
 ]:
     setattr(SolveResult, _name, _value)

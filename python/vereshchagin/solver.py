@@ -67,6 +67,13 @@ class BatchResult:
         Iterations of each row's friction max-min (-1 in rows without friction).
     segment_nu : dict or None
         ``{key: (B, m_i) view of nu}`` for each ``constraints`` key.
+    contact_force : ndarray, shape (B, k, 3)
+        With ``contacts`` (k of them, every row's): the force each surface applies to the robot,
+        base axes, N (k = 0 without contacts).
+    contact_status : ndarray of int32, shape (B, k)
+        :class:`ContactStatus` codes: 0 separating, 1 sticking, 2 sliding.
+    contact_outcome : ndarray of int32, shape (B,)
+        :class:`ContactOutcome` codes: 0 none, 1 unique, 2 consistent.
     """
 
     qdd: np.ndarray
@@ -81,6 +88,9 @@ class BatchResult:
     gauss_value: Optional[np.ndarray] = None
     iterations: Optional[np.ndarray] = None
     segment_nu: Optional[dict] = None
+    contact_force: Optional[np.ndarray] = None
+    contact_status: Optional[np.ndarray] = None
+    contact_outcome: Optional[np.ndarray] = None
 
 
 class Solver(_core.Solver):
@@ -157,6 +167,7 @@ class Solver(_core.Solver):
         tau_ff_pass_through=None,
         threads=1,
         a_desired=None,
+        contacts=None,
     ) -> BatchResult:
         """Solve B states at once (each row exactly as :meth:`solve` would).
 
@@ -185,6 +196,8 @@ class Solver(_core.Solver):
             are joined and :class:`SolverError` says so.
         a_desired : array_like, shape (B, 6) or (6,), optional
             Instead of ``beta``: the last segment's classical acceleration (see :meth:`solve`).
+        contacts : list of Contact, optional
+            Point contacts of every row (see :meth:`solve`).
 
         Returns
         -------
@@ -211,6 +224,7 @@ class Solver(_core.Solver):
             tau_ff_pass_through,
             threads,
             a_desired,
+            contacts,
         )
         if not out.pop("any_friction"):
             for key in ("friction_torque", "limit_torque", "status", "gauss_value", "iterations"):

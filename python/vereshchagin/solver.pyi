@@ -5,6 +5,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from .contacts import Contact
 
 @dataclass(frozen=True)
 class BatchResult:
@@ -20,6 +21,9 @@ class BatchResult:
     gauss_value: Optional[NDArray[np.float64]] = None
     iterations: Optional[NDArray[np.int32]] = None
     segment_nu: Optional[dict] = None
+    contact_force: Optional[NDArray[np.float64]] = None
+    contact_status: Optional[NDArray[np.int32]] = None
+    contact_outcome: Optional[NDArray[np.int32]] = None
 
 class Solver(_core.Solver):
     def __init__(
@@ -45,6 +49,7 @@ class Solver(_core.Solver):
         tau_ff_pass_through: Optional[ArrayLike] = None,
         threads: int = 1,
         a_desired: Optional[ArrayLike] = None,
+        contacts: Optional[Sequence[Contact]] = None,
     ) -> BatchResult: ...
     @property
     def chain(self) -> _core.Chain: ...

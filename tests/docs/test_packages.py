@@ -63,5 +63,5 @@ def test_the_library_package_holds_no_experiments():
 
     files = metadata.files("vereshchagin")
     names = {str(f) for f in files}
-    assert not any(n.startswith(("vereshchagin/contact", "vereshchagin/experiments")) for n in names)
+    assert not any(n.startswith(("vereshchagin/contact/", "vereshchagin/experiments")) for n in names)
     assert not hasattr(vereshchagin, "contact")

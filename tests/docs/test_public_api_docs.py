@@ -139,6 +139,7 @@ def test_solve_has_a_full_docstring_and_signature():
         "constraints",
         "out",
         "a_desired",
+        "contacts",
     ):
         assert section in doc, section
     params = list(inspect.signature(vs.Solver.solve).parameters)
@@ -156,6 +157,7 @@ def test_solve_has_a_full_docstring_and_signature():
         "tau_ff_pass_through",
         "out",
         "a_desired",
+        "contacts",
     ]
 
 

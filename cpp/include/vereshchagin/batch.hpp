@@ -61,6 +61,9 @@ struct BatchInput {
   /// Friction: empty: none; one entry: every row's; else one per row (nullptr: that row has none).
   /// Not owned: each must outlive the solves.
   std::vector<const FrictionModel*> friction;
+  /// Point contacts of every row (SolveInput::contacts; empty: none), with their velocity tolerance.
+  std::vector<PointContact> contacts;
+  double contact_velocity_tolerance = 1e-6;  ///< SolveInput::contact_velocity_tolerance (m/s)
 
   /// Constraint columns of every row (the size of nu).
   int columns() const;
@@ -87,6 +90,12 @@ struct BatchOutput {
   double* gauss_value = nullptr;   ///< see friction_torque
   int* status = nullptr;           ///< see friction_torque
   int* iterations = nullptr;       ///< see friction_torque
+  /// Contact outputs (nullptr: not written), k = the rows' contacts: per row the forces (k x 3,
+  /// Data::contactForces() transposed), the statuses (k, ContactStatus as int) and the outcome (1,
+  /// ContactOutcome as int).
+  double* contact_force = nullptr;
+  int* contact_status = nullptr;   ///< see contact_force
+  int* contact_outcome = nullptr;  ///< see contact_force
 
   /// Copies `data`'s results (after a successful solve of a row with `columns` columns, with or
   /// without friction) as row b. Returns false when gauss_value is not finite (an overflow).
@@ -96,8 +105,9 @@ struct BatchOutput {
 /// The outputs of one row packed in one buffer of doubles, in this order: qdd and tau_command
 /// (n_joints each), nu (m), link_acc ((n_segments + 1) x 6, row-major), then with friction
 /// friction_torque and limit_torque (n_joints each) and status (n_joints int32 values in
-/// ceil(n_joints / 2) doubles). The Python package's SolveResult stores its outputs (and pickles
-/// them) in this layout; the scalars live outside the buffer.
+/// ceil(n_joints / 2) doubles), then with contacts contact_force (contacts x 3, row-major) and
+/// contact_status (contacts int32 values in ceil(contacts / 2) doubles). The Python package's SolveResult stores its
+/// outputs (and pickles them) in this layout; the scalars live outside the buffer.
 struct PackedRow {
   /// An output's place in the buffer (see offset()).
   enum Field {
@@ -108,35 +118,44 @@ struct PackedRow {
     FrictionTorque,  ///< friction torques (n_joints; with friction)
     LimitTorque,     ///< joint-limit reactions (n_joints; with friction)
     Status,          ///< JointStatus as int32 (n_joints; with friction)
+    ContactForce,    ///< contact forces (contacts x 3)
+    ContactStatus,   ///< ContactStatus as int32 (contacts)
     End,             ///< the end of the buffer
   };
   long n_joints = 0;      ///< n
   long n_segments = 0;    ///< segments of the model
   long m = 0;             ///< constraint columns (the size of nu)
   bool friction = false;  ///< whether the friction outputs are stored
+  long contacts = 0;      ///< point contacts (the rows of contact_force)
 
   /// The first double of `field` (End: the buffer's length; the friction fields: their place as
   /// if stored). Inline, as output(): the solve path of the Python package calls them per solve.
   std::ptrdiff_t offset(Field field) const {
     const std::ptrdiff_t n = n_joints, link = 6 * (n_segments + 1), friction_start = 2 * n + m + link;
     if (field <= LinkAcc) return field == Qdd ? 0 : field == TauCommand ? n : field == Nu ? 2 * n : 2 * n + m;
-    if (field != End) return friction_start + (field - FrictionTorque) * n;
-    return friction ? friction_start + 2 * n + (n + 1) / 2 : friction_start;
+    if (field <= Status) return friction_start + (field - FrictionTorque) * n;
+    const std::ptrdiff_t contact_start = friction ? friction_start + 2 * n + (n + 1) / 2 : friction_start;
+    if (field == ContactForce) return contact_start;
+    return contact_start + 3 * contacts + (field == End ? (contacts + 1) / 2 : 0);
   }
-  /// "n_joints = 7, n_segments = 8, m = 6 with friction" (or "without friction").
+  /// "n_joints = 7, n_segments = 8, m = 6 with friction" (or "without friction"; ", 2 contacts" when
+  /// there are contacts).
   std::string describe() const;
   /// Whether the sizes are ones a model can have (0 .. 2^24 joints and segments, 0 .. 6 columns per
   /// segment): the check of a layout read from outside (an unpickled result) before it is allocated.
   bool plausible() const;
   /// Whether both describe the same layout.
   bool operator==(const PackedRow& o) const {
-    return n_joints == o.n_joints && n_segments == o.n_segments && m == o.m && friction == o.friction;
+    return n_joints == o.n_joints && n_segments == o.n_segments && m == o.m && friction == o.friction &&
+           contacts == o.contacts;
   }
   /// A BatchOutput that writes row 0 into `buffer` (offset(End) doubles; the friction outputs
-  /// nullptr without friction) and the scalars (1 each) where the pointers point.
+  /// nullptr without friction, the contact ones without contacts) and the scalars (1 each) where
+  /// the pointers point.
   BatchOutput output(double* buffer, double* smallest_singular_value, int* constraint_rank, double* gauss_value,
-                     int* iterations) const {
+                     int* iterations, int* contact_outcome) const {
     double* const fr = friction ? buffer + offset(FrictionTorque) : nullptr;
+    double* const ct = contacts > 0 ? buffer + offset(ContactForce) : nullptr;
     return {buffer,
             buffer + n_joints,
             buffer + offset(Nu),
@@ -147,7 +166,10 @@ struct PackedRow {
             fr ? fr + n_joints : nullptr,
             gauss_value,
             fr ? reinterpret_cast<int*>(fr + 2 * n_joints) : nullptr,
-            iterations};
+            iterations,
+            ct,
+            ct ? reinterpret_cast<int*>(ct + 3 * contacts) : nullptr,
+            ct ? contact_outcome : nullptr};
   }
 };
 
