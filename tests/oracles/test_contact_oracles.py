@@ -6,29 +6,19 @@ of Gauss's principle, and every enumerated solution against its own sign conditi
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 import pytest
 
 from support.chains import pin_configuration, random_chain, random_state
-from support.contact_oracle import _candidate, check_solution, contact_problem, enumerate_modes, frictionless_qp
+from support.contact_oracle import (
+    _candidate,
+    check_solution,
+    contact_problem,
+    enumerate_modes,
+    frictionless_qp,
+    pin_rigid_3d,
+)
 
 RTOL = 1e-9
-
-
-def _pin_sticking_qdd(model, data, q, qd, tau, frame, point):
-    placement = model.frames[frame].placement * pin.SE3(np.eye(3), np.asarray(point, float))
-    cm = pin.RigidConstraintModel(
-        pin.ContactType.CONTACT_3D,
-        model,
-        model.frames[frame].parentJoint,
-        placement,
-        0,
-        pin.SE3.Identity(),
-        pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
-    )
-    cd = cm.createData()
-    pin.initConstraintDynamics(model, data, [cm], [cd])
-    return pin.constraintDynamics(model, data, q, qd, tau, [cm], [cd], pin.ProximalSettings(1e-14, 0.0, 1))
 
 
 def _resting_problem(rng, n, segments, contact):
@@ -54,7 +44,7 @@ def test_a_sticking_point_matches_pinocchio_constraint_dynamics(seed):
     spec = dict(frame=rc.tip_frames[-1], point=point, normal=[0.0, 0.0, 1.0], mu=100.0)
     prob = contact_problem(model, data, qp, qd, tau, [spec])
     sol, resid = _candidate(prob, ("stick",))
-    expected = _pin_sticking_qdd(model, model.createData(), qp, qd, tau, rc.tip_frames[-1], point)
+    expected, _ = pin_rigid_3d(model, model.createData(), qp, qd, tau, rc.tip_frames[-1], point)
     assert resid < 1e-12
     assert np.linalg.norm(sol.qdd - expected) <= RTOL * max(1.0, np.linalg.norm(expected))
 

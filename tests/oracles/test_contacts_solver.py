@@ -12,7 +12,7 @@ import pytest
 
 import vereshchagin as vs
 from support.chains import pin_configuration, random_chain, random_state
-from support.contact_oracle import contact_problem, enumerate_modes, frictionless_qp
+from support.contact_oracle import contact_problem, enumerate_modes, frictionless_qp, pin_rigid_3d
 
 RTOL = 1e-9
 STATUS = {"separating": vs.ContactStatus.SEPARATING, "sticking": vs.ContactStatus.STICKING}
@@ -20,24 +20,6 @@ STATUS = {"separating": vs.ContactStatus.SEPARATING, "sticking": vs.ContactStatu
 
 def _rel(a, b):
     return np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(1.0, np.linalg.norm(b))
-
-
-def _pin_sticking(model, data, q, qd, tau, frame, point):
-    """qdd and the contact force (base axes, on the robot) of a point held in 3-D by Pinocchio."""
-    placement = model.frames[frame].placement * pin.SE3(np.eye(3), np.asarray(point, float))
-    cm = pin.RigidConstraintModel(
-        pin.ContactType.CONTACT_3D,
-        model,
-        model.frames[frame].parentJoint,
-        placement,
-        0,
-        pin.SE3.Identity(),
-        pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
-    )
-    cd = cm.createData()
-    pin.initConstraintDynamics(model, data, [cm], [cd])
-    qdd = pin.constraintDynamics(model, data, q, qd, tau, [cm], [cd], pin.ProximalSettings(1e-14, 0.0, 1))
-    return qdd, data.lambda_c.copy()
 
 
 def _resting(rng, n, k, mu, force=None, first=2):
@@ -82,7 +64,7 @@ def test_a_sticking_point_is_pinocchios_rigid_3d_contact(seed):
     point = rng.normal(size=3) * 0.1
     contact = vs.Contact(rc.n_segments - 1, point=point, normal=[0.0, 0.0, 1.0], mu=1e6)
     r = solver.solve(q, qd, tau_ff=tau, contacts=[contact])
-    qdd, lam = _pin_sticking(rc.model, rc.data(), pin_configuration(rc.model, q), qd, tau, rc.tip_frames[-1], point)
+    qdd, lam = pin_rigid_3d(rc.model, rc.data(), pin_configuration(rc.model, q), qd, tau, rc.tip_frames[-1], point)
     if lam[2] <= 0.0:  # Pinocchio's bilateral answer pulls: the support lifts off instead
         assert r.contact_status[0] == vs.ContactStatus.SEPARATING
         return
@@ -170,3 +152,30 @@ def test_solve_batch_with_contacts_equals_solve_row_by_row():
         np.testing.assert_array_equal(batch.qdd[b], r.qdd)
         np.testing.assert_array_equal(batch.contact_force[b], r.contact_force)
         np.testing.assert_array_equal(batch.contact_status[b], r.contact_status)
+
+
+@pytest.mark.parametrize("name", ["baxter", "talos", "random_3", "random_8", "random_11"])
+def test_frictionless_supports_on_trees_are_gauss_qp(name):
+    """1 to 8 supports on random segments of a tree (Pinocchio's joint order mapped by name)."""
+    from support.trees import robot
+
+    case = robot(name)
+    rng = np.random.default_rng([31, len(name)])
+    names = list(case.tree.segment_names)
+    for k in (1, 3, 5, 8):
+        q, _ = case.random_state(rng)
+        tau = rng.normal(size=case.n) * 3
+        contacts = []
+        for s in rng.choice(len(names), size=min(k, len(names)), replace=False):
+            normal = rng.normal(size=3)
+            contacts.append(
+                vs.Contact(names[s], point=rng.normal(size=3) * 0.05, normal=normal / np.linalg.norm(normal))
+            )
+        r = case.solver().solve(q, np.zeros(case.n), tau_ff=tau, contacts=contacts)
+        specs = [dict(frame=case.model.getFrameId(c.segment), point=c.point, normal=c.normal, mu=0.0) for c in contacts]
+        model = case.model
+        prob = contact_problem(model, model.createData(), case.pin_q(q), np.zeros(model.nv), case.pin_v(tau), specs)
+        expected = frictionless_qp(prob)
+        assert _rel(r.qdd, case.ours(expected)) <= RTOL, f"{name}, {k} supports"
+        gen = sum(c.J.T @ f for c, f in zip(prob.contacts, r.contact_force))
+        assert _rel(gen, prob.H @ expected - prob.h) <= RTOL

@@ -328,3 +328,23 @@ def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6):
     A = np.zeros((0, nv)) if A is None else np.asarray(A, float)
     b = np.zeros(0) if b is None else np.asarray(b, float)
     return ContactProblem(H, h, A, b, contacts)
+
+
+def pin_rigid_3d(model, data, q, qd, tau, frame, point):
+    """Pinocchio's answer for a point of frame ``frame`` (its local coordinates ``point``) held in
+    3-D (``RigidConstraintModel`` CONTACT_3D, LOCAL_WORLD_ALIGNED): ``(qdd, force)``, the force the
+    constraint applies to the robot in base axes (``data.lambda_c``)."""
+    placement = model.frames[frame].placement * pin.SE3(np.eye(3), np.asarray(point, float))
+    cm = pin.RigidConstraintModel(
+        pin.ContactType.CONTACT_3D,
+        model,
+        model.frames[frame].parentJoint,
+        placement,
+        0,
+        pin.SE3.Identity(),
+        pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+    )
+    cd = cm.createData()
+    pin.initConstraintDynamics(model, data, [cm], [cd])
+    qdd = pin.constraintDynamics(model, data, q, qd, tau, [cm], [cd], pin.ProximalSettings(1e-14, 0.0, 1))
+    return qdd, data.lambda_c.copy()
