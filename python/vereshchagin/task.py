@@ -105,7 +105,7 @@ def directions(names: Union[str, Sequence], frame=None) -> np.ndarray:
                 raise SolverError(f"a direction vector must be finite and nonzero, got {v}")
             v = v / norm
         cols.append(np.concatenate([R @ v[:3], R @ v[3:]]))
-    return np.array(cols, dtype=float).reshape(-1, 6).T
+    return np.ascontiguousarray(np.array(cols, dtype=float).reshape(-1, 6).T)  # C order: the solve views it in place
 
 
 def beta_for(alpha, a_desired, twist, gravity=_G_EARTH) -> np.ndarray:
