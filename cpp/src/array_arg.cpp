@@ -22,11 +22,15 @@ std::string unconvertedMessage(const char* name, const std::string& type, const 
   return note.empty() ? why : why + " (its conversion raised " + note + ")";
 }
 
+bool realDtype(char kind, int ndim) {
+  return (kind == 'f' || kind == 'i' || kind == 'u') && ndim <= 3;
+}
+
 std::string dtypeMessage(const char* name, char kind, const std::string& dtype, int ndim) {
+  if (realDtype(kind, ndim)) return "";
   if (kind != 'f' && kind != 'i' && kind != 'u')
     return std::string(name) + " must hold real numbers (int or float), got dtype " + dtype;
-  if (ndim > 3) return std::string(name) + " has " + std::to_string(ndim) + " dimensions; at most 3 are meaningful";
-  return "";
+  return std::string(name) + " has " + std::to_string(ndim) + " dimensions; at most 3 are meaningful";
 }
 
 std::string vectorMessage(const ArrayArg& a, const char* name, long n) {

@@ -64,10 +64,7 @@ int ContactStage::activeForces(const SolveInput& in, const Eigen::Ref<const Eige
     }
     if (p.stick_col >= 0) {
       const Vector3 ft = -nu(p.stick_col) * p.t1 - nu(p.stick_col + 1) * p.t2;
-      const double apothem = pc.mu * std::max(fn, 0.0) * std::cos(M_PI / pc.facets);
-      for (int i = 0; i < pc.facets; ++i)  // inside every edge of the polygon
-        if (edgeNormal(p, i, pc.facets).dot(ft) > apothem + 1e-12 * std::max(1.0, std::abs(fn)))
-          return worst >= 0 ? worst : -2;
+      if (!insidePolygon(p, ft, std::max(fn, 0.0), pc.mu, pc.facets)) return worst >= 0 ? worst : -2;
       f += ft;
     }
     // A support at zero normal force to round-off (its tangential force zero with it): no force.
@@ -80,9 +77,8 @@ int ContactStage::activeForces(const SolveInput& in, const Eigen::Ref<const Eige
 bool ContactStage::droppedSeparate(const SolveInput& in, const Eigen::VectorXd& qdd) {
   for (std::size_t k = 0; k < points_.size(); ++k) {
     if (!points_[k].dropped) continue;
-    Vector6 bias;
-    pointKinematics(in.contacts[k], bias);
-    const Vector3 a = jac_.topRows<3>() * qdd + bias.head<3>();
+    Vector3 bias;
+    const Vector3 a = pointAcceleration(in.contacts[k], qdd, bias);
     if (points_[k].n.dot(a) < -1e-9 * std::max(1.0, a.norm())) return false;
   }
   return true;
@@ -96,10 +92,9 @@ bool ContactStage::heldPointsStill(const SolveInput& in, const Eigen::VectorXd& 
     const Point& p = points_[k];
     const bool normal = p.normal_col >= 0 || !in.contacts[k].isSupport();
     if (!normal && p.stick_col < 0) continue;
-    Vector6 bias;
-    pointKinematics(in.contacts[k], bias);
-    const Vector3 a = jac_.topRows<3>() * qdd + bias.head<3>();
-    const double tol = 1e-8 * std::max(1.0, bias.head<3>().norm());
+    Vector3 bias;
+    const Vector3 a = pointAcceleration(in.contacts[k], qdd, bias);
+    const double tol = 1e-8 * std::max(1.0, bias.norm());
     if (normal && std::abs(p.n.dot(a)) > tol) return false;
     if (p.stick_col >= 0 && (std::abs(p.t1.dot(a)) > tol || std::abs(p.t2.dot(a)) > tol)) return false;
   }
@@ -166,15 +161,15 @@ int ContactStage::redundantGuess(DataImpl& d, const SolveInput& in) {
   auto nu = act_nu_.head(m), masked = act_masked_.head(m);
   nu = c.nu();
   auto C = act_cmd_.topLeftCorner(n, dn);
-  for (int j = 0; j <= dn; ++j) {  // the motors' torque of each null direction, then of nu0
-    if (j < dn)
-      masked = act_null_.col(j).head(m);
-    else
-      masked = nu;
+  // The motors' torque of multipliers `x`: its task and set-point columns only.
+  const auto motorTorque = [&](const auto& x, auto&& tau) {
+    masked = x;
     masked.tail(m - motor).setZero();
-    const int rc = j < dn ? c.commandTorquesOf(masked, C.col(j)) : c.commandTorquesOf(masked, act_tau_.head(n));
-    if (rc != 0) return 0;
-  }
+    return c.commandTorquesOf(masked, tau) == 0;
+  };
+  for (int j = 0; j < dn; ++j)
+    if (!motorTorque(act_null_.col(j).head(m), C.col(j))) return 0;
+  if (!motorTorque(nu, act_tau_.head(n))) return 0;
   // Second rule: the least contact forces, sum ||f||^2 = sum of the surface columns' nu^2 (+ const).
   const auto Ns = act_null_.block(motor, 0, m - motor, dn);
   auto P = act_q_.topLeftCorner(dn, dn);
@@ -205,7 +200,7 @@ void ContactStage::reserveActive(int m, int rows) {
     act_r_.resize(rows, act_null_.cols());
     act_rhs_.resize(rows);
   }
-  lqp_.reserve(static_cast<int>(act_null_.cols()), static_cast<int>(act_r_.rows()), n);
+  lqp_.reserve(static_cast<int>(act_null_.cols()), static_cast<int>(act_r_.rows()));
 }
 
 int ContactStage::tryAllActive(DataImpl& d, const SolveInput& in) {

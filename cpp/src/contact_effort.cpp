@@ -40,9 +40,8 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
     const int ci = static_cast<int>(c);
     // The point's acceleration in the solved motion: a support whose normal acceleration is not
     // zero leaves its surface (no force); one at rest with zero tangential acceleration may stick.
-    Vector6 bias;
-    pointKinematics(pc, bias);
-    const Vector3 a = jac_.topRows<3>() * qdd + bias.head<3>();
+    Vector3 bias;
+    const Vector3 a = pointAcceleration(pc, qdd, bias);
     const double an = pt.n.dot(a), a_tol = 1e-9 * std::max(1.0, a.norm());
     const Vector3 at_ = a - an * pt.n;
     const bool resting = pt.kind == kTouching || pt.kind == kSetPointRest;
@@ -166,7 +165,7 @@ void ContactStage::reserveEffort(int p, int k, int m) {
     eff_r_all_.resize(rows, eff_dir_.cols());
     eff_rhs_.resize(rows);
   }
-  lqp_.reserve(static_cast<int>(eff_dir_.cols()), rows, n);
+  lqp_.reserve(static_cast<int>(eff_dir_.cols()), rows);
 }
 
 }  // namespace detail

@@ -165,9 +165,7 @@ int ContactStage::trySticking(DataImpl& d, const SolveInput& in) {
     if (p.stick_col < 0) continue;
     const PointContact& pc = in.contacts[k];
     const Vector3 ft = -nu(p.stick_col) * p.t1 - nu(p.stick_col + 1) * p.t2;  // tau_cmd = -J^T alfa nu
-    const double fn = p.n.dot(forces.col(k)), apothem = pc.mu * fn * std::cos(M_PI / pc.facets);
-    for (int i = 0; i < pc.facets; ++i)  // inside every edge of the polygon
-      if (edgeNormal(p, i, pc.facets).dot(ft) > apothem + 1e-12 * std::max(1.0, std::abs(fn))) return 0;
+    if (!insidePolygon(p, ft, p.n.dot(forces.col(k)), pc.mu, pc.facets)) return 0;
     forces.col(k) += ft;
   }
   // Held columns that contradict the task (a task column along a held direction) are met only in

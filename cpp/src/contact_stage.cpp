@@ -57,6 +57,13 @@ bool ContactStage::pushes(const Point& p, const Vector3& f) {
   return p.n.dot(f) > 1e-12 * std::max(1.0, f.norm());
 }
 
+bool ContactStage::insidePolygon(const Point& p, const Vector3& ft, double fn, double mu, int facets) {
+  const double apothem = mu * fn * std::cos(M_PI / facets), tol = 1e-12 * std::max(1.0, std::abs(fn));
+  for (int i = 0; i < facets; ++i)  // inside every edge
+    if (edgeNormal(p, i, facets).dot(ft) > apothem + tol) return false;
+  return true;
+}
+
 bool ContactStage::convexProblem(const SolveInput& in) const {
   for (std::size_t k = 0; k < points_.size(); ++k)
     if ((points_[k].kind == kTouching || points_[k].kind == kSliding) && in.contacts[k].mu > 0.0) return false;
@@ -67,6 +74,13 @@ void ContactStage::pointKinematics(const PointContact& pc, Vector6& bias) {
   const FrameRef at{pc.segment, KDL::Frame(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)))};
   (void)frameJacobian(model_, kin_, at, jac_);
   (void)frameBiasAcceleration(model_, kin_, at, bias);
+}
+
+Vector3 ContactStage::pointAcceleration(const PointContact& pc, const Eigen::VectorXd& qdd, Vector3& bias) {
+  Vector6 b;
+  pointKinematics(pc, b);
+  bias = b.head<3>();
+  return jac_.topRows<3>() * qdd + bias;
 }
 
 void ContactStage::addForce(const PointContact& pc, const Vector3& f) {

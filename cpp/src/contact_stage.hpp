@@ -80,11 +80,16 @@ class ContactStage {
   static Vector3 edgeNormal(const Point& p, int i, int facets);
   // A support's force pushes (f_n above round-off), i.e. it does not separate.
   static bool pushes(const Point& p, const Vector3& f);
+  // The tangential force ft lies in the polygon mu fn conv{d_j} (to round-off of fn).
+  static bool insidePolygon(const Point& p, const Vector3& ft, double fn, double mu, int facets);
   // No touching support has friction: the accelerations are unique (ContactOutcome::Unique).
   bool convexProblem(const SolveInput& in) const;
   // jac_ and `bias` of the contact point (linear rows 0..2: its velocity Jacobian and classical
   // acceleration at qdd = 0, base axes), from kin_ at the solve's state.
   void pointKinematics(const PointContact& pc, Vector6& bias);
+  // The contact point's acceleration (base axes) at joint accelerations qdd; `bias`: its part at
+  // qdd = 0 (pointKinematics; jac_ holds the point's Jacobian afterwards).
+  Vector3 pointAcceleration(const PointContact& pc, const Eigen::VectorXd& qdd, Vector3& bias);
   // A force on the contact point as one more wrench of work_.
   void addForce(const PointContact& pc, const Vector3& f);
   // The final sweep: the input with every contact force (`forces`) as a wrench.
@@ -139,8 +144,7 @@ class ContactStage {
   int nz_ = 0, ncol_ = 0, nrow_ = 0;
   // Least effort (contact_effort.cpp): per free force coordinate its direction, contact, value,
   // wrench and responses; the validity rows in the coordinates; the programme's matrices.
-  ConvexQp qp_;
-  LexicographicQp lqp_;  // least effort, then least contact force
+  LexicographicQp lqp_;  // least effort, then least contact force (both paths)
   Matrix3X eff_dir_;
   Eigen::VectorXi eff_contact_, eff_seg_;
   Eigen::VectorXd eff_x_, eff_c_, eff_dx_, eff_r_, eff_rhs_;

@@ -145,8 +145,7 @@ Lemke::Result ConvexQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& Q, const 
   return result;
 }
 
-void LexicographicQp::reserve(int p, int k, int n) {
-  (void)n;
+void LexicographicQp::reserve(int p, int k) {
   if (q_.rows() < p) {
     q_.resize(p, p), v_.resize(p, p), z_.resize(p, p), q2_.resize(p, p);
     c_.resize(p), w_.resize(p), c2_.resize(p);

@@ -55,11 +55,11 @@ class ConvexQp {
 //     min 1/2 ||t + C x||^2,
 // then, among its minimisers (x = x1 + Z w, Z spanning C's null space: C x is unique), the one
 // with the least 1/2 x^T P x + p^T x (P positive definite on Z's span, so the answer is unique).
-// Skips the second when C has independent columns. Workspace by reserve(p, k, n) (p unknowns, k
-// rows, n entries of t); solve() allocates nothing within it.
+// Skips the second when C has independent columns. Workspace by reserve(p, k) (p unknowns, k
+// rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:
-  void reserve(int p, int k, int n);
+  void reserve(int p, int k);
   Lemke::Result solve(const Eigen::Ref<const Eigen::MatrixXd>& C, const Eigen::Ref<const Eigen::VectorXd>& t,
                       const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
                       const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,

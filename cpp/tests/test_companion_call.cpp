@@ -76,6 +76,9 @@ TEST_CASE("arguments that are no real array are named with why") {
   CHECK(vs::dtypeMessage("q", 'c', "complex128", 1) == "q must hold real numbers (int or float), got dtype complex128");
   CHECK(vs::dtypeMessage("q", 'f', "float32", 4) == "q has 4 dimensions; at most 3 are meaningful");
   CHECK(vs::dtypeMessage("q", 'u', "uint8", 3).empty());
+  CHECK(vs::realDtype('i', 0));
+  CHECK(!vs::realDtype('b', 1));
+  CHECK(!vs::realDtype('f', 4));
 }
 
 TEST_CASE("companion arguments are checked in order with the Python messages") {

@@ -95,7 +95,7 @@ inline F64View asF64(PyObject* obj, const char* name) {
                                              typeName(e.value().ptr()) + ": " + std::string(py::str(e.value()))));
     }
     // The dtype's text only for the message (str(dtype) costs about a microsecond).
-    if (!vereshchagin::dtypeMessage(name, any.dtype().kind(), "", any.ndim()).empty())
+    if (!vereshchagin::realDtype(any.dtype().kind(), any.ndim()))
       raise(vereshchagin::dtypeMessage(name, any.dtype().kind(), py::str(any.dtype()), any.ndim()));
     v.keep = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(any);  // a float64 copy
     if (!v.keep) {

@@ -101,13 +101,13 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
   const auto twist = [frame](const M& m, O q, O qd, O s) { return run(m, K::Twist, {q, qd}, frame(m, s)); };
   const auto jdot = [frame](const M& m, O q, O qd, O s) { return run(m, K::JacobianDotTimesQd, {q, qd}, frame(m, s)); };
   const auto id = [](const M& m, O q, O qd, O qdd, O f, O g) { return run(m, K::InverseDynamics, {q, qd, qdd, g, f}); };
-  // mass_matrix: a float64 q of the right length straight into the library (the generic path's
-  // argument table costs about 5 % of this call); anything else, or a failure, through run().
+  // mass_matrix: a q of the right length straight into the library (the generic path's argument
+  // table costs about 5 % of this call); another shape, or a failure, through run() for its message.
   const auto mass = [](const M& m, O q) {
     vs::DynamicsData& d = m.companions();
     const py::ssize_t n = static_cast<py::ssize_t>(d.model().nrOfJoints());
-    const F64View v = asF64(q.ptr(), "q");
-    if (v.ndim != 1 || v.shape[0] != n || v.keep) return run(m, K::MassMatrix, {q});
+    const F64View v = asF64(q.ptr(), "q");  // v.keep: a converted copy, alive for this call
+    if (v.ndim != 1 || v.shape[0] != n) return run(m, K::MassMatrix, {q});
     py::array out = newDoubles({n, n});
     const vs::JointPositions jq(Eigen::Map<const Eigen::VectorXd>(v.data, n));
     if (!vs::massMatrix(d.model(), d, jq, Eigen::Map<Eigen::MatrixXd>(doubles(out), n, n)))

@@ -41,8 +41,12 @@ std::string notArrayMessage(const char* name, bool none);
 /// `note` (the conversion's error, "Type: message") is empty.
 std::string unconvertedMessage(const char* name, const std::string& type, const std::string& note);
 
+/// Whether an array of numpy dtype kind `kind` and `ndim` dimensions is a real array the solver
+/// takes: kind 'f', 'i' or 'u', at most 3 dimensions.
+bool realDtype(char kind, int ndim);
+
 /// "" for an array of numpy dtype kind 'f', 'i' or 'u' (`dtype`: its name) with at most 3
-/// dimensions, else why not: "<name> must hold real numbers (int or float), got dtype <dtype>",
+/// dimensions (realDtype), else why not: "<name> must hold real numbers (int or float), got dtype <dtype>",
 /// "<name> has <ndim> dimensions; at most 3 are meaningful".
 std::string dtypeMessage(const char* name, char kind, const std::string& dtype, int ndim);
 
