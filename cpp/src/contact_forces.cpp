@@ -52,7 +52,9 @@ void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
     }
   }
   auto dqdd = dqdd_.leftCols(ncol_);
-  (void)d.core.wrenchResponse(col_segment_.head(ncol_), col_wrench_.leftCols(ncol_), dqdd, nullptr);
+  (void)d.core.wrenchResponse(col_segment_.head(ncol_contacts_), col_wrench_.leftCols(ncol_contacts_),
+                              dqdd_.leftCols(ncol_contacts_), nullptr);
+  prepareJointColumns(d);
   const auto Jt = rows_jac_.topLeftCorner(n, nrow_);  // one column per row: no strided products
   acc_per_col_.topLeftCorner(nrow_, ncol_).noalias() = Jt.transpose() * dqdd;
   rows0_.head(nrow_).noalias() = Jt.transpose() * d.core.res.qdd;
@@ -75,6 +77,7 @@ void ContactStage::assembleLcp(const SolveInput& in) {
       coef(t1 + 1, beta0 + j) = d(1);
     }
   }
+  jointCoefficients();
   auto rz = rows_per_z_.topLeftCorner(nrow_, nz_);
   rz.noalias() = acc_per_col_.topLeftCorner(nrow_, ncol_) * coef;
   auto M = lcp_m_.topLeftCorner(nz_, nz_);
@@ -104,6 +107,7 @@ void ContactStage::assembleLcp(const SolveInput& in) {
     else
       q(gamma) = pc.mu * pc.force;
   }
+  assembleJointLcp();
 }
 
 // Lemke's pivoting, then the certificate: z >= 0, w = M z + q >= 0, z_i w_i = 0 (to round-off).
@@ -140,11 +144,12 @@ void ContactStage::applyForces(const SolveInput& in) {
     forces.col(k) = p.fixed + f;
     if (p.ncol > 0 && !f.isZero(0.0)) addForce(in.contacts[k], f);
   }
+  if (nz_ > 0) applyJointTorques();
 }
 
 // The problem of the current layout on work_: base solve, response, complementarity, forces.
 int ContactStage::forcesOfLcp(DataImpl& d, const SolveInput& in, bool convex) {
-  if (int rc = runInput(d, work_)) return rc;
+  if (int rc = runWork(d)) return rc;
   if (nz_ > 0) {
     prepareColumns(d, in);
     assembleLcp(in);
@@ -158,7 +163,7 @@ int ContactStage::trySticking(DataImpl& d, const SolveInput& in) {
   layout(in, true);
   buildWorkInput(in, true);
   if (forcesOfLcp(d, in, true) != 0) return 0;  // no normal forces with every resting point held
-  if (int rc = runInput(d, work_)) return rc;   // with the normal forces: the tangential ones in nu
+  if (int rc = runWork(d)) return rc;           // with the normal forces: the tangential ones in nu
   const auto nu = d.core.nu();
   for (std::size_t k = 0; k < points_.size(); ++k) {
     const Point& p = points_[k];
@@ -196,7 +201,14 @@ void ContactStage::reportStatus(const SolveInput& in, bool stuck) {
 
 int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   if (int rc = classify(d.core, in)) return rc;
-  if (const int rc = tryAllActive(d, in); rc != 0) return rc < 0 ? rc : 0;
+  joint_friction_ = in.friction != nullptr;
+  joints_.clear();
+  if (joint_friction_) {
+    if (int rc = checkJointFriction(d, in)) return rc;
+    classifyJoints(in);
+  } else if (const int rc = tryAllActive(d, in); rc != 0) {
+    return rc < 0 ? rc : 0;
+  }
   bool stickable = false;
   for (const Point& p : points_) stickable = stickable || p.kind == kTouching || p.kind == kSetPointRest;
   if (stickable) {
@@ -204,16 +216,21 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
     if (rc < 0) return rc;
     if (rc == 1) {
       reportStatus(in, true);
-      return leastEffort(d, in);
+      return finish(d, in);
     }
   }
   layout(in, false);
   buildWorkInput(in, false);
   if (int rc = forcesOfLcp(d, in, convexProblem(in))) return rc;
   if (nz_ > 0)
-    if (int rc = runInput(d, work_)) return rc;
+    if (int rc = runWork(d)) return rc;
   reportStatus(in, false);
-  return leastEffort(d, in);
+  return finish(d, in);
+}
+
+int ContactStage::finish(DataImpl& d, const SolveInput& in) {
+  if (int rc = leastEffort(d, in)) return rc;
+  return joint_friction_ ? finalFriction(d, in) : 0;
 }
 
 }  // namespace detail

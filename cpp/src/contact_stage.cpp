@@ -91,11 +91,16 @@ int ContactStage::solveWithForces(DataImpl& d, const SolveInput& in) {
   buildWorkInput(in, false);  // the set-points' columns and known forces
   for (std::size_t k = 0; k < points_.size(); ++k)
     if (const Vector3 f = forces.col(k) - points_[k].fixed; !f.isZero(0.0)) addForce(in.contacts[k], f);
-  return runInput(d, work_);
+  return runWork(d);
 }
 
 ContactStage::ContactStage(const Model& model) : model_(model), kin_(model), work_(model) {
-  jac_.resize(6, model.nrOfJoints());
+  const int n = static_cast<int>(model.nrOfJoints());
+  jac_.resize(6, n);
+  joints_.reserve(n);
+  joint_tau_.setZero(n), ff_user_.setZero(n), qdd_contacts_.setZero(n);
+  joint_index_.setZero(n);
+  joint_dtau_.resize(n, n);
 }
 
 int ContactStage::check(HdCore& c, const SolveInput& in) const {
@@ -127,8 +132,6 @@ int ContactStage::check(HdCore& c, const SolveInput& in) const {
   if (!(std::isfinite(in.contact_velocity_tolerance) && in.contact_velocity_tolerance >= 0.0))
     return c.fail(E_CONTACT, "contact_velocity_tolerance must be finite and >= 0, got %g",
                   in.contact_velocity_tolerance);
-  if (in.friction != nullptr)
-    return c.fail(E_CONTACT, "contacts together with joint friction are not supported yet: solve without friction");
   for (int k = 0; k < 3; ++k)
     if (in.base_acceleration.vel(k) != 0.0 || in.base_acceleration.rot(k) != 0.0)
       return c.fail(E_CONTACT, "contacts need a base at rest: base_acceleration must be zero");
@@ -199,6 +202,7 @@ void ContactStage::layout(const SolveInput& in, bool stick) {
     p.var = nz_, p.col = ncol_, p.row = nrow_;
     nz_ += p.nvar, ncol_ += p.ncol, nrow_ += p.nrow;
   }
+  layoutJoints();
   reserve(static_cast<int>(in.contacts.size()), nz_, ncol_, nrow_);
 }
 
@@ -228,6 +232,10 @@ void ContactStage::reserve(int contacts, int unknowns, int columns, int rows) {
 void ContactStage::buildWorkInput(const SolveInput& in, bool stick) {
   work_ = in;
   work_.contacts.clear();
+  if (joint_friction_) {  // the friction as known torques (contact_joints.cpp)
+    work_.friction = nullptr;
+    work_.ff_torques = ff_user_ + joint_tau_;
+  }
   const auto column = [this](int segment, const Vector3& point, const Vector3& e) {
     ConstraintBlock b;
     b.segment = segment;

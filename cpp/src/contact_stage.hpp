@@ -14,6 +14,12 @@
 //      of the unknowns (the acceleration-level formulation of Stewart and Trinkle), solved exactly
 //      by Lemke's pivoting (lemke.hpp) and checked (the certificate);
 //   4. the final solve with the contact forces as wrenches: every result comes from it.
+// With joint friction (input.friction, contact_joints.cpp) every solve of steps 0-3 runs without
+// the friction stage: moving joints get their kinetic friction as known torques and each resting
+// joint with static friction or on a limit one more unknown torque (bounded, maximum dissipation)
+// in the same complementarity problem; the all-active guess is skipped. Step 4 then runs the
+// friction stage with the contact forces as wrenches: its max-min has the same unique qdd, and it
+// picks the joints' friction torques by its least-command rule.
 #pragma once
 
 #include <vector>
@@ -96,6 +102,32 @@ class ContactStage {
   int solveWithForces(DataImpl& d, const SolveInput& in);
 
   int classify(HdCore& c, const SolveInput& in);
+  // Joint friction with contacts (contact_joints.cpp). A resting joint's unknown torque on the
+  // joint (N m or N), bounded by [lo, hi] (-f_j .. f_j, opened to +inf at a lower limit and to -inf
+  // at an upper one): its unknowns in z, its response column and its row (qdd_j).
+  struct JointUnknown {
+    int joint = 0;
+    double lo = 0.0, hi = 0.0;
+    int var = 0, nvar = 0, col = 0, row = 0;
+  };
+  // The input's friction model checked (the friction stage's messages); 0 or an error code.
+  int checkJointFriction(DataImpl& d, const SolveInput& in);
+  // Kinetic friction of the moving joints and the offsets of the resting ones into joint_tau_,
+  // the resting joints into joints_.
+  void classifyJoints(const SolveInput& in);
+  // The joints' unknowns after the contacts' in z, columns and rows (layout()).
+  void layoutJoints();
+  static double offset(const JointUnknown& u);  // tau_j at z = 0: lo, else hi, else 0
+  void prepareJointColumns(DataImpl& d);
+  void jointCoefficients();
+  void assembleJointLcp();
+  void applyJointTorques();
+  // runInput on work_ with the input's ff_torques alone as the pass-through driver.
+  int runWork(DataImpl& d);
+  // Step 4 with the friction stage; 0 or an error code with its message.
+  int finalFriction(DataImpl& d, const SolveInput& in);
+  // The least-effort programme, then (with joint friction) finalFriction.
+  int finish(DataImpl& d, const SolveInput& in);
   // Roles and sizes of one problem: the sticking trial (every resting point with friction held
   // tangentially by two constraint columns) or the full polygonal problem.
   void layout(const SolveInput& in, bool stick);
@@ -155,6 +187,15 @@ class ContactStage {
   // multipliers, the motors' torques per direction, the programme in the null coordinates.
   Eigen::MatrixXd act_null_, act_cmd_, act_q_, act_r_;
   Eigen::VectorXd act_nu_, act_masked_, act_tau_, act_lin_, act_y_, act_rhs_;
+  // Joint friction (contact_joints.cpp): the resting joints' unknowns, the known joint torques of
+  // the solves (kinetic friction, the resting joints' offsets, then their solved torques), the
+  // input's ff_torques (zero if empty), the resting joints' indices, the qdd of step 3.
+  std::vector<JointUnknown> joints_;
+  Eigen::VectorXd joint_tau_, ff_user_, qdd_contacts_;
+  Eigen::VectorXi joint_index_;
+  Eigen::MatrixXd joint_dtau_;   // n x n: responseColumns' command-torque columns (not used)
+  int ncol_contacts_ = 0;        // the contacts' response columns (the joints' follow)
+  bool joint_friction_ = false;  // this solve has joint friction
 };
 
 }  // namespace detail

@@ -70,8 +70,10 @@ const Eigen::VectorXd& Data::commandTorques() const noexcept {
   return impl_->friction_last ? impl_->friction_core->tau_cmd_ : impl_->core.res.tau_cmd;
 }
 Eigen::Map<const Eigen::VectorXd> Data::nu() const noexcept {
-  if (impl_->contacts_last)
-    return Eigen::Map<const Eigen::VectorXd>(impl_->core.nu().data(), impl_->contact_stage->user_columns);
+  if (impl_->contacts_last) {  // the input's own columns (the set-points' follow them)
+    const double* nu = impl_->friction_last ? impl_->friction_core->nu_.data() : impl_->core.nu().data();
+    return Eigen::Map<const Eigen::VectorXd>(nu, impl_->contact_stage->user_columns);
+  }
   if (!impl_->friction_last) return impl_->core.nu();
   const detail::FrictionCore& f = *impl_->friction_core;
   return Eigen::Map<const Eigen::VectorXd>(f.nu_.data(), f.m_keep_);

@@ -7,6 +7,8 @@
 // Random chains and trees at rest (every point touching), q random, tasks as classical set-points.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include <Eigen/Dense>
 
 #include "random_chain.hpp"
@@ -364,4 +366,45 @@ TEST_CASE("a force set-point the task drags along slides, its friction at the op
   CHECK(data.contactStatus()[0] == ContactStatus::Sliding);
   CHECK((data.contactForces().col(0) - Vector3(-2.0, 0.0, 5.0)).norm() <= 1e-12);
   CHECK(replay(model, in, data) <= 1e-12);
+}
+
+TEST_CASE("contacts with joint friction: the replay identity, friction bounds, and zero friction") {
+  RandomGen g(29);
+  int checked = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const bool tree = trial % 2 == 1;
+    const Model model = randomModel(g, tree, 6);
+    const int n = static_cast<int>(model.nrOfJoints());
+    SolveInput in = restingInput(g, model, 1 + trial % 3, trial % 3 == 0 ? 0.0 : 0.6, NAN);
+    FrictionModel fm;
+    fm.static_friction = Eigen::VectorXd::Zero(n);
+    Data plain(model), data(model);
+    REQUIRE(solve(model, plain, in));
+    in.friction = &fm;  // zero friction: the contacts' answer
+    REQUIRE(solve(model, data, in));
+    CHECK((data.qdd() - plain.qdd()).cwiseAbs().maxCoeff() <= 1e-10 * std::max(1.0, plain.qdd().cwiseAbs().maxCoeff()));
+    for (int j = 0; j < n; ++j) fm.static_friction(j) = g.uniform(0.0, 2.0);
+    in.q_dot(trial % n) = 0.5;  // one joint moving: its kinetic friction
+    const Status s = solve(model, data, in);
+    if (!s) {  // a support approaching its surface is refused; none else
+      CHECK(std::string(s.message()).find("approaches") != std::string::npos);
+      continue;
+    }
+    // H qdd = h + tau_command + friction + limits + sum_c J_c^T f_c, and every friction torque within
+    // its bound, opposing the joint's velocity (moving) or its acceleration (resting, slipping).
+    const Dense d = dense(model, in);
+    Eigen::VectorXd r = d.H * data.qdd() - d.h - data.commandTorques() - data.frictionTorques() - data.limitTorques();
+    for (std::size_t c = 0; c < in.contacts.size(); ++c) r -= d.J[c].transpose() * data.contactForces().col(c);
+    CHECK(r.cwiseAbs().maxCoeff() <= 1e-9 * std::max(1.0, d.h.cwiseAbs().maxCoeff()));
+    ++checked;
+    for (int j = 0; j < n; ++j) {
+      const double t = data.frictionTorques()(j), f = fm.static_friction(j), a = data.qdd()(j);
+      CHECK(std::abs(t) <= f * (1.0 + 1e-12));
+      if (in.q_dot(j) != 0.0)
+        CHECK(t == doctest::Approx(-f));
+      else if (std::abs(a) > 1e-9 * std::max(1.0, data.qdd().cwiseAbs().maxCoeff()))
+        CHECK(t == doctest::Approx(a > 0.0 ? -f : f));
+    }
+  }
+  CHECK(checked >= 6);
 }

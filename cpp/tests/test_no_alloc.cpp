@@ -378,7 +378,8 @@ TEST_CASE_FIXTURE(Fixture, "tree solves do not allocate") {
 TEST_CASE_FIXTURE(Fixture, "solves with contacts do not allocate once warm") {
   // Supports with and without friction, a force set-point with friction, at rest and moving (so
   // the sticking trial, the full complementarity problem and the separating and sliding paths all
-  // run), with a task on the last segment. The first solve of each size allocates the stage.
+  // run), with a task on the last segment, with and without joint friction. The first solve of each
+  // size allocates the stage.
   const vereshchagin::Model model(chain);
   vereshchagin::Data data(model);
   vereshchagin::SolveInput in(model);
@@ -413,7 +414,10 @@ TEST_CASE_FIXTURE(Fixture, "solves with contacts do not allocate once warm") {
   const std::vector<vereshchagin::PointContact> resting = in.contacts;
   double csum = 0.0;
   int cfail = 0;
-  const auto run = [&](int s, bool moving, int columns) {
+  vereshchagin::FrictionModel fm;  // joint friction together with the contacts (every other solve)
+  fm.static_friction = Eigen::VectorXd::Constant(n, 0.4);
+  const auto run = [&](int s, bool moving, int columns, bool friction = false) {
+    in.friction = friction ? &fm : nullptr;
     in.setState(vereshchagin::JointPositions(q[s].data), vereshchagin::JointVelocities(moving ? qd[s].data : rest));
     for (std::size_t c = 0; c < in.contacts.size(); ++c)
       in.contacts[c].normal = moving ? sliding_normals[s][c] : resting[c].normal;
@@ -425,9 +429,10 @@ TEST_CASE_FIXTURE(Fixture, "solves with contacts do not allocate once warm") {
     if (st) csum += data.qdd()(0) + data.contactForces()(2, 0);
   };
   for (int s = 0; s < kSets; ++s)
-    for (int columns = 0; columns <= 2; ++columns) run(s, s % 2 == 1, columns);  // warm: every size once
+    for (int columns = 0; columns <= 2; ++columns)
+      for (const bool friction : {false, true}) run(s, s % 2 == 1, columns, friction);  // warm: every size once
   const Counts c0 = now();
-  for (int it = 0; it < 300; ++it) run(it % kSets, it % 2 == 1, it % 3);
+  for (int it = 0; it < 300; ++it) run(it % kSets, it % 2 == 1, it % 3, it % 4 >= 2);
   const Counts c1 = now();
   CHECK_MESSAGE(cfail == 0, "contact solves failed: " << str(cfail));
   CHECK_MESSAGE(std::isfinite(csum), "non-finite contact results");

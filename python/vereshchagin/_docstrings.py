@@ -553,8 +553,8 @@ contacts : list of Contact, optional
     friction the solve finds exactly with the motion (a point may lift off), and force
     set-points, which stay on their surface and push with a given normal force. The surfaces
     supply the contact forces, the motors only ``tau_command``; where the forces are not unique,
-    the least motor effort, then the least contact force (docs: "Contacts"). Not together with
-    ``friction`` yet.
+    the least motor effort, then the least contact force (docs: "Contacts"). With ``friction``,
+    joint friction, joint limits and the contacts are solved as one problem.
 
 Returns
 -------

@@ -17,8 +17,14 @@ and per contact, a_c = J_c qdd + bias_c the contact point's acceleration:
 * force set-point: a_n = 0 held by the motors (multiplier nu_c), f_n equal to the set-point, the
   tangential force as for a support.
 
+Joint friction and limits (``ContactProblem.joints``): a resting joint j gets a torque tau_j on
+the joint in [lo, hi] (-f_j .. f_j; hi = +inf at a lower limit, lo = -inf at an upper one) with
+maximum dissipation: it sticks (qdd_j = 0, tau_j inside the bounds), or moves up with tau_j = lo
+(qdd_j >= 0) or down with tau_j = hi (qdd_j <= 0). Moving joints' kinetic friction is part of h.
+
 ``enumerate_modes`` tries every mode per contact (separate, stick, slide at a vertex, slide on an
-edge) with one linear KKT solve each and keeps the candidates that meet every sign condition.
+edge) and per resting joint (stick, up, down) with one linear KKT solve each and keeps the
+candidates that meet every sign condition.
 ``frictionless_qp`` solves the frictionless case as the convex QP of Gauss's principle with scipy
 and polishes it to its active set's exact KKT solution. ``contact_problem`` builds the problem of a
 Pinocchio model. Written from the formulation above, independently of the solver under test.
@@ -74,12 +80,20 @@ class Contact:
 
 
 @dataclass
+class JointFriction:
+    index: int  # the joint (velocity index)
+    lo: float  # bounds of the torque on the joint, N m (-inf / +inf: unbounded on that side)
+    hi: float
+
+
+@dataclass
 class ContactProblem:
     H: np.ndarray
-    h: np.ndarray  # generalised force: tau - C(q, qd) qd - g(q) + J_ext^T f_ext
+    h: np.ndarray  # generalised force: tau - C(q, qd) qd - g(q) + J_ext^T f_ext (+ kinetic friction)
     A: np.ndarray  # (m, n) task rows
     b: np.ndarray  # (m,)
     contacts: list = field(default_factory=list)
+    joints: list = field(default_factory=list)  # JointFriction of the resting joints
 
 
 @dataclass
@@ -89,6 +103,8 @@ class ContactSolution:
     forces: np.ndarray  # (k, 3)
     modes: tuple  # per contact: 'separate', 'stick', ('vertex', j), ('edge', j)
     setpoint_nu: np.ndarray  # motor multipliers of the force set-points
+    joint_torques: np.ndarray = None  # (n,) the resting joints' friction and limit torques
+    joint_modes: tuple = ()  # per resting joint: 'stick', 'up', 'down'
 
     @property
     def status(self):
@@ -154,8 +170,14 @@ def _mode_equations(c, mode):
     return dj[None, :] if c.force is not None else np.vstack([n, dj])
 
 
-def _candidate(prob, modes):
-    """The KKT solution of one mode per contact (least squares if singular) and its residual."""
+def joint_modes(j):
+    """The modes resting joint ``j`` (JointFriction) can be in."""
+    return ["stick"] + (["up"] if np.isfinite(j.lo) else []) + (["down"] if np.isfinite(j.hi) else [])
+
+
+def _candidate(prob, modes, jmodes=()):
+    """The KKT solution of one mode per contact and per resting joint (least squares if singular)
+    and its residual."""
     n, m = prob.H.shape[0], prob.A.shape[0]
     cols, f0s, rows = [], [], []
     for c, mode in zip(prob.contacts, modes):
@@ -165,11 +187,19 @@ def _candidate(prob, modes):
         rows.append(_mode_equations(c, mode))
     setp = [i for i, c in enumerate(prob.contacts) if c.force is not None]
     p = sum(G.shape[1] for G in cols)
-    size = n + m + len(setp) + p
+    stuck = [j.index for j, jm in zip(prob.joints, jmodes) if jm == "stick"]
+    size = n + m + len(setp) + p + len(stuck)
     top = np.zeros((n, size))
     top[:, :n] = prob.H
     top[:, n : n + m] = -prob.A.T
     h = prob.h.copy()
+    slipping = np.zeros(n)
+    for j, jm in zip(prob.joints, jmodes):
+        if jm != "stick":
+            slipping[j.index] = j.lo if jm == "up" else j.hi
+    h = h + slipping
+    for s_, idx in enumerate(stuck):
+        top[idx, size - len(stuck) + s_] = -1.0
     for s, i in enumerate(setp):
         c = prob.contacts[i]
         top[:, n + m + s] = -c.J.T @ c.normal
@@ -191,6 +221,11 @@ def _candidate(prob, modes):
         block[:, :n] = R @ c.J
         K = np.vstack([K, block])
         rhs.append(-(R @ c.bias))
+    for idx in stuck:  # qdd_j = 0
+        row = np.zeros(size)
+        row[idx] = 1.0
+        K = np.vstack([K, row])
+        rhs.append([0.0])
     rhs = np.concatenate([np.atleast_1d(r) for r in rhs])
     x = np.linalg.lstsq(K, rhs, rcond=None)[0]
     resid = np.linalg.norm(K @ x - rhs) / max(1.0, np.linalg.norm(rhs))
@@ -199,7 +234,10 @@ def _candidate(prob, modes):
     for G, f0 in zip(cols, f0s):
         forces.append(G @ x[off : off + G.shape[1]] + f0)
         off += G.shape[1]
-    return ContactSolution(qdd, nu, np.array(forces).reshape(-1, 3), tuple(modes), snu), resid
+    torques = slipping.copy()
+    torques[stuck] = x[off:]
+    sol = ContactSolution(qdd, nu, np.array(forces).reshape(-1, 3), tuple(modes), snu, torques, tuple(jmodes))
+    return sol, resid
 
 
 def _signs_hold(c, mode, f, acc, tol):
@@ -220,7 +258,8 @@ def _signs_hold(c, mode, f, acc, tol):
     if np.any(outward @ ft > apothem + tol * scale_f):
         return False
     sliding = np.linalg.norm(_tangential_velocity(c)) > c.tol
-    if mode == "stick" or sliding:  # a_t = 0 imposed, or the vertex chosen by the velocity
+    if mode == "stick" or sliding or mu == 0.0:  # a_t = 0 imposed, the vertex chosen by the velocity,
+        # or no friction (every vertex is the normal)
         return True
     kind, j = mode
     proj = D @ at
@@ -230,9 +269,20 @@ def _signs_hold(c, mode, f, acc, tol):
     return proj[j] <= proj.min() + tol * scale_a and proj[j] < -tol * scale_a
 
 
+def _joint_signs_hold(j, mode, torque, qdd_j, tol, scale_a):
+    if mode == "up":
+        return qdd_j >= -tol * scale_a
+    if mode == "down":
+        return qdd_j <= tol * scale_a
+    scale_t = max(1.0, abs(torque))
+    return j.lo - tol * scale_t <= torque <= j.hi + tol * scale_t
+
+
 def check_solution(prob, sol, tol=1e-9):
     """True if ``sol`` meets the equations and every sign condition of its modes."""
     r = prob.H @ sol.qdd - prob.h - prob.A.T @ sol.nu
+    if sol.joint_torques is not None:
+        r = r - sol.joint_torques
     setp = [c for c in prob.contacts if c.force is not None]
     for c, s in zip(setp, sol.setpoint_nu):
         r = r - c.J.T @ c.normal * s
@@ -247,14 +297,19 @@ def check_solution(prob, sol, tol=1e-9):
             return False
         if not _signs_hold(c, mode, f, acc, tol):
             return False
+    scale_a = max(1.0, np.linalg.norm(sol.qdd))
+    for j, mode in zip(prob.joints, sol.joint_modes):
+        if not _joint_signs_hold(j, mode, sol.joint_torques[j.index], sol.qdd[j.index], tol, scale_a):
+            return False
     return True
 
 
 def enumerate_modes(prob, tol=1e-9, resid_tol=1e-10):
     """Every mode combination whose KKT solution meets the sign conditions, distinct in qdd."""
     found = []
-    for modes in itertools.product(*[contact_modes(c) for c in prob.contacts]):
-        sol, resid = _candidate(prob, modes)
+    k = len(prob.contacts)
+    for combo in itertools.product(*[contact_modes(c) for c in prob.contacts], *[joint_modes(j) for j in prob.joints]):
+        sol, resid = _candidate(prob, combo[:k], combo[k:])
         if resid > resid_tol or not check_solution(prob, sol, tol):
             continue
         scale = max(1.0, np.linalg.norm(sol.qdd))
@@ -309,9 +364,12 @@ def point_jacobian(model, data, frame_id, point):
     return J, bias, v.linear + np.cross(w, r)
 
 
-def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6):
+def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6, friction=None):
     """The problem of a Pinocchio model (gravity = model.gravity). ``specs``: dicts with frame,
-    point, normal, mu, facets, force. ``A``, ``b``: task rows in joint space (default none)."""
+    point, normal, mu, facets, force. ``A``, ``b``: task rows in joint space (default none).
+    ``friction``: dict with static, kinetic (default static), lower, upper (default none),
+    velocity_tolerance (1e-6), limit_tolerance (1e-9), per velocity index of ``model``, and the
+    joint positions ``q`` (one per joint) when ``model`` has continuous joints and limits are given."""
     nv = model.nv
     H = pin.crba(model, data, q)
     H = np.triu(H) + np.triu(H, 1).T
@@ -327,7 +385,30 @@ def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6):
         )
     A = np.zeros((0, nv)) if A is None else np.asarray(A, float)
     b = np.zeros(0) if b is None else np.asarray(b, float)
-    return ContactProblem(H, h, A, b, contacts)
+    joints = []
+    if friction is not None:
+        h, joints = _joint_friction(friction.get("q", q), qd, h, friction)
+    return ContactProblem(H, h, A, b, contacts, joints)
+
+
+def _joint_friction(q, qd, h, fr):
+    """Kinetic friction of the moving joints into h; the resting joints' bounds (q: one
+    coordinate per joint, revolute joints without wrap-around)."""
+    fs = np.asarray(fr["static"], float)
+    fk = np.asarray(fr.get("kinetic", fs), float)
+    lower, upper = fr.get("lower"), fr.get("upper")
+    vtol, ltol = fr.get("velocity_tolerance", 1e-6), fr.get("limit_tolerance", 1e-9)
+    h = h.copy()
+    joints = []
+    for j in range(len(fs)):
+        if abs(qd[j]) > vtol:
+            h[j] -= fk[j] * np.sign(qd[j])
+            continue
+        at_lower = lower is not None and q[j] <= lower[j] + ltol
+        at_upper = upper is not None and q[j] >= upper[j] - ltol
+        if fs[j] > 0.0 or at_lower or at_upper:
+            joints.append(JointFriction(j, -np.inf if at_upper else -fs[j], np.inf if at_lower else fs[j]))
+    return h, joints
 
 
 def pin_rigid_3d(model, data, q, qd, tau, frame, point):

@@ -77,8 +77,12 @@ def test_contacts_argument_messages():
         solver.solve(q, qd, contacts=[vs.Contact("no_such_link")])
     with pytest.raises(vs.SolverError, match="fixed base"):
         solver.solve(q, qd, contacts=[vs.Contact("base_link")])
-    with pytest.raises(vs.SolverError, match="joint friction"):
-        solver.solve(q, qd, friction=True, contacts=[vs.Contact(3)])
+    # With contacts the friction model is checked as without them.
+    bad = vs.Friction(static=-np.ones(chain.n_joints))
+    with pytest.raises(vs.SolverError, match=r"friction.static\[0\].*must be finite and >= 0"):
+        solver.solve(q, qd, friction=bad, contacts=[vs.Contact(3)])
+    with pytest.raises(vs.SolverError, match=r"friction.static must have shape \(7,\), got \(3,\)"):
+        solver.solve(q, qd, friction=vs.Friction(static=np.ones(3)), contacts=[vs.Contact(3)])
 
 
 def test_results_carry_contact_outputs_and_pickle_them():

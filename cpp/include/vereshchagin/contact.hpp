@@ -6,6 +6,12 @@
 /// Results: Data::contactForces(), contactStatus(), contactOutcome(). The math, signs and the
 /// polygon's orientation are in the docs' "Contacts" page.
 ///
+/// With joint friction (SolveInput::friction), joint friction, joint limits and the contacts are one
+/// complementarity problem (each resting joint with friction or on a limit one more bounded unknown
+/// torque); the last sweep runs the friction stage with the contact forces as wrenches, so
+/// Data::frictionTorques(), limitTorques() and jointStatus() are the friction stage's (its max-min
+/// reproduces the contact problem's qdd, which the solve checks: Error::NoContactSolution if not).
+///
 /// Frames, signs, units: the point in the segment's tip frame (m); the normal in base axes, unit,
 /// pointing from the surface into the robot (the direction the surface pushes); forces in base
 /// axes (N), ON the robot BY the surface, applied at the point. A point is at rest along the

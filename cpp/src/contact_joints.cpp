@@ -1,0 +1,163 @@
+// Joint friction and joint limits together with contacts (contact_stage.hpp). The friction
+// stage's max-min (friction_solver.hpp) and the contact conditions are solved as one
+// complementarity problem: each resting joint with static friction f_j or on a limit has an
+// unknown torque tau_j on the joint, bounded by [lo, hi] (-f_j .. f_j; hi = +inf at a lower limit,
+// lo = -inf at an upper one), with maximum dissipation: qdd_j > 0 gives tau_j = lo, qdd_j < 0
+// gives tau_j = hi, a torque strictly inside the bounds gives qdd_j = 0. Unknowns z per joint
+// (a = qdd_j, affine in z like the contact points' accelerations):
+//   both bounds finite: tau_j = lo + u, z = (u, s), w = (a + s, (hi - lo) - u): s is a's negative
+//     part, u reaches hi - lo when a < 0;
+//   lo finite only (a lower limit): tau_j = lo + u, z = u, w = a;
+//   hi finite only (an upper limit): tau_j = hi - v, z = v, w = -a;
+//   neither (both limits): tau_j = u1 - u2, z = (u1, u2), w = (a, -a).
+// Moving joints get their kinetic friction -fk_j sign(qd_j) as a known torque. Every solve of the
+// stage runs without the friction stage, with these torques added to ff_torques while the
+// input's ff_torques alone drive the pass-through. The last solve (finalFriction) runs the
+// friction stage itself with the contact forces as wrenches: its max-min has a unique qdd, the
+// one found here (checked), and it picks the joints' torques by its least-command rule, so every
+// joint output (friction and limit torques, statuses, the Gauss value) is the friction stage's.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "contact_stage.hpp"
+#include "data_impl.hpp"
+#include "friction_core.hpp"
+#include "hd_core.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+namespace {
+
+constexpr int E_NO_SOLUTION = static_cast<int>(Error::NoContactSolution);
+
+}  // namespace
+
+int ContactStage::checkJointFriction(DataImpl& d, const SolveInput& in) {
+  FrictionCore& f = d.friction();
+  if (const int rc = f.checkFriction(*in.friction)) return d.core.fail(rc, "%s", f.message_.data());
+  return 0;
+}
+
+void ContactStage::classifyJoints(const SolveInput& in) {
+  const FrictionModel& fm = *in.friction;
+  const Eigen::VectorXd& fs = fm.static_friction;
+  const Eigen::VectorXd& fk = fm.kinetic_friction.size() ? fm.kinetic_friction : fm.static_friction;
+  const bool limits = fm.lower.size() != 0;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  joints_.clear();
+  for (int j = 0; j < static_cast<int>(model_.nrOfJoints()); ++j) {
+    ff_user_(j) = in.ff_torques.size() ? in.ff_torques(j) : 0.0;
+    joint_tau_(j) = 0.0;
+    if (std::abs(in.q_dot(j)) > fm.velocity_tolerance) {
+      joint_tau_(j) = -fk(j) * (in.q_dot(j) > 0.0 ? 1.0 : -1.0);
+      continue;
+    }
+    const bool at_lower = limits && in.q(j) <= fm.lower(j) + fm.limit_tolerance;
+    const bool at_upper = limits && in.q(j) >= fm.upper(j) - fm.limit_tolerance;
+    if (!(fs(j) > 0.0 || at_lower || at_upper)) continue;
+    JointUnknown u;
+    u.joint = j;
+    u.lo = at_upper ? -inf : -fs(j);
+    u.hi = at_lower ? inf : fs(j);
+    joints_.push_back(u);  // within the capacity reserved for every joint
+  }
+}
+
+double ContactStage::offset(const JointUnknown& u) {
+  return std::isfinite(u.lo) ? u.lo : std::isfinite(u.hi) ? u.hi : 0.0;
+}
+
+void ContactStage::layoutJoints() {
+  ncol_contacts_ = ncol_;
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    JointUnknown& u = joints_[i];
+    u.nvar = std::isfinite(u.lo) == std::isfinite(u.hi) ? 2 : 1;
+    joint_tau_(u.joint) = offset(u);  // the problem's base solve: z = 0
+    u.var = nz_, u.col = ncol_, u.row = nrow_;
+    joint_index_(static_cast<Eigen::Index>(i)) = u.joint;
+    nz_ += u.nvar, ++ncol_, ++nrow_;
+  }
+}
+
+// The joints' response columns (qdd per unit torque on each resting joint) and rows (qdd_j).
+void ContactStage::prepareJointColumns(DataImpl& d) {
+  const int kj = static_cast<int>(joints_.size());
+  if (kj == 0) return;
+  (void)d.core.responseColumns(joint_index_.head(kj), dqdd_.middleCols(ncol_contacts_, kj), joint_dtau_.leftCols(kj),
+                               nullptr);
+  for (const JointUnknown& u : joints_) {
+    rows_jac_.col(u.row).setZero();
+    rows_jac_(u.joint, u.row) = 1.0;
+    rows_bias_(u.row) = 0.0;
+  }
+}
+
+void ContactStage::jointCoefficients() {
+  for (const JointUnknown& u : joints_) {
+    const bool lo = std::isfinite(u.lo), hi = std::isfinite(u.hi);
+    coef_(u.col, u.var) = lo || !hi ? 1.0 : -1.0;    // u (or u1), or v at an upper limit
+    if (!lo && !hi) coef_(u.col, u.var + 1) = -1.0;  // u2
+  }
+}
+
+// The joints' rows of M and q (see the top of this file); M and q zero there before.
+void ContactStage::assembleJointLcp() {
+  auto rz = rows_per_z_.topLeftCorner(nrow_, nz_);
+  auto M = lcp_m_.topLeftCorner(nz_, nz_);
+  auto q = lcp_q_.head(nz_);
+  for (const JointUnknown& u : joints_) {
+    const bool lo = std::isfinite(u.lo), hi = std::isfinite(u.hi);
+    const double sign = lo || !hi ? 1.0 : -1.0;  // w = a, or -a at an upper limit
+    M.row(u.var) = sign * rz.row(u.row);
+    q(u.var) = sign * rows0_(u.row);
+    if (lo && hi) {  // w_u = a + s, w_s = (hi - lo) - u
+      M(u.var, u.var + 1) += 1.0;
+      M(u.var + 1, u.var) = -1.0;
+      q(u.var + 1) = u.hi - u.lo;
+    } else if (!lo && !hi) {  // w_u2 = -a
+      M.row(u.var + 1) = -rz.row(u.row);
+      q(u.var + 1) = -rows0_(u.row);
+    }
+  }
+}
+
+// The joints' torques of z into joint_tau_ and work_'s ff_torques.
+void ContactStage::applyJointTorques() {
+  const auto z = z_.head(nz_);
+  for (const JointUnknown& u : joints_) {
+    joint_tau_(u.joint) = offset(u) + coef_.row(u.col).head(nz_).dot(z);
+    work_.ff_torques(u.joint) = ff_user_(u.joint) + joint_tau_(u.joint);
+  }
+}
+
+int ContactStage::runWork(DataImpl& d) {
+  d.core.ws.pt.driver = joint_friction_ ? &ff_user_ : nullptr;
+  const int rc = runInput(d, work_);
+  d.core.ws.pt.driver = nullptr;
+  return rc;
+}
+
+int ContactStage::finalFriction(DataImpl& d, const SolveInput& in) {
+  qdd_contacts_ = d.core.res.qdd;
+  buildWorkInput(in, false);
+  for (std::size_t k = 0; k < points_.size(); ++k)
+    if (const Vector3 f = forces.col(k) - points_[k].fixed; !f.isZero(0.0)) addForce(in.contacts[k], f);
+  work_.friction = in.friction;
+  work_.ff_torques = ff_user_;
+  FrictionCore& f = d.friction();
+  if (const int rc = runInput(d, work_)) return d.core.fail(rc, "%s", f.message_.data());
+  // The certificate: the friction stage's unique qdd is the contact problem's.
+  const double scale = std::max(1.0, qdd_contacts_.cwiseAbs().maxCoeff());
+  const double diff = (f.qdd_ - qdd_contacts_).cwiseAbs().maxCoeff();
+  if (!(diff <= 1e-7 * scale))
+    return d.core.fail(E_NO_SOLUTION,
+                       "contacts with joint friction: the friction stage's accelerations differ from the contact "
+                       "problem's by %g (scale %g): the answer is not certified",
+                       diff, scale);
+  return 0;
+}
+
+}  // namespace detail
+}  // namespace vereshchagin
