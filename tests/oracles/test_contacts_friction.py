@@ -195,14 +195,15 @@ def test_solve_batch_with_friction_and_contacts_equals_solve_row_by_row():
 
 @pytest.mark.parametrize("name", ["baxter", "random_3", "random_8"])
 def test_trees_with_joint_friction_and_supports(name):
-    """Supports on random segments of a tree with breakaway friction on three joints."""
+    """1 to 8 frictionless supports on random segments of a tree with breakaway friction on three
+    joints."""
     from support.trees import robot
 
     case = robot(name)
     rng = np.random.default_rng([41, len(name)])
     names = list(case.tree.segment_names)
     n = case.n
-    for k in (1, 3):
+    for k in (1, 3, 5, 8):
         q, _ = case.random_state(rng)
         tau = rng.normal(size=n) * 3
         fs = np.zeros(n)

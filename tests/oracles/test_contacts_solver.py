@@ -12,7 +12,7 @@ import pytest
 
 import vereshchagin as vs
 from support.chains import pin_configuration, random_chain, random_state
-from support.contact_oracle import contact_problem, enumerate_modes, frictionless_qp, pin_rigid_3d
+from support.contact_oracle import contact_problem, enumerate_modes, frictionless_qp, pin_rigid_3d, tangent_basis
 
 RTOL = 1e-9
 STATUS = {"separating": vs.ContactStatus.SEPARATING, "sticking": vs.ContactStatus.STICKING}
@@ -124,6 +124,35 @@ def test_force_set_points_push_with_their_force(seed):
     for c, f in zip(contacts, r.contact_force):
         assert abs(c.normal @ f - 4.0) <= RTOL * 4.0
     _matches_an_enumerated_solution(r, _problem(rc, q, qd, tau, contacts), contacts)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_force_set_point_is_pinocchios_constrained_forward_dynamics(seed):
+    """A force set-point F: Pinocchio's ``forwardDynamics`` with the point's normal row held (and,
+    when it sticks, its two tangential rows) and the surface's push F n as a known force. The
+    normal row's multiplier is the motors' (tau_command), the tangential ones the surface's."""
+    rng = np.random.default_rng(450 + seed)
+    rc = random_chain(rng, 7, prismatic=False)
+    q, _ = random_state(rng, rc)
+    qd, tau = np.zeros(7), rng.normal(size=7)
+    point, normal, force = rng.normal(size=3) * 0.1, rng.normal(size=3), 6.0
+    normal /= np.linalg.norm(normal)
+    stick = seed % 2 == 0  # friction far inside the cone (sticks), or none (frictionless)
+    contact = vs.Contact(rc.n_segments - 2, point=point, normal=normal, mu=1e4 if stick else 0.0, force=force)
+    r = rc.solver().solve(q, qd, tau_ff=tau, contacts=[contact])
+    c = _problem(rc, q, qd, tau, [contact]).contacts[0]
+    t1, t2 = tangent_basis(normal)
+    rows = np.vstack([normal, t1, t2]) if stick else normal[None, :]
+    model = rc.model
+    data = model.createData()
+    pq = pin_configuration(model, q)
+    qdd = pin.forwardDynamics(model, data, pq, qd, tau + c.J.T @ (force * normal), rows @ c.J, rows @ c.bias)
+    lam = data.lambda_c.copy()  # M qdd = tau - b + J^T lam
+    assert _rel(r.qdd, qdd) <= RTOL
+    expected_force = force * normal + (lam[1] * t1 + lam[2] * t2 if stick else 0.0)
+    assert _rel(r.contact_force[0], expected_force) <= RTOL
+    assert _rel(r.tau_command, c.J.T @ normal * lam[0]) <= RTOL
+    assert r.contact_status[0] == (vs.ContactStatus.STICKING if stick else vs.ContactStatus.SLIDING)
 
 
 def test_replaying_the_motors_and_the_contact_forces_gives_qdd():

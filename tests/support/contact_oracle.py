@@ -126,6 +126,8 @@ def contact_modes(c):
         return ["separate"]
     vt = _tangential_velocity(c)
     sep = [] if c.force is not None else ["separate"]
+    if c.mu == 0.0:  # every vertex is the normal: one mode for all (touching, sliding alike)
+        return sep + [("vertex", 0)]
     if np.linalg.norm(vt) > tol:  # sliding: the vertex most opposed to the velocity
         return sep + [("vertex", int(np.argmin(c.directions @ vt)))]
     k = c.facets
