@@ -208,3 +208,52 @@ def test_frictionless_supports_on_trees_are_gauss_qp(name):
         assert _rel(r.qdd, case.ours(expected)) <= RTOL, f"{name}, {k} supports"
         gen = sum(c.J.T @ f for c, f in zip(prob.contacts, r.contact_force))
         assert _rel(gen, prob.H @ expected - prob.h) <= RTOL
+
+
+def _painleve(sign):
+    """A chain whose tip slides on a surface with friction mu = 3 where the normal force pulls the
+    point into the surface (the sliding direction's effective normal mass n^T J H^-1 J^T (n + mu d*)
+    is negative: Painleve's paradox), with tau_ff chosen so the contact-free normal acceleration has
+    the given sign: none (sign < 0) or two (sign > 0) consistent answers."""
+    for seed in range(400):
+        rng = np.random.default_rng(1000 + seed)
+        rc = random_chain(rng, 4, prismatic=False)
+        q, qd = random_state(rng, rc)
+        tau = np.zeros(4)
+        point = rng.normal(size=3) * 0.1
+        seg = rc.n_segments - 1
+        c0 = _problem(rc, q, qd, tau, [vs.Contact(seg, point=point)]).contacts[0]
+        v = c0.velocity
+        normal = np.cross(v, rng.normal(size=3))  # perpendicular to the velocity: touching, sliding
+        normal /= np.linalg.norm(normal)
+        contact = vs.Contact(seg, point=point, normal=normal, mu=3.0)
+        prob = _problem(rc, q, qd, tau, [contact])
+        c = prob.contacts[0]
+        d = c.directions[np.argmin(c.directions @ (c.velocity - normal * (normal @ c.velocity)))]
+        nJ = normal @ c.J
+        m = nJ @ np.linalg.solve(prob.H, c.J.T @ (normal + 3.0 * d))
+        if m >= -0.05 * abs(nJ @ np.linalg.solve(prob.H, nJ)):
+            continue
+        # Shift tau_ff along J^T n until the free normal acceleration is +-1 m/s^2.
+        a0 = nJ @ np.linalg.solve(prob.H, prob.h) + normal @ c.bias
+        unit = nJ @ np.linalg.solve(prob.H, nJ)
+        tau = (sign * 1.0 - a0) / unit * nJ
+        return rc, q, qd, tau, contact
+    raise AssertionError("no Painleve configuration found")
+
+
+def test_painleve_without_an_answer_is_reported():
+    rc, q, qd, tau, contact = _painleve(-1.0)
+    assert enumerate_modes(_problem(rc, q, qd, tau, [contact])) == []
+    with pytest.raises(vs.SolverError, match="Painleve"):
+        rc.solver().solve(q, qd, tau_ff=tau, contacts=[contact])
+
+
+def test_painleve_with_two_answers_returns_one_of_them_as_consistent():
+    rc, q, qd, tau, contact = _painleve(1.0)
+    prob = _problem(rc, q, qd, tau, [contact])
+    found = enumerate_modes(prob)
+    assert len(found) == 2  # lift off, or press with a large force
+    r = rc.solver().solve(q, qd, tau_ff=tau, contacts=[contact])
+    assert r.contact_outcome == vs.ContactOutcome.CONSISTENT
+    assert min(_rel(r.qdd, s.qdd) for s in found) <= RTOL
