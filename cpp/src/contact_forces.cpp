@@ -48,7 +48,8 @@ void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
       col_segment_(p.col + c) = pc.segment;
       col_wrench_.col(p.col + c) << e, p.r.cross(e);
       rows_jac_.col(p.row + c).head(n).noalias() = jac_.topRows<3>().transpose() * rows[first + c];
-      rows_bias_(p.row + c) = rows[first + c].dot(bias.head<3>());
+      // Over a time step the row is the end velocity over dt: J qdd + v / dt (v = J qd).
+      rows_bias_(p.row + c) = dt_ > 0.0 ? rows[first + c].dot(p.v) / dt_ : rows[first + c].dot(bias.head<3>());
     }
   }
   auto dqdd = dqdd_.leftCols(ncol_);
@@ -202,15 +203,18 @@ void ContactStage::reportStatus(const SolveInput& in, bool stuck) {
 int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   if (int rc = classify(d.core, in)) return rc;
   joint_friction_ = in.friction != nullptr;
+  dt_ = in.time_step;
   joints_.clear();
+  if (dt_ > 0.0) stepKinds(in);
   if (joint_friction_) {
     if (int rc = checkJointFriction(d, in)) return rc;
     classifyJoints(in);
-  } else if (const int rc = tryAllActive(d, in); rc != 0) {
-    return rc < 0 ? rc : 0;
+  } else if (dt_ == 0.0) {
+    if (const int rc = tryAllActive(d, in); rc != 0) return rc < 0 ? rc : 0;
   }
   bool stickable = false;
   for (const Point& p : points_) stickable = stickable || p.kind == kTouching || p.kind == kSetPointRest;
+  stickable = stickable && dt_ == 0.0;  // (over a time step: the general problem)
   if (stickable) {
     const int rc = trySticking(d, in);
     if (rc < 0) return rc;
@@ -229,6 +233,10 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
 }
 
 int ContactStage::finish(DataImpl& d, const SolveInput& in) {
+  if (dt_ > 0.0) {  // (no least-effort programme over a time step yet)
+    stepOutputs(d, in);
+    return 0;
+  }
   if (int rc = leastEffort(d, in)) return rc;
   return joint_friction_ ? finalFriction(d, in) : 0;
 }

@@ -50,17 +50,21 @@ void ContactStage::classifyJoints(const SolveInput& in) {
   for (int j = 0; j < static_cast<int>(model_.nrOfJoints()); ++j) {
     ff_user_(j) = in.ff_torques.size() ? in.ff_torques(j) : 0.0;
     joint_tau_(j) = 0.0;
-    if (std::abs(in.q_dot(j)) > fm.velocity_tolerance) {
+    const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
+    if (moving && dt_ == 0.0) {  // at the instant: kinetic friction against the velocity
       joint_tau_(j) = -fk(j) * (in.q_dot(j) > 0.0 ? 1.0 : -1.0);
       continue;
     }
-    const bool at_lower = limits && in.q(j) <= fm.lower(j) + fm.limit_tolerance;
-    const bool at_upper = limits && in.q(j) >= fm.upper(j) - fm.limit_tolerance;
-    if (!(fs(j) > 0.0 || at_lower || at_upper)) continue;
+    // At rest, or over a time step (friction against the end velocity, kinetic while moving).
+    const double f = moving ? fk(j) : fs(j);
+    const bool at_lower = !moving && limits && in.q(j) <= fm.lower(j) + fm.limit_tolerance;
+    const bool at_upper = !moving && limits && in.q(j) >= fm.upper(j) - fm.limit_tolerance;
+    if (!(f > 0.0 || at_lower || at_upper)) continue;
     JointUnknown u;
     u.joint = j;
-    u.lo = at_upper ? -inf : -fs(j);
-    u.hi = at_lower ? inf : fs(j);
+    u.lo = at_upper ? -inf : -f;
+    u.hi = at_lower ? inf : f;
+    u.row_bias = dt_ > 0.0 ? in.q_dot(j) / dt_ : 0.0;
     joints_.push_back(u);  // within the capacity reserved for every joint
   }
 }
@@ -90,7 +94,7 @@ void ContactStage::prepareJointColumns(DataImpl& d) {
   for (const JointUnknown& u : joints_) {
     rows_jac_.col(u.row).setZero();
     rows_jac_(u.joint, u.row) = 1.0;
-    rows_bias_(u.row) = 0.0;
+    rows_bias_(u.row) = u.row_bias;
   }
 }
 

@@ -96,6 +96,7 @@ int ContactStage::solveWithForces(DataImpl& d, const SolveInput& in) {
 
 ContactStage::ContactStage(const Model& model) : model_(model), kin_(model), work_(model) {
   const int n = static_cast<int>(model.nrOfJoints());
+  step_friction.setZero(n), step_limit.setZero(n);
   jac_.resize(6, n);
   joints_.reserve(n);
   joint_tau_.setZero(n), ff_user_.setZero(n), qdd_contacts_.setZero(n);
@@ -162,7 +163,7 @@ int ContactStage::classify(HdCore& c, const SolveInput& in) {
     // Sliding: the vertex most opposed to the tangential velocity.
     p.slide_dir = vt.norm() > tol ? mostOpposed(p, vt, pc.facets) : Vector3::Zero();
     if (pc.isSupport()) {
-      if (vn < -tol)
+      if (vn < -tol && in.time_step == 0.0)  // (over a time step: an impulse)
         return c.fail(E_CONTACT,
                       "contacts[%zu] approaches its surface at %g m/s: an impact needs an impulse, not a force", k,
                       -vn);
@@ -236,27 +237,29 @@ void ContactStage::buildWorkInput(const SolveInput& in, bool stick) {
     work_.friction = nullptr;
     work_.ff_torques = ff_user_ + joint_tau_;
   }
-  const auto column = [this](int segment, const Vector3& point, const Vector3& e) {
+  const auto column = [this](int segment, const Point& p, const Vector3& point, const Vector3& e) {
     ConstraintBlock b;
     b.segment = segment;
     b.columns = 1;
     b.alfa.col(0) << e, Vector3::Zero();  // the point's acceleration along e ...
     b.point = point;
-    b.classical = true;  // ... held at zero (classical: the physical acceleration)
+    b.classical = true;  // ... held at zero (classical: the physical acceleration), over a time step
+    if (dt_ > 0.0)       // at the value that ends the step with zero velocity along e: J qdd = -v / dt
+      b.classical_acceleration.head<3>() = e * (e.dot(p.bias) - e.dot(p.v) / dt_);
     work_.constraints.push_back(b);
   };
   for (std::size_t k = 0; k < in.contacts.size(); ++k) {
     const Point& p = points_[k];
     const PointContact& pc = in.contacts[k];
     if (p.kind != kSetPointRest && p.kind != kSetPointSliding) continue;
-    column(pc.segment, pc.point, p.n);
+    column(pc.segment, p, pc.point, p.n);
     addForce(pc, p.fixed);
   }
   if (!stick) return;
   for (std::size_t k = 0; k < in.contacts.size(); ++k) {
     if (points_[k].stick_col < 0) continue;
-    column(in.contacts[k].segment, in.contacts[k].point, points_[k].t1);
-    column(in.contacts[k].segment, in.contacts[k].point, points_[k].t2);
+    column(in.contacts[k].segment, points_[k], in.contacts[k].point, points_[k].t1);
+    column(in.contacts[k].segment, points_[k], in.contacts[k].point, points_[k].t2);
   }
 }
 

@@ -53,6 +53,8 @@ class ContactStage {
   std::vector<ContactStatus> status;
   ContactOutcome outcome = ContactOutcome::None;
   int user_columns = 0;  // the input's own constraint columns (nu's size)
+  // A solve over a time step (contact_step.cpp): the joints' friction and limit torques (n).
+  Eigen::VectorXd step_friction, step_limit;
 
  private:
   // The contact's state at (q, qd); a frictionless point at rest counts as sliding (kSliding).
@@ -67,6 +69,7 @@ class ContactStage {
     Vector3 slide_dir;        // sliding: the polygon vertex direction most opposed to v_t (else 0)
     Vector3 dir;              // kNormalOnly: the force per unit normal force
     Vector3 fixed;            // the known part of the force (set-points)
+    Vector3 bias;             // a time step: the point's classical acceleration at qdd = 0 (base axes)
     int var = 0, nvar = 0;    // its unknowns in z
     int col = 0, ncol = 0;    // its response columns
     int row = 0, nrow = 0;    // its acceleration rows
@@ -108,6 +111,7 @@ class ContactStage {
   struct JointUnknown {
     int joint = 0;
     double lo = 0.0, hi = 0.0;
+    double row_bias = 0.0;  // its row at qdd = 0: 0 at the instant, qd_j / dt over a time step
     int var = 0, nvar = 0, col = 0, row = 0;
   };
   // The input's friction model checked (the friction stage's messages); 0 or an error code.
@@ -124,6 +128,10 @@ class ContactStage {
   void applyJointTorques();
   // runInput on work_ with the input's ff_torques alone as the pass-through driver.
   int runWork(DataImpl& d);
+  // A time step (contact_step.cpp): every support and set-point's kind from its end velocity (the
+  // polygon's vertex chosen by the problem), the points' classical bias; the joints' outputs.
+  void stepKinds(const SolveInput& in);
+  void stepOutputs(DataImpl& d, const SolveInput& in);
   // Step 4 with the friction stage; 0 or an error code with its message.
   int finalFriction(DataImpl& d, const SolveInput& in);
   // The least-effort programme, then (with joint friction) finalFriction.
@@ -196,6 +204,7 @@ class ContactStage {
   Eigen::MatrixXd joint_dtau_;   // n x n: responseColumns' command-torque columns (not used)
   int ncol_contacts_ = 0;        // the contacts' response columns (the joints' follow)
   bool joint_friction_ = false;  // this solve has joint friction
+  double dt_ = 0.0;              // SolveInput::time_step (0: the instant)
 };
 
 }  // namespace detail

@@ -93,9 +93,11 @@ const Matrix6X& Data::linkAccelerations() const {
   return impl_->core.linkAccelerations();
 }
 const Eigen::VectorXd& Data::frictionTorques() const noexcept {
+  if (impl_->step_last) return impl_->contact_stage->step_friction;
   return impl_->friction_last ? impl_->friction_core->friction_ : impl_->zeros;
 }
 const Eigen::VectorXd& Data::limitTorques() const noexcept {
+  if (impl_->step_last) return impl_->contact_stage->step_limit;
   return impl_->friction_last ? impl_->friction_core->limit_ : impl_->zeros;
 }
 const std::vector<JointStatus>& Data::jointStatus() const noexcept {

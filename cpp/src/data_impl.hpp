@@ -41,7 +41,8 @@ struct DataImpl {
   Eigen::VectorXd zeros;       // n_joints
   std::vector<JointStatus> status_per_joint;
   std::unique_ptr<ContactStage> contact_stage;
-  bool contacts_last = false;  // the last successful solve had contacts
+  bool contacts_last = false;  // the last successful solve had contacts (or friction over a time step)
+  bool step_last = false;      // ... over a time step: the joint outputs are the contact stage's
 };
 
 // Assembles `in` into the core's arguments and runs the sweeps (with the friction stage when it

@@ -68,6 +68,8 @@ int checkInput(HdCore& c, const SolveInput& in) {
       return c.fail(E_NF, "base_acceleration contains NaN or Inf");
     moving_base = moving_base || in.base_acceleration.vel(k) != 0.0 || in.base_acceleration.rot(k) != 0.0;
   }
+  if (!(std::isfinite(in.time_step) && in.time_step >= 0.0))
+    return c.fail(E_RANGE, "time_step must be finite and >= 0 (s; 0: the instant), got %g", in.time_step);
   if (classical && moving_base)
     return c.fail(E_RANGE,
                   "a classical set-point (ConstraintBlock::classical) needs a base at rest: base_acceleration "
@@ -125,9 +127,10 @@ int run(DataImpl& d, const SolveInput& in, int m) {
   return d.friction().solveImpl(in.q, in.q_dot, alfa, beta, &segments, f_ext, in.ff_torques, *in.friction);
 }
 
-// Joint status of the friction stage (or all Moving after a frictionless solve).
+// Joint status of the friction stage (or all Moving after a frictionless solve); a step's
+// statuses are written by the contact stage (step_last).
 void recordStatus(DataImpl& d, bool with_friction) {
-  if (!with_friction && !d.friction_last) return;
+  if (!with_friction && !d.friction_last && !d.step_last) return;
   for (std::size_t j = 0; j < d.status_per_joint.size(); ++j)
     d.status_per_joint[j] = with_friction ? static_cast<JointStatus>(d.friction_core->status_[j]) : JointStatus::Moving;
 }
@@ -152,15 +155,20 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
     recordStatus(d, false);
     d.friction_last = false;
     d.contacts_last = false;
+    d.step_last = false;
     return d.status(rc);
   }
-  const bool with_contacts = !input.contacts.empty();
+  // The contact stage: contacts, or friction over a time step (its impulse problem).
+  const bool with_friction = input.friction != nullptr;
+  const bool step = input.time_step > 0.0 && with_friction;
+  const bool with_contacts = !input.contacts.empty() || step;
   if (with_contacts) rc = d.contacts().check(c, input);
   if (rc == 0) rc = with_contacts ? d.contacts().solve(d, input) : detail::runInput(d, input);
   d.contacts_last = with_contacts && rc == 0;
-  const bool with_friction = input.friction != nullptr;
-  recordStatus(d, with_friction && rc == 0);
-  d.friction_last = with_friction && rc == 0;
+  const bool step_now = input.time_step > 0.0 && with_contacts && rc == 0;
+  if (!step_now) recordStatus(d, with_friction && rc == 0);  // (else written by the stage)
+  d.step_last = step_now;
+  d.friction_last = with_friction && rc == 0 && !step_now;
   if (rc == 0) {
     c.message[0] = '\0';
     return Status();

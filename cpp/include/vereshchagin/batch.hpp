@@ -64,6 +64,7 @@ struct BatchInput {
   /// Point contacts of every row (SolveInput::contacts; empty: none), with their velocity tolerance.
   std::vector<PointContact> contacts;
   double contact_velocity_tolerance = 1e-6;  ///< SolveInput::contact_velocity_tolerance (m/s)
+  double time_step = 0.0;                    ///< SolveInput::time_step (s; 0: the instant)
 
   /// Constraint columns of every row (the size of nu).
   int columns() const;

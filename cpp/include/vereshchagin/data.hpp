@@ -128,4 +128,13 @@ class Data {
 /// Results in data. Nothing of the input outlives the call.
 Status solve(const Model& model, Data& data, const SolveInput& input);
 
+/// One step of semi-implicit Euler over input.time_step = dt > 0 (s): solve() over the time step
+/// (the conditions of friction, limits and contacts on the end velocities, see
+/// SolveInput::time_step), then qd_next = q_dot + dt qdd, exactly 0 for a joint friction holds
+/// (JointStatus::Stick), and q_next = q + dt qd_next (n_joints each; they may alias input.q and
+/// input.q_dot). Error::OutOfRange for dt <= 0, SizeMismatch for wrong sizes, else solve()'s
+/// status. The results of the solve stay in data.
+Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,
+            Eigen::Ref<Eigen::VectorXd> qd_next);
+
 }  // namespace vereshchagin

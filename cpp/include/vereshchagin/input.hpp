@@ -93,6 +93,14 @@ struct SolveInput {
   std::vector<PointContact> contacts;
   /// Below this speed (m/s) a contact point is at rest along the normal, resp. not sliding.
   double contact_velocity_tolerance = 1e-6;
+  /// Time step dt (s) of a velocity-level solve; 0 (default): the instant. With dt > 0 the
+  /// conditions of joint friction, joint limits and contacts hold at the end of the step, for the
+  /// velocities qd+ = q_dot + dt qdd (the result's qdd is the step's mean acceleration): a joint or
+  /// contact point whose holding force stays within friction ends the step at zero velocity, a
+  /// sliding one gets the full friction against its end velocity (it cannot be reversed by it), a
+  /// support ends the step not approaching its surface (an impact is an impulse). The contact
+  /// points' Jacobians are those at q (semi-implicit Euler; step() in data.hpp integrates).
+  double time_step = 0.0;
   /// Physical gravity, base axes, m/s^2 (Earth with z up: (0, 0, -9.81)), and the base's own
   /// commanded spatial acceleration [linear; angular] (base axes, base origin; zero: a fixed
   /// base). The solver's root acceleration is base_acceleration - [gravity; 0].

@@ -1,0 +1,85 @@
+// The contact stage over a time step (SolveInput::time_step > 0, contact_stage.hpp): the same
+// complementarity problem as at the instant, with every condition on the velocities at the end of
+// the step, qd+ = q_dot + dt qdd, instead of the accelerations. A contact point's row is its end
+// velocity over dt, J qdd + J q_dot / dt (J at q: semi-implicit); a joint's row qdd_j + q_dot_j / dt.
+// So every support is an unknown whatever its velocity now (it may be hit, or leave), its friction
+// polygon's force sits against its end velocity (maximum dissipation), a set-point's normal column
+// ends the step with zero normal velocity, and every joint with friction is an unknown bounded by
+// its static friction at rest and its kinetic friction while moving: a joint whose holding torque
+// stays within the bound ends the step at zero velocity, a sliding one gets the full friction
+// against its end velocity, which friction alone cannot reverse. The sticking trial, the
+// all-active guess and the least-effort programme are instant-only; the joint outputs (friction
+// and limit torques, statuses) are this stage's (the friction stage is instant-only too).
+#include <algorithm>
+#include <cmath>
+
+#include "contact_stage.hpp"
+#include "data_impl.hpp"
+#include "hd_core.hpp"
+
+namespace vereshchagin {
+namespace detail {
+
+void ContactStage::stepKinds(const SolveInput& in) {
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    Point& p = points_[k];
+    const PointContact& pc = in.contacts[k];
+    Vector6 bias;
+    pointKinematics(pc, bias);
+    p.bias = bias.head<3>();
+    p.slide_dir.setZero();  // the vertex is the problem's, not the velocity's
+    if (pc.isSupport())
+      p.kind = pc.mu > 0.0 ? kTouching : kSliding;  // (frictionless: the normal alone)
+    else
+      p.kind = pc.mu > 0.0 ? kSetPointRest : kSetPointSliding;
+  }
+}
+
+void ContactStage::stepOutputs(DataImpl& d, const SolveInput& in) {
+  step_friction.setZero();
+  step_limit.setZero();
+  std::fill(d.status_per_joint.begin(), d.status_per_joint.end(), JointStatus::Moving);
+  if (!joint_friction_) return;
+  const FrictionModel& fm = *in.friction;
+  const Eigen::VectorXd& fs = fm.static_friction;
+  const Eigen::VectorXd& fk = fm.kinetic_friction.size() ? fm.kinetic_friction : fm.static_friction;
+  const Eigen::VectorXd& qdd = d.core.res.qdd;
+  const double a_max = qdd.cwiseAbs().maxCoeff();
+  for (const JointUnknown& u : joints_) {
+    const int j = u.joint;
+    const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
+    const double f = moving ? fk(j) : fs(j), t = joint_tau_(j);
+    step_friction(j) = std::clamp(t, -f, f);  // beyond the friction bound: the limit's reaction
+    step_limit(j) = t - step_friction(j);
+    // Ends the step at rest: its end velocity is round-off of the step's velocity change.
+    const double v = in.q_dot(j) + dt_ * qdd(j);
+    const bool stuck = std::abs(v) <= 1e-9 * std::max(std::abs(in.q_dot(j)), dt_ * a_max);
+    d.status_per_joint[j] = stuck    ? JointStatus::Stick
+                            : moving ? JointStatus::Moving
+                            : v > 0  ? JointStatus::SlipPositive
+                                     : JointStatus::SlipNegative;
+  }
+}
+
+}  // namespace detail
+
+Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,
+            Eigen::Ref<Eigen::VectorXd> qd_next) {
+  const long n = static_cast<long>(model.nrOfJoints());
+  if (!(input.time_step > 0.0) || !std::isfinite(input.time_step))
+    return Status(Error::OutOfRange, "step() needs a finite SolveInput::time_step > 0 (s)");
+  if (q_next.size() != n || qd_next.size() != n)
+    return Status(Error::SizeMismatch, "step(): q_next and qd_next must have one entry per joint");
+  const Status s = solve(model, data, input);
+  if (!s) return s;
+  const double dt = input.time_step;
+  const Eigen::VectorXd& qdd = data.qdd();
+  const std::vector<JointStatus>& status = data.jointStatus();
+  for (long j = 0; j < n; ++j) {  // a joint held by friction ends the step exactly at rest
+    qd_next(j) = status[j] == JointStatus::Stick ? 0.0 : input.q_dot(j) + dt * qdd(j);
+    q_next(j) = input.q(j) + dt * qd_next(j);
+  }
+  return s;
+}
+
+}  // namespace vereshchagin
