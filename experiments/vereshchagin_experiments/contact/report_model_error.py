@@ -33,21 +33,26 @@ def _findings(g_c, g_n, w_c, w_n) -> tuple[list, dict]:
     oc, on = metrics.grasp_outcome(g_c), metrics.grasp_outcome(g_n)
     ec, en = metrics.effort(g_c, g_c.window("slide")), metrics.effort(g_n, g_n.window("slide"))
     ac, an = metrics.writing_accuracy(w_c), metrics.writing_accuracy(w_n)
-    done = (
-        oc["contact_detected"]
-        and abs(oc["distance_x"] - 0.10) <= 0.005
-        and abs(on["distance_x"] - 0.10) <= 0.005
-        and abs(ac["length"] - 0.10) < 0.005
-        and abs(an["length"] - 0.10) < 0.005
-        and not g_n.table_touch
-    )
+    failed = [
+        reason
+        for reason, bad in (
+            ("contact not detected", not oc["contact_detected"]),
+            (f"contact slide {1e3 * oc['distance_x']:.1f} mm", abs(oc["distance_x"] - 0.10) > 0.005),
+            (f"contactless slide {1e3 * on['distance_x']:.1f} mm", abs(on["distance_x"] - 0.10) > 0.005),
+            (f"contact line {1e3 * ac['length']:.1f} mm", abs(ac["length"] - 0.10) >= 0.005),
+            (f"contactless line {1e3 * an['length']:.1f} mm", abs(an["length"] - 0.10) >= 0.005),
+            ("contactless grasp touched the table", bool(g_n.table_touch)),
+        )
+        if bad
+    ]
+    done = not failed
     cells = [
         f"{1e3 * oc['distance_x']:.1f}",
         f"{ec['mean_abs_tau'][1]:.2f} / {en['mean_abs_tau'][1]:.2f}",
         f"{ec['energy_tau2'].sum():.0f} / {en['energy_tau2'].sum():.0f}",
         f"{1e3 * ac['max_displacement']:.3f} / {1e3 * an['max_displacement']:.3f}",
         f"{1e3 * ac['mean_displacement']:+.3f} / {1e3 * an['mean_displacement']:+.3f}",
-        "yes" if done else "**no**",
+        "yes" if done else "**no**: " + ", ".join(failed),
     ]
     found = dict(
         done=done,
