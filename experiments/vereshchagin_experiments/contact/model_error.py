@@ -8,9 +8,10 @@ physical) and each joint's dry friction ``frictionloss`` are multiplied by indep
 drawn uniformly from ``[1 - spread, 1 + spread]`` (default +-10 %) by ``numpy``'s
 ``default_rng(seed)``. Centres of mass, geometry, damping and the motors are unchanged.
 
-:func:`run_perturbed` repeats the grasp and writing cases (contact and contactless) for a few seeds
-so that the report can show whether the contact findings survive a model the controller does not
-know exactly (:func:`.report_model_error.model_error_section`).
+:func:`run_perturbed` repeats the grasp and writing cases (contact and contactless) and the resting
+elbow (unsupported and with the support as a constraint) for a few seeds so that the report can
+show whether the contact findings survive a model the controller does not know exactly
+(:func:`.report_model_error.model_error_section`).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from .elbow import elbow
 from .use_cases import Run, grasp, writing
 
 __all__ = ["SEEDS", "SPREAD", "perturb_plant", "run_perturbed"]
@@ -65,13 +67,15 @@ def run_perturbed(
     spread: float = SPREAD,
     say: Optional[Callable[[str], None]] = None,
 ) -> dict:
-    """Grasp and writing, contact and contactless, on a perturbed plant per seed.
+    """Grasp and writing (contact and contactless) and the resting elbow (unsupported and
+    constraint) on a perturbed plant per seed.
 
     Returns
     -------
     dict
-        ``{(seed, case, variant): Run}`` with ``case`` in ``("grasp", "writing")`` and
-        ``variant`` in ``("contact", "contactless")``.
+        ``{(seed, case, variant): Run}``: ``case`` ``"grasp"`` or ``"writing"`` with ``variant``
+        ``"contact"`` / ``"contactless"``; ``case`` ``"elbow"`` with ``"unsupported"`` /
+        ``"constraint"``.
     """
     runs: dict[tuple, Run] = {}
     for seed in seeds:
@@ -80,6 +84,8 @@ def run_perturbed(
             variant = "contact" if contact else "contactless"
             runs[(seed, "grasp", variant)] = grasp(contact, quick, perturb=hook)
             runs[(seed, "writing", variant)] = writing(contact, quick, perturb=hook)
+        for variant in ("unsupported", "constraint"):
+            runs[(seed, "elbow", variant)] = elbow(variant, quick, perturb=hook)
         if say is not None:
             say(f"[contact] model error: seed {seed} done")
     return runs

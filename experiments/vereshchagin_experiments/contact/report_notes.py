@@ -68,7 +68,7 @@ def differences_lines() -> list[str]:
         "What differs from the report (read every comparison below with these in mind):",
         "",
         "- No model error in the main runs: the plant is compiled from the controller's own URDF (same masses, "
-        "inertias, friction). The section 'Model error' repeats use cases 1 and 2 on perturbed plants.",
+        "inertias, friction). The section 'Model error' repeats the use cases on perturbed plants.",
         f"- The joint friction values are chosen, not measured (Kinova publishes none): {f[0]} N m on joints 0-3, "
         f"{f[4]} N m on joints 4-6, static = kinetic.",
         "- beta includes gravity and the velocity product (w × v terms) through `vs.task.beta_for`; the report "
