@@ -78,9 +78,10 @@ def differences_lines() -> list[str]:
         "unconstrained directions.",
         f"- Heights: the grasp starts with the gripper's lowest point {100 * DESCENT:g} cm (quick: 5 cm) above the "
         f"table; the report's arm moved about 25 cm down from its start pose. The contactless slide runs "
-        f"{100 * CLEARANCE:g} cm above the table (the report gives no height). Writing: contact starts with the pen "
-        "tip 1 cm above the paper and approaches until contact (the report started on the paper); contactless "
-        "draws with the pen tip 10 cm above the table (the report: the gripper's centre 10 cm above it).",
+        f"{100 * CLEARANCE:g} cm above the table (the report gives no height). Writing: contact starts with the pen's "
+        "axis end 1 cm above the paper (its rounded tip's lowest point 5 mm) and approaches until contact (the "
+        "report started on the paper); contactless draws with the axis end 10 cm above the table (the tip's "
+        "lowest point 9.5 cm; the report: the gripper's centre 10 cm above it).",
         "- The writing start pose is the grasp's start pose with a pen pointing down (the report gives no "
         "joint angles for writing, only photographs).",
         "- No object is grasped: the gripper is rigid, its closing command is only recorded, the table holds nothing.",
