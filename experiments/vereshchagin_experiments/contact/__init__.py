@@ -16,8 +16,14 @@ closed loop at 1 kHz, with this package's solver inside the controller:
   while the other slides, the tree solver against the arms solved as separate chains
   (:mod:`.dual_arm_report`: ``--case dual-arm``);
 - :mod:`.metrics`: effort and accuracy numbers of a run (the report's Tables 6.1-6.3);
+- :mod:`.model_error`: the plant's inertias and joint friction perturbed (seeded), for the
+  model-error runs;
 - :mod:`.report`: runs everything and writes tables and figures
-  (``python -m vereshchagin_experiments reproduce --case contact``).
+  (``python -m vereshchagin_experiments reproduce --case contact``), with :mod:`.lau2023` (the
+  published numbers), :mod:`.report_notes` (setup, gains, differences from the report),
+  :mod:`.report_figures` and :mod:`.report_model_error`.
+
+Joints are counted from 0 in every table and figure, as in the report.
 
 Units are SI (m, rad, s, N, N m); poses and twists are in the robot's base frame, z up, gravity
 ``[0, 0, -9.81]`` m/s^2.

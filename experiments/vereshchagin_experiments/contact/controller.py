@@ -45,6 +45,8 @@ from vereshchagin.task import beta_for, directions, pose_error
 __all__ = [
     "CONTACT_GAINS",
     "FREE_GAINS",
+    "REPORT_CONTACT_GAINS",
+    "REPORT_FREE_GAINS",
     "FRICTION_MODES",
     "CascadedController",
     "ControllerConfig",
@@ -75,21 +77,35 @@ class Gains:
     k_vel: tuple = (30.0, 2.0)
 
 
+REPORT_FREE_GAINS = Gains((40.0, 80.0), (30.0, 2.0))
+"""Gains of W. K. Lau (2023), use case 1, before contact, as published (sec. 5.1); see :data:`FREE_GAINS`."""
+REPORT_CONTACT_GAINS = Gains((10.0, 80.0), (4.0, 40.0))
+"""Gains of W. K. Lau (2023), use case 1, after contact, as published (sec. 5.1); not used as such
+(:data:`CONTACT_GAINS`)."""
 FREE_GAINS = Gains((40.0, 80.0), (30.0, 40.0))
-"""Gains of W. K. Lau (2023), use case 1, before contact, except the angular ``k_vel`` = 40 instead of 2."""
+"""Free-space gains: :data:`REPORT_FREE_GAINS` with the angular ``k_vel`` = 40 instead of 2.
+
+Measured with the report's 2 (joints counted from 0): the full grasp (25 cm descent) completes
+(contact slide 99.4 mm, only the gripper touching the table), but in the quick grasp (5 cm
+descent) the wrist tilts on landing: the wrist links touch the table too, contact is detected
+0.8 s late and the slide ends at 95.7 mm; in writing the pen, pressed on the paper during the
+approach, turns the wrist (joint 5 from 55 to 122 degrees before contact is detected) and the
+line is drawn 64 mm backwards. The report's use case 3 failed the same way (a wrist joint
+rotating to its limit; its text blames the angular gain).
+"""
 CONTACT_GAINS = Gains((10.0, 80.0), (15.0, 40.0))
-"""Gains of W. K. Lau (2023), use case 1, after contact, except the linear ``k_vel`` = 15 instead of 4.
+"""Gains after contact: :data:`REPORT_CONTACT_GAINS` with the linear ``k_vel`` = 15 instead of 4.
 
 In contact the velocity loop is the only feedback against what the model compensates imperfectly:
 the sliding friction ``mu N`` of the table (about 15 N when the arm's weight presses with ~50 N
 after the report's 25 cm descent) and the joint friction near rest (the solver's max-min gives
 full friction to joints it predicts slipping at tiny accelerations, the plant's soft dry friction
-holds them with less, the wrist joints chatter). With ``k_vel`` = 4 the correction is at most
-``4 * v_max`` = 0.2 m/s^2 (about 1 N at the tool) and the slide stalls; measured over the full
-slide (25 cm descent, ``friction_velocity_tolerance`` 0.01): k_vel 4 -> 48 mm, 7 -> 60 mm,
-10 -> 96 mm, 15 -> 99.5 mm, 20 -> 99.6 mm, 30 -> 99.7 mm. Limiting the pressing force instead
-(motors carrying all but 12 N of the weight along the released direction) still stalls at 50 mm
-with k_vel = 4. The quick mode (5 cm descent) completes with 4.
+holds them with less). With ``k_vel`` = 4 the correction is at most ``4 * v_max`` = 0.2 m/s^2
+(about 1 N at the tool) and the slide stalls. Measured over the full slide (25 cm descent,
+``friction_velocity_tolerance`` 0.01): with the report's exact gains (:data:`REPORT_FREE_GAINS`
+and :data:`REPORT_CONTACT_GAINS`) the slide reaches 66 mm; with the free-space angular ``k_vel``
+= 40 and the in-contact linear ``k_vel`` = 4 -> 48 mm, 7 -> 60 mm, 10 -> 96 mm, 15 -> 99.5 mm.
+The quick mode (5 cm descent) completes with 4.
 """
 
 

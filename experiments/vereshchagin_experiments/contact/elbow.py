@@ -33,8 +33,8 @@ import numpy as np
 from vereshchagin import Solver
 from vereshchagin.task import beta_for
 from .controller import CascadedController, ControllerConfig
-from .mujoco_plant import ELBOW_RADIUS, MujocoGen3, Scene, build_model
-from .use_cases import SLIDE, Phase, _shifted, gen3_model, run_loop
+from .mujoco_plant import ELBOW_RADIUS, Scene
+from .use_cases import SLIDE, Phase, _plant, _shifted, gen3_model, run_loop
 
 __all__ = ["ELBOW_POSE", "ELBOW_SEGMENT", "VARIANTS", "elbow"]
 
@@ -85,7 +85,7 @@ def support_share(chain, seg: int):
     return share
 
 
-def elbow(variant: str, quick: bool = False, progress=None):
+def elbow(variant: str, quick: bool = False, progress=None, perturb=None):
     """Run use case 3 in one of :data:`VARIANTS` (see module doc).
 
     Parameters
@@ -97,6 +97,8 @@ def elbow(variant: str, quick: bool = False, progress=None):
         Shorter settle, slide and hold phases.
     progress : callable, optional
         ``progress(fraction)``, see :func:`~.use_cases.run_loop`.
+    perturb : callable, optional
+        Model error of the plant, as in :func:`~.use_cases.grasp` (``info["plant_error"]``).
 
     Returns
     -------
@@ -120,7 +122,7 @@ def elbow(variant: str, quick: bool = False, progress=None):
     if variant != "unsupported":
         top = p_e[2] - ELBOW_RADIUS
         support = ((p_e[0], p_e[1], top / 2.0), (0.05, 0.06, top / 2.0))
-    robot = MujocoGen3(build_model(urdf, chain, Scene(support=support)), q0)
+    robot, plant_error = _plant(urdf, chain, Scene(support=support), q0, perturb)
     solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
     ctl = CascadedController(chain, solver, ControllerConfig(posture_gains=(0.0, 3.0)))
     if variant != "plant":
@@ -149,5 +151,6 @@ def elbow(variant: str, quick: bool = False, progress=None):
         elbow_z=elbow_z,
         support_top=None if support is None else 2 * support[0][2],
         support_force_model=np.array(nu_log[: len(run.t)]) if nu_log else np.full(len(run.t), np.nan),
+        plant_error=plant_error,
     )
     return run

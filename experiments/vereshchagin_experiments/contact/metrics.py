@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["dual_arm_outcome", "effort", "elbow_outcome", "grasp_outcome", "writing_accuracy"]
+__all__ = ["STROKE_END", "dual_arm_outcome", "effort", "elbow_outcome", "grasp_outcome", "writing_accuracy"]
 
 
 def effort(run, mask=None) -> dict:
@@ -89,6 +89,10 @@ def grasp_outcome(run, phase: str = "slide") -> dict:
     )
 
 
+STROKE_END = 0.005
+"""m: the last part of the 0.10 m line counted as the stroke's end (stopping and standing still)."""
+
+
 def writing_accuracy(run, phase: str = "write") -> dict:
     """Displacement of the pen tip in y from the reference line (y = y at the start, along +x).
 
@@ -105,18 +109,26 @@ def writing_accuracy(run, phase: str = "write") -> dict:
         ``max_displacement``: max |dy| and ``mean_displacement``: signed mean dy (m, base y) over
         the drawn part (x between the start and start + 0.10 m), as Table 6.3 of W. K. Lau (2023);
         NaN if nothing was drawn; ``length``: final x minus start x (m); ``contact_fraction``:
-        share of the drawn samples in which the plant reports table contact.
+        share of the drawn samples in which the plant reports table contact. The same over the
+        stroke without its end (x below start + 0.10 m - :data:`STROKE_END`, where the pen still
+        moves): ``max_displacement_stroke``, ``mean_displacement_stroke`` (m, NaN if none);
+        ``max_at``: x of the largest |dy| from the start (m).
     """
     m = run.window(phase)
     tool = run.tool[m]
     x0, y0 = tool[0, 0], tool[0, 1]
     drawn = (tool[:, 0] >= x0 + 1e-4) & (tool[:, 0] <= x0 + 0.10)
     dy = tool[drawn, 1] - y0
+    stroke = tool[drawn, 0] < x0 + 0.10 - STROKE_END
+    nan = float("nan")
     return dict(
-        max_displacement=float(np.abs(dy).max()) if dy.size else float("nan"),
-        mean_displacement=float(dy.mean()) if dy.size else float("nan"),
+        max_displacement=float(np.abs(dy).max()) if dy.size else nan,
+        mean_displacement=float(dy.mean()) if dy.size else nan,
         length=float(tool[-1, 0] - x0),
         contact_fraction=float((run.table_force[m][drawn] > 0).mean()) if dy.size else 0.0,
+        max_displacement_stroke=float(np.abs(dy[stroke]).max()) if stroke.any() else nan,
+        mean_displacement_stroke=float(dy[stroke].mean()) if stroke.any() else nan,
+        max_at=float(tool[drawn, 0][np.argmax(np.abs(dy))] - x0) if dy.size else nan,
     )
 
 

@@ -8,12 +8,14 @@ links are fused into ``bracelet_link`` by both). Then it adds
 - joint friction ``frictionloss`` and viscous ``damping`` from the URDF ``<dynamics>`` tags
   (MuJoCo reads them: friction -> frictionloss, damping -> damping), ``armature`` = the chain's
   rotor inertia (0 for the Gen3: Kinova gives none);
-- one torque motor per joint (gear 1, ``ctrlrange`` = +-effort limit: 39 N m joints 1-4,
-  9 N m joints 5-7);
+- one torque motor per joint (gear 1, ``ctrlrange`` = +-effort limit: 39 N m joints 0-3,
+  9 N m joints 4-6, counted from 0);
 - a table (box; top at ``Scene.table_top``), optionally an elbow support (box) and a pen held in
   the gripper (capsule, pointing down at the start pose);
-- a collision sphere around each elbow actuator (joint 4; every body named ``*forearm_link``),
-  radius 0.055 m.
+- a collision sphere around each elbow actuator (joint 3 counted from 0 as in the report; every
+  body named ``*forearm_link``), radius 0.055 m;
+- names for the URDF's unnamed collision geoms: ``gripper`` for the gripper's box, the link's
+  name for the others.
 
 A tree robot (:func:`vereshchagin.robots.dual_gen3_urdf` with a :class:`vereshchagin.Tree`) is
 built the same way: one motor per joint in the tree's joint order, contact geoms on every arm.
@@ -119,6 +121,21 @@ def _add_pen(spec, chain, direction, fr) -> None:
     )
 
 
+def _name_arm_geoms(spec) -> None:
+    """Name the URDF's unnamed collision geoms after what they are (the logs list who touches the table).
+
+    The gripper's box (on ``*robotiq_85_base_link``) becomes ``*gripper``; any other geom takes its
+    link's name (``forearm_link``, ...), with ``_2``, ``_3`` ... when a link holds several.
+    """
+    for body in spec.bodies:
+        unnamed = [g for g in body.geoms if not g.name]
+        for k, g in enumerate(unnamed):
+            base = body.name
+            if g.type == mujoco.mjtGeom.mjGEOM_BOX and base.endswith("robotiq_85_base_link"):
+                base = base.removesuffix("robotiq_85_base_link") + "gripper"
+            g.name = base if k == 0 else f"{base}_{k + 1}"
+
+
 def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
     """Compile the plant (see module doc).
 
@@ -147,6 +164,7 @@ def build_model(urdf: str, chain, scene: Scene = Scene()) -> mujoco.MjModel:
     fr = [scene.friction, 0.005, 1e-4]
     for g in spec.geoms:
         g.contype, g.conaffinity, g.group, g.friction = 1, 0, ARM, fr
+    _name_arm_geoms(spec)
     joints = list(chain.joint_names)
     rotor = np.asarray(chain.rotor_inertia, float)
     for k, name in enumerate(joints):

@@ -384,13 +384,33 @@ def _gripper_low_point(model, q, T_frame, body: str = "bracelet_link") -> np.nda
     return (np.linalg.inv(np.asarray(T_frame)) @ np.append(corner, 1.0))[:3]
 
 
+def _plant(urdf, chain, scene, q0, perturb=None):
+    """The MuJoCo plant of ``scene`` at rest at ``q0``, changed by ``perturb`` (model error) if given.
+
+    Returns the :class:`~.mujoco_plant.MujocoGen3` and ``perturb``'s result (None without it).
+    """
+    model = build_model(urdf, chain, scene)
+    error = perturb(model) if perturb is not None else None
+    return MujocoGen3(model, q0), error
+
+
 def _controller(chain, tool_point, **overrides):
     solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
     return CascadedController(chain, solver, ControllerConfig(contact_point=tuple(tool_point), **overrides))
 
 
-def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[float] = None) -> Run:
+def grasp(
+    contact: bool,
+    quick: bool = False,
+    progress=None,
+    descent: Optional[float] = None,
+    perturb: Optional[Callable[[Any], dict]] = None,
+) -> Run:
     """Use case 1: approach the table, slide 0.10 m along +x (in contact or 0.03 m above), grasp.
+
+    Gains: :data:`~.controller.FREE_GAINS` and :data:`~.controller.CONTACT_GAINS` (why they
+    differ from the report's: their documentation). Nothing is grasped: the gripper is rigid and
+    its closing command is only recorded.
 
     Parameters
     ----------
@@ -404,12 +424,17 @@ def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[f
     descent : float, optional
         Height (m) of the gripper's lowest point above the table at the start; overrides
         ``quick``'s choice.
+    perturb : callable, optional
+        ``perturb(mujoco.MjModel) -> dict``: changes the compiled plant in place before the run
+        (model error, :mod:`.model_error`); its result is stored as ``info["plant_error"]``.
+        None: the plant is the controller's model.
 
     Returns
     -------
     Run
         Phases ``approach``, ``slide``, ``grasp``; ``info``: ``table_top`` (m, base z),
         ``descent`` (m), ``tool_point`` (3,) (the gripper's lowest point, end-effector frame, m).
+
     """
     urdf, chain = gen3_model()
     q0 = np.array(robots.GEN3_START_POSE)
@@ -419,7 +444,7 @@ def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[f
     low = _gripper_low_point(probe, q0, chain.fk(q0))
     z_low = (np.asarray(chain.fk(q0)) @ np.append(low, 1.0))[2]
     scene = Scene(table_top=float(z_low - descent))
-    robot = MujocoGen3(build_model(urdf, chain, scene), q0)
+    robot, plant_error = _plant(urdf, chain, scene, q0, perturb)
     ctl = _controller(chain, low)
     v = ctl.config.v_max
     approach_time = descent / v + 2.0
@@ -441,12 +466,14 @@ def grasp(contact: bool, quick: bool = False, progress=None, descent: Optional[f
             Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0),
         ]
     run = run_loop(robot, ctl, phases, "grasp", "contact" if contact else "contactless", low, progress)
-    run.info.update(table_top=scene.table_top, descent=descent, tool_point=low)
+    run.info.update(table_top=scene.table_top, descent=descent, tool_point=low, plant_error=plant_error)
     return run
 
 
-def writing(contact: bool, quick: bool = False, progress=None) -> Run:
+def writing(contact: bool, quick: bool = False, progress=None, perturb: Optional[Callable[[Any], dict]] = None) -> Run:
     """Use case 2: draw a 0.10 m line along +x with the pen on the table, or 0.10 m above it.
+
+    The start pose is the grasp's (the report gives none for writing, only photographs).
 
     Parameters
     ----------
@@ -457,12 +484,15 @@ def writing(contact: bool, quick: bool = False, progress=None) -> Run:
         Accepted for a uniform signature; the writing runs are short either way.
     progress : callable, optional
         ``progress(fraction)``, see :func:`run_loop`.
+    perturb : callable, optional
+        Model error of the plant, as in :func:`grasp`.
 
     Returns
     -------
     Run
         Phases ``approach`` (contact) or ``settle``, then ``write``; ``info``: ``table_top``
         (m, base z), ``tool_point`` (3,) (the pen tip, end-effector frame, m).
+
     """
     urdf, chain = gen3_model()
     q0 = np.array(robots.GEN3_START_POSE)
@@ -473,7 +503,7 @@ def writing(contact: bool, quick: bool = False, progress=None) -> Run:
     z_tip = (T0 @ np.append(tip_ee, 1.0))[2]
     gap = 0.01 if contact else 0.10
     scene = Scene(table_top=float(z_tip - gap), pen_direction=tuple(pen_dir))
-    robot = MujocoGen3(build_model(urdf, chain, scene), q0)
+    robot, plant_error = _plant(urdf, chain, scene, q0, perturb)
     # Tracked point: the end-effector origin, as in the report (the pen tip, 0.12 m below the grip,
     # moves with orientation errors). Tracking the pen tip itself (``with_tool_link``) made the
     # free-space variant drift in the self-motion; not pursued.
@@ -491,5 +521,5 @@ def writing(contact: bool, quick: bool = False, progress=None) -> Run:
             Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time),
         ]
     run = run_loop(robot, ctl, phases, "writing", "contact" if contact else "contactless", tip_ee, progress)
-    run.info.update(table_top=scene.table_top, tool_point=tip_ee)
+    run.info.update(table_top=scene.table_top, tool_point=tip_ee, plant_error=plant_error)
     return run
