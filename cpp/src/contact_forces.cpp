@@ -48,8 +48,10 @@ void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
       col_segment_(p.col + c) = pc.segment;
       col_wrench_.col(p.col + c) << e, p.r.cross(e);
       rows_jac_.col(p.row + c).head(n).noalias() = jac_.topRows<3>().transpose() * rows[first + c];
-      // Over a time step the row is the end velocity over dt: J qdd + v / dt (v = J qd).
-      rows_bias_(p.row + c) = dt_ > 0.0 ? rows[first + c].dot(p.v) / dt_ : rows[first + c].dot(bias.head<3>());
+      // Over a time step the row is the end velocity over dt, v+ / dt = a + v / dt to first order
+      // (a = J qdd + bias the point's acceleration, v = J qd).
+      const double row_v = dt_ > 0.0 ? rows[first + c].dot(p.v) / dt_ : 0.0;
+      rows_bias_(p.row + c) = rows[first + c].dot(bias.head<3>()) + row_v;
     }
   }
   auto dqdd = dqdd_.leftCols(ncol_);
@@ -129,6 +131,7 @@ int ContactStage::solveLcp(HdCore& c, bool convex) {
                            "problem can have none: Painleve's paradox)");
   const double scale = std::max({1.0, q.cwiseAbs().maxCoeff(), (w - q).cwiseAbs().maxCoeff()});  // w - q = M z
   const double tol = 1e-9 * scale;
+  lcp_scale_ = scale;
   for (int i = 0; i < nz_; ++i)
     if (w(i) < -tol || std::abs(w(i) * z(i)) > tol * std::max(1.0, std::abs(z(i))))
       return c.fail(E_NO_SOLUTION, "contacts: the certificate of the contact forces failed at unknown %d", i);

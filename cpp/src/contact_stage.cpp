@@ -97,6 +97,7 @@ int ContactStage::solveWithForces(DataImpl& d, const SolveInput& in) {
 ContactStage::ContactStage(const Model& model) : model_(model), kin_(model), work_(model) {
   const int n = static_cast<int>(model.nrOfJoints());
   step_friction.setZero(n), step_limit.setZero(n);
+  step_qd_.setZero(n), gauss_tau_.setZero(n), gauss_out_.setZero(n);
   jac_.resize(6, n);
   joints_.reserve(n);
   joint_tau_.setZero(n), ff_user_.setZero(n), qdd_contacts_.setZero(n);
@@ -244,8 +245,8 @@ void ContactStage::buildWorkInput(const SolveInput& in, bool stick) {
     b.alfa.col(0) << e, Vector3::Zero();  // the point's acceleration along e ...
     b.point = point;
     b.classical = true;  // ... held at zero (classical: the physical acceleration), over a time step
-    if (dt_ > 0.0)       // at the value that ends the step with zero velocity along e: J qdd = -v / dt
-      b.classical_acceleration.head<3>() = e * (e.dot(p.bias) - e.dot(p.v) / dt_);
+    if (dt_ > 0.0)       // at the value that ends the step at rest along e: v+ = v + dt a = 0
+      b.classical_acceleration.head<3>() = -e.dot(p.v) / dt_ * e;
     work_.constraints.push_back(b);
   };
   for (std::size_t k = 0; k < in.contacts.size(); ++k) {

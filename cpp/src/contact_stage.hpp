@@ -55,6 +55,9 @@ class ContactStage {
   int user_columns = 0;  // the input's own constraint columns (nu's size)
   // A solve over a time step (contact_step.cpp): the joints' friction and limit torques (n).
   Eigen::VectorXd step_friction, step_limit;
+  // Its Gauss value, Z0(qdd) + sum_j f_j |qd_j + dt qdd_j| / dt (Z0 as friction_solver.hpp's, the
+  // friction and limit torques of every joint with friction in dtau), by one articulated pass.
+  double stepGaussValue(DataImpl& d);
 
  private:
   // The contact's state at (q, qd); a frictionless point at rest counts as sliding (kSliding).
@@ -69,7 +72,6 @@ class ContactStage {
     Vector3 slide_dir;        // sliding: the polygon vertex direction most opposed to v_t (else 0)
     Vector3 dir;              // kNormalOnly: the force per unit normal force
     Vector3 fixed;            // the known part of the force (set-points)
-    Vector3 bias;             // a time step: the point's classical acceleration at qdd = 0 (base axes)
     int var = 0, nvar = 0;    // its unknowns in z
     int col = 0, ncol = 0;    // its response columns
     int row = 0, nrow = 0;    // its acceleration rows
@@ -129,7 +131,7 @@ class ContactStage {
   // runInput on work_ with the input's ff_torques alone as the pass-through driver.
   int runWork(DataImpl& d);
   // A time step (contact_step.cpp): every support and set-point's kind from its end velocity (the
-  // polygon's vertex chosen by the problem), the points' classical bias; the joints' outputs.
+  // polygon's vertex chosen by the problem); the joints' outputs.
   void stepKinds(const SolveInput& in);
   void stepOutputs(DataImpl& d, const SolveInput& in);
   // Step 4 with the friction stage; 0 or an error code with its message.
@@ -205,6 +207,9 @@ class ContactStage {
   int ncol_contacts_ = 0;        // the contacts' response columns (the joints' follow)
   bool joint_friction_ = false;  // this solve has joint friction
   double dt_ = 0.0;              // SolveInput::time_step (0: the instant)
+  double lcp_scale_ = 1.0;       // the last complementarity problem's scale (accelerations)
+  Eigen::VectorXd step_qd_;      // a time step: the input's q_dot (stepGaussValue); gauss buffers
+  Eigen::VectorXd gauss_tau_, gauss_out_;
 };
 
 }  // namespace detail

@@ -1,7 +1,8 @@
 // The contact stage over a time step (SolveInput::time_step > 0, contact_stage.hpp): the same
 // complementarity problem as at the instant, with every condition on the velocities at the end of
 // the step, qd+ = q_dot + dt qdd, instead of the accelerations. A contact point's row is its end
-// velocity over dt, J qdd + J q_dot / dt (J at q: semi-implicit); a joint's row qdd_j + q_dot_j / dt.
+// velocity over dt to first order, a + v / dt (a = J qdd + bias its acceleration, v = J q_dot: the
+// instant's row plus v / dt); a joint's row qdd_j + q_dot_j / dt.
 // So every support is an unknown whatever its velocity now (it may be hit, or leave), its friction
 // polygon's force sits against its end velocity (maximum dissipation), a set-point's normal column
 // ends the step with zero normal velocity, and every joint with friction is an unknown bounded by
@@ -12,6 +13,7 @@
 // and limit torques, statuses) are this stage's (the friction stage is instant-only too).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "contact_stage.hpp"
 #include "data_impl.hpp"
@@ -24,9 +26,6 @@ void ContactStage::stepKinds(const SolveInput& in) {
   for (std::size_t k = 0; k < points_.size(); ++k) {
     Point& p = points_[k];
     const PointContact& pc = in.contacts[k];
-    Vector6 bias;
-    pointKinematics(pc, bias);
-    p.bias = bias.head<3>();
     p.slide_dir.setZero();  // the vertex is the problem's, not the velocity's
     if (pc.isSupport())
       p.kind = pc.mu > 0.0 ? kTouching : kSliding;  // (frictionless: the normal alone)
@@ -39,12 +38,14 @@ void ContactStage::stepOutputs(DataImpl& d, const SolveInput& in) {
   step_friction.setZero();
   step_limit.setZero();
   std::fill(d.status_per_joint.begin(), d.status_per_joint.end(), JointStatus::Moving);
+  step_qd_ = in.q_dot;
   if (!joint_friction_) return;
   const FrictionModel& fm = *in.friction;
   const Eigen::VectorXd& fs = fm.static_friction;
   const Eigen::VectorXd& fk = fm.kinetic_friction.size() ? fm.kinetic_friction : fm.static_friction;
   const Eigen::VectorXd& qdd = d.core.res.qdd;
-  const double a_max = qdd.cwiseAbs().maxCoeff();
+  // Round-off of the rows (v+ / dt): the complementarity problem's scale (none: the motion's).
+  const double a_tol = 1e-9 * (nz_ > 0 ? lcp_scale_ : std::max(1.0, qdd.cwiseAbs().maxCoeff()));
   for (const JointUnknown& u : joints_) {
     const int j = u.joint;
     const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
@@ -53,12 +54,26 @@ void ContactStage::stepOutputs(DataImpl& d, const SolveInput& in) {
     step_limit(j) = t - step_friction(j);
     // Ends the step at rest: its end velocity is round-off of the step's velocity change.
     const double v = in.q_dot(j) + dt_ * qdd(j);
-    const bool stuck = std::abs(v) <= 1e-9 * std::max(std::abs(in.q_dot(j)), dt_ * a_max);
+    const bool stuck = std::abs(v) <= dt_ * a_tol;
     d.status_per_joint[j] = stuck    ? JointStatus::Stick
                             : moving ? JointStatus::Moving
                             : v > 0  ? JointStatus::SlipPositive
                                      : JointStatus::SlipNegative;
   }
+}
+
+double ContactStage::stepGaussValue(DataImpl& d) {
+  HdCore& c = d.core;
+  if (!c.res.solved) return std::numeric_limits<double>::quiet_NaN();
+  gauss_tau_ = c.res.tau_cmd + step_friction + step_limit;  // H (qdd - qdd_free)
+  c.inverseInertia(gauss_tau_, gauss_out_);
+  double dissipation = 0.0;
+  for (const JointUnknown& u : joints_) {
+    if (d.status_per_joint[u.joint] == JointStatus::Stick) continue;  // (round-off times a huge f)
+    const double f = std::isfinite(u.hi) ? u.hi : std::isfinite(u.lo) ? -u.lo : 0.0;
+    dissipation += f * std::abs(step_qd_(u.joint) / dt_ + c.res.qdd(u.joint));
+  }
+  return 0.5 * gauss_tau_.dot(gauss_out_) + dissipation;
 }
 
 }  // namespace detail

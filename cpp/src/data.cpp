@@ -105,6 +105,7 @@ const std::vector<JointStatus>& Data::jointStatus() const noexcept {
 }
 double Data::gaussValue() const {
   const EntryGuard guard(impl_->core.busy);
+  if (guard && impl_->step_last) return impl_->contact_stage->stepGaussValue(*impl_);
   if (!guard || !impl_->friction_last) return std::numeric_limits<double>::quiet_NaN();
   return impl_->friction_core->gaussValue();
 }

@@ -189,6 +189,7 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   parseFriction(a[6]);
   input.contacts.clear();
   if (given(a[kContactsArg])) parseContacts(a[kContactsArg]);
+  input.time_step = given(a[kTimeStepArg]) ? scalarArg(a[kTimeStepArg], "time_step") : 0.0;  // (range: by solve)
   // Pass-through weights: one per constraint column (their range: checked by vereshchagin::solve).
   if (given(a[8])) input.f_ext_pass_through = vector(a[8], "f_ext_pass_through", columns, /*scalar_ok=*/true);
   if (given(a[9])) input.ff_pass_through = vector(a[9], "tau_ff_pass_through", columns, /*scalar_ok=*/true);

@@ -235,6 +235,7 @@ class Solver:
         out: Optional[SolveResult] = None,
         a_desired: Optional[ArrayLike] = None,
         contacts: Optional[Sequence[Contact]] = None,
+        time_step: Optional[float] = None,
     ) -> SolveResult: ...
     def _time_cpp(self, reps: int, /, *args: object, **kwargs: object) -> float: ...
     def _solve_dict(self, /, *args: object, **kwargs: object) -> dict: ...
@@ -254,6 +255,7 @@ class Solver:
         threads: int = 1,
         a_desired: Optional[ArrayLike] = None,
         contacts: Optional[Sequence[Contact]] = None,
+        time_step: Optional[float] = None,
     ) -> dict: ...
     def response_columns(
         self, joints: Sequence[int], hold_sticking: bool = True

@@ -494,7 +494,7 @@ DOCS["Tree.fk_all"] = _fk_all(", in segment order")
 
 # ---- Solver (solver_bindings.cpp): the C++ core of vereshchagin.Solver (solver.py) ----
 
-DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None)
+DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None, time_step=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -555,6 +555,13 @@ contacts : list of Contact, optional
     supply the contact forces, the motors only ``tau_command``; where the forces are not unique,
     the least motor effort, then the least contact force (docs: "Contacts"). With ``friction``,
     joint friction, joint limits and the contacts are solved as one problem.
+time_step : float, optional
+    dt > 0 (s): solve over a time step instead of at the instant. The conditions of joint
+    friction, joint limits and contacts hold for the velocities at the end of the step,
+    ``qd + dt qdd`` (``qdd`` is then the step's mean acceleration): a joint or contact point
+    friction can hold ends the step at rest, a sliding one gets the full friction against its
+    end velocity, a support ends the step not approaching its surface. :meth:`Solver.step`
+    integrates. Default (None or 0): the instant.
 
 Returns
 -------
@@ -577,7 +584,7 @@ The GIL is released during the solve. One solver serialises concurrent calls; us
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
 """
 
-DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None, contacts=None)
+DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None, contacts=None, time_step=None)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 """

@@ -168,6 +168,7 @@ class Solver(_core.Solver):
         threads=1,
         a_desired=None,
         contacts=None,
+        time_step=None,
     ) -> BatchResult:
         """Solve B states at once (each row exactly as :meth:`solve` would).
 
@@ -198,6 +199,8 @@ class Solver(_core.Solver):
             Instead of ``beta``: the last segment's classical acceleration (see :meth:`solve`).
         contacts : list of Contact, optional
             Point contacts of every row (see :meth:`solve`).
+        time_step : float, optional
+            Every row over a time step (see :meth:`solve`).
 
         Returns
         -------
@@ -225,6 +228,7 @@ class Solver(_core.Solver):
             threads,
             a_desired,
             contacts,
+            time_step,
         )
         if not out.pop("any_friction"):
             for key in ("friction_torque", "limit_torque", "status", "gauss_value", "iterations"):
@@ -232,6 +236,46 @@ class Solver(_core.Solver):
         layout = out.pop("segment_nu")  # (key, first column, columns) per constraints= entry
         segment_nu = {key: out["nu"][:, start : start + count] for key, start, count in layout}
         return BatchResult(**out, segment_nu=segment_nu or None)
+
+    def step(self, q, qd, time_step, **solve_args):
+        """One step of semi-implicit Euler over ``time_step`` with friction and contacts solved exactly.
+
+        :meth:`solve` with ``time_step``: the conditions of joint friction, joint limits and
+        contacts hold for the velocities at the end of the step, ``qd_next = qd + dt qdd``; then
+        ``q_next = q + dt qd_next``. A joint that friction holds (status 1, sticking) ends the
+        step exactly at rest, so a held arm keeps ``q`` bitwise (docs: "Friction in discrete
+        time").
+
+        Parameters
+        ----------
+        q, qd : array_like, shape (n,)
+            Joint positions (rad or m) and velocities (rad/s or m/s) at the start of the step.
+        time_step : float
+            dt > 0, s.
+        **solve_args
+            Any other argument of :meth:`solve` (``tau_ff``, ``friction``, ``contacts``, a task, ...).
+
+        Returns
+        -------
+        q_next, qd_next : ndarray, shape (n,)
+            The state at the end of the step.
+        result : SolveResult
+            The solve over the step: ``qdd`` is the step's mean acceleration, ``friction_torque``,
+            ``limit_torque``, ``contact_force`` the step's (impulses over dt).
+
+        Raises
+        ------
+        SolverError
+            A ``time_step`` that is not a positive number, or what :meth:`solve` raises.
+        """
+        dt = time_step
+        if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating, np.integer)) or not dt > 0.0:
+            raise _core.SolverError(f"time_step must be a number > 0 (s), got {time_step!r}")
+        result = self.solve(q, qd, time_step=dt, **solve_args)
+        qd_next = np.asarray(qd, dtype=np.float64) + float(dt) * result.qdd
+        if result.status is not None:  # held by friction: exactly at rest
+            qd_next[result.status == 1] = 0.0
+        return np.asarray(q, dtype=np.float64) + float(dt) * qd_next, qd_next, result
 
     @property
     def chain(self) -> _core.Chain:

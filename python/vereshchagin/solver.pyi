@@ -50,7 +50,11 @@ class Solver(_core.Solver):
         threads: int = 1,
         a_desired: Optional[ArrayLike] = None,
         contacts: Optional[Sequence[Contact]] = None,
+        time_step: Optional[float] = None,
     ) -> BatchResult: ...
+    def step(
+        self, q: ArrayLike, qd: ArrayLike, time_step: float, **solve_args: object
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], SolveResult]: ...
     @property
     def chain(self) -> _core.Chain: ...
     @property

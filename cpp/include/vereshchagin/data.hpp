@@ -72,6 +72,8 @@ class Data {
   /// tip origin, root acceleration included). Computed on first request.
   const Matrix6X& linkAccelerations() const;
   /// With friction (zero / Moving without): friction and limit torques, joint status, Gauss value.
+  /// Over a time step (SolveInput::time_step) they are the step's: the torques of the impulses
+  /// over dt, Stick for a joint that ends the step at rest, and Z0(qdd) + sum_j f_j |qd+_j| / dt.
   const Eigen::VectorXd& frictionTorques() const noexcept;
   const Eigen::VectorXd& limitTorques() const noexcept;          ///< joint limit reactions (n_joints)
   const std::vector<JointStatus>& jointStatus() const noexcept;  ///< JointStatus of each joint

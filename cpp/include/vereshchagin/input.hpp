@@ -98,8 +98,9 @@ struct SolveInput {
   /// velocities qd+ = q_dot + dt qdd (the result's qdd is the step's mean acceleration): a joint or
   /// contact point whose holding force stays within friction ends the step at zero velocity, a
   /// sliding one gets the full friction against its end velocity (it cannot be reversed by it), a
-  /// support ends the step not approaching its surface (an impact is an impulse). The contact
-  /// points' Jacobians are those at q (semi-implicit Euler; step() in data.hpp integrates).
+  /// support ends the step not approaching its surface (an impact is an impulse). A contact
+  /// point's end velocity is taken to first order, v + dt a (its velocity and acceleration at q);
+  /// step() in data.hpp integrates (semi-implicit Euler).
   double time_step = 0.0;
   /// Physical gravity, base axes, m/s^2 (Earth with z up: (0, 0, -9.81)), and the base's own
   /// commanded spatial acceleration [linear; angular] (base axes, base origin; zero: a fixed
