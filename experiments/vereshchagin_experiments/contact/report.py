@@ -461,6 +461,11 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
         lines, passed = section(runs, out)
         idx += lines
         ok &= passed
+    from .contact_report import section as contacts_section  # imports this module: here, not at the top
+
+    lines, passed = contacts_section(runs, out, quick, say)
+    idx += lines
+    ok &= passed
     secs = time.perf_counter() - t_start
     idx += [
         f"Contact experiments: {len(runs)} runs, {sum(r.t[-1] for r in runs.values()):.1f} s simulated in "
