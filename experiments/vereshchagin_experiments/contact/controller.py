@@ -228,8 +228,8 @@ class CascadedController:
     v_des : ndarray, shape (6,)
         The desired twist of the last cycle (m/s, rad/s; base axes, end-effector origin).
     uncertified : int
-        Cycles whose contact solve was refused as "not certified" and redone without joint
-        friction (:func:`~.surfaces.solve_certified`).
+        Cycles whose contact solve was refused as "not certified" and redone in two stages
+        (:func:`~.surfaces.solve_certified`).
     """
 
     def __init__(self, chain, solver, config: ControllerConfig = ControllerConfig()):
@@ -257,7 +257,7 @@ class CascadedController:
         self.support_share: Optional[Callable[[Any, np.ndarray], np.ndarray]] = None
         self.contacts: Optional[Callable[[np.ndarray, np.ndarray], tuple]] = None
         self.v_des = np.zeros(6)  # the last cycle's desired twist (for contacts' reference velocity)
-        self.uncertified = 0  # cycles solved without joint friction (surfaces.solve_certified)
+        self.uncertified = 0  # cycles solved in two stages (surfaces.solve_certified)
         self._all = list(range(n))
         self._alpha: dict[tuple, np.ndarray] = {}  # constraint directions (6, m) per tuple of names
 
@@ -384,7 +384,16 @@ class CascadedController:
         if cts:
             kw["contacts"] = cts
         res, fell_back = solve_certified(
-            self.solver, q, qd_solve, alpha, beta, f_ext=f_ext, tau_ff=tau_ff, friction=self.friction, **kw
+            self.solver,
+            q,
+            qd_solve,
+            alpha,
+            beta,
+            model=self.chain,
+            f_ext=f_ext,
+            tau_ff=tau_ff,
+            friction=self.friction,
+            **kw,
         )
         self.uncertified += fell_back
         if cts:  # the model's upward force of the surfaces, N

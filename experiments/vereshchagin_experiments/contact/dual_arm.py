@@ -37,12 +37,13 @@ Variants (:data:`VARIANTS`):
 
 With the surfaces as the solver's contacts (:data:`CONTACT_VARIANT`, ``contacts``): the tree
 solver, the same table, and the resting hand's point a support with the table's friction in the
-solve (:mod:`.surfaces`) instead of the share removed by hand; the resting hand's task holds the
-five directions other than the table's normal (:data:`REST_COLUMNS`), the support its height.
-(With the 6-D hold the support is redundant with the task and gets the force of least motor
-effort; but then the P loop's corrections can ask the held point to accelerate into the table,
-which the solve rightly refuses, and the least-effort forces, which the plant's passive contact
-does not reproduce, kicked the light wrist joints in the first cycle.)
+solve (:mod:`.surfaces`) instead of the share removed by hand; the resting hand's task holds only
+its orientation (:data:`REST_COLUMNS`), the table its position (normal force and static friction).
+With the 6-D hold the support is redundant with the task and gets the forces of least motor
+effort: the P loop's corrections then asked the held point to accelerate into the table, which
+the solve rightly refuses ("no consistent contact forces"). Holding x and y as well (5 columns)
+ran, but the least-effort share of the friction jumped from cycle to cycle (chatter 0.37 N m per
+step at the torso and the left shoulder, against 0.12 with the orientation alone).
 
 Open-loop task error (:func:`open_loop_error`): the torques a solve intends for every joint
 (motors, the table's share, the joint friction the solve predicted, ``tau_ff`` with the viscous
@@ -111,8 +112,8 @@ UP = 2
 """Column of the resting hand's ``alpha`` (= I6) along the table normal (linear base z)."""
 GRAVITY = np.array([0.0, 0.0, -9.81])
 ALPHA = np.eye(6)
-REST_COLUMNS = [0, 1, 3, 4, 5]
-"""The resting hand's task columns in the ``contacts`` variant: all but linear z (the support's)."""
+REST_COLUMNS = [3, 4, 5]
+"""The resting hand's task columns in the ``contacts`` variant: its orientation (the table holds its position)."""
 
 
 def start_pose() -> np.ndarray:
@@ -281,7 +282,7 @@ class DualArmController:
         beta_r, _, _ = self._hand_beta(REST_FRAME, self.rest_goal, q, qd)
         beta_t, T, tw = self._hand_beta(TASK_FRAME, self.goal, q, qd)
         cons = {REST_FRAME: (ALPHA, beta_r), TASK_FRAME: (ALPHA, beta_t)}
-        if self.contacts is not None:  # the table holds the resting hand's z: the task the other five
+        if self.contacts is not None:  # the table holds the resting hand's position: the task its orientation
             cons[REST_FRAME] = (ALPHA[:, REST_COLUMNS], beta_r[REST_COLUMNS])
         K, D = self.config.posture_gains
         motor_ff = K * (self.q_ref - q) - D * qd
@@ -295,7 +296,7 @@ class DualArmController:
             tau_ff = ff - np.asarray(p.model.damping) * qdp
             kw = {"contacts": cts} if cts else {}
             args = dict(tau_ff=tau_ff, constraints={f: cons[f] for f in p.frames}, **kw)
-            res, fell_back = solve_certified(p.solver, qp, qd_solve[p.idx], friction=p.friction, **args)
+            res, fell_back = solve_certified(p.solver, qp, qd_solve[p.idx], model=p.model, friction=p.friction, **args)
             self.uncertified += fell_back
             if cts:  # the table's force on the resting hand, and its joint torque in the intended total
                 f_c = np.asarray(res.contact_force)[0]
@@ -409,7 +410,7 @@ def dual_arm(variant: str, quick: bool = False, progress=None, config: Optional[
         x = info.inputs
         err = open_loop_error(tree, truth, x["q"], x["qd"], x["model_torque"], x["constraints"])
         e = [err[REST_FRAME], err[TASK_FRAME]]
-        lin.append([np.sqrt(np.mean(v[: len(v) - 3] ** 2)) for v in e])  # 5 rows: x, y, then angular
+        lin.append([np.sqrt(np.mean(v[:-3] ** 2)) if len(v) > 3 else np.nan for v in e])  # NaN: no linear rows
         ang.append([np.sqrt(np.mean(v[len(v) - 3 :] ** 2)) for v in e])
         force.append(x["table_force"])
         rest.append(np.asarray(tree.fk(x["q"], REST_FRAME))[:3, 3])
