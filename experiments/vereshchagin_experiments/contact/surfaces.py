@@ -28,9 +28,13 @@ Sliding direction (a second workaround, optional): the solver puts a sliding poi
 against its tangential velocity, a discontinuous function of it. The gripper on MuJoCo's table
 wobbles (its measured point velocity swings by +-30 mm/s sideways at 1 kHz); friction set from
 the last sample lags the plant's and pumped the wobble up until the wrist rolled and the tool left
-its line by up to 18 cm. With ``reference`` the solve gets the velocity the controller asks for
-(the desired twist's linear part), as the old ``f_ext`` friction compensation did: the points'
-tangential velocity in the solve is the reference's. What the loop measures is otherwise unchanged.
+its line by up to 18 cm. With ``reference`` (the velocity the controller asks for, the desired
+twist's linear part) a tracked point slides in the solve along the reference's tangential
+direction, as the old ``f_ext`` friction compensation did, at its measured speed along it but at
+least 1.5 ``rest_speed`` (so that a slide just starting is not taken for a resting point the task
+drags: that stalled the full grasp); a reference slower than ``rest_speed`` makes it rest. Using
+the reference's speed itself instead made the solve's joint velocities far from the measured ones
+(the full grasp then crawled at 20 mm/s and stopped 15 mm short). What the loop measures is otherwise unchanged.
 
 Units SI; points in the link's own frame (m), normals in base axes (unit, from the surface into
 the robot), forces in N.
@@ -164,8 +168,7 @@ class SceneContacts:
     reference : callable, optional
         ``reference() -> (3,)``: the velocity the controller wants the tracked points
         (``ContactPoint.tracked``) to move with (m/s, base axes). Given, their tangential velocity
-        in the solve is this one's tangential part instead of the measured one (module doc);
-        None: the measured one.
+        in the solve points along this one's tangential part (module doc); None: the measured one.
 
     Attributes
     ----------
@@ -204,7 +207,12 @@ class SceneContacts:
             vt = v - n * (n @ v)
             if p.tracked and self.reference is not None:
                 r = np.asarray(self.reference(), float)
-                vt = r - n * (n @ r)
+                r = r - n * (n @ r)
+                if np.linalg.norm(r) >= self.rest_speed:  # slides along r, at the measured speed along it (or more)
+                    u = r / np.linalg.norm(r)
+                    vt = u * max(float(vt @ u), 1.5 * self.rest_speed)
+                else:
+                    vt = np.zeros(3)
             resting = bool(np.linalg.norm(vt) < self.rest_speed)
             contacts.append(p.contact(T, resting))
             rows.append(Jp)
