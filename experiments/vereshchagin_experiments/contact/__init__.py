@@ -16,6 +16,9 @@ closed loop at 1 kHz, with this package's solver inside the controller:
   while the other slides, the tree solver against the arms solved as separate chains
   (:mod:`.dual_arm_report`: ``--case dual-arm``);
 - :mod:`.metrics`: effort and accuracy numbers of a run (the report's Tables 6.1-6.3);
+- :mod:`.surfaces`: the scene's surfaces as the solver's point contacts (``vs.Contact``), used by
+  the "after" variants in place of the hand-made table forces and shares (:mod:`.contact_report`:
+  the before / after tables, two resting points, the table surfaces);
 - :mod:`.report`: runs everything and writes tables and figures
   (``python -m vereshchagin_experiments reproduce --case contact``).
 
