@@ -131,6 +131,19 @@ def _wrist_table(urdf: str, chain, q0, support) -> tuple[np.ndarray, Scene]:
     return low, Scene(support=support, **table)
 
 
+def _logger(variant: str, log: dict):
+    """``on_cycle`` for :func:`~.use_cases.run_loop`: the command, ``-nu_e`` or the contacts' upward forces into ``log``."""
+
+    def on_cycle(k, command, info) -> None:
+        log["command"].append(np.array(command, float))
+        if variant in ("unsupported", "constraint"):
+            log["nu"].append(-float(np.asarray(info.result.nu)[N_TOOL]))
+        elif variant in CONTACT_VARIANTS:
+            log["contact"].append(np.array(info.result.contact_force)[:, 2])
+
+    return on_cycle
+
+
 def elbow(variant: str, quick: bool = False, progress=None):
     """Run use case 3 in one of :data:`VARIANTS` (see module doc).
 
@@ -197,23 +210,14 @@ def elbow(variant: str, quick: bool = False, progress=None):
         Phase("slide", lambda T: _shifted(T, dx=ELBOW_DX, R=R0), SLIDE / v + (1.0 if quick else 1.5)),
         Phase("hold", lambda T: _shifted(T, R=R0), duration),
     ]
-    nu_log: list[float] = []
-    contact_log: list[np.ndarray] = []
-    commands: list[np.ndarray] = []
-
-    def log_nu(k, command, info) -> None:
-        commands.append(np.array(command, float))
-        if variant in ("unsupported", "constraint"):
-            nu_log.append(-float(np.asarray(info.result.nu)[N_TOOL]))
-        elif variant in CONTACT_VARIANTS:
-            contact_log.append(np.array(info.result.contact_force)[:, 2])
-
-    run = run_loop(robot, ctl, phases, "elbow", variant, (0.0, 0.0, 0.0), progress, on_cycle=log_nu)
-    if contact_log:
-        forces = np.array(contact_log)
+    log: dict[str, list] = {"nu": [], "contact": [], "command": []}
+    run = run_loop(robot, ctl, phases, "elbow", variant, (0.0, 0.0, 0.0), progress, on_cycle=_logger(variant, log))
+    nu_log = log["nu"]
+    if log["contact"]:
+        forces = np.array(log["contact"])
         nu_log = list(forces[:, 0])
         run.info["table_force_model"] = forces[:, 1] if forces.shape[1] > 1 else np.zeros(len(forces))
-    run.info["command"] = np.array(commands)
+    run.info["command"] = np.array(log["command"])
     run.info["uncertified"] = ctl.uncertified
     elbow_z = np.array([np.asarray(chain.fk(q, segment=seg))[2, 3] for q in run.q])
     run.info.update(
