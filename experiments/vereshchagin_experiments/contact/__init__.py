@@ -18,6 +18,9 @@ closed loop at 1 kHz, with this package's solver inside the controller:
 - :mod:`.metrics`: effort and accuracy numbers of a run (the report's Tables 6.1-6.3);
 - :mod:`.model_error`: the plant's inertias and joint friction perturbed (seeded), for the
   model-error runs;
+- :mod:`.surfaces`: the scene's surfaces as the solver's point contacts (``vs.Contact``), used by
+  the "after" variants in place of the hand-made table forces and shares (:mod:`.contact_report`:
+  the before / after tables, two resting points, the table surfaces);
 - :mod:`.report`: runs everything and writes tables and figures
   (``python -m vereshchagin_experiments reproduce --case contact``), with :mod:`.lau2023` (the
   published numbers), :mod:`.report_notes` (setup, gains, differences from the report),

@@ -41,6 +41,7 @@ import numpy as np
 
 from vereshchagin.friction import Friction
 from vereshchagin.task import beta_for, directions, pose_error
+from .surfaces import solve_certified
 
 __all__ = [
     "CONTACT_GAINS",
@@ -234,6 +235,17 @@ class CascadedController:
     support_share : callable or None
         ``support_share(result, q) -> (n,)``: joint torque (N m) the environment supplies,
         subtracted from the motor command.
+    contacts : callable or None
+        ``contacts(q, qd) -> (list of vereshchagin.Contact, qd_solve)`` (e.g.
+        :class:`~.surfaces.SceneContacts`): the surfaces passed to the commanding solve with the
+        velocity ``qd_solve`` (rad/s) to solve with; when it returns contacts, no table force is
+        estimated into ``f_ext`` and ``CycleInfo.normal_force_estimate`` is the solver's upward
+        contact force (N, summed over the contacts). None: no contacts (the hand-made variants).
+    v_des : ndarray, shape (6,)
+        The desired twist of the last cycle (m/s, rad/s; base axes, end-effector origin).
+    uncertified : int
+        Cycles whose contact solve was refused as "not certified" and redone in two stages
+        (:func:`~.surfaces.solve_certified`).
     """
 
     def __init__(self, chain, solver, config: ControllerConfig = ControllerConfig()):
@@ -259,6 +271,9 @@ class CascadedController:
         self.q_ref: Optional[np.ndarray] = None
         self.extra_constraints: Optional[Union[dict, Callable[[np.ndarray, np.ndarray], dict]]] = None
         self.support_share: Optional[Callable[[Any, np.ndarray], np.ndarray]] = None
+        self.contacts: Optional[Callable[[np.ndarray, np.ndarray], tuple]] = None
+        self.v_des = np.zeros(6)  # the last cycle's desired twist (for contacts' reference velocity)
+        self.uncertified = 0  # cycles solved in two stages (surfaces.solve_certified)
         self._all = list(range(n))
         self._alpha: dict[tuple, np.ndarray] = {}  # constraint directions (6, m) per tuple of names
 
@@ -345,6 +360,7 @@ class CascadedController:
             self._alpha[names] = directions(names)
         alpha = self._alpha[names]
         a_des, v_des = cascaded_acceleration(e, tw, self.gains, cfg, alpha)
+        self.v_des = v_des
         beta = beta_for(alpha, a_des, tw, self.solver.gravity)
 
         tau_motor_ff = np.zeros(self.n)
@@ -362,12 +378,14 @@ class CascadedController:
 
         f_ext = None
         N = 0.0
+        cts, qd_solve = self.contacts(q, qd) if self.contacts is not None else ([], qd)
         if self.in_contact:
             r = T[:3, :3] @ np.asarray(cfg.contact_point, float)
             w = np.concatenate([[0.0, 0.0, 1.0], np.cross(r, [0.0, 0.0, 1.0])])
             if K or D:  # keep the posture term from lifting the tool: remove its push along w
                 tau_ff = self._without_push(q, qd, alpha, beta, tau_ff, tau_motor_ff, w, kw)
                 tau_motor_ff = tau_ff + self.damping * qd
+        if self.in_contact and not cts:  # no contacts in the solve: the table's force estimated into f_ext
             res0 = self.solver.solve(q, qd, alpha, beta, tau_ff=tau_ff, **kw)
             Gc, _ = self.solver.response_columns(self._all)
             Jw = np.asarray(self.chain.jacobian(q)).T @ w
@@ -379,7 +397,23 @@ class CascadedController:
             F = N * np.array([0.0, 0.0, 1.0]) - cfg.mu_estimate * N * u
             f_ext = np.zeros((self.chain.n_segments, 6))
             f_ext[-1] = np.concatenate([F, np.cross(r, F)])
-        res = self.solver.solve(q, qd, alpha, beta, f_ext=f_ext, tau_ff=tau_ff, friction=self.friction, **kw)
+        if cts:
+            kw["contacts"] = cts
+        res, fell_back = solve_certified(
+            self.solver,
+            q,
+            qd_solve,
+            alpha,
+            beta,
+            model=self.chain,
+            f_ext=f_ext,
+            tau_ff=tau_ff,
+            friction=self.friction,
+            **kw,
+        )
+        self.uncertified += fell_back
+        if cts:  # the model's upward force of the surfaces, N
+            N = float(np.asarray(res.contact_force)[:, 2].sum())
         tau = np.asarray(res.tau_command) + tau_motor_ff + self._friction_feedforward(qd, res.qdd)
         if self.support_share is not None:
             tau = tau - self.support_share(res, q)

@@ -35,6 +35,16 @@ Variants (:data:`VARIANTS`):
   counted once, but neither chain knows the other arm: the coupling through the torso (the
   other arm's inertia about the torso axis, its reaction on the torso) is what it ignores.
 
+With the surfaces as the solver's contacts (:data:`CONTACT_VARIANT`, ``contacts``): the tree
+solver, the same table, and the resting hand's point a support with the table's friction in the
+solve (:mod:`.surfaces`) instead of the share removed by hand; the resting hand's task holds only
+its orientation (:data:`REST_COLUMNS`), the table its position (normal force and static friction).
+With the 6-D hold the support is redundant with the task and gets the forces of least motor
+effort: the P loop's corrections then asked the held point to accelerate into the table, which
+the solve rightly refuses ("no consistent contact forces"). Holding x and y as well (5 columns)
+ran, but the least-effort share of the friction jumped from cycle to cycle (chatter 0.37 N m per
+step at the torso and the left shoulder, against 0.12 with the orientation alone).
+
 Open-loop task error (:func:`open_loop_error`): the torques a solve intends for every joint
 (motors, the table's share, the joint friction the solve predicted, ``tau_ff`` with the viscous
 damping) are applied to the true tree dynamics (the tree solver without constraints, i.e.
@@ -57,6 +67,7 @@ from vereshchagin import Solver
 from vereshchagin.task import beta_for, pose_error
 from .controller import ControllerConfig, CycleInfo, cascaded_acceleration
 from .mujoco_plant import MujocoGen3, Scene, build_model
+from .surfaces import SceneContacts, point_jacobian, solve_certified, tool_support
 from .use_cases import (
     JOINT_DAMPING,
     JOINT_FRICTION,
@@ -81,6 +92,8 @@ __all__ = [
 ]
 
 VARIANTS = ("table", "unsupported", "separate")
+CONTACT_VARIANT = "contacts"
+"""The tree solver with the resting hand as the solver's contact (module doc)."""
 FRICTION_MODES = ("maxmin", "none", "smooth")
 """``ControllerConfig.friction_mode`` s the dual-arm controller takes (see :data:`CONFIG`)."""
 CONFIG = ControllerConfig(hold_band=(1e-3, 1e-2))
@@ -99,6 +112,8 @@ UP = 2
 """Column of the resting hand's ``alpha`` (= I6) along the table normal (linear base z)."""
 GRAVITY = np.array([0.0, 0.0, -9.81])
 ALPHA = np.eye(6)
+REST_COLUMNS = [3, 4, 5]
+"""The resting hand's task columns in the ``contacts`` variant: its orientation (the table holds its position)."""
 
 
 def start_pose() -> np.ndarray:
@@ -173,7 +188,7 @@ class DualArmController:
     ----------
     tree : Tree
         From :func:`dual_arm_model` (the model the plant is built from).
-    variant : {"table", "unsupported", "separate"}
+    variant : {"table", "unsupported", "separate", "contacts"}
         See the module doc; ``table`` and ``separate`` leave the resting hand's upward share to
         the table.
     config : ControllerConfig, optional
@@ -200,8 +215,8 @@ class DualArmController:
 
     def __init__(self, tree: Tree, variant: str, config: Optional[ControllerConfig] = None):
         config = CONFIG if config is None else config
-        if variant not in VARIANTS:
-            raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")
+        if variant not in VARIANTS + (CONTACT_VARIANT,):
+            raise ValueError(f"variant must be one of {VARIANTS + (CONTACT_VARIANT,)}, got {variant!r}")
         if config.friction_mode not in FRICTION_MODES:
             raise ValueError(f"friction_mode must be one of {FRICTION_MODES}, got {config.friction_mode!r}")
         self.tree, self.variant, self.config = tree, variant, config
@@ -211,7 +226,11 @@ class DualArmController:
             self.parts = [_part(half.chain(f), tree, (f,), config, True) for f in (REST_FRAME, TASK_FRAME)]
         else:
             self.parts = [_part(tree, tree, (REST_FRAME, TASK_FRAME), config, False)]
-        self.table_share = variant != "unsupported"
+        self.table_share = variant in ("table", "separate")
+        self.contacts = None
+        self.uncertified = 0
+        if variant == CONTACT_VARIANT:
+            self.contacts = SceneContacts(tree, [tool_support(REST_FRAME, (0.0, 0.0, 0.0), Scene().friction)])
         self.goal: Optional[np.ndarray] = None
         self.rest_goal: Optional[np.ndarray] = None
         self.q_ref: Optional[np.ndarray] = None
@@ -263,18 +282,26 @@ class DualArmController:
         beta_r, _, _ = self._hand_beta(REST_FRAME, self.rest_goal, q, qd)
         beta_t, T, tw = self._hand_beta(TASK_FRAME, self.goal, q, qd)
         cons = {REST_FRAME: (ALPHA, beta_r), TASK_FRAME: (ALPHA, beta_t)}
+        if self.contacts is not None:  # the table holds the resting hand's position: the task its orientation
+            cons[REST_FRAME] = (ALPHA[:, REST_COLUMNS], beta_r[REST_COLUMNS])
         K, D = self.config.posture_gains
         motor_ff = K * (self.q_ref - q) - D * qd
         tau, total = np.zeros(self.n), np.zeros(self.n)
         force = 0.0
         res = None
+        cts, qd_solve = self.contacts(q, qd) if self.contacts is not None else ([], qd)
         for p in self.parts:
             qp, qdp = q[p.idx], qd[p.idx]
             ff = motor_ff[p.idx] * p.torso_scale
             tau_ff = ff - np.asarray(p.model.damping) * qdp
-            res = p.solver.solve(
-                qp, qdp, tau_ff=tau_ff, friction=p.friction, constraints={f: cons[f] for f in p.frames}
-            )
+            kw = {"contacts": cts} if cts else {}
+            args = dict(tau_ff=tau_ff, constraints={f: cons[f] for f in p.frames}, **kw)
+            res, fell_back = solve_certified(p.solver, qp, qd_solve[p.idx], model=p.model, friction=p.friction, **args)
+            self.uncertified += fell_back
+            if cts:  # the table's force on the resting hand, and its joint torque in the intended total
+                f_c = np.asarray(res.contact_force)[0]
+                force = float(f_c[2])
+                total[p.idx] += point_jacobian(p.model, qp, REST_FRAME, np.zeros(3)).T @ f_c
             share = np.zeros(len(p.idx))
             if self.table_share and REST_FRAME in p.frames:
                 nu_up = float((res.segment_nu or {})[REST_FRAME][UP])
@@ -338,7 +365,7 @@ def dual_arm(variant: str, quick: bool = False, progress=None, config: Optional[
 
     Parameters
     ----------
-    variant : {"table", "unsupported", "separate"}
+    variant : {"table", "unsupported", "separate", "contacts"}
         Who carries the resting hand and which solver commands.
     quick : bool
         Shorter settle and hold phases (0.5 s instead of 1 s) and a shorter tail on the slide.
@@ -361,8 +388,8 @@ def dual_arm(variant: str, quick: bool = False, progress=None, config: Optional[
     ValueError
         If ``variant`` is not one of :data:`VARIANTS` (or ``config.friction_mode`` unknown).
     """
-    if variant not in VARIANTS:
-        raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")
+    if variant not in VARIANTS + (CONTACT_VARIANT,):
+        raise ValueError(f"variant must be one of {VARIANTS + (CONTACT_VARIANT,)}, got {variant!r}")
     urdf, tree = dual_arm_model()
     q0 = start_pose()
     scene = _scene(tree, q0) if variant != "unsupported" else Scene()
@@ -376,14 +403,15 @@ def dual_arm(variant: str, quick: bool = False, progress=None, config: Optional[
         Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), SLIDE / ctl.config.v_max + (1.0 if quick else 1.5)),
         Phase("hold", lambda T: _shifted(T, R=R0), duration),
     ]
-    force, lin, ang, rest = [], [], [], []
+    force, lin, ang, rest, commands = [], [], [], [], []
 
     def log(k, command, info) -> None:
+        commands.append(np.array(command, float))
         x = info.inputs
         err = open_loop_error(tree, truth, x["q"], x["qd"], x["model_torque"], x["constraints"])
         e = [err[REST_FRAME], err[TASK_FRAME]]
-        lin.append([np.sqrt(np.mean(v[:3] ** 2)) for v in e])
-        ang.append([np.sqrt(np.mean(v[3:] ** 2)) for v in e])
+        lin.append([np.sqrt(np.mean(v[:-3] ** 2)) if len(v) > 3 else np.nan for v in e])  # NaN: no linear rows
+        ang.append([np.sqrt(np.mean(v[len(v) - 3 :] ** 2)) for v in e])
         force.append(x["table_force"])
         rest.append(np.asarray(tree.fk(x["q"], REST_FRAME))[:3, 3])
 
@@ -394,5 +422,7 @@ def dual_arm(variant: str, quick: bool = False, progress=None, config: Optional[
         table_force_model=np.array(force),
         open_loop=np.array(lin),
         open_loop_ang=np.array(ang),
+        command=np.array(commands),
+        uncertified=ctl.uncertified,
     )
     return run

@@ -16,6 +16,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from . import metrics
+from .contact_report import dual_arm_section
 from .controller import ControllerConfig
 from .dual_arm import CONFIG, VARIANTS, dual_arm, dual_arm_model
 from .report import _bar, md_table, write_csv
@@ -363,6 +364,9 @@ def run(
     ok = all(checks.values())
     tables = dict(effort=(header, rows), errors=(eheader, erows), options=(oheader, orows, options))
     idx = _index_lines(quick, efforts, outcomes, tables, checks)
+    lines, passed, _ = dual_arm_section(runs["table"], quick, say)
+    idx += lines
+    ok &= passed
     secs = time.perf_counter() - t_start
     idx += [f"Dual-arm case: {len(runs)} runs in {secs:.1f} s wall time.", ""]
     return dict(index=idx, runs=runs, option_runs=option_runs, options=options, ok=ok, checks=checks, seconds=secs)

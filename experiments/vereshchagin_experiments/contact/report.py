@@ -497,6 +497,11 @@ def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] 
     lines, passed = model_error_section(runs, perturbed, out, md_table, write_csv)
     idx += lines
     ok &= passed
+    from .contact_report import section as contacts_section  # imports this module: here, not at the top
+
+    lines, passed = contacts_section(runs, out, quick, say)
+    idx += lines
+    ok &= passed
     secs = time.perf_counter() - t_start
     n_runs = len(runs) + len(perturbed)
     simulated = sum(r.t[-1] for r in runs.values()) + sum(r.t[-1] for r in perturbed.values())

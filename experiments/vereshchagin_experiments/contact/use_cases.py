@@ -29,6 +29,7 @@ from vereshchagin import Chain
 from vereshchagin import Solver
 from .controller import CascadedController, ControllerConfig
 from .mujoco_plant import MujocoGen3, Scene, build_model, pen_tip
+from .surfaces import CONTACT_CONFIG, SceneContacts, pen_setpoint, tool_support
 
 __all__ = [
     "JOINT_FRICTION",
@@ -384,6 +385,11 @@ def _gripper_low_point(model, q, T_frame, body: str = "bracelet_link") -> np.nda
     return (np.linalg.inv(np.asarray(T_frame)) @ np.append(corner, 1.0))[:3]
 
 
+def _controller(chain, tool_point, **overrides):
+    solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
+    return CascadedController(chain, solver, ControllerConfig(contact_point=tuple(tool_point), **overrides))
+
+
 def _plant(urdf, chain, scene, q0, perturb=None):
     """The MuJoCo plant of ``scene`` at rest at ``q0``, changed by ``perturb`` (model error) if given.
 
@@ -394,16 +400,13 @@ def _plant(urdf, chain, scene, q0, perturb=None):
     return MujocoGen3(model, q0), error
 
 
-def _controller(chain, tool_point, **overrides):
-    solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
-    return CascadedController(chain, solver, ControllerConfig(contact_point=tuple(tool_point), **overrides))
-
-
 def grasp(
     contact: bool,
     quick: bool = False,
     progress=None,
     descent: Optional[float] = None,
+    solver_contacts: bool = False,
+    mu: Optional[float] = None,
     perturb: Optional[Callable[[Any], dict]] = None,
 ) -> Run:
     """Use case 1: approach the table, slide 0.10 m along +x (in contact or 0.03 m above), grasp.
@@ -424,6 +427,12 @@ def grasp(
     descent : float, optional
         Height (m) of the gripper's lowest point above the table at the start; overrides
         ``quick``'s choice.
+    solver_contacts : bool
+        With ``contact``: once contact is detected, the gripper's lowest edge is a support with
+        the table's friction in the solve (:mod:`.surfaces`) instead of the estimated table force
+        in ``f_ext``; variant ``"solver-contacts"``.
+    mu : float, optional
+        The table's friction coefficient (plant and contact); None: the scene's default (0.3).
     perturb : callable, optional
         ``perturb(mujoco.MjModel) -> dict``: changes the compiled plant in place before the run
         (model error, :mod:`.model_error`); its result is stored as ``info["plant_error"]``.
@@ -433,8 +442,9 @@ def grasp(
     -------
     Run
         Phases ``approach``, ``slide``, ``grasp``; ``info``: ``table_top`` (m, base z),
-        ``descent`` (m), ``tool_point`` (3,) (the gripper's lowest point, end-effector frame, m).
-
+        ``descent`` (m), ``tool_point`` (3,) (the gripper's lowest point, end-effector frame, m),
+        ``mu``, ``table_force_model`` ((k,) the model's table force per sample, N: the ``f_ext``
+        estimate, or the solver's contact force) and ``command`` ((k, n) the commands, N m).
     """
     urdf, chain = gen3_model()
     q0 = np.array(robots.GEN3_START_POSE)
@@ -443,9 +453,12 @@ def grasp(
     probe = build_model(urdf, chain, Scene())
     low = _gripper_low_point(probe, q0, chain.fk(q0))
     z_low = (np.asarray(chain.fk(q0)) @ np.append(low, 1.0))[2]
-    scene = Scene(table_top=float(z_low - descent))
+    scene = Scene(table_top=float(z_low - descent), **_friction(mu))
     robot, plant_error = _plant(urdf, chain, scene, q0, perturb)
-    ctl = _controller(chain, low)
+    ctl = _controller(chain, low, **(CONTACT_CONFIG if contact and solver_contacts else {}))
+    if contact and solver_contacts:
+        points = [tool_support(robots.GEN3_TIP_LINK, low, scene.friction)]
+        ctl.contacts = SceneContacts(chain, points, active=lambda: ctl.in_contact, reference=lambda: ctl.v_des[:3])
     v = ctl.config.v_max
     approach_time = descent / v + 2.0
     slide_time = SLIDE / v + 1.5
@@ -465,12 +478,27 @@ def grasp(
             Phase("slide", lambda T: _shifted(T, dx=SLIDE, R=R0), slide_time),
             Phase("grasp", lambda T: _shifted(T, R=R0), 0.3, gripper=1.0),
         ]
-    run = run_loop(robot, ctl, phases, "grasp", "contact" if contact else "contactless", low, progress)
-    run.info.update(table_top=scene.table_top, descent=descent, tool_point=low, plant_error=plant_error)
+    log, on_cycle = _model_force_log()
+    run = run_loop(robot, ctl, phases, "grasp", _variant(contact, solver_contacts), low, progress, on_cycle)
+    run.info.update(
+        table_top=scene.table_top,
+        descent=descent,
+        tool_point=low,
+        mu=scene.friction,
+        uncertified=ctl.uncertified,
+        plant_error=plant_error,
+        **_arrays(log),
+    )
     return run
 
 
-def writing(contact: bool, quick: bool = False, progress=None, perturb: Optional[Callable[[Any], dict]] = None) -> Run:
+def writing(
+    contact: bool,
+    quick: bool = False,
+    progress=None,
+    solver_contacts: bool = False,
+    perturb: Optional[Callable[[Any], dict]] = None,
+) -> Run:
     """Use case 2: draw a 0.10 m line along +x with the pen on the table, or 0.10 m above it.
 
     The start pose is the grasp's (the report gives none for writing, only photographs).
@@ -484,6 +512,10 @@ def writing(contact: bool, quick: bool = False, progress=None, perturb: Optional
         Accepted for a uniform signature; the writing runs are short either way.
     progress : callable, optional
         ``progress(fraction)``, see :func:`run_loop`.
+    solver_contacts : bool
+        With ``contact``: once contact is detected, the pen tip is a normal-force set-point
+        (:data:`~.surfaces.WRITING_FORCE`, the table's friction) in the solve instead of the
+        estimated table force in ``f_ext``; variant ``"solver-contacts"``.
     perturb : callable, optional
         Model error of the plant, as in :func:`grasp`.
 
@@ -491,8 +523,8 @@ def writing(contact: bool, quick: bool = False, progress=None, perturb: Optional
     -------
     Run
         Phases ``approach`` (contact) or ``settle``, then ``write``; ``info``: ``table_top``
-        (m, base z), ``tool_point`` (3,) (the pen tip, end-effector frame, m).
-
+        (m, base z), ``tool_point`` (3,) (the pen tip, end-effector frame, m),
+        ``table_force_model`` and ``command`` as in :func:`grasp`.
     """
     urdf, chain = gen3_model()
     q0 = np.array(robots.GEN3_START_POSE)
@@ -507,7 +539,10 @@ def writing(contact: bool, quick: bool = False, progress=None, perturb: Optional
     # Tracked point: the end-effector origin, as in the report (the pen tip, 0.12 m below the grip,
     # moves with orientation errors). Tracking the pen tip itself (``with_tool_link``) made the
     # free-space variant drift in the self-motion; not pursued.
-    ctl = _controller(chain, tip_ee)
+    ctl = _controller(chain, tip_ee, **(CONTACT_CONFIG if contact and solver_contacts else {}))
+    if contact and solver_contacts:
+        points = [pen_setpoint(robots.GEN3_TIP_LINK, tip_ee, scene.friction)]
+        ctl.contacts = SceneContacts(chain, points, active=lambda: ctl.in_contact, reference=lambda: ctl.v_des[:3])
     v = ctl.config.v_max
     draw_time = SLIDE / v + 1.5
     if contact:
@@ -520,6 +555,39 @@ def writing(contact: bool, quick: bool = False, progress=None, perturb: Optional
             Phase("settle", lambda T: _shifted(T, R=R0), 0.3, contact=False),
             Phase("write", lambda T: _shifted(T, dx=SLIDE, R=R0), draw_time),
         ]
-    run = run_loop(robot, ctl, phases, "writing", "contact" if contact else "contactless", tip_ee, progress)
-    run.info.update(table_top=scene.table_top, tool_point=tip_ee, plant_error=plant_error)
+    log, on_cycle = _model_force_log()
+    run = run_loop(robot, ctl, phases, "writing", _variant(contact, solver_contacts), tip_ee, progress, on_cycle)
+    run.info.update(
+        table_top=scene.table_top,
+        tool_point=tip_ee,
+        uncertified=ctl.uncertified,
+        plant_error=plant_error,
+        **_arrays(log),
+    )
     return run
+
+
+def _friction(mu: Optional[float]) -> dict:
+    """``Scene`` keyword for a table friction coefficient ``mu`` (none: the scene's default)."""
+    return {} if mu is None else {"friction": float(mu)}
+
+
+def _arrays(log: dict) -> dict:
+    return {k: np.array(v) for k, v in log.items()}
+
+
+def _variant(contact: bool, solver_contacts: bool) -> str:
+    return ("solver-contacts" if solver_contacts else "contact") if contact else "contactless"
+
+
+def _model_force_log() -> tuple[dict, Callable]:
+    """``(log, on_cycle)``: ``on_cycle`` logs the model's table and friction force and the command into ``log``."""
+    log: dict[str, list] = {"table_force_model": [], "friction_force_model": [], "command": []}
+
+    def on_cycle(k, command, info) -> None:
+        log["table_force_model"].append(float(info.normal_force_estimate))
+        f = np.asarray(getattr(info.result, "contact_force", np.zeros((0, 3))))
+        log["friction_force_model"].append(float(np.linalg.norm(f[:, :2].sum(0))) if len(f) else 0.0)
+        log["command"].append(np.array(command, float))
+
+    return log, on_cycle
