@@ -84,6 +84,7 @@ class JointFriction:
     index: int  # the joint (velocity index)
     lo: float  # bounds of the torque on the joint, N m (-inf / +inf: unbounded on that side)
     hi: float
+    offset: float = 0.0  # the joint's row is qdd_j + offset (over a time step: qd_j / dt)
 
 
 @dataclass
@@ -223,11 +224,12 @@ def _candidate(prob, modes, jmodes=()):
         block[:, :n] = R @ c.J
         K = np.vstack([K, block])
         rhs.append(-(R @ c.bias))
-    for idx in stuck:  # qdd_j = 0
+    offsets = {j.index: j.offset for j in prob.joints}
+    for idx in stuck:  # qdd_j + offset = 0
         row = np.zeros(size)
         row[idx] = 1.0
         K = np.vstack([K, row])
-        rhs.append([0.0])
+        rhs.append([-offsets[idx]])
     rhs = np.concatenate([np.atleast_1d(r) for r in rhs])
     x = np.linalg.lstsq(K, rhs, rcond=None)[0]
     resid = np.linalg.norm(K @ x - rhs) / max(1.0, np.linalg.norm(rhs))
@@ -301,7 +303,8 @@ def check_solution(prob, sol, tol=1e-9):
             return False
     scale_a = max(1.0, np.linalg.norm(sol.qdd))
     for j, mode in zip(prob.joints, sol.joint_modes):
-        if not _joint_signs_hold(j, mode, sol.joint_torques[j.index], sol.qdd[j.index], tol, scale_a):
+        row = sol.qdd[j.index] + j.offset
+        if not _joint_signs_hold(j, mode, sol.joint_torques[j.index], row, tol, scale_a):
             return False
     return True
 
@@ -366,12 +369,17 @@ def point_jacobian(model, data, frame_id, point):
     return J, bias, v.linear + np.cross(w, r)
 
 
-def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6, friction=None):
+def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6, friction=None, time_step=None):
     """The problem of a Pinocchio model (gravity = model.gravity). ``specs``: dicts with frame,
     point, normal, mu, facets, force. ``A``, ``b``: task rows in joint space (default none).
     ``friction``: dict with static, kinetic (default static), lower, upper (default none),
     velocity_tolerance (1e-6), limit_tolerance (1e-9), per velocity index of ``model``, and the
-    joint positions ``q`` (one per joint) when ``model`` has continuous joints and limits are given."""
+    joint positions ``q`` (one per joint) when ``model`` has continuous joints and limits are given.
+
+    ``time_step`` dt: the problem over a time step, every condition on the end velocities: a
+    contact's rows are its end velocity over dt to first order, a + v / dt (so each point counts as
+    at rest and every mode is tried), a joint's row qdd_j + qd_j / dt, every joint with friction an
+    unknown bounded by its static friction at rest and its kinetic friction while moving."""
     nv = model.nv
     H = pin.crba(model, data, q)
     H = np.triu(H) + np.triu(H, 1).T
@@ -382,6 +390,8 @@ def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6, fr
     for s in specs:
         J, bias, vel = point_jacobian(model, data, s["frame"], s.get("point", np.zeros(3)))
         normal = np.asarray(s["normal"], float)
+        if time_step:  # the end velocity over dt: the point counts as at rest, its rows gain v / dt
+            bias, vel = bias + vel / time_step, np.zeros(3)
         contacts.append(
             Contact(J, bias, vel, normal / np.linalg.norm(normal), s["mu"], s.get("facets", 4), s.get("force"), tol)
         )
@@ -389,13 +399,14 @@ def contact_problem(model, data, q, qd, tau, specs, A=None, b=None, tol=1e-6, fr
     b = np.zeros(0) if b is None else np.asarray(b, float)
     joints = []
     if friction is not None:
-        h, joints = _joint_friction(friction.get("q", q), qd, h, friction)
+        h, joints = _joint_friction(friction.get("q", q), qd, h, friction, time_step)
     return ContactProblem(H, h, A, b, contacts, joints)
 
 
-def _joint_friction(q, qd, h, fr):
+def _joint_friction(q, qd, h, fr, time_step=None):
     """Kinetic friction of the moving joints into h; the resting joints' bounds (q: one
-    coordinate per joint, revolute joints without wrap-around)."""
+    coordinate per joint, revolute joints without wrap-around). Over a time step every joint with
+    friction is an unknown (kinetic bound while moving), its row offset qd_j / dt."""
     fs = np.asarray(fr["static"], float)
     fk = np.asarray(fr.get("kinetic", fs), float)
     lower, upper = fr.get("lower"), fr.get("upper")
@@ -403,13 +414,16 @@ def _joint_friction(q, qd, h, fr):
     h = h.copy()
     joints = []
     for j in range(len(fs)):
-        if abs(qd[j]) > vtol:
+        moving = abs(qd[j]) > vtol
+        if moving and not time_step:
             h[j] -= fk[j] * np.sign(qd[j])
             continue
-        at_lower = lower is not None and q[j] <= lower[j] + ltol
-        at_upper = upper is not None and q[j] >= upper[j] - ltol
-        if fs[j] > 0.0 or at_lower or at_upper:
-            joints.append(JointFriction(j, -np.inf if at_upper else -fs[j], np.inf if at_lower else fs[j]))
+        f = fk[j] if moving else fs[j]
+        at_lower = not moving and lower is not None and q[j] <= lower[j] + ltol
+        at_upper = not moving and upper is not None and q[j] >= upper[j] - ltol
+        if f > 0.0 or at_lower or at_upper:
+            offset = qd[j] / time_step if time_step else 0.0
+            joints.append(JointFriction(j, -np.inf if at_upper else -f, np.inf if at_lower else f, offset))
     return h, joints
 
 

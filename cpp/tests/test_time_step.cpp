@@ -1,0 +1,99 @@
+// The solve over a time step (SolveInput::time_step) and step() (data.hpp): a chain held by
+// friction under gravity keeps q bitwise over 10^6 steps; a moving chain friction can stop comes
+// to exact rest; the step's joint outputs obey their bounds and oppose the end velocities; and
+// the argument checks of step().
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "random_chain.hpp"
+#include "vereshchagin/data.hpp"
+#include "vereshchagin/dynamics.hpp"
+
+using namespace vereshchagin;
+using testutil::RandomGen;
+
+namespace {
+
+// Breakaway friction `factor` times the gravity torques at q (plus `extra`), kinetic 0.8 of it.
+FrictionModel holdingFriction(const Model& model, const Eigen::VectorXd& q, double factor, double extra) {
+  const int n = static_cast<int>(model.nrOfJoints());
+  DynamicsData dyn(model);
+  Eigen::VectorXd g(n);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  REQUIRE(inverseDynamics(model, dyn, JointPositions(q), JointVelocities(zero), JointAccelerations(zero),
+                          Matrix6X::Zero(6, model.nrOfSegments()), KDL::Vector(0, 0, -9.81), g));
+  FrictionModel fm;
+  fm.static_friction = factor * g.cwiseAbs() + Eigen::VectorXd::Constant(n, extra);
+  fm.kinetic_friction = 0.8 * fm.static_friction;
+  return fm;
+}
+
+}  // namespace
+
+TEST_CASE("a chain held by friction keeps q bitwise over a million steps") {
+  RandomGen g(71);
+  const Model model(g.chain(4));
+  Data data(model);
+  SolveInput in(model);
+  in.q = g.q(4).data;
+  in.q_dot.setZero();
+  const FrictionModel fm = holdingFriction(model, in.q, 1.1, 0.01);
+  in.friction = &fm;
+  in.time_step = 1e-3;
+  const Eigen::VectorXd q0 = in.q;
+  Eigen::VectorXd q_next(4), qd_next(4);
+  bool ok = true;
+  for (int k = 0; k < 1000000 && ok; ++k) {
+    ok = static_cast<bool>(step(model, data, in, q_next, qd_next));
+    in.q = q_next;
+    in.q_dot = qd_next;
+  }
+  REQUIRE(ok);
+  CHECK((in.q.array() == q0.array()).all());
+  CHECK((in.q_dot.array() == 0.0).all());
+  for (const JointStatus s : data.jointStatus()) CHECK(s == JointStatus::Stick);
+}
+
+TEST_CASE("a moving chain friction can stop comes to exact rest and stays") {
+  RandomGen g(72);
+  const Model model(g.chain(5));
+  Data data(model);
+  SolveInput in(model);
+  in.q = g.q(5).data;
+  const FrictionModel fm = holdingFriction(model, in.q, 1.5, 1.0);
+  in.q_dot = Eigen::VectorXd::Constant(5, 0.05);
+  in.friction = &fm;
+  in.time_step = 1e-3;
+  Eigen::VectorXd q_next(5), qd_next(5), q_rest(5);
+  int stopped = -1;
+  for (int k = 0; k < 3000; ++k) {
+    REQUIRE(step(model, data, in, q_next, qd_next));
+    // Friction never pushes along the end velocity, and stays within its bound.
+    for (int j = 0; j < 5; ++j) {
+      CHECK(data.frictionTorques()(j) * qd_next(j) <= 0.0);
+      CHECK(std::abs(data.frictionTorques()(j)) <= fm.static_friction(j) * (1 + 1e-12));
+    }
+    if (stopped < 0 && (qd_next.array() == 0.0).all()) stopped = k, q_rest = q_next;
+    in.q = q_next;
+    in.q_dot = qd_next;
+  }
+  REQUIRE(stopped >= 0);
+  CHECK(stopped < 2000);
+  CHECK((in.q.array() == q_rest.array()).all());
+}
+
+TEST_CASE("step() checks its arguments") {
+  RandomGen g(73);
+  const Model model(g.chain(3));
+  Data data(model);
+  SolveInput in(model);
+  Eigen::VectorXd q_next(3), qd_next(3), wrong(2);
+  CHECK(step(model, data, in, q_next, qd_next).code() == Error::OutOfRange);  // time_step 0
+  in.time_step = 1e-3;
+  CHECK(step(model, data, in, wrong, qd_next).code() == Error::SizeMismatch);
+  CHECK(step(model, data, in, q_next, qd_next));  // no friction: explicit Euler on the solve's qdd
+  CHECK(q_next.isApprox(in.q + 1e-3 * qd_next));
+  in.time_step = -1.0;
+  CHECK(solve(model, data, in).code() == Error::OutOfRange);
+}
