@@ -3,9 +3,10 @@
 // conditions is as valid (redundant contacts, or a contact whose direction a task constraint also
 // holds). The solve takes the one of least motor effort: the smallest ||tau_command||^2 (the
 // motors' torques: the task's constraint forces and the set-points' reactions), so that surfaces
-// carry what they can and the motors only the rest. A small convex programme in the contact forces'
-// free coordinates (lemke.hpp, ConvexQp); skipped when the response columns of those coordinates
-// are independent (the forces are then unique).
+// carry what they can and the motors only the rest. With joint friction, the torques of the
+// sticking joints (within their bounds) are coordinates too: the friction solver's least-command
+// rule, together with the contacts. A small convex programme in the free coordinates (lemke.hpp,
+// ConvexQp); skipped when their response columns are independent (the forces are then unique).
 #include <algorithm>
 #include <cmath>
 
@@ -78,6 +79,20 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
       }
     }
   }
+  // The sticking joints with friction or on a limit (their row zero): a torque within its bounds.
+  const double a_tol = 1e-9 * (nz_ > 0 ? lcp_scale_ : std::max(1.0, qdd.cwiseAbs().maxCoeff()));
+  eff_contacts_ = p;
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    const JointUnknown& u = joints_[i];
+    if (std::abs(qdd(u.joint) + u.row_bias) > a_tol) continue;
+    eff_dir_.col(p).setZero();
+    eff_contact_(p) = -1 - static_cast<int>(i);
+    eff_joint_(p - eff_contacts_) = u.joint;
+    eff_x_(p) = joint_tau_(u.joint);
+    const int x = p++;
+    if (std::isfinite(u.lo)) eff_rows_(addRow(u.lo), x) = 1.0;    // tau >= lo
+    if (std::isfinite(u.hi)) eff_rows_(addRow(-u.hi), x) = -1.0;  // tau <= hi
+  }
   eff_k_ = k;
   return p;
 }
@@ -85,12 +100,13 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
 int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   HdCore& c = d.core;
   const int n = static_cast<int>(model_.nrOfJoints()), m = c.res.m;
-  int k_max = 0;
+  const int nj = static_cast<int>(joints_.size());
+  int k_max = 2 * nj;
   for (const PointContact& pc : in.contacts) k_max += 1 + pc.facets;
-  reserveEffort(3 * static_cast<int>(in.contacts.size()), k_max, m);
-  const int p = effortCoordinates(in, c.res.qdd);
+  reserveEffort(3 * static_cast<int>(in.contacts.size()) + nj, k_max, m);
+  const int p = effortCoordinates(in, c.res.qdd), pc = eff_contacts_;
   if (p == 0 || m == 0) return 0;  // no motor columns: nothing to trade
-  for (int i = 0; i < p; ++i) {
+  for (int i = 0; i < pc; ++i) {
     const int ci = eff_contact_(i);
     const Vector3 e = eff_dir_.col(i);
     eff_seg_(i) = in.contacts[ci].segment;
@@ -98,8 +114,10 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   }
   auto G = eff_dqdd_.topLeftCorner(n, p);
   auto N = eff_dnu_.topLeftCorner(m, p);
-  Eigen::Ref<Eigen::MatrixXd> dnu(N);
-  if (c.wrenchResponse(eff_seg_.head(p), eff_wrench_.leftCols(p), G, &dnu) != 0) return 0;
+  Eigen::Ref<Eigen::MatrixXd> dnu_c(N.leftCols(pc)), dnu_j(N.rightCols(p - pc));
+  if (c.wrenchResponse(eff_seg_.head(pc), eff_wrench_.leftCols(pc), G.leftCols(pc), &dnu_c) != 0) return 0;
+  if (p > pc && c.responseColumns(eff_joint_.head(p - pc), G.rightCols(p - pc), joint_dtau_.leftCols(0), &dnu_j))
+    return 0;
   // Unique forces when G has independent columns (certified Cholesky of G^T G).
   auto GtG = eff_gtg_.topLeftCorner(p, p);
   GtG.noalias() = G.transpose() * G;
@@ -123,18 +141,19 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   // coordinates (their Gram matrix per contact; the gradient at x* is e_i . f_c).
   auto P = eff_q_.topLeftCorner(p, p);
   auto pv = eff_c_.head(p);
-  for (int i = 0; i < p; ++i) {
+  for (int i = 0; i < p; ++i) {  // (the joints' coordinates: none of it)
     for (int j = 0; j < p; ++j)
       P(i, j) = eff_contact_(i) == eff_contact_(j) ? eff_dir_.col(i).dot(eff_dir_.col(j)) : 0.0;
-    pv(i) = eff_dir_.col(i).dot(forces.col(eff_contact_(i)));
+    pv(i) = i < pc ? eff_dir_.col(i).dot(forces.col(eff_contact_(i))) : 0.0;
   }
   auto dx = eff_dx_.head(p);
   if (lqp_.solve(T, c.res.tau_cmd, P, pv, R, r, dx) != Lemke::kSolved) return 0;  // keep the forces found
   eff_x_.head(p) += dx;
-  for (int i = 0; i < p; ++i) forces.col(eff_contact_(i)) = points_[eff_contact_(i)].fixed;  // known part
-  for (int i = 0; i < p; ++i) forces.col(eff_contact_(i)) += eff_x_(i) * eff_dir_.col(i);
+  for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) = points_[eff_contact_(i)].fixed;  // known part
+  for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) += eff_x_(i) * eff_dir_.col(i);
+  for (int i = pc; i < p; ++i) joint_tau_(eff_joint_(i - pc)) = eff_x_(i);
   if (const int rc = solveWithForces(d, in)) return rc;
-  for (int i = 0; i < p; ++i) {  // the supports' statuses with their new forces
+  for (int i = 0; i < pc; ++i) {  // the supports' statuses with their new forces
     const int ci = eff_contact_(i);
     if (!in.contacts[ci].isSupport()) continue;
     if (!pushes(points_[ci], forces.col(ci)))
@@ -150,6 +169,7 @@ void ContactStage::reserveEffort(int p, int k, int m) {
   if (eff_dir_.cols() < p) {
     eff_dir_.resize(3, p);
     eff_contact_.resize(p), eff_x_.resize(p), eff_seg_.resize(p), eff_c_.resize(p), eff_dx_.resize(p);
+    eff_joint_.resize(p);
     eff_wrench_.resize(6, p);
     eff_gtg_.resize(p, p), eff_l_.resize(p, p), eff_q_.resize(p, p);
     eff_dqdd_.resize(n, p);

@@ -236,12 +236,10 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
 }
 
 int ContactStage::finish(DataImpl& d, const SolveInput& in) {
-  if (dt_ > 0.0) {  // (no least-effort programme over a time step yet)
-    stepOutputs(d, in);
-    return 0;
-  }
-  if (int rc = leastEffort(d, in)) return rc;
-  return joint_friction_ ? finalFriction(d, in) : 0;
+  if (dt_ == 0.0)  // (no least-effort programme over a time step yet)
+    if (int rc = leastEffort(d, in)) return rc;
+  if (joint_friction_ || dt_ > 0.0) jointOutputs(d, in);
+  return 0;
 }
 
 }  // namespace detail

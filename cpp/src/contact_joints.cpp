@@ -12,10 +12,10 @@
 //   neither (both limits): tau_j = u1 - u2, z = (u1, u2), w = (a, -a).
 // Moving joints get their kinetic friction -fk_j sign(qd_j) as a known torque. Every solve of the
 // stage runs without the friction stage, with these torques added to ff_torques while the
-// input's ff_torques alone drive the pass-through. The last solve (finalFriction) runs the
-// friction stage itself with the contact forces as wrenches: its max-min has a unique qdd, the
-// one found here (checked), and it picks the joints' torques by its least-command rule, so every
-// joint output (friction and limit torques, statuses, the Gauss value) is the friction stage's.
+// input's ff_torques alone drive the pass-through. Where the joints' torques are not unique, the
+// least-effort programme (contact_effort.cpp) trades them with the contact forces for the least
+// motor command (the friction stage's least-command rule, here together with the contacts). The
+// joint outputs (friction and limit torques, statuses, the Gauss value) are this stage's.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -143,24 +143,48 @@ int ContactStage::runWork(DataImpl& d) {
   return rc;
 }
 
-int ContactStage::finalFriction(DataImpl& d, const SolveInput& in) {
-  qdd_contacts_ = d.core.res.qdd;
-  buildWorkInput(in, false);
-  for (std::size_t k = 0; k < points_.size(); ++k)
-    if (const Vector3 f = forces.col(k) - points_[k].fixed; !f.isZero(0.0)) addForce(in.contacts[k], f);
-  work_.friction = in.friction;
-  work_.ff_torques = ff_user_;
-  FrictionCore& f = d.friction();
-  if (const int rc = runInput(d, work_)) return d.core.fail(rc, "%s", f.message_.data());
-  // The certificate: the friction stage's unique qdd is the contact problem's.
-  const double scale = std::max(1.0, qdd_contacts_.cwiseAbs().maxCoeff());
-  const double diff = (f.qdd_ - qdd_contacts_).cwiseAbs().maxCoeff();
-  if (!(diff <= 1e-7 * scale))
-    return d.core.fail(E_NO_SOLUTION,
-                       "contacts with joint friction: the friction stage's accelerations differ from the contact "
-                       "problem's by %g (scale %g): the answer is not certified",
-                       diff, scale);
-  return 0;
+void ContactStage::jointOutputs(DataImpl& d, const SolveInput& in) {
+  joint_friction = joint_tau_;  // kinetic friction of the moving joints (at the instant), else 0
+  joint_limit.setZero();
+  std::fill(d.status_per_joint.begin(), d.status_per_joint.end(), JointStatus::Moving);
+  q_dot_ = in.q_dot;
+  if (!joint_friction_) {
+    joint_friction.setZero();
+    return;
+  }
+  const FrictionModel& fm = *in.friction;
+  const Eigen::VectorXd& qdd = d.core.res.qdd;
+  // Round-off of the rows (qdd_j, or v+_j / dt): the complementarity problem's scale.
+  const double a_tol = 1e-9 * (nz_ > 0 ? lcp_scale_ : std::max(1.0, qdd.cwiseAbs().maxCoeff()));
+  for (const JointUnknown& u : joints_) {
+    const int j = u.joint;
+    const double f = std::isfinite(u.hi) ? u.hi : std::isfinite(u.lo) ? -u.lo : 0.0, t = joint_tau_(j);
+    joint_friction(j) = std::clamp(t, -f, f);  // beyond the friction bound: the limit's reaction
+    joint_limit(j) = t - joint_friction(j);
+    const double row = qdd(j) + u.row_bias;  // the acceleration, or the end velocity over dt
+    const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
+    d.status_per_joint[j] = std::abs(row) <= a_tol ? JointStatus::Stick
+                            : moving               ? JointStatus::Moving
+                            : row > 0              ? JointStatus::SlipPositive
+                                                   : JointStatus::SlipNegative;
+  }
+}
+
+double ContactStage::gaussValue(DataImpl& d) {
+  HdCore& c = d.core;
+  if (!c.res.solved) return std::numeric_limits<double>::quiet_NaN();
+  // H (qdd - qdd_free) = the command plus the unknown joints' torques (qdd_free: the motion under
+  // ff_torques, the contact forces and, at the instant, the moving joints' kinetic friction).
+  gauss_tau_ = c.res.tau_cmd;
+  double dissipation = 0.0;
+  for (const JointUnknown& u : joints_) {
+    gauss_tau_(u.joint) += joint_tau_(u.joint);
+    if (d.status_per_joint[u.joint] == JointStatus::Stick) continue;  // (round-off times a huge f)
+    const double f = std::isfinite(u.hi) ? u.hi : std::isfinite(u.lo) ? -u.lo : 0.0;
+    dissipation += f * std::abs(c.res.qdd(u.joint) + u.row_bias);
+  }
+  c.inverseInertia(gauss_tau_, gauss_out_);
+  return 0.5 * gauss_tau_.dot(gauss_out_) + dissipation;
 }
 
 }  // namespace detail

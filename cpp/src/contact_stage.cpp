@@ -96,11 +96,11 @@ int ContactStage::solveWithForces(DataImpl& d, const SolveInput& in) {
 
 ContactStage::ContactStage(const Model& model) : model_(model), kin_(model), work_(model) {
   const int n = static_cast<int>(model.nrOfJoints());
-  step_friction.setZero(n), step_limit.setZero(n);
-  step_qd_.setZero(n), gauss_tau_.setZero(n), gauss_out_.setZero(n);
+  joint_friction.setZero(n), joint_limit.setZero(n);
+  q_dot_.setZero(n), gauss_tau_.setZero(n), gauss_out_.setZero(n);
   jac_.resize(6, n);
   joints_.reserve(n);
-  joint_tau_.setZero(n), ff_user_.setZero(n), qdd_contacts_.setZero(n);
+  joint_tau_.setZero(n), ff_user_.setZero(n);
   joint_index_.setZero(n);
   joint_dtau_.resize(n, n);
 }

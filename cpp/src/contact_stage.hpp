@@ -53,11 +53,12 @@ class ContactStage {
   std::vector<ContactStatus> status;
   ContactOutcome outcome = ContactOutcome::None;
   int user_columns = 0;  // the input's own constraint columns (nu's size)
-  // A solve over a time step (contact_step.cpp): the joints' friction and limit torques (n).
-  Eigen::VectorXd step_friction, step_limit;
-  // Its Gauss value, Z0(qdd) + sum_j f_j |qd_j + dt qdd_j| / dt (Z0 as friction_solver.hpp's, the
-  // friction and limit torques of every joint with friction in dtau), by one articulated pass.
-  double stepGaussValue(DataImpl& d);
+  // With joint friction or over a time step (contact_joints.cpp): the joints' friction and limit
+  // torques (n) and the Gauss value, Z0(qdd) + sum_j f_j |row_j| (row_j = qdd_j, or the end
+  // velocity over dt; Z0 as friction_solver.hpp's with the unknown joints' torques in dtau), by one
+  // articulated pass.
+  Eigen::VectorXd joint_friction, joint_limit;
+  double gaussValue(DataImpl& d);
 
  private:
   // The contact's state at (q, qd); a frictionless point at rest counts as sliding (kSliding).
@@ -131,12 +132,11 @@ class ContactStage {
   // runInput on work_ with the input's ff_torques alone as the pass-through driver.
   int runWork(DataImpl& d);
   // A time step (contact_step.cpp): every support and set-point's kind from its end velocity (the
-  // polygon's vertex chosen by the problem); the joints' outputs.
+  // polygon's vertex chosen by the problem).
   void stepKinds(const SolveInput& in);
-  void stepOutputs(DataImpl& d, const SolveInput& in);
-  // Step 4 with the friction stage; 0 or an error code with its message.
-  int finalFriction(DataImpl& d, const SolveInput& in);
-  // The least-effort programme, then (with joint friction) finalFriction.
+  // The joints' outputs and statuses (into d.status_per_joint) of the last sweep.
+  void jointOutputs(DataImpl& d, const SolveInput& in);
+  // The least-effort programme (at the instant), then the joints' outputs.
   int finish(DataImpl& d, const SolveInput& in);
   // Roles and sizes of one problem: the sticking trial (every resting point with friction held
   // tangentially by two constraint columns) or the full polygonal problem.
@@ -188,7 +188,8 @@ class ContactStage {
   // wrench and responses; the validity rows in the coordinates; the programme's matrices.
   LexicographicQp lqp_;  // least effort, then least contact force (both paths)
   Matrix3X eff_dir_;
-  Eigen::VectorXi eff_contact_, eff_seg_;
+  Eigen::VectorXi eff_contact_, eff_seg_, eff_joint_;  // eff_contact_: -1 - i for joints_[i]
+  int eff_contacts_ = 0;                               // the contacts' coordinates (the joints' follow)
   Eigen::VectorXd eff_x_, eff_c_, eff_dx_, eff_r_, eff_rhs_;
   Matrix6X eff_wrench_;
   Eigen::MatrixXd eff_dqdd_, eff_dnu_, eff_dtau_, eff_gtg_, eff_l_, eff_q_, eff_rows_, eff_r_all_;
@@ -199,16 +200,16 @@ class ContactStage {
   Eigen::VectorXd act_nu_, act_masked_, act_tau_, act_lin_, act_y_, act_rhs_;
   // Joint friction (contact_joints.cpp): the resting joints' unknowns, the known joint torques of
   // the solves (kinetic friction, the resting joints' offsets, then their solved torques), the
-  // input's ff_torques (zero if empty), the resting joints' indices, the qdd of step 3.
+  // input's ff_torques (zero if empty), the resting joints' indices.
   std::vector<JointUnknown> joints_;
-  Eigen::VectorXd joint_tau_, ff_user_, qdd_contacts_;
+  Eigen::VectorXd joint_tau_, ff_user_;
   Eigen::VectorXi joint_index_;
   Eigen::MatrixXd joint_dtau_;   // n x n: responseColumns' command-torque columns (not used)
   int ncol_contacts_ = 0;        // the contacts' response columns (the joints' follow)
   bool joint_friction_ = false;  // this solve has joint friction
   double dt_ = 0.0;              // SolveInput::time_step (0: the instant)
   double lcp_scale_ = 1.0;       // the last complementarity problem's scale (accelerations)
-  Eigen::VectorXd step_qd_;      // a time step: the input's q_dot (stepGaussValue); gauss buffers
+  Eigen::VectorXd q_dot_;        // the input's q_dot (jointOutputs); gaussValue's buffers
   Eigen::VectorXd gauss_tau_, gauss_out_;
 };
 

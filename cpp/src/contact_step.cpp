@@ -10,10 +10,9 @@
 // stays within the bound ends the step at zero velocity, a sliding one gets the full friction
 // against its end velocity, which friction alone cannot reverse. The sticking trial, the
 // all-active guess and the least-effort programme are instant-only; the joint outputs (friction
-// and limit torques, statuses) are this stage's (the friction stage is instant-only too).
+// and limit torques, statuses) are this stage's (contact_joints.cpp).
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "contact_stage.hpp"
 #include "data_impl.hpp"
@@ -32,48 +31,6 @@ void ContactStage::stepKinds(const SolveInput& in) {
     else
       p.kind = pc.mu > 0.0 ? kSetPointRest : kSetPointSliding;
   }
-}
-
-void ContactStage::stepOutputs(DataImpl& d, const SolveInput& in) {
-  step_friction.setZero();
-  step_limit.setZero();
-  std::fill(d.status_per_joint.begin(), d.status_per_joint.end(), JointStatus::Moving);
-  step_qd_ = in.q_dot;
-  if (!joint_friction_) return;
-  const FrictionModel& fm = *in.friction;
-  const Eigen::VectorXd& fs = fm.static_friction;
-  const Eigen::VectorXd& fk = fm.kinetic_friction.size() ? fm.kinetic_friction : fm.static_friction;
-  const Eigen::VectorXd& qdd = d.core.res.qdd;
-  // Round-off of the rows (v+ / dt): the complementarity problem's scale (none: the motion's).
-  const double a_tol = 1e-9 * (nz_ > 0 ? lcp_scale_ : std::max(1.0, qdd.cwiseAbs().maxCoeff()));
-  for (const JointUnknown& u : joints_) {
-    const int j = u.joint;
-    const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
-    const double f = moving ? fk(j) : fs(j), t = joint_tau_(j);
-    step_friction(j) = std::clamp(t, -f, f);  // beyond the friction bound: the limit's reaction
-    step_limit(j) = t - step_friction(j);
-    // Ends the step at rest: its end velocity is round-off of the step's velocity change.
-    const double v = in.q_dot(j) + dt_ * qdd(j);
-    const bool stuck = std::abs(v) <= dt_ * a_tol;
-    d.status_per_joint[j] = stuck    ? JointStatus::Stick
-                            : moving ? JointStatus::Moving
-                            : v > 0  ? JointStatus::SlipPositive
-                                     : JointStatus::SlipNegative;
-  }
-}
-
-double ContactStage::stepGaussValue(DataImpl& d) {
-  HdCore& c = d.core;
-  if (!c.res.solved) return std::numeric_limits<double>::quiet_NaN();
-  gauss_tau_ = c.res.tau_cmd + step_friction + step_limit;  // H (qdd - qdd_free)
-  c.inverseInertia(gauss_tau_, gauss_out_);
-  double dissipation = 0.0;
-  for (const JointUnknown& u : joints_) {
-    if (d.status_per_joint[u.joint] == JointStatus::Stick) continue;  // (round-off times a huge f)
-    const double f = std::isfinite(u.hi) ? u.hi : std::isfinite(u.lo) ? -u.lo : 0.0;
-    dissipation += f * std::abs(step_qd_(u.joint) / dt_ + c.res.qdd(u.joint));
-  }
-  return 0.5 * gauss_tau_.dot(gauss_out_) + dissipation;
 }
 
 }  // namespace detail

@@ -71,8 +71,7 @@ const Eigen::VectorXd& Data::commandTorques() const noexcept {
 }
 Eigen::Map<const Eigen::VectorXd> Data::nu() const noexcept {
   if (impl_->contacts_last) {  // the input's own columns (the set-points' follow them)
-    const double* nu = impl_->friction_last ? impl_->friction_core->nu_.data() : impl_->core.nu().data();
-    return Eigen::Map<const Eigen::VectorXd>(nu, impl_->contact_stage->user_columns);
+    return Eigen::Map<const Eigen::VectorXd>(impl_->core.nu().data(), impl_->contact_stage->user_columns);
   }
   if (!impl_->friction_last) return impl_->core.nu();
   const detail::FrictionCore& f = *impl_->friction_core;
@@ -93,11 +92,11 @@ const Matrix6X& Data::linkAccelerations() const {
   return impl_->core.linkAccelerations();
 }
 const Eigen::VectorXd& Data::frictionTorques() const noexcept {
-  if (impl_->step_last) return impl_->contact_stage->step_friction;
+  if (impl_->stage_joints) return impl_->contact_stage->joint_friction;
   return impl_->friction_last ? impl_->friction_core->friction_ : impl_->zeros;
 }
 const Eigen::VectorXd& Data::limitTorques() const noexcept {
-  if (impl_->step_last) return impl_->contact_stage->step_limit;
+  if (impl_->stage_joints) return impl_->contact_stage->joint_limit;
   return impl_->friction_last ? impl_->friction_core->limit_ : impl_->zeros;
 }
 const std::vector<JointStatus>& Data::jointStatus() const noexcept {
@@ -105,7 +104,7 @@ const std::vector<JointStatus>& Data::jointStatus() const noexcept {
 }
 double Data::gaussValue() const {
   const EntryGuard guard(impl_->core.busy);
-  if (guard && impl_->step_last) return impl_->contact_stage->stepGaussValue(*impl_);
+  if (guard && impl_->stage_joints) return impl_->contact_stage->gaussValue(*impl_);
   if (!guard || !impl_->friction_last) return std::numeric_limits<double>::quiet_NaN();
   return impl_->friction_core->gaussValue();
 }

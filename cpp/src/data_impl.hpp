@@ -42,7 +42,7 @@ struct DataImpl {
   std::vector<JointStatus> status_per_joint;
   std::unique_ptr<ContactStage> contact_stage;
   bool contacts_last = false;  // the last successful solve had contacts (or friction over a time step)
-  bool step_last = false;      // ... over a time step: the joint outputs are the contact stage's
+  bool stage_joints = false;   // ... with joint friction or over a time step: the joint outputs are the stage's
 };
 
 // Assembles `in` into the core's arguments and runs the sweeps (with the friction stage when it

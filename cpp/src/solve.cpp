@@ -127,10 +127,10 @@ int run(DataImpl& d, const SolveInput& in, int m) {
   return d.friction().solveImpl(in.q, in.q_dot, alfa, beta, &segments, f_ext, in.ff_torques, *in.friction);
 }
 
-// Joint status of the friction stage (or all Moving after a frictionless solve); a step's
-// statuses are written by the contact stage (step_last).
+// Joint status of the friction stage (or all Moving after a frictionless solve); with contacts
+// and friction, or over a time step, the contact stage writes them (stage_joints).
 void recordStatus(DataImpl& d, bool with_friction) {
-  if (!with_friction && !d.friction_last && !d.step_last) return;
+  if (!with_friction && !d.friction_last && !d.stage_joints) return;
   for (std::size_t j = 0; j < d.status_per_joint.size(); ++j)
     d.status_per_joint[j] = with_friction ? static_cast<JointStatus>(d.friction_core->status_[j]) : JointStatus::Moving;
 }
@@ -155,7 +155,7 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
     recordStatus(d, false);
     d.friction_last = false;
     d.contacts_last = false;
-    d.step_last = false;
+    d.stage_joints = false;
     return d.status(rc);
   }
   // The contact stage: contacts, or friction over a time step (its impulse problem).
@@ -165,10 +165,10 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
   if (with_contacts) rc = d.contacts().check(c, input);
   if (rc == 0) rc = with_contacts ? d.contacts().solve(d, input) : detail::runInput(d, input);
   d.contacts_last = with_contacts && rc == 0;
-  const bool step_now = input.time_step > 0.0 && with_contacts && rc == 0;
-  if (!step_now) recordStatus(d, with_friction && rc == 0);  // (else written by the stage)
-  d.step_last = step_now;
-  d.friction_last = with_friction && rc == 0 && !step_now;
+  const bool stage_joints = with_contacts && rc == 0 && (with_friction || input.time_step > 0.0);
+  if (!stage_joints) recordStatus(d, with_friction && rc == 0);  // (else written by the stage)
+  d.stage_joints = stage_joints;
+  d.friction_last = with_friction && rc == 0 && !stage_joints;
   if (rc == 0) {
     c.message[0] = '\0';
     return Status();

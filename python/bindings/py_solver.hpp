@@ -17,7 +17,8 @@
 namespace vsbind {
 
 // Positions in the argument array of SolveArgs::parse (solve()'s parameter order).
-inline constexpr int kOutArg = 10, kADesiredArg = 11, kContactsArg = 12, kTimeStepArg = 13, kNumSolveArgs = 14;
+inline constexpr int kOutArg = 10, kADesiredArg = 11, kContactsArg = 12, kTimeStepArg = 13, kVelocityTolArg = 14,
+                     kNumSolveArgs = 15;
 
 // The arguments of one solve (1 row, no batch axis) or of a batch (B rows, each argument shared or with a leading
 // batch axis) as a BatchInput, shapes checked by BatchArgs with messages naming the argument (values: by solve(), per
@@ -27,7 +28,8 @@ inline constexpr int kOutArg = 10, kADesiredArg = 11, kContactsArg = 12, kTimeSt
 class SolveArgs : public vereshchagin::BatchArgs {
  public:
   // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
-  // tau_ff_pass_through, (out: not read), a_desired, contacts, time_step (nullptr or None: not given).
+  // tau_ff_pass_through, (out: not read), a_desired, contacts, time_step, contact_velocity_tolerance
+  // (nullptr or None: not given).
   void parse(class PySolver& s, PyObject* const* args, bool batch);
 
   bool any_friction = false;

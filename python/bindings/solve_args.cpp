@@ -190,6 +190,8 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   input.contacts.clear();
   if (given(a[kContactsArg])) parseContacts(a[kContactsArg]);
   input.time_step = given(a[kTimeStepArg]) ? scalarArg(a[kTimeStepArg], "time_step") : 0.0;  // (range: by solve)
+  const bool v_tol = given(a[kVelocityTolArg]);
+  input.contact_velocity_tolerance = v_tol ? scalarArg(a[kVelocityTolArg], "contact_velocity_tolerance") : 1e-6;
   // Pass-through weights: one per constraint column (their range: checked by vereshchagin::solve).
   if (given(a[8])) input.f_ext_pass_through = vector(a[8], "f_ext_pass_through", columns, /*scalar_ok=*/true);
   if (given(a[9])) input.ff_pass_through = vector(a[9], "tau_ff_pass_through", columns, /*scalar_ok=*/true);

@@ -13,7 +13,7 @@ namespace {
 // clang-format off
 constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
                                         "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired", "contacts",
-                                        "time_step"};
+                                        "time_step", "contact_velocity_tolerance"};
 // clang-format on
 static_assert(sizeof(kSolveParams) == kNumSolveArgs * sizeof(char*), "one name per SolveArgs::parse argument");
 PyObject* g_names[2][kNumSolveArgs];  // interned: solve()'s, solve_batch()'s
@@ -100,10 +100,10 @@ using O = const py::object&;
 // _solve_pybind: solve() bound the plain pybind11 way (named arguments with defaults), the
 // benchmark of the fast call's gain.
 py::object solvePybind(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_ff, O friction, O constraints, O f_pass,
-                       O t_pass, O out, O a_desired, O contacts, O time_step) {
-  PyObject* a[kNumSolveArgs] = {q.ptr(),      qd.ptr(),        alpha.ptr(),       beta.ptr(),   f_ext.ptr(),
-                                tau_ff.ptr(), friction.ptr(),  constraints.ptr(), f_pass.ptr(), t_pass.ptr(),
-                                out.ptr(),    a_desired.ptr(), contacts.ptr(),    time_step.ptr()};
+                       O t_pass, O out, O a_desired, O contacts, O time_step, O v_tol) {
+  PyObject* a[kNumSolveArgs] = {q.ptr(),      qd.ptr(),        alpha.ptr(),       beta.ptr(),      f_ext.ptr(),
+                                tau_ff.ptr(), friction.ptr(),  constraints.ptr(), f_pass.ptr(),    t_pass.ptr(),
+                                out.ptr(),    a_desired.ptr(), contacts.ptr(),    time_step.ptr(), v_tol.ptr()};
   return s.solve(a, out.is_none() ? nullptr : out.ptr());
 }
 
@@ -137,7 +137,7 @@ void bindSolver(py::module_& mod) {
           py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
           py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, py::arg("out") = none,
           py::arg("a_desired") = none, py::arg("contacts") = none, py::arg("time_step") = none,
-          doc("_core.Solver._solve_pybind"));
+          py::arg("contact_velocity_tolerance") = none, doc("_core.Solver._solve_pybind"));
 }
 
 }  // namespace vsbind

@@ -236,6 +236,7 @@ class Solver:
         a_desired: Optional[ArrayLike] = None,
         contacts: Optional[Sequence[Contact]] = None,
         time_step: Optional[float] = None,
+        contact_velocity_tolerance: Optional[float] = None,
     ) -> SolveResult: ...
     def _time_cpp(self, reps: int, /, *args: object, **kwargs: object) -> float: ...
     def _solve_dict(self, /, *args: object, **kwargs: object) -> dict: ...
@@ -256,6 +257,7 @@ class Solver:
         a_desired: Optional[ArrayLike] = None,
         contacts: Optional[Sequence[Contact]] = None,
         time_step: Optional[float] = None,
+        contact_velocity_tolerance: Optional[float] = None,
     ) -> dict: ...
     def response_columns(
         self, joints: Sequence[int], hold_sticking: bool = True

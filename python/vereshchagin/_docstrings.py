@@ -494,7 +494,7 @@ DOCS["Tree.fk_all"] = _fk_all(", in segment order")
 
 # ---- Solver (solver_bindings.cpp): the C++ core of vereshchagin.Solver (solver.py) ----
 
-DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None, time_step=None)
+DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None, time_step=None, contact_velocity_tolerance=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -562,6 +562,10 @@ time_step : float, optional
     friction can hold ends the step at rest, a sliding one gets the full friction against its
     end velocity, a support ends the step not approaching its surface. :meth:`Solver.step`
     integrates. Default (None or 0): the instant.
+contact_velocity_tolerance : float, optional
+    Speed (m/s) at or below which a contact point is at rest along its normal, resp. not sliding
+    (default 1e-6). A support approaching its surface faster is refused at the instant (an impact
+    needs an impulse: solve over a ``time_step`` instead).
 
 Returns
 -------
@@ -584,7 +588,7 @@ The GIL is released during the solve. One solver serialises concurrent calls; us
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
 """
 
-DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None, contacts=None, time_step=None)
+DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None, contacts=None, time_step=None, contact_velocity_tolerance=None)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 """

@@ -169,6 +169,7 @@ class Solver(_core.Solver):
         a_desired=None,
         contacts=None,
         time_step=None,
+        contact_velocity_tolerance=None,
     ) -> BatchResult:
         """Solve B states at once (each row exactly as :meth:`solve` would).
 
@@ -201,6 +202,8 @@ class Solver(_core.Solver):
             Point contacts of every row (see :meth:`solve`).
         time_step : float, optional
             Every row over a time step (see :meth:`solve`).
+        contact_velocity_tolerance : float, optional
+            As in :meth:`solve`.
 
         Returns
         -------
@@ -229,6 +232,7 @@ class Solver(_core.Solver):
             a_desired,
             contacts,
             time_step,
+            contact_velocity_tolerance,
         )
         if not out.pop("any_friction"):
             for key in ("friction_torque", "limit_torque", "status", "gauss_value", "iterations"):

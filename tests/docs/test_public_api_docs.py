@@ -140,6 +140,8 @@ def test_solve_has_a_full_docstring_and_signature():
         "out",
         "a_desired",
         "contacts",
+        "time_step",
+        "contact_velocity_tolerance",
     ):
         assert section in doc, section
     params = list(inspect.signature(vs.Solver.solve).parameters)
@@ -158,6 +160,8 @@ def test_solve_has_a_full_docstring_and_signature():
         "out",
         "a_desired",
         "contacts",
+        "time_step",
+        "contact_velocity_tolerance",
     ]
 
 

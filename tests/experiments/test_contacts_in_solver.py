@@ -70,28 +70,6 @@ def test_scene_contacts_give_a_contact_consistent_velocity():
     assert sf.SceneContacts(chain, points, active=lambda: False)(q, np.ones(7))[0] == []
 
 
-def test_solve_certified_on_the_dual_arm_tree_at_rest():
-    """Contacts with joint friction on the tree at rest: the library refuses its answer as not
-    certified (a reported failure); the two-stage workaround still gives a consistent command."""
-    _, tree = dual_arm_model()
-    solver = vs.Solver(tree, gravity=[0.0, 0.0, -9.81])
-    I6 = np.eye(6)
-    cons = {
-        "left_rest_point": (I6[:, 3:], np.zeros(3)),
-        "right_end_effector_link": (I6, np.array([0, 0, 9.81, 0, 0, 0.0])),
-    }
-    friction = vs.Friction(static=np.asarray(tree.friction), velocity_tolerance=0.01)
-    contacts = [vs.Contact("left_rest_point", mu=0.15, facets=32)]
-    res, _ = sf.solve_certified(
-        solver, start_pose(), np.zeros(15), model=tree, friction=friction, constraints=cons, contacts=contacts
-    )
-    f = np.asarray(res.contact_force)
-    assert f.shape == (1, 3) and 20.0 < f[0, 2] < 50.0 and np.linalg.norm(f[0, :2]) <= 0.15 * f[0, 2] + 1e-9
-    assert np.all(np.isfinite(res.tau_command)) and np.all(
-        np.abs(res.friction_torque) <= np.asarray(tree.friction) + 1e-9
-    )
-
-
 def test_grasp_slides_with_the_table_as_a_support():
     run = grasp(True, quick=True, solver_contacts=True)
     o = metrics.grasp_outcome(run)
@@ -142,3 +120,29 @@ def test_dual_arm_resting_hand_as_a_contact():
     o = metrics.dual_arm_outcome(run)
     assert o["table_fraction"] > 0.99 and abs(o["final_error_x"]) < 0.005 and o["rest_drift"] < 0.005
     assert 0.8 < o["table_force"] / o["table_force_model"] < 1.25
+
+
+def test_the_dual_arm_rest_with_joint_friction_is_certified():
+    """The dual-arm tree at rest in its start pose, the resting hand held in five directions with a
+    support under it, the other hand held, every joint with friction: once refused as "not
+    certified" (a separate friction-stage sweep disagreed by 1e-5 rad/s^2 in three light wrist
+    joints of this nearly singular problem). The joints' torques now come from the same problem as
+    the contact forces: everything sticks, the table carries the arm, and the answer replays."""
+    import vereshchagin as vs
+
+    _, tree = dual_arm_model()
+    solver = vs.Solver(tree, gravity=[0, 0, -9.81])
+    I6, q, n = np.eye(6), start_pose(), tree.n_joints
+    cons = {
+        "left_rest_point": (I6[:, [0, 1, 3, 4, 5]], np.zeros(5)),
+        "right_end_effector_link": (I6, np.array([0, 0, 9.81, 0, 0, 0.0])),
+    }
+    fr = vs.Friction(static=np.asarray(tree.friction), velocity_tolerance=0.01)
+    r = solver.solve(q, np.zeros(n), friction=fr, constraints=cons, contacts=[vs.Contact("left_rest_point", mu=0.0)])
+    assert 25.0 < r.contact_force[0, 2] < 40.0  # the table carries the resting arm
+    # Replay through the tree's own dynamics: H qdd = tau_cmd + friction + J^T f - (C qd + g).
+    J = np.asarray(tree.jacobian(q, "left_rest_point"))[:3]
+    lhs = tree.mass_matrix(q) @ r.qdd
+    rhs = r.tau_command + r.friction_torque + r.limit_torque + J.T @ r.contact_force[0] - tree.gravity_torques(q)
+    assert np.abs(lhs - rhs).max() <= 1e-12 * np.abs(tree.gravity_torques(q)).max()
+    assert (r.status == 1).all() and np.abs(r.qdd).max() <= 1e-8  # round-off of a nearly singular problem

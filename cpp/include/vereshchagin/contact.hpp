@@ -8,21 +8,9 @@
 ///
 /// With joint friction (SolveInput::friction), joint friction, joint limits and the contacts are one
 /// complementarity problem (each resting joint with friction or on a limit one more bounded unknown
-/// torque); the last sweep runs the friction stage with the contact forces as wrenches, so
-/// Data::frictionTorques(), limitTorques() and jointStatus() are the friction stage's (its max-min
-/// reproduces the contact problem's qdd, which the solve checks: Error::NoContactSolution if not).
-///
-/// Frames, signs, units: the point in the segment's tip frame (m); the normal in base axes, unit,
-/// pointing from the surface into the robot (the direction the surface pushes); forces in base
-/// axes (N), ON the robot BY the surface, applied at the point. A point is at rest along the
-/// normal (touching) when its normal velocity is at most SolveInput::contact_velocity_tolerance,
-/// separating above it; a support approaching the surface faster than that is refused (it needs
-/// an impulse, not a force). Tangentially it slides when its tangential speed exceeds the same
-/// tolerance.
-///
-/// The friction polygon of a contact with k facets has its k vertices at mu f_n d_j,
-/// d_j = cos(2 pi j / k) t1 + sin(2 pi j / k) t2 (j = 0 .. k-1): inscribed in the circular cone.
-/// t1 = unit(e x n) for the base axis e least aligned with n (the first on ties), t2 = n x t1.
+/// torque, maximum dissipation); where the torques are not unique, the sticking joints' torques
+/// join the least-effort programme (the friction solver's least-command rule). Data's joint outputs
+/// (frictionTorques(), limitTorques(), jointStatus(), gaussValue()) come from the same answer.
 #pragma once
 
 #include <limits>

@@ -89,7 +89,7 @@ struct SolveInput {
   /// Point contacts (contact.hpp): supports and normal-force set-points on any segments. The
   /// constraint columns of nu stay those of `constraints`; a set-point's normal reaction is part of
   /// the command torques. With `friction`, joint friction, joint limits and the contacts are solved
-  /// together (the joint outputs are the friction stage's, see contact.hpp).
+  /// together (contact.hpp).
   std::vector<PointContact> contacts;
   /// Below this speed (m/s) a contact point is at rest along the normal, resp. not sliding.
   double contact_velocity_tolerance = 1e-6;

@@ -85,14 +85,13 @@ def _numbers(run) -> dict:
         plant=plant,
         model=model,
         chatter=chatter(run, w),
-        uncertified=int(run.info.get("uncertified", 0)),
     )
 
 
 def _rows(pairs) -> tuple[list, list, dict]:
     """Header, rows and numbers for ``pairs`` of ``(case label, variant label, run)``."""
     header = ["case", "variant", "accuracy [mm]", "∫τ² [N² m² s]", "shoulder avg |τ| [N m]"]
-    header += ["surface force plant / model [N]", "command chatter [N m/step]", "two-stage cycles (workaround)"]
+    header += ["surface force plant / model [N]", "command chatter [N m/step]"]
     rows, nums = [], {}
     for case, variant, run in pairs:
         n = _numbers(run)
@@ -106,7 +105,6 @@ def _rows(pairs) -> tuple[list, list, dict]:
                 f"{n['shoulder']:.2f}",
                 f"{n['plant']:.1f} / {n['model']:.1f}",
                 f"{n['chatter']:.3f}",
-                f"{n['uncertified']}",
             ]
         )
     return header, rows, nums

@@ -41,7 +41,6 @@ import numpy as np
 
 from vereshchagin.friction import Friction
 from vereshchagin.task import beta_for, directions, pose_error
-from .surfaces import solve_certified
 
 __all__ = [
     "CONTACT_GAINS",
@@ -243,9 +242,6 @@ class CascadedController:
         contact force (N, summed over the contacts). None: no contacts (the hand-made variants).
     v_des : ndarray, shape (6,)
         The desired twist of the last cycle (m/s, rad/s; base axes, end-effector origin).
-    uncertified : int
-        Cycles whose contact solve was refused as "not certified" and redone in two stages
-        (:func:`~.surfaces.solve_certified`).
     """
 
     def __init__(self, chain, solver, config: ControllerConfig = ControllerConfig()):
@@ -273,7 +269,6 @@ class CascadedController:
         self.support_share: Optional[Callable[[Any, np.ndarray], np.ndarray]] = None
         self.contacts: Optional[Callable[[np.ndarray, np.ndarray], tuple]] = None
         self.v_des = np.zeros(6)  # the last cycle's desired twist (for contacts' reference velocity)
-        self.uncertified = 0  # cycles solved in two stages (surfaces.solve_certified)
         self._all = list(range(n))
         self._alpha: dict[tuple, np.ndarray] = {}  # constraint directions (6, m) per tuple of names
 
@@ -399,19 +394,7 @@ class CascadedController:
             f_ext[-1] = np.concatenate([F, np.cross(r, F)])
         if cts:
             kw["contacts"] = cts
-        res, fell_back = solve_certified(
-            self.solver,
-            q,
-            qd_solve,
-            alpha,
-            beta,
-            model=self.chain,
-            f_ext=f_ext,
-            tau_ff=tau_ff,
-            friction=self.friction,
-            **kw,
-        )
-        self.uncertified += fell_back
+        res = self.solver.solve(q, qd_solve, alpha, beta, f_ext=f_ext, tau_ff=tau_ff, friction=self.friction, **kw)
         if cts:  # the model's upward force of the surfaces, N
             N = float(np.asarray(res.contact_force)[:, 2].sum())
         tau = np.asarray(res.tau_command) + tau_motor_ff + self._friction_feedforward(qd, res.qdd)

@@ -67,7 +67,7 @@ from vereshchagin import Solver
 from vereshchagin.task import beta_for, pose_error
 from .controller import ControllerConfig, CycleInfo, cascaded_acceleration
 from .mujoco_plant import MujocoGen3, Scene, build_model
-from .surfaces import SceneContacts, point_jacobian, solve_certified, tool_support
+from .surfaces import SceneContacts, point_jacobian, tool_support
 from .use_cases import (
     JOINT_DAMPING,
     JOINT_FRICTION,
@@ -228,7 +228,6 @@ class DualArmController:
             self.parts = [_part(tree, tree, (REST_FRAME, TASK_FRAME), config, False)]
         self.table_share = variant in ("table", "separate")
         self.contacts = None
-        self.uncertified = 0
         if variant == CONTACT_VARIANT:
             self.contacts = SceneContacts(tree, [tool_support(REST_FRAME, (0.0, 0.0, 0.0), Scene().friction)])
         self.goal: Optional[np.ndarray] = None
@@ -296,8 +295,7 @@ class DualArmController:
             tau_ff = ff - np.asarray(p.model.damping) * qdp
             kw = {"contacts": cts} if cts else {}
             args = dict(tau_ff=tau_ff, constraints={f: cons[f] for f in p.frames}, **kw)
-            res, fell_back = solve_certified(p.solver, qp, qd_solve[p.idx], model=p.model, friction=p.friction, **args)
-            self.uncertified += fell_back
+            res = p.solver.solve(qp, qd_solve[p.idx], friction=p.friction, **args)
             if cts:  # the table's force on the resting hand, and its joint torque in the intended total
                 f_c = np.asarray(res.contact_force)[0]
                 force = float(f_c[2])
@@ -423,6 +421,5 @@ def dual_arm(variant: str, quick: bool = False, progress=None, config: Optional[
         open_loop=np.array(lin),
         open_loop_ang=np.array(ang),
         command=np.array(commands),
-        uncertified=ctl.uncertified,
     )
     return run

@@ -220,7 +220,6 @@ def elbow(variant: str, quick: bool = False, progress=None, perturb=None):
         nu_log = list(forces[:, 0])
         run.info["table_force_model"] = forces[:, 1] if forces.shape[1] > 1 else np.zeros(len(forces))
     run.info["command"] = np.array(log["command"])
-    run.info["uncertified"] = ctl.uncertified
     elbow_z = np.array([np.asarray(chain.fk(q, segment=seg))[2, 3] for q in run.q])
     run.info.update(
         elbow_z=elbow_z,

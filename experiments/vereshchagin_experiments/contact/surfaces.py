@@ -47,7 +47,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from vereshchagin import Contact, SolverError
+from vereshchagin import Contact
 
 __all__ = [
     "RESTING_SPEED",
@@ -57,7 +57,6 @@ __all__ = [
     "elbow_support",
     "pen_setpoint",
     "point_jacobian",
-    "solve_certified",
     "tool_support",
     "wrist_support",
 ]
@@ -240,46 +239,3 @@ def elbow_support(frame: str, radius: float, mu: float) -> ContactPoint:
 def wrist_support(frame: str, low_point, mu: float) -> ContactPoint:
     """The gripper under the wrist (its lowest edge, ``low_point`` in ``frame``, m) resting on a table."""
     return ContactPoint(frame, tuple(float(x) for x in low_point), mu=mu, tracked=True)
-
-
-def solve_certified(solver, q, qd, *args, model=None, friction=None, **kw):
-    """``solver.solve(q, qd, *args, friction=friction, **kw)``; ``(result, fell_back)``.
-
-    Workaround for a library failure: with contacts and joint friction the solve sometimes
-    refuses its answer ("the friction stage's accelerations differ from the contact problem's by
-    ~1e-5 ... not certified"), e.g. on the dual-arm tree at rest in its start pose with one
-    support. That cycle is then solved in two stages (``fell_back`` True): the contacts without
-    joint friction give the contact forces, which the friction-aware solve without contacts gets
-    as known wrenches in ``f_ext`` (what the library's own last sweep does). The result's
-    ``contact_*`` come from the first stage, the rest from the second. Only for supports (a
-    set-point's held normal has no wrench form) and with ``model`` (the solver's Chain or Tree);
-    other errors propagate.
-    """
-    try:
-        return solver.solve(q, qd, *args, friction=friction, **kw), False
-    except SolverError as e:
-        contacts = kw.get("contacts") or []
-        supports = all(c.force is None for c in contacts)
-        if friction is None or not contacts or not supports or model is None or "not certified" not in str(e):
-            raise
-    first = solver.solve(q, qd, *args, **kw)
-    kw = dict(kw)
-    kw.pop("contacts")
-    f_ext = kw.pop("f_ext", None)
-    f_ext = np.zeros((model.n_segments, 6)) if f_ext is None else np.array(f_ext, float)
-    for c, f in zip(contacts, np.asarray(first.contact_force)):
-        seg = model.segment_index(c.segment)
-        p = np.asarray(model.fk(q, c.segment)) @ np.append(c.point, 1.0)
-        r = p[:3] - np.asarray(model.fk(q, seg))[:3, 3]
-        f_ext[seg] += np.concatenate([f, np.cross(r, f)])
-    return _TwoStage(solver.solve(q, qd, *args, friction=friction, f_ext=f_ext, **kw), first), True
-
-
-class _TwoStage:
-    """A solve result whose ``contact_*`` attributes are those of ``contacts``, the rest of ``result``."""
-
-    def __init__(self, result, contacts):
-        self._result, self._contacts = result, contacts
-
-    def __getattr__(self, name):
-        return getattr(self._contacts if name.startswith("contact") else self._result, name)

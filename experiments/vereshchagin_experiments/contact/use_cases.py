@@ -485,7 +485,6 @@ def grasp(
         descent=descent,
         tool_point=low,
         mu=scene.friction,
-        uncertified=ctl.uncertified,
         plant_error=plant_error,
         **_arrays(log),
     )
@@ -560,7 +559,6 @@ def writing(
     run.info.update(
         table_top=scene.table_top,
         tool_point=tip_ee,
-        uncertified=ctl.uncertified,
         plant_error=plant_error,
         **_arrays(log),
     )
