@@ -45,7 +45,8 @@ class FrictionCore {
                 const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                 const Eigen::Ref<const Eigen::VectorXi>* segments,
                 const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
-                const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
+                const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction,
+                double time_step = 0.0);
   // The hybrid-dynamics solve of the current problem with joint torques tau (segments or not).
   int hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
               const Eigen::Ref<const ChainHdSolver::Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
@@ -94,7 +95,12 @@ class FrictionCore {
   double gscale_ = 0.0;          // scale of the QP gradient (see boxQp())
   bool free_full_rank_ = false;  // the last free-set factorisation had full rank
   bool solved_ = false;
-  Eigen::VectorXd fstatic_;  // static friction of the last solve (gaussValue())
+  // A solve over a time step dt (SolveInput::time_step; 0: the instant): every joint with friction
+  // is resting-like (bounded by its static friction at rest, its kinetic one while moving), its
+  // row qdd_j + qd_j / dt (shift_ = qd / dt: the QP's c is shifted by it).
+  double dt_ = 0.0;
+  Eigen::VectorXd shift_;
+  Eigen::VectorXd fbound_;  // each resting joint's friction bound of the last solve (gaussValue())
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;                    // joint index of each resting joint
   Eigen::MatrixXd Gc_, Tc_, Q_, work_, L_;  // Tc_ stays empty (0 x 0): tau_cmd follows from nu

@@ -160,7 +160,7 @@ FrictionCore::FrictionCore(HdCore& hd) : hd_(&hd) {
   nj_ = hd.model.nj;
   const int n = static_cast<int>(nj_);
   qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = ff_driver_ = Eigen::VectorXd::Zero(n);
-  fstatic_ = Eigen::VectorXd::Zero(n);
+  fbound_ = shift_ = Eigen::VectorXd::Zero(n);
   status_.assign(n, Moving);
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
   Gc_ = Q_ = work_ = L_ = Eigen::MatrixXd::Zero(n, n);
@@ -255,7 +255,8 @@ int FrictionCore::checkFriction(const FrictionModel& friction) {
 // Stage 1: kinetic friction of moving joints as feed-forward (into tau0_); the resting joints
 // with friction or on a limit into rest_, with the bounds of their mu (friction torque -mu):
 // [-f, f], opened to -inf at a lower limit (the reaction pushes up) and to +inf at an upper one.
-// Returns their number k.
+// Over a time step every joint with friction goes into rest_ (f: kinetic while moving) and its
+// row is shifted by qd / dt (shift_). Returns their number k.
 int FrictionCore::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
                                 const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                                 const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
@@ -265,15 +266,21 @@ int FrictionCore::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
   int k = 0;
   for (long j = 0; j < static_cast<long>(nj_); ++j) {
     tau0_(j) = ff_driver_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
-    if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
+    shift_(j) = dt_ > 0.0 ? q_dot(j) / dt_ : 0.0;
+    fbound_(j) = 0.0;
+    const bool moving = std::abs(q_dot(j)) > friction.velocity_tolerance;
+    if (moving && dt_ == 0.0) {
       tau0_(j) -= fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
       continue;
     }
-    const bool at_lower = limits && q(j) <= friction.lower(j) + friction.limit_tolerance;
-    const bool at_upper = limits && q(j) >= friction.upper(j) - friction.limit_tolerance;
-    if (fs(j) > 0.0 || at_lower || at_upper) {
-      lo_(k) = at_lower ? -kInf : -fs(j);
-      hi_(k) = at_upper ? kInf : fs(j);
+    // At rest, or over a time step (friction against the end velocity, kinetic while moving).
+    const double f = moving ? fk(j) : fs(j);
+    const bool at_lower = !moving && limits && q(j) <= friction.lower(j) + friction.limit_tolerance;
+    const bool at_upper = !moving && limits && q(j) >= friction.upper(j) - friction.limit_tolerance;
+    if (f > 0.0 || at_lower || at_upper) {
+      lo_(k) = at_lower ? -kInf : -f;
+      hi_(k) = at_upper ? kInf : f;
+      fbound_(j) = f;
       rest_(k++) = static_cast<int>(j);
     }
   }
@@ -293,7 +300,7 @@ int FrictionCore::optimiseResting(int k) {
   int rc = hd_->responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), &dnu);
   if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   for (int a = 0; a < k; ++a) {
-    c_(a) = qdd0_(rest_(a));
+    c_(a) = qdd0_(rest_(a)) + shift_(rest_(a));  // (over a time step: the end velocity over dt)
     for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
   }
   // Scale of Q for every "is it zero" decision: max over the resting joints of Q_jj and of
@@ -325,7 +332,8 @@ void FrictionCore::frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_do
   const double acc_scale = std::max(1.0, n ? qdd_.cwiseAbs().maxCoeff() : 0.0);  // (no joints: empty)
   int a = 0;
   for (long j = 0; j < n; ++j) {
-    if (std::abs(q_dot(j)) > friction.velocity_tolerance) {
+    const bool moving = std::abs(q_dot(j)) > friction.velocity_tolerance;
+    if (moving && dt_ == 0.0) {
       friction_(j) = -fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
       limit_(j) = 0.0;
       status_[j] = Moving;
@@ -334,13 +342,13 @@ void FrictionCore::frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_do
     friction_(j) = 0.0;
     limit_(j) = 0.0;
     if (a < k && rest_(a) == j) {
-      // Friction holds what it can (up to f_j); a limit reaction takes the rest.
-      const double total = -x_(a++);
-      friction_(j) = std::min(fs(j), std::max(-fs(j), total));
+      // Friction holds what it can (up to its bound); a limit reaction takes the rest.
+      const double total = -x_(a++), f = moving ? fk(j) : fs(j);
+      friction_(j) = std::min(f, std::max(-f, total));
       limit_(j) = total - friction_(j);
     }
-    const double acc = qdd_(j);
-    status_[j] = std::abs(acc) <= 1e-9 * acc_scale ? Stick : (acc > 0.0 ? SlipPositive : SlipNegative);
+    const double row = qdd_(j) + shift_(j);  // the acceleration, or the end velocity over dt
+    status_[j] = std::abs(row) <= 1e-9 * acc_scale ? Stick : moving ? Moving : row > 0.0 ? SlipPositive : SlipNegative;
   }
 }
 
@@ -349,8 +357,10 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
                             const Eigen::Ref<const Eigen::VectorXd>& beta,
                             const Eigen::Ref<const Eigen::VectorXi>* segments,
                             const Eigen::Ref<const ChainHdSolver::Matrix6X>& f_ext,
-                            const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
+                            const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction,
+                            double time_step) {
   solved_ = false;
+  dt_ = time_step;
   const long n = nj_;
   int rc = checkFriction(friction);
   if (rc != ChainHdSolver::E_NOERROR) return rc;
@@ -363,7 +373,6 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
   const int k = restingJoints(q, q_dot, ff_torques, friction);
   rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
   if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
-  fstatic_ = friction.static_friction;
   iterations_ = 0;
   if (k > 0) {
     rc = optimiseResting(k);
@@ -404,11 +413,11 @@ double FrictionCore::gaussValue() {
   // Z0 = 1/2 dtau^T H^-1 dtau, from the articulated inertias of hd_'s last solve (same q).
   double dissipation = 0.0;
   for (unsigned int j = 0; j < nj_; ++j) {
-    const bool resting = status_[j] != Moving;
+    const bool resting = status_[j] != Moving || fbound_(j) > 0.0;  // (over a step: moving, bounded)
     tmp_(j) = tau_cmd_(j) + (resting ? friction_(j) + limit_(j) : 0.0);
     // A sticking joint has qdd = 0: its round-off residual times a huge f (up to 1e308) must not
     // overflow the sum.
-    if (resting && status_[j] != Stick) dissipation += fstatic_(j) * std::abs(qdd_(j));
+    if (resting && status_[j] != Stick) dissipation += fbound_(j) * std::abs(qdd_(j) + shift_(j));
   }
   if (!hd_->res.solved) return std::numeric_limits<double>::quiet_NaN();
   hd_->inverseInertia(tmp_, tmp2_);

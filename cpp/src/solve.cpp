@@ -124,7 +124,8 @@ int run(DataImpl& d, const SolveInput& in, int m) {
   const auto beta = d.beta.head(m);
   const Eigen::Ref<const Eigen::VectorXi> segments = d.segments.head(m);
   if (in.friction == nullptr) return c.solveSegments(in.q, in.q_dot, alfa, beta, segments, f_ext, in.ff_torques);
-  return d.friction().solveImpl(in.q, in.q_dot, alfa, beta, &segments, f_ext, in.ff_torques, *in.friction);
+  return d.friction().solveImpl(in.q, in.q_dot, alfa, beta, &segments, f_ext, in.ff_torques, *in.friction,
+                                in.time_step);
 }
 
 // Joint status of the friction stage (or all Moving after a frictionless solve); with contacts
@@ -158,10 +159,10 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
     d.stage_joints = false;
     return d.status(rc);
   }
-  // The contact stage: contacts, or friction over a time step (its impulse problem).
+  // The contact stage with contacts (joint friction, at the instant or over a time step, alone:
+  // the friction stage).
   const bool with_friction = input.friction != nullptr;
-  const bool step = input.time_step > 0.0 && with_friction;
-  const bool with_contacts = !input.contacts.empty() || step;
+  const bool with_contacts = !input.contacts.empty();
   if (with_contacts) rc = d.contacts().check(c, input);
   if (rc == 0) rc = with_contacts ? d.contacts().solve(d, input) : detail::runInput(d, input);
   d.contacts_last = with_contacts && rc == 0;

@@ -22,6 +22,12 @@
 /// problem on the optimal face, solved in the range space of Q_StSt): static friction holds what
 /// it can and the motors add only the rest.
 ///
+/// Over a time step (SolveInput::time_step > 0 through solve(model, data, input); data.hpp's
+/// step()): every joint with friction takes part, bounded by its static friction at rest and its
+/// kinetic friction while moving, and the max-min is on the end velocities qd + dt qdd: the box
+/// QP's c is shifted by W qd / dt; the least-command rule and the outputs follow (a joint that ends
+/// the step at rest is Stick, one at rest that breaks away SlipPositive / SlipNegative).
+///
 /// Units, frames, segment and joint order are those of the underlying HdSolver (ChainHdSolver for
 /// a chain, TreeHdSolver for a tree; hd_solver.hpp). Outputs after solve():
 ///  * qdd (n): joint accelerations.
