@@ -15,6 +15,7 @@ void Lemke::reserve(int n) {
   if (n <= capacity()) return;
   tableau_.resize(n, 2 * n + 2);
   basis_.resize(n);
+  factor_.resize(n);
 }
 
 // The leaving row for `entering`: the lexicographic minimum of (rhs, B^-1 row) / pivot entry over
@@ -57,14 +58,19 @@ int Lemke::ratioTest(int entering, int n, double tol) const {
   return best;
 }
 
+// Row `row` scaled to a unit pivot, then T(i, j) -= T(i, col) T(row, j) for every other row i:
+// column by column (the tableau is column-major, so each update is one contiguous axpy), skipping
+// the columns whose pivot-row entry is zero (nothing to subtract).
 void Lemke::pivot(int row, int col, int n) {
   auto T = tableau_.topLeftCorner(n, 2 * n + 2);
   const double p = T(row, col);
   T.row(row) /= p;
-  for (int i = 0; i < n; ++i) {
-    if (i == row) continue;
-    const double f = T(i, col);
-    if (f != 0.0) T.row(i) -= f * T.row(row);
+  auto f = factor_.head(n);
+  f = T.col(col);
+  f(row) = 0.0;  // the pivot row keeps its scaled values
+  for (int j = 0; j < 2 * n + 2; ++j) {
+    const double r = T(row, j);
+    if (r != 0.0) T.col(j) -= f * r;
   }
   basis_(row) = col;
 }
