@@ -29,7 +29,7 @@ class Lemke {
   void pivot(int row, int col, int n);
   // Tableau [I | -M | -e | q] over the variables w (0..n-1), z (n..2n-1), z0 (2n), rhs (2n+1).
   Eigen::MatrixXd tableau_;
-  Eigen::VectorXi basis_;  // variable in the basis of each row
+  Eigen::VectorXi basis_;   // variable in the basis of each row
   Eigen::VectorXd factor_;  // pivot(): the pivot column's multipliers
 };
 
