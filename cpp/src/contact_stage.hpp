@@ -155,6 +155,27 @@ class ContactStage {
   // multipliers, the motors' torques per direction, the programme in the null coordinates.
   Eigen::MatrixXd act_null_, act_cmd_, act_q_, act_r_;
   Eigen::VectorXd act_nu_, act_masked_, act_tau_, act_lin_, act_y_, act_rhs_;
+  // speed: the all-active guess on one base solve and the held directions' response
+  // (contact_active.cpp). reserveActive(directions, rows) sizes these.
+  // Per held direction h: its unit force (base axes), segment, wrench about the tip origin,
+  // acceleration row J^T e (n_joints), value a0 at the base solve, response dqdd, dnu and motors'
+  // torques; the Delassus matrix A (h x h). Per round: the active directions (act_idx_), A's
+  // pivoted Cholesky factor, the held values x, A's null directions (act_null_). Per contact: its
+  // normal's and first tangent's direction index (-1: none).
+  int heldDirections(DataImpl& d, const SolveInput& in);
+  int heldResponse(DataImpl& d, int h);
+  int activeDirections();
+  int factorActive(int k, double rcond);
+  int activeRows(const SolveInput& in, int k, int dn);
+  bool droppedSeparate(const Eigen::Ref<const Eigen::VectorXd>& x, int k);
+  bool heldRowsStill(const Eigen::Ref<const Eigen::VectorXd>& x, int k);
+  int redundantGuess(DataImpl& d, const SolveInput& in, int k, int dn);
+  Eigen::VectorXi act_seg_, act_idx_, act_piv_, act_normal_, act_tangent_;
+  Matrix3X act_dirs_;
+  Matrix6X act_wrench_;
+  Eigen::MatrixXd act_rows_, act_dqdd_, act_dnu_, act_del_, act_v_, act_tk_, act_c_;
+  Eigen::VectorXd act_a0_, act_x_, act_w_, act_diag_, act_tau0_;
+  double act_scale_ = 0.0;  // A's scale without the constraints (rank decisions)
 };
 
 }  // namespace detail
