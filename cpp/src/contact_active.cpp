@@ -125,13 +125,24 @@ int ContactStage::activeForces(const SolveInput& in, const Eigen::Ref<const Eige
     }
     if (p.stick_col >= 0) {
       const Vector3 ft = x(p.stick_col) * p.t1 + x(p.stick_col + 1) * p.t2;
-      if (!insidePolygon(p, ft, std::max(fn, 0.0), pc.mu, pc.facets)) return worst >= 0 ? worst : -2;
+      if (!insidePolygon(p, ft, std::max(fn, 0.0), pc.mu, pc.facets) &&
+          !(act_edge_tol_ > 0.0 && polygonExcess(p, ft, std::max(fn, 0.0), pc) <= act_edge_tol_ * std::max(1.0, fn)))
+        return worst >= 0 ? worst : -2;
       f += ft;
     }
     // A support at zero normal force to round-off (its tangential force zero with it): no force.
     forces.col(k) = pc.isSupport() && fn <= 0.0 ? Vector3::Zero() : f;
   }
   return worst;
+}
+
+// How far the tangential force ft lies outside the polygon mu fn conv{d_j}: the largest
+// e_i . ft - mu fn cos(pi / facets) over the edges (<= 0 inside).
+double ContactStage::polygonExcess(const Point& p, const Vector3& ft, double fn, const PointContact& pc) {
+  const double apothem = pc.mu * fn * std::cos(M_PI / pc.facets);
+  double excess = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < pc.facets; ++i) excess = std::max(excess, edgeNormal(p, i, pc.facets).dot(ft) - apothem);
+  return excess;
 }
 
 // A dropped support's point must not move into its surface: n . a >= 0 (to round-off), with the
@@ -229,7 +240,9 @@ int ContactStage::activeRows(const SolveInput& in, int k, int dn) {
   for (std::size_t c = 0; c < points_.size(); ++c) {
     const Point& p = points_[c];
     const PointContact& pc = in.contacts[c];
-    if (p.normal_col >= 0) {  // f_n >= 0
+    // f_n >= 0; implied by the polygon's rows when the point has them (their sum is
+    // facets mu cos(pi / facets) f_n >= 0, the edge normals summing to zero).
+    if (p.normal_col >= 0 && p.stick_col < 0) {
       act_r_.row(rows).head(dn) = N.row(p.normal_col);
       act_rhs_(rows++) = -x(p.normal_col);
     }
@@ -276,7 +289,11 @@ int ContactStage::redundantGuess(DataImpl& d, const SolveInput& in, int k, int d
   auto y = act_y_.head(dn);
   if (lqp_.solve(C, tau0, P, pv, act_r_.topLeftCorner(rows, dn), act_rhs_.head(rows), y) != Lemke::kSolved) return 0;
   x.noalias() += N * y;
-  if (activeForces(in, x) != -1) return 0;
+  // The least effort puts forces on polygon edges: accept them to the programme's round-off.
+  act_edge_tol_ = 1e-9;
+  const int admissible = activeForces(in, x);
+  act_edge_tol_ = 0.0;
+  if (admissible != -1) return 0;
   if (int rc = solveWithForces(d, in)) return rc;
   reportStatus(in, true);
   return 1;

@@ -160,6 +160,12 @@ void LexicographicQp::reserve(int p, int k) {
     rz_.resize(k, q_.cols());
     r2_.resize(k);
   }
+  if (l2_.rows() < p || m2_.rows() < k) {
+    const Eigen::Index pp = std::max<Eigen::Index>(p, l2_.rows()), kk = std::max<Eigen::Index>(k, m2_.rows());
+    l2_.resize(pp, pp), g2_.resize(pp, kk + 1), m2_.resize(kk, kk);
+    q2v_.resize(kk), l_.resize(kk), s_.resize(kk);
+    lemke2_.reserve(static_cast<int>(kk));
+  }
   qp_.reserve(static_cast<int>(q_.cols()), static_cast<int>(rz_.rows()));
 }
 
@@ -200,9 +206,37 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
   r2 = r;
   r2.noalias() -= R * x;
   auto w = w_.head(d);
-  if (qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved) return Lemke::kSolved;  // keep x1
+  if (!strictSecond(Q2, c2, RZ, r2, w) && qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved)
+    return Lemke::kSolved;  // keep x1
   x.noalias() += Z * w;
   return Lemke::kSolved;
+}
+
+// The second programme has a positive definite Q2 (P is, on Z's span): its dual is an LCP in the
+// k multipliers alone, w = Q2^-1 (RZ^T l - c2), s = RZ w - r2 = (RZ Q2^-1 RZ^T) l - RZ Q2^-1 c2 - r2,
+// half the size of the doubled primal. False (w unset) when Q2's Cholesky is not certain or the
+// pivoting does not finish: the primal form then runs.
+bool LexicographicQp::strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2,
+                                   const Eigen::Ref<const Eigen::VectorXd>& c2,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& RZ,
+                                   const Eigen::Ref<const Eigen::VectorXd>& r2, Eigen::Ref<Eigen::VectorXd> w) {
+  const int d = static_cast<int>(c2.size()), k = static_cast<int>(r2.size());
+  auto L = l2_.topLeftCorner(d, d);
+  if (!choleskyCertified(Q2, L, 1e-12 * std::max(1e-300, Q2.diagonal().cwiseAbs().maxCoeff()))) return false;
+  auto G = g2_.topLeftCorner(d, k + 1);  // Q2^-1 [RZ^T, c2]
+  G.leftCols(k) = RZ.transpose();
+  G.col(k) = c2;
+  choleskySolveColumns(L, G);
+  auto M = m2_.topLeftCorner(k, k);
+  M.noalias() = RZ * G.leftCols(k);
+  auto q = q2v_.head(k);
+  q = -r2;
+  q.noalias() -= RZ * G.col(k);
+  int pivots = 0;
+  if (lemke2_.solve(M, q, l_.head(k), s_.head(k), 100 + 40 * k, pivots) != Lemke::kSolved) return false;
+  w.noalias() = G.leftCols(k) * l_.head(k);
+  w -= G.col(k);
+  return true;
 }
 
 }  // namespace detail

@@ -56,8 +56,9 @@ class ConvexQp {
 //     min 1/2 ||t + C x||^2,
 // then, among its minimisers (x = x1 + Z w, Z spanning C's null space: C x is unique), the one
 // with the least 1/2 x^T P x + p^T x (P positive definite on Z's span, so the answer is unique).
-// Skips the second when C has independent columns. Workspace by reserve(p, k) (p unknowns, k
-// rows); solve() allocates nothing within it.
+// Skips the second when C has independent columns; the second runs as the LCP of its dual (k
+// multipliers) when its Hessian is certainly positive definite. Workspace by reserve(p, k) (p
+// unknowns, k rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:
   void reserve(int p, int k);
@@ -67,9 +68,13 @@ class LexicographicQp {
                       Eigen::Ref<Eigen::VectorXd> x);
 
  private:
+  bool strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2, const Eigen::Ref<const Eigen::VectorXd>& c2,
+                    const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
+                    Eigen::Ref<Eigen::VectorXd> w);
   ConvexQp qp_;
-  Eigen::MatrixXd q_, v_, z_, rz_, q2_;
-  Eigen::VectorXd c_, r2_, w_, c2_;
+  Lemke lemke2_;  // the second programme's dual
+  Eigen::MatrixXd q_, v_, z_, rz_, q2_, l2_, g2_, m2_;
+  Eigen::VectorXd c_, r2_, w_, c2_, q2v_, l_, s_;
 };
 
 }  // namespace detail
