@@ -215,7 +215,7 @@ def compare(solver, model, data, name, which, mu, seed):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", help="also write the Markdown section to this file")
-    ap.add_argument("--batches", type=int, default=21)
+    ap.add_argument("--batches", type=int, default=11)
     ap.add_argument("--batch-ms", type=float, default=10.0)
     args = ap.parse_args()
     t_start = time.perf_counter()
