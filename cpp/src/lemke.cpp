@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "dense_small.hpp"
 
@@ -154,7 +155,8 @@ Lemke::Result ConvexQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& Q, const 
 void LexicographicQp::reserve(int p, int k) {
   if (q_.rows() < p) {
     q_.resize(p, p), v_.resize(p, p), z_.resize(p, p), q2_.resize(p, p);
-    c_.resize(p), w_.resize(p), c2_.resize(p);
+    c_.resize(p), w_.resize(p), c2_.resize(p), diag_.resize(p);
+    idx_.resize(p), piv_.resize(p);
   }
   if (rz_.rows() < k || rz_.cols() < q_.cols()) {
     rz_.resize(k, q_.cols());
@@ -182,13 +184,7 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
   c.noalias() = C.transpose() * t;
   const int limit = 100 + 40 * (2 * p + k);
   if (const Lemke::Result res = qp_.solve(Q, c, R, r, x, limit); res != Lemke::kSolved) return res;
-  // C's null space: the eigenvectors of C^T C at (relatively) zero eigenvalues.
-  auto V = v_.topLeftCorner(p, p);
-  jacobiEigen(Q, V);  // Q becomes diagonal
-  const double cut = 1e-12 * std::max(1e-300, Q.diagonal().cwiseAbs().maxCoeff());
-  int d = 0;
-  for (int j = 0; j < p; ++j)
-    if (Q(j, j) <= cut) z_.col(d++).head(p) = V.col(j);
+  const int d = nullBasis(Q);
   if (d == 0) return Lemke::kSolved;
   const auto Z = z_.topLeftCorner(p, d);
   auto PZ = v_.topLeftCorner(p, d);  // V is no longer needed
@@ -210,6 +206,32 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
     return Lemke::kSolved;  // keep x1
   x.noalias() += Z * w;
   return Lemke::kSolved;
+}
+
+// A basis of C's null space into z_'s first columns (returns their number) from the pivoted
+// Cholesky factor of Q = C^T C (pivots above 1e-12 of its largest diagonal entry): Q(perm, perm) ~
+// V V^T with V lower trapezoidal in pivot order (L1 its r x r top); the null direction of each
+// position b not pivoted has z(b) = 1 and z(piv) = -L1^-T V(b, :)^T.
+int LexicographicQp::nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q) {
+  const int p = static_cast<int>(Q.rows());
+  for (int i = 0; i < p; ++i) idx_(i) = i;
+  auto V = v_.topLeftCorner(p, p);
+  const double top = std::max(1e-300, Q.diagonal().cwiseAbs().maxCoeff());
+  const int r = pivotedCholeskyLeft(Q, idx_, p, V, diag_, piv_, 1e-12 * top);
+  constexpr double kDone = -std::numeric_limits<double>::infinity();  // pivotedCholeskyLeft's mark
+  int d = 0;
+  for (int b = 0; b < p && r < p; ++b) {
+    if (diag_(b) == kDone) continue;  // a pivot
+    auto z = z_.col(d++).head(p);
+    z.setZero();
+    z(b) = 1.0;
+    for (int i = r - 1; i >= 0; --i) {  // L1^T c = -V(b, :)^T, back substitution
+      double v = -V(b, i);
+      for (int j = i + 1; j < r; ++j) v -= V(piv_(j), i) * z(piv_(j));
+      z(piv_(i)) = v / V(piv_(i), i);
+    }
+  }
+  return d;
 }
 
 // The second programme has a positive definite Q2 (P is, on Z's span): its dual is an LCP in the

@@ -54,7 +54,8 @@ class ConvexQp {
 
 // Two convex programmes in turn over the same feasible set R x >= r: first
 //     min 1/2 ||t + C x||^2,
-// then, among its minimisers (x = x1 + Z w, Z spanning C's null space: C x is unique), the one
+// then, among its minimisers (x = x1 + Z w, Z spanning C's null space, from a pivoted Cholesky
+// factor of C^T C: C x is unique), the one
 // with the least 1/2 x^T P x + p^T x (P positive definite on Z's span, so the answer is unique).
 // Skips the second when C has independent columns; the second runs as the LCP of its dual (k
 // multipliers) when its Hessian is certainly positive definite. Workspace by reserve(p, k) (p
@@ -71,8 +72,11 @@ class LexicographicQp {
   bool strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2, const Eigen::Ref<const Eigen::VectorXd>& c2,
                     const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
                     Eigen::Ref<Eigen::VectorXd> w);
+  int nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q);
   ConvexQp qp_;
   Lemke lemke2_;  // the second programme's dual
+  Eigen::VectorXi idx_, piv_;
+  Eigen::VectorXd diag_;
   Eigen::MatrixXd q_, v_, z_, rz_, q2_, l2_, g2_, m2_;
   Eigen::VectorXd c_, r2_, w_, c2_, q2v_, l_, s_;
 };
