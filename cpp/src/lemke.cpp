@@ -158,9 +158,9 @@ void LexicographicQp::reserve(int p, int k) {
     c_.resize(p), w_.resize(p), c2_.resize(p), diag_.resize(p);
     idx_.resize(p), piv_.resize(p);
   }
-  if (rz_.rows() < k || rz_.cols() < q_.cols()) {
-    rz_.resize(k, q_.cols());
-    r2_.resize(k);
+  if (rz_.rows() < k || rz_.cols() < q_.cols()) {  // never smaller: callers of several sizes share it
+    rz_.resize(std::max<Eigen::Index>(k, rz_.rows()), q_.cols());
+    r2_.resize(rz_.rows());
   }
   if (l2_.rows() < p || m2_.rows() < k) {
     const Eigen::Index pp = std::max<Eigen::Index>(p, l2_.rows()), kk = std::max<Eigen::Index>(k, m2_.rows());
