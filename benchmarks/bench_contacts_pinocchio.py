@@ -238,7 +238,7 @@ def main():
     out = ["### Python: point contacts against Pinocchio's ADMM and PGS (Gen3, 3-D task)", ""]
     out.append(
         f"pinocchio {pin.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}, vereshchagin from "
-        f"`{vs.__file__}`. bench_contacts' problem from Python (see the script's docstring for the mapping: time "
+        f"`.../{Path(vs.__file__).parent.parent.name}/vereshchagin` (the installed package). bench_contacts' problem from Python (see the script's docstring for the mapping: time "
         "step 1, q_dot = 0, G = J M^-1 J^T, g = J qdd_free, lambda = forces; the task as a PointAnchorConstraint"
         f"Model); tolerance {TOL:g} for both Pinocchio solvers. {args.batches} interleaved batches of about "
         f"{args.batch_ms:.0f} ms, median per-call time; ratio = median of per-batch ratios. Run time {wall:.0f} s."
