@@ -18,7 +18,10 @@
    contacts and a 3-D task vs plain solves, about 15 s);
    and, when CMake found Pinocchio's C++ headers, DIR/benchmarks/bench_tree_kkt (Baxter: our
    TreeHdSolver vs a dense KKT solve from Pinocchio's C++ pieces, about 20 s) and
-   DIR/benchmarks/bench_pv (Gen3, tip held: ours vs Pinocchio's pv and constrainedABA, about 5 s);
+   DIR/benchmarks/bench_pv (Gen3, tip held: ours vs Pinocchio's pv and constrainedABA, about 5 s)
+   and DIR/benchmarks/bench_contacts_pinocchio (the contacts of bench_contacts vs Pinocchio's ADMM
+   and PGS at 1e-10, about 70 s); then benchmarks/bench_contacts_pinocchio.py (the same from
+   Python, about 3 min);
 6. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
    the method, the target checks and all reports.
 """
@@ -243,6 +246,15 @@ def main():
     pv_file, pv_exe = build / "bench_pv.md", build / "benchmarks" / "bench_pv"
     pv_file.unlink(missing_ok=True)
     pv_rc = run([pv_exe, pv_file], stdout=subprocess.DEVNULL).returncode if pv_exe.exists() else 0
+    cpin_file, cpin_exe = build / "bench_contacts_pinocchio.md", build / "benchmarks" / "bench_contacts_pinocchio"
+    cpin_file.unlink(missing_ok=True)
+    cpin_rc = run([cpin_exe, cpin_file], stdout=subprocess.DEVNULL).returncode if cpin_exe.exists() else 0
+    pypin_file = build / "bench_contacts_pinocchio_py.md"
+    pypin_file.unlink(missing_ok=True)
+    pypin_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_contacts_pinocchio.py", "--out", pypin_file],
+        stdout=subprocess.DEVNULL,
+    ).returncode
     load_end = loadavg()
 
     cpp_md, py_md = cpp_file.read_text(), py_file.read_text()
@@ -321,6 +333,15 @@ def main():
         if ct_file.exists()
         else f"**bench_contacts exited with code {ct_rc} and wrote no report.**",
         "",
+        cpin_file.read_text().rstrip()
+        if cpin_file.exists()
+        else "**bench_contacts_pinocchio was not built (Pinocchio's C++ headers not found) or wrote no report "
+        f"(exit code {cpin_rc}).**",
+        "",
+        pypin_file.read_text().rstrip()
+        if pypin_file.exists()
+        else f"**bench_contacts_pinocchio.py exited with code {pypin_rc} and wrote no report.**",
+        "",
         pv_file.read_text().rstrip()
         if pv_file.exists()
         else f"**bench_pv was not built (Pinocchio's C++ headers not found) or wrote no report (exit code {pv_rc}).**",
@@ -330,7 +351,10 @@ def main():
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
     return (
         0
-        if all(rc == 0 for rc in (cpp_rc, py_rc, fr_rc, frpy_rc, seg_rc, face_rc, tree_rc, kkt_rc, pv_rc, ct_rc))
+        if all(
+            rc == 0
+            for rc in (cpp_rc, py_rc, fr_rc, frpy_rc, seg_rc, face_rc, tree_rc, kkt_rc, pv_rc, ct_rc, cpin_rc, pypin_rc)
+        )
         else 1
     )
 

@@ -132,7 +132,8 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   R.bottomRows(k) = eff_rows_.topLeftCorner(k, p);
   const double tol = 1e-12 * std::max(1.0, G.cwiseAbs().maxCoeff());
   r.head(2 * n).setConstant(-tol);  // G dx = 0 to round-off
-  r.tail(k) = eff_r_.head(k) - eff_rows_.topLeftCorner(k, p) * eff_x_.head(p);
+  r.tail(k) = eff_r_.head(k);       // (two statements: no temporary)
+  r.tail(k).noalias() -= eff_rows_.topLeftCorner(k, p) * eff_x_.head(p);
   // tau_cmd is linear in nu: its change per coordinate, column by column.
   auto T = eff_dtau_.topLeftCorner(n, p);
   for (int i = 0; i < p; ++i)
@@ -176,10 +177,11 @@ void ContactStage::reserveEffort(int p, int k, int m) {
     eff_dtau_.resize(n, p);
   }
   if (eff_rows_.rows() < k || eff_rows_.cols() < eff_dir_.cols()) {
-    eff_rows_.resize(k, eff_dir_.cols());
-    eff_r_.resize(k);
+    eff_rows_.resize(std::max<Eigen::Index>(k, eff_rows_.rows()), eff_dir_.cols());  // (never shrinks)
+    eff_r_.resize(eff_rows_.rows());
   }
-  if (eff_dnu_.rows() < m || eff_dnu_.cols() < eff_dir_.cols()) eff_dnu_.resize(std::max(m, 1), eff_dir_.cols());
+  if (eff_dnu_.rows() < m || eff_dnu_.cols() < eff_dir_.cols())
+    eff_dnu_.resize(std::max<Eigen::Index>({m, 1, eff_dnu_.rows()}), eff_dir_.cols());  // (never shrinks)
   const int rows = 2 * n + static_cast<int>(eff_rows_.rows());
   if (eff_r_all_.rows() < rows || eff_r_all_.cols() < eff_dir_.cols()) {
     eff_r_all_.resize(rows, eff_dir_.cols());

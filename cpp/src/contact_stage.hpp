@@ -154,13 +154,9 @@ class ContactStage {
   // The all-active guess (contact_active.cpp): 1 if it holds (forces, final sweep and statuses
   // done), 0 if not (go on with the general method), or an error code of the final sweep.
   int tryAllActive(DataImpl& d, const SolveInput& in);
-  void buildActiveInput(const SolveInput& in);
   int activeForces(const SolveInput& in, const Eigen::Ref<const Eigen::VectorXd>& nu);
-  bool droppedSeparate(const SolveInput& in, const Eigen::VectorXd& qdd);
   bool heldPointsStill(const SolveInput& in, const Eigen::VectorXd& qdd);
-  int activeRows(const SolveInput& in, int dn);
-  int redundantGuess(DataImpl& d, const SolveInput& in);
-  void reserveActive(int m, int rows);
+  void reserveActive(int directions, int rows);
   // Least motor effort among the force distributions that keep qdd (contact_effort.cpp): 0 or an
   // error code of the final sweep.
   int leastEffort(DataImpl& d, const SolveInput& in);
@@ -197,7 +193,7 @@ class ContactStage {
   // The all-active guess with redundant columns (contact_active.cpp): K's null directions, the
   // multipliers, the motors' torques per direction, the programme in the null coordinates.
   Eigen::MatrixXd act_null_, act_cmd_, act_q_, act_r_;
-  Eigen::VectorXd act_nu_, act_masked_, act_tau_, act_lin_, act_y_, act_rhs_;
+  Eigen::VectorXd act_tau_, act_lin_, act_y_, act_rhs_;
   // Joint friction (contact_joints.cpp): the resting joints' unknowns, the known joint torques of
   // the solves (kinetic friction, the resting joints' offsets, then their solved torques), the
   // input's ff_torques (zero if empty), the resting joints' indices.
@@ -211,6 +207,29 @@ class ContactStage {
   double lcp_scale_ = 1.0;       // the last complementarity problem's scale (accelerations)
   Eigen::VectorXd q_dot_;        // the input's q_dot (jointOutputs); gaussValue's buffers
   Eigen::VectorXd gauss_tau_, gauss_out_;
+  // speed: the all-active guess on one base solve and the held directions' response
+  // (contact_active.cpp). reserveActive(directions, rows) sizes these.
+  // Per held direction h: its unit force (base axes), segment, wrench about the tip origin,
+  // acceleration row J^T e (n_joints), value a0 at the base solve, response dqdd, dnu and motors'
+  // torques; the Delassus matrix A (h x h). Per round: the active directions (act_idx_), A's
+  // pivoted Cholesky factor, the held values x, A's null directions (act_null_). Per contact: its
+  // normal's and first tangent's direction index (-1: none).
+  int heldDirections(DataImpl& d, const SolveInput& in);
+  int heldResponse(DataImpl& d, int h);
+  int activeDirections();
+  int factorActive(int k, double rcond);
+  int activeRows(const SolveInput& in, int k, int dn);
+  bool droppedSeparate(const Eigen::Ref<const Eigen::VectorXd>& x, int k);
+  bool heldRowsStill(const Eigen::Ref<const Eigen::VectorXd>& x, int k);
+  int redundantGuess(DataImpl& d, const SolveInput& in, int k, int dn);
+  Eigen::VectorXi act_seg_, act_idx_, act_piv_, act_normal_, act_tangent_;
+  Matrix3X act_dirs_;
+  Matrix6X act_wrench_;
+  Eigen::MatrixXd act_rows_, act_dqdd_, act_dnu_, act_del_, act_v_, act_tk_, act_c_;
+  Eigen::VectorXd act_a0_, act_x_, act_w_, act_diag_, act_tau0_;
+  double act_scale_ = 0.0;     // A's scale without the constraints (rank decisions)
+  double act_edge_tol_ = 0.0;  // activeForces: a sticking force may lie this far (x max(1, f_n)) outside
+  static double polygonExcess(const Point& p, const Vector3& ft, double fn, const PointContact& pc);
 };
 
 }  // namespace detail

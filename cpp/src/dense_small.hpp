@@ -337,9 +337,12 @@ double smallestEigenvalue(MA& A, MW& work) {
 // off-diagonal pair at a time, A <- J^T A J, V <- V J. On return the diagonal of A holds the
 // eigenvalues (unsorted) and the columns of V the orthonormal eigenvectors. Stops when the
 // off-diagonal mass is below eps^2 of A's Frobenius norm squared, after at most max_sweeps sweeps
-// (convergence is quadratic; 6-10 sweeps are typical). Returns the number of sweeps.
+// (convergence is quadratic; 6-10 sweeps are typical). Returns the number of sweeps. A and V:
+// column-major with contiguous columns (blocks of a MatrixXd).
 template <typename MA, typename MV>
 int jacobiEigen(MA& A, MV& V, int max_sweeps = 60) {
+  static_assert(!(MA::Flags & Eigen::RowMajorBit) && !(MV::Flags & Eigen::RowMajorBit),
+                "jacobiEigen rotates contiguous columns: column-major storage only");
   const int k = static_cast<int>(A.rows());
   V.setIdentity();
   const double total = A.squaredNorm();
@@ -362,16 +365,25 @@ int jacobiEigen(MA& A, MV& V, int max_sweeps = 60) {
         A(p, p) -= t * apq;
         A(q, q) += t * apq;
         A(p, q) = A(q, p) = 0.0;
-        for (int r = 0; r < k; ++r) {
-          if (r != p && r != q) {
-            const double arp = A(r, p), arq = A(r, q);
-            A(r, p) = A(p, r) = c * arp - s * arq;
-            A(r, q) = A(q, r) = s * arp + c * arq;
+        // Columns p and q (contiguous) first, then rows p and q from them (symmetry).
+        double* cp = &A(0, p);
+        double* cq = &A(0, q);
+        const auto rotate = [c, s](double* x, double* y, int lo, int hi) {
+          for (int r = lo; r < hi; ++r) {
+            const double xr = x[r], yr = y[r];
+            x[r] = c * xr - s * yr;
+            y[r] = s * xr + c * yr;
           }
-          const double vrp = V(r, p), vrq = V(r, q);
-          V(r, p) = c * vrp - s * vrq;
-          V(r, q) = s * vrp + c * vrq;
+        };
+        rotate(cp, cq, 0, p);
+        rotate(cp, cq, p + 1, q);
+        rotate(cp, cq, q + 1, k);
+        for (int r = 0; r < k; ++r) {
+          if (r == p || r == q) continue;
+          A(p, r) = cp[r];
+          A(q, r) = cq[r];
         }
+        rotate(&V(0, p), &V(0, q), 0, k);
       }
     }
   }

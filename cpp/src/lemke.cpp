@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "dense_small.hpp"
 
@@ -15,6 +16,7 @@ void Lemke::reserve(int n) {
   if (n <= capacity()) return;
   tableau_.resize(n, 2 * n + 2);
   basis_.resize(n);
+  factor_.resize(n);
 }
 
 // The leaving row for `entering`: the lexicographic minimum of (rhs, B^-1 row) / pivot entry over
@@ -57,14 +59,19 @@ int Lemke::ratioTest(int entering, int n, double tol) const {
   return best;
 }
 
+// Row `row` scaled to a unit pivot, then T(i, j) -= T(i, col) T(row, j) for every other row i:
+// column by column (the tableau is column-major, so each update is one contiguous axpy), skipping
+// the columns whose pivot-row entry is zero (nothing to subtract).
 void Lemke::pivot(int row, int col, int n) {
   auto T = tableau_.topLeftCorner(n, 2 * n + 2);
   const double p = T(row, col);
   T.row(row) /= p;
-  for (int i = 0; i < n; ++i) {
-    if (i == row) continue;
-    const double f = T(i, col);
-    if (f != 0.0) T.row(i) -= f * T.row(row);
+  auto f = factor_.head(n);
+  f = T.col(col);
+  f(row) = 0.0;  // the pivot row keeps its scaled values
+  for (int j = 0; j < 2 * n + 2; ++j) {
+    const double r = T(row, j);
+    if (r != 0.0) T.col(j) -= f * r;
   }
   basis_(row) = col;
 }
@@ -148,11 +155,18 @@ Lemke::Result ConvexQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& Q, const 
 void LexicographicQp::reserve(int p, int k) {
   if (q_.rows() < p) {
     q_.resize(p, p), v_.resize(p, p), z_.resize(p, p), q2_.resize(p, p);
-    c_.resize(p), w_.resize(p), c2_.resize(p);
+    c_.resize(p), w_.resize(p), c2_.resize(p), diag_.resize(p);
+    idx_.resize(p), piv_.resize(p);
   }
-  if (rz_.rows() < k || rz_.cols() < q_.cols()) {
-    rz_.resize(k, q_.cols());
-    r2_.resize(k);
+  if (rz_.rows() < k || rz_.cols() < q_.cols()) {  // never smaller: callers of several sizes share it
+    rz_.resize(std::max<Eigen::Index>(k, rz_.rows()), q_.cols());
+    r2_.resize(rz_.rows());
+  }
+  if (l2_.rows() < p || m2_.rows() < k) {
+    const Eigen::Index pp = std::max<Eigen::Index>(p, l2_.rows()), kk = std::max<Eigen::Index>(k, m2_.rows());
+    l2_.resize(pp, pp), g2_.resize(pp, kk + 1), m2_.resize(kk, kk);
+    q2v_.resize(kk), l_.resize(kk), s_.resize(kk);
+    lemke2_.reserve(static_cast<int>(kk));
   }
   qp_.reserve(static_cast<int>(q_.cols()), static_cast<int>(rz_.rows()));
 }
@@ -170,13 +184,7 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
   c.noalias() = C.transpose() * t;
   const int limit = 100 + 40 * (2 * p + k);
   if (const Lemke::Result res = qp_.solve(Q, c, R, r, x, limit); res != Lemke::kSolved) return res;
-  // C's null space: the eigenvectors of C^T C at (relatively) zero eigenvalues.
-  auto V = v_.topLeftCorner(p, p);
-  jacobiEigen(Q, V);  // Q becomes diagonal
-  const double cut = 1e-12 * std::max(1e-300, Q.diagonal().cwiseAbs().maxCoeff());
-  int d = 0;
-  for (int j = 0; j < p; ++j)
-    if (Q(j, j) <= cut) z_.col(d++).head(p) = V.col(j);
+  const int d = nullBasis(Q);
   if (d == 0) return Lemke::kSolved;
   const auto Z = z_.topLeftCorner(p, d);
   auto PZ = v_.topLeftCorner(p, d);  // V is no longer needed
@@ -194,9 +202,63 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
   r2 = r;
   r2.noalias() -= R * x;
   auto w = w_.head(d);
-  if (qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved) return Lemke::kSolved;  // keep x1
+  if (!strictSecond(Q2, c2, RZ, r2, w) && qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved)
+    return Lemke::kSolved;  // keep x1
   x.noalias() += Z * w;
   return Lemke::kSolved;
+}
+
+// A basis of C's null space into z_'s first columns (returns their number) from the pivoted
+// Cholesky factor of Q = C^T C (pivots above 1e-12 of its largest diagonal entry): Q(perm, perm) ~
+// V V^T with V lower trapezoidal in pivot order (L1 its r x r top); the null direction of each
+// position b not pivoted has z(b) = 1 and z(piv) = -L1^-T V(b, :)^T.
+int LexicographicQp::nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q) {
+  const int p = static_cast<int>(Q.rows());
+  for (int i = 0; i < p; ++i) idx_(i) = i;
+  auto V = v_.topLeftCorner(p, p);
+  const double top = std::max(1e-300, Q.diagonal().cwiseAbs().maxCoeff());
+  const int r = pivotedCholeskyLeft(Q, idx_, p, V, diag_, piv_, 1e-12 * top);
+  constexpr double kDone = -std::numeric_limits<double>::infinity();  // pivotedCholeskyLeft's mark
+  int d = 0;
+  for (int b = 0; b < p && r < p; ++b) {
+    if (diag_(b) == kDone) continue;  // a pivot
+    auto z = z_.col(d++).head(p);
+    z.setZero();
+    z(b) = 1.0;
+    for (int i = r - 1; i >= 0; --i) {  // L1^T c = -V(b, :)^T, back substitution
+      double v = -V(b, i);
+      for (int j = i + 1; j < r; ++j) v -= V(piv_(j), i) * z(piv_(j));
+      z(piv_(i)) = v / V(piv_(i), i);
+    }
+  }
+  return d;
+}
+
+// The second programme has a positive definite Q2 (P is, on Z's span): its dual is an LCP in the
+// k multipliers alone, w = Q2^-1 (RZ^T l - c2), s = RZ w - r2 = (RZ Q2^-1 RZ^T) l - RZ Q2^-1 c2 - r2,
+// half the size of the doubled primal. False (w unset) when Q2's Cholesky is not certain or the
+// pivoting does not finish: the primal form then runs.
+bool LexicographicQp::strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2,
+                                   const Eigen::Ref<const Eigen::VectorXd>& c2,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& RZ,
+                                   const Eigen::Ref<const Eigen::VectorXd>& r2, Eigen::Ref<Eigen::VectorXd> w) {
+  const int d = static_cast<int>(c2.size()), k = static_cast<int>(r2.size());
+  auto L = l2_.topLeftCorner(d, d);
+  if (!choleskyCertified(Q2, L, 1e-12 * std::max(1e-300, Q2.diagonal().cwiseAbs().maxCoeff()))) return false;
+  auto G = g2_.topLeftCorner(d, k + 1);  // Q2^-1 [RZ^T, c2]
+  G.leftCols(k) = RZ.transpose();
+  G.col(k) = c2;
+  choleskySolveColumns(L, G);
+  auto M = m2_.topLeftCorner(k, k);
+  M.noalias() = RZ * G.leftCols(k);
+  auto q = q2v_.head(k);
+  q = -r2;
+  q.noalias() -= RZ * G.col(k);
+  int pivots = 0;
+  if (lemke2_.solve(M, q, l_.head(k), s_.head(k), 100 + 40 * k, pivots) != Lemke::kSolved) return false;
+  w.noalias() = G.leftCols(k) * l_.head(k);
+  w -= G.col(k);
+  return true;
 }
 
 }  // namespace detail

@@ -29,7 +29,8 @@ class Lemke {
   void pivot(int row, int col, int n);
   // Tableau [I | -M | -e | q] over the variables w (0..n-1), z (n..2n-1), z0 (2n), rhs (2n+1).
   Eigen::MatrixXd tableau_;
-  Eigen::VectorXi basis_;  // variable in the basis of each row
+  Eigen::VectorXi basis_;   // variable in the basis of each row
+  Eigen::VectorXd factor_;  // pivot(): the pivot column's multipliers
 };
 
 // A small convex quadratic programme on Lemke's pivoting:
@@ -53,10 +54,12 @@ class ConvexQp {
 
 // Two convex programmes in turn over the same feasible set R x >= r: first
 //     min 1/2 ||t + C x||^2,
-// then, among its minimisers (x = x1 + Z w, Z spanning C's null space: C x is unique), the one
+// then, among its minimisers (x = x1 + Z w, Z spanning C's null space, from a pivoted Cholesky
+// factor of C^T C: C x is unique), the one
 // with the least 1/2 x^T P x + p^T x (P positive definite on Z's span, so the answer is unique).
-// Skips the second when C has independent columns. Workspace by reserve(p, k) (p unknowns, k
-// rows); solve() allocates nothing within it.
+// Skips the second when C has independent columns; the second runs as the LCP of its dual (k
+// multipliers) when its Hessian is certainly positive definite. Workspace by reserve(p, k) (p
+// unknowns, k rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:
   void reserve(int p, int k);
@@ -66,9 +69,16 @@ class LexicographicQp {
                       Eigen::Ref<Eigen::VectorXd> x);
 
  private:
+  bool strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2, const Eigen::Ref<const Eigen::VectorXd>& c2,
+                    const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
+                    Eigen::Ref<Eigen::VectorXd> w);
+  int nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q);
   ConvexQp qp_;
-  Eigen::MatrixXd q_, v_, z_, rz_, q2_;
-  Eigen::VectorXd c_, r2_, w_, c2_;
+  Lemke lemke2_;  // the second programme's dual
+  Eigen::VectorXi idx_, piv_;
+  Eigen::VectorXd diag_;
+  Eigen::MatrixXd q_, v_, z_, rz_, q2_, l2_, g2_, m2_;
+  Eigen::VectorXd c_, r2_, w_, c2_, q2v_, l_, s_;
 };
 
 }  // namespace detail

@@ -440,3 +440,45 @@ TEST_CASE_FIXTURE(Fixture, "solves with contacts do not allocate once warm") {
                                                                       << str(c1.news - c0.news) << ", malloc "
                                                                       << str(c1.mallocs - c0.mallocs));
 }
+
+TEST_CASE_FIXTURE(Fixture, "redundant resting contacts (the least-effort guess) do not allocate once warm") {
+  // Four supports with friction at rest and a task: twelve held directions on seven joints, so the
+  // all-active guess factors a rank-deficient Delassus matrix and runs the least-effort programme
+  // (both stages, the second through its dual) in A's null space; dropping a pulling support and
+  // the general method run on the states where the guess fails.
+  const vereshchagin::Model model(chain);
+  vereshchagin::Data data(model);
+  vereshchagin::SolveInput in(model);
+  in.constraints.reserve(2);
+  const int segments[4] = {static_cast<int>(ns) - 1, static_cast<int>(ns) - 2, 3, 2};
+  for (int k = 0; k < 4; ++k) {
+    vereshchagin::PointContact pc;
+    pc.segment = segments[k];
+    pc.point = vereshchagin::Vector3(0.03 * (k % 2 ? 1 : -1), 0.02, -0.05);
+    pc.normal = vereshchagin::Vector3(0.1 * k, -0.1, 1.0).normalized();
+    pc.mu = 0.9;
+    in.contacts.push_back(pc);
+  }
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+  double csum = 0.0;
+  int cfail = 0;
+  const auto run = [&](int s, int columns) {
+    in.setState(vereshchagin::JointPositions(q[s].data), vereshchagin::JointVelocities(rest));
+    in.ff_torques = ff[s].data;
+    in.constraints.clear();
+    if (columns > 0 && !in.addConstraint(static_cast<int>(ns) - 1, alfa_m[columns], beta[columns].data)) ++cfail;
+    const vereshchagin::Status st = vereshchagin::solve(model, data, in);
+    if (!st && st.code() != vereshchagin::Error::NoContactSolution) ++cfail;
+    if (st) csum += data.qdd()(0) + data.contactForces()(2, 0);
+  };
+  for (int s = 0; s < kSets; ++s)
+    for (int columns = 0; columns <= 2; ++columns) run(s, columns);  // warm: every size once
+  const Counts c0 = now();
+  for (int it = 0; it < 300; ++it) run(it % kSets, it % 3);
+  const Counts c1 = now();
+  CHECK_MESSAGE(cfail == 0, "contact solves failed: " << str(cfail));
+  CHECK_MESSAGE(std::isfinite(csum), "non-finite contact results");
+  CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "contact solves allocated: operator new "
+                                                                      << str(c1.news - c0.news) << ", malloc "
+                                                                      << str(c1.mallocs - c0.mallocs));
+}
