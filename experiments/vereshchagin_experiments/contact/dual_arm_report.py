@@ -8,6 +8,8 @@ separate-chains shortcut and the closed-loop outcome in the MuJoCo plant.
 
 from __future__ import annotations
 
+import re
+
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -76,7 +78,7 @@ def _effort_table(joint_names, efforts: dict) -> tuple[list, list]:
     rows = []
     for j, name in enumerate(joint_names):
         rows.append(
-            [name]
+            [joint_label(name)]
             + [f"{e['mean_abs_tau'][j]:.3f}" for e in efforts.values()]
             + [f"{e['energy_tau2'][j]:.2f}" for e in efforts.values()]
         )
@@ -118,6 +120,16 @@ def _error_table(outcomes: dict) -> tuple[list, list]:
     return header, rows
 
 
+def joint_label(name: str) -> str:
+    """A joint's name as the report counts: ``left_joint_5`` (the URDF's, from 1) -> ``left joint 4``."""
+    m = re.fullmatch(r"(left|right)_joint_(\d+)", name)
+    return f"{m.group(1)} joint {int(m.group(2)) - 1}" if m else name.replace("_", " ")
+
+
+def _legend_below(ax) -> None:
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3, frameon=False)
+
+
 def _plot_chatter(axes, option_runs: dict, joint_names) -> None:
     """Right column: rolling command chatter per option, and one resting joint's command close up."""
     j = joint_names.index("left_joint_5")
@@ -128,58 +140,68 @@ def _plot_chatter(axes, option_runs: dict, joint_names) -> None:
         t0 = r.t[m][len(r.t[m]) // 2]
         near = (r.t >= t0) & (r.t < t0 + 0.1)
         axes[1].plot(r.t[near], r.tau[near, j], color=f"C{c}", lw=1, label=label)
-    axes[0].set_ylabel("command chatter, mean |Δτ| per step, 50 ms mean [N m]")
-    axes[1].set_ylabel(f"{joint_names[j]} motor torque [N m]")
+    axes[0].set_ylabel("mean |Δτ| per step, 50 ms mean [N m]")
+    axes[1].set_ylabel(f"{joint_label(joint_names[j])} motor torque [N m]")
+
+
+RELIEVED = (2, 4, 9)  # left shoulder and elbow (the resting arm), right shoulder (the sliding one)
 
 
 def _plot(path: Path, runs: dict, joint_names, option_runs: dict) -> None:
+    """Six panels, one question each; joints counted from 0 per arm as in Lau (2023)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, grid = plt.subplots(2, 3, figsize=(17, 8))
-    axes = grid[:, :2]
+    fig, grid = plt.subplots(2, 3, figsize=(17, 10))
     _plot_chatter(grid[:, 2], option_runs, list(joint_names))
-    styles = dict(zip(runs, ["-", "--", ":"]))
+    styles = dict(zip(VARIANTS, ["-", "--", ":"]))
+    # Which joints does the table relieve? (the table variant against the unsupported one)
+    for c, j in enumerate(RELIEVED):
+        for v in ("table", "unsupported"):
+            if v in runs:
+                r = runs[v]
+                grid[0, 0].plot(
+                    r.t, r.tau[:, j], styles[v], color=f"C{c}", lw=1, label=f"{joint_label(joint_names[j])}, {v}"
+                )
     for v, r in runs.items():
-        for c, j in enumerate(KEY_JOINTS):
-            axes[0, 0].plot(r.t, r.tau[:, j], styles[v], color=f"C{c}", lw=1, label=f"{joint_names[j]} {v}")
+        style = styles.get(v, "-.")
         ol = np.maximum(np.asarray(r.info["open_loop"]).max(axis=1), 1e-17)
-        axes[0, 1].semilogy(r.t, ol, styles[v], color="k", lw=1, label=v)
-        tip = r.tip
-        axes[1, 0].plot(
+        grid[0, 1].semilogy(r.t, ol, style, color="k", lw=1, label=v)
+        tip, rest = r.tip, np.asarray(r.info["rest"])
+        grid[1, 0].plot(
             r.t,
             1e3 * np.hypot(tip[:, 1] - tip[0, 1], tip[:, 2] - tip[0, 2]),
-            styles[v],
+            style,
             color="C0",
             label=f"sliding hand off its line, {v}",
         )
-        rest = np.asarray(r.info["rest"])
-        axes[1, 0].plot(
-            r.t, 1e3 * np.linalg.norm(rest - rest[0], axis=1), styles[v], color="C3", label=f"resting hand drift, {v}"
+        grid[1, 0].plot(
+            r.t, 1e3 * np.linalg.norm(rest - rest[0], axis=1), style, color="C3", label=f"resting hand drift, {v}"
         )
         if r.info["table_top"] is not None:
-            axes[1, 1].plot(r.t, r.table_force, styles[v], color="C2", label=f"plant, {v}")
-            axes[1, 1].plot(r.t, r.info["table_force_model"], styles[v], color="C4", label=f"model -ν_z, {v}")
-    axes[0, 0].set_ylabel("motor torque [N m]")
-    axes[0, 1].set_ylabel("open-loop hand acceleration error, linear RMS [m/s²]")
-    axes[1, 0].set_ylabel("closed-loop error [mm]")
-    axes[1, 1].set_ylabel("table force [N]")
-    titles = ["torques (solid table, dashed unsupported, dotted separate)", "shortcut's task error (open loop)"]
-    titles += ["friction handling (table variant): command chatter"]
-    titles += [
-        "tracking in the MuJoCo plant",
-        "resting hand: table force",
-        "a resting joint's command, 0.1 s of the slide",
+            grid[1, 1].plot(r.t, r.table_force, style, color="C2", label=f"plant, {v}")
+            grid[1, 1].plot(r.t, r.info["table_force_model"], style, color="C4", label=f"model, {v}")
+    grid[0, 0].set_ylabel("motor torque [N m]")
+    grid[0, 1].set_ylabel("linear RMS [m/s²]")
+    grid[1, 0].set_ylabel("error [mm]")
+    grid[1, 1].set_ylabel("table force [N]")
+    titles = [
+        "which joints does the table relieve? (solid: table, dashed: unsupported)",
+        "how far off is each shortcut's task? (open loop, hand acceleration error)",
+        "how much does the command chatter? (friction handling, table variant)",
+        "how well do the hands track in the MuJoCo plant?",
+        "does the model's table force match the plant's?",
+        "a resting joint's command over 0.1 s of the slide",
     ]
     for a, title in zip(grid.flat, titles):
         a.set_title(title, fontsize=9)
         a.set_xlabel("time [s]")
         a.grid(alpha=0.3)
-        a.legend(fontsize=6)
+        _legend_below(a)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 
