@@ -74,6 +74,10 @@ std::string endBlockArgs(bool alpha, bool beta, bool a_desired, bool tree) {
   return {};
 }
 
+FrictionModel modelFriction(const Model& model) {
+  return frictionOfJoints(model.jointInfos());
+}
+
 FrictionModel frictionOfJoints(const std::vector<JointInfo>& joints) {
   const auto n = static_cast<Eigen::Index>(joints.size());
   FrictionModel out;

@@ -52,11 +52,11 @@ void ContactStage::classifyJoints(const SolveInput& in) {
     joint_tau_(j) = 0.0;
     const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
     if (moving && dt_ == 0.0) {  // at the instant: kinetic friction against the velocity
-      joint_tau_(j) = -fk(j) * (in.q_dot(j) > 0.0 ? 1.0 : -1.0);
+      joint_tau_(j) = -(fk.size() ? fk(j) : 0.0) * (in.q_dot(j) > 0.0 ? 1.0 : -1.0);  // (empty: none)
       continue;
     }
     // At rest, or over a time step (friction against the end velocity, kinetic while moving).
-    const double f = moving ? fk(j) : fs(j);
+    const double f = moving ? (fk.size() ? fk(j) : 0.0) : (fs.size() ? fs(j) : 0.0);
     const bool at_lower = !moving && limits && in.q(j) <= fm.lower(j) + fm.limit_tolerance;
     const bool at_upper = !moving && limits && in.q(j) >= fm.upper(j) - fm.limit_tolerance;
     if (!(f > 0.0 || at_lower || at_upper)) continue;

@@ -215,6 +215,7 @@ int FrictionCore::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
 // Stage 0: the friction model's sizes and values (0 or E_INVALID_FRICTION with a message).
 int FrictionCore::checkFriction(const FrictionModel& friction) {
   const long n = nj_;
+  if (friction.empty()) return ChainHdSolver::E_NOERROR;  // no friction (restingJoints reads zeros)
   const Eigen::VectorXd& fs = friction.static_friction;
   const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
   if (fs.size() != n)
@@ -269,12 +270,13 @@ int FrictionCore::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
     shift_(j) = dt_ > 0.0 ? q_dot(j) / dt_ : 0.0;
     fbound_(j) = 0.0;
     const bool moving = std::abs(q_dot(j)) > friction.velocity_tolerance;
+    const double fsj = fs.size() ? fs(j) : 0.0, fkj = fk.size() ? fk(j) : 0.0;  // (empty: none)
     if (moving && dt_ == 0.0) {
-      tau0_(j) -= fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
+      tau0_(j) -= fkj * (q_dot(j) > 0.0 ? 1.0 : -1.0);
       continue;
     }
     // At rest, or over a time step (friction against the end velocity, kinetic while moving).
-    const double f = moving ? fk(j) : fs(j);
+    const double f = moving ? fkj : fsj;
     const bool at_lower = !moving && limits && q(j) <= friction.lower(j) + friction.limit_tolerance;
     const bool at_upper = !moving && limits && q(j) >= friction.upper(j) - friction.limit_tolerance;
     if (f > 0.0 || at_lower || at_upper) {
@@ -333,8 +335,9 @@ void FrictionCore::frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_do
   int a = 0;
   for (long j = 0; j < n; ++j) {
     const bool moving = std::abs(q_dot(j)) > friction.velocity_tolerance;
+    const double fsj = fs.size() ? fs(j) : 0.0, fkj = fk.size() ? fk(j) : 0.0;  // (empty: none)
     if (moving && dt_ == 0.0) {
-      friction_(j) = -fk(j) * (q_dot(j) > 0.0 ? 1.0 : -1.0);
+      friction_(j) = -fkj * (q_dot(j) > 0.0 ? 1.0 : -1.0);
       limit_(j) = 0.0;
       status_[j] = Moving;
       continue;
@@ -343,7 +346,7 @@ void FrictionCore::frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_do
     limit_(j) = 0.0;
     if (a < k && rest_(a) == j) {
       // Friction holds what it can (up to its bound); a limit reaction takes the rest.
-      const double total = -x_(a++), f = moving ? fk(j) : fs(j);
+      const double total = -x_(a++), f = moving ? fkj : fsj;
       friction_(j) = std::min(f, std::max(-f, total));
       limit_(j) = total - friction_(j);
     }

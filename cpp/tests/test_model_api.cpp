@@ -517,3 +517,45 @@ TEST_CASE("errors: codes, sizes, values, another model's Data") {
   CHECK(solve(hd.model(), hd.data(), in2).ok());
   CHECK(hd.model().nrOfJoints() == 4);
 }
+
+TEST_CASE("modelFriction and an empty FrictionModel (no friction)") {
+  const char* urdf = R"(<robot name="r">
+    <link name="base"/>
+    <link name="a"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    <link name="b"><inertial><origin xyz="0.2 0 0"/><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    <joint name="j0" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+      <limit lower="-1" upper="2" effort="10" velocity="1"/><dynamics friction="0.7"/></joint>
+    <joint name="j1" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>
+      <limit lower="-0.5" upper="0.5" effort="10" velocity="1"/><dynamics friction="0.2"/></joint>
+  </robot>)";
+  const UrdfResult loaded = chainFromUrdfString(urdf);
+  REQUIRE(loaded.ok);
+  const Model model(loaded.robot);
+  const FrictionModel fm = modelFriction(model);
+  CHECK(fm.static_friction.isApprox(Eigen::Vector2d(0.7, 0.2)));
+  CHECK(fm.lower.isApprox(Eigen::Vector2d(-1.0, -0.5)));
+  CHECK(fm.upper.isApprox(Eigen::Vector2d(2.0, 0.5)));
+  CHECK(!fm.empty());
+  // A model from KDL objects carries no friction: an empty model, and a solve with it is the
+  // frictionless solve, bit for bit, at the instant and over a time step.
+  RandomGen g(9);
+  const Model kmodel(g.chain(4));
+  const FrictionModel none = modelFriction(kmodel);
+  CHECK(none.empty());
+  Data plain(kmodel), with_empty(kmodel);
+  SolveInput in(kmodel);
+  in.q = g.q(4).data;
+  in.q_dot = g.qdot(4).data;
+  REQUIRE(solve(kmodel, plain, in));
+  in.friction = &none;
+  for (const double dt : {0.0, 1e-3}) {
+    in.time_step = dt;
+    REQUIRE(solve(kmodel, with_empty, in));
+    CHECK((with_empty.qdd().array() == plain.qdd().array()).all());
+    CHECK((with_empty.frictionTorques().array() == 0.0).all());
+  }
+  // The friction solver's own face takes it too.
+  FrictionSolver fs(g.chain(3), KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero()));
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(3);
+  CHECK(fs.solve(q, q, Eigen::MatrixXd(6, 0), Eigen::VectorXd(0), Eigen::MatrixXd(6, 0), q, FrictionModel()) == 0);
+}

@@ -18,6 +18,19 @@ struct FrictionModel {
   /// bound on its size). Empty vectors: no limits; +-infinity entries: no limit on that side.
   Eigen::VectorXd lower, upper;   ///< lower and upper joint position limits (rad or m)
   double limit_tolerance = 1e-9;  ///< distance (rad or m) from a limit at which a joint counts as on it
+
+  /// Every vector empty: zero friction and no limits on every joint, as an empty f_ext means no
+  /// external wrench (the solve's motion is the frictionless one; the friction outputs are zero).
+  bool empty() const noexcept {
+    return static_friction.size() == 0 && kinetic_friction.size() == 0 && lower.size() == 0 && upper.size() == 0;
+  }
 };
+
+class Model;
+
+/// The model's own friction in one call: its joints' static friction (a URDF's `<dynamics
+/// friction>`, N m or N) and position limits, kinetic friction equal to static, FrictionModel's
+/// default tolerances; empty (no friction) for a model built from KDL objects, which carry none.
+FrictionModel modelFriction(const Model& model);
 
 }  // namespace vereshchagin
