@@ -28,12 +28,6 @@
 namespace vereshchagin {
 namespace detail {
 
-namespace {
-
-constexpr int E_NO_SOLUTION = static_cast<int>(Error::NoContactSolution);
-
-}  // namespace
-
 int ContactStage::checkJointFriction(DataImpl& d, const SolveInput& in) {
   FrictionCore& f = d.friction();
   if (const int rc = f.checkFriction(*in.friction)) return d.core.fail(rc, "%s", f.message_.data());
@@ -41,29 +35,23 @@ int ContactStage::checkJointFriction(DataImpl& d, const SolveInput& in) {
 }
 
 void ContactStage::classifyJoints(const SolveInput& in) {
-  const FrictionModel& fm = *in.friction;
-  const Eigen::VectorXd& fs = fm.static_friction;
-  const Eigen::VectorXd& fk = fm.kinetic_friction.size() ? fm.kinetic_friction : fm.static_friction;
-  const bool limits = fm.lower.size() != 0;
   constexpr double inf = std::numeric_limits<double>::infinity();
   joints_.clear();
   for (int j = 0; j < static_cast<int>(model_.nrOfJoints()); ++j) {
     ff_user_(j) = in.ff_torques.size() ? in.ff_torques(j) : 0.0;
     joint_tau_(j) = 0.0;
-    const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
-    if (moving && dt_ == 0.0) {  // at the instant: kinetic friction against the velocity
-      joint_tau_(j) = -(fk.size() ? fk(j) : 0.0) * (in.q_dot(j) > 0.0 ? 1.0 : -1.0);  // (empty: none)
+    const JointFriction jf = jointFriction(*in.friction, j, in.q(j), in.q_dot(j));
+    if (jf.moving && dt_ == 0.0) {  // at the instant: kinetic friction against the velocity
+      joint_tau_(j) = -jf.f * (in.q_dot(j) > 0.0 ? 1.0 : -1.0);
       continue;
     }
     // At rest, or over a time step (friction against the end velocity, kinetic while moving).
-    const double f = moving ? (fk.size() ? fk(j) : 0.0) : (fs.size() ? fs(j) : 0.0);
-    const bool at_lower = !moving && limits && in.q(j) <= fm.lower(j) + fm.limit_tolerance;
-    const bool at_upper = !moving && limits && in.q(j) >= fm.upper(j) - fm.limit_tolerance;
-    if (!(f > 0.0 || at_lower || at_upper)) continue;
+    if (!jf.unknown(dt_)) continue;
     JointUnknown u;
     u.joint = j;
-    u.lo = at_upper ? -inf : -f;
-    u.hi = at_lower ? inf : f;
+    u.f = jf.f;
+    u.lo = jf.at_upper ? -inf : -jf.f;
+    u.hi = jf.at_lower ? inf : jf.f;
     u.row_bias = dt_ > 0.0 ? in.q_dot(j) / dt_ : 0.0;
     joints_.push_back(u);  // within the capacity reserved for every joint
   }
@@ -158,7 +146,7 @@ void ContactStage::jointOutputs(DataImpl& d, const SolveInput& in) {
   const double a_tol = 1e-9 * (nz_ > 0 ? lcp_scale_ : std::max(1.0, qdd.cwiseAbs().maxCoeff()));
   for (const JointUnknown& u : joints_) {
     const int j = u.joint;
-    const double f = std::isfinite(u.hi) ? u.hi : std::isfinite(u.lo) ? -u.lo : 0.0, t = joint_tau_(j);
+    const double f = u.f, t = joint_tau_(j);
     joint_friction(j) = std::clamp(t, -f, f);  // beyond the friction bound: the limit's reaction
     joint_limit(j) = t - joint_friction(j);
     const double row = qdd(j) + u.row_bias;  // the acceleration, or the end velocity over dt
@@ -180,7 +168,7 @@ double ContactStage::gaussValue(DataImpl& d) {
   for (const JointUnknown& u : joints_) {
     gauss_tau_(u.joint) += joint_tau_(u.joint);
     if (d.status_per_joint[u.joint] == JointStatus::Stick) continue;  // (round-off times a huge f)
-    const double f = std::isfinite(u.hi) ? u.hi : std::isfinite(u.lo) ? -u.lo : 0.0;
+    const double f = u.f;
     dissipation += f * std::abs(c.res.qdd(u.joint) + u.row_bias);
   }
   c.inverseInertia(gauss_tau_, gauss_out_);

@@ -114,6 +114,7 @@ class ContactStage {
   struct JointUnknown {
     int joint = 0;
     double lo = 0.0, hi = 0.0;
+    double f = 0.0;         // its friction bound (static at rest, kinetic while moving over a step)
     double row_bias = 0.0;  // its row at qdd = 0: 0 at the instant, qd_j / dt over a time step
     int var = 0, nvar = 0, col = 0, row = 0;
   };

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -23,6 +24,29 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kZeroCurvature = 1e-10;
 // Gradient entries (accelerations) below this fraction of the gradient's scale are zero.
 constexpr double kGradientTolerance = 1e-11;
+
+// One joint's friction in a solve (shared by the friction stage and the contact stage so that both
+// read a FrictionModel alike): moving when |qd_j| exceeds the velocity tolerance; f its bound, the
+// kinetic friction while moving and the static one at rest (0 for an empty model); on a lower or
+// upper limit (at rest only). At the instant a moving joint's friction is the known torque
+// -f sign(qd_j); at rest, or over a time step, the joint is an unknown when f > 0 or on a limit.
+struct JointFriction {
+  bool moving = false, at_lower = false, at_upper = false;
+  double f = 0.0;
+  bool unknown(double dt) const { return (!moving || dt > 0.0) && (f > 0.0 || at_lower || at_upper); }
+};
+
+inline JointFriction jointFriction(const FrictionModel& m, long j, double q, double q_dot) {
+  const Eigen::VectorXd& fk = m.kinetic_friction.size() ? m.kinetic_friction : m.static_friction;
+  JointFriction out;
+  out.moving = std::abs(q_dot) > m.velocity_tolerance;
+  const Eigen::VectorXd& bound = out.moving ? fk : m.static_friction;
+  out.f = bound.size() ? bound(j) : 0.0;  // (an empty model: none)
+  const bool limits = !out.moving && m.lower.size() != 0;
+  out.at_lower = limits && q <= m.lower(j) + m.limit_tolerance;
+  out.at_upper = limits && q >= m.upper(j) - m.limit_tolerance;
+  return out;
+}
 
 class FrictionCore {
  public:

@@ -261,28 +261,21 @@ int FrictionCore::checkFriction(const FrictionModel& friction) {
 int FrictionCore::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
                                 const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                                 const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
-  const Eigen::VectorXd& fs = friction.static_friction;
-  const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
-  const bool limits = friction.lower.size() != 0;
   int k = 0;
   for (long j = 0; j < static_cast<long>(nj_); ++j) {
     tau0_(j) = ff_driver_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
     shift_(j) = dt_ > 0.0 ? q_dot(j) / dt_ : 0.0;
     fbound_(j) = 0.0;
-    const bool moving = std::abs(q_dot(j)) > friction.velocity_tolerance;
-    const double fsj = fs.size() ? fs(j) : 0.0, fkj = fk.size() ? fk(j) : 0.0;  // (empty: none)
-    if (moving && dt_ == 0.0) {
-      tau0_(j) -= fkj * (q_dot(j) > 0.0 ? 1.0 : -1.0);
+    const JointFriction jf = jointFriction(friction, j, q(j), q_dot(j));
+    if (jf.moving && dt_ == 0.0) {
+      tau0_(j) -= jf.f * (q_dot(j) > 0.0 ? 1.0 : -1.0);
       continue;
     }
     // At rest, or over a time step (friction against the end velocity, kinetic while moving).
-    const double f = moving ? fkj : fsj;
-    const bool at_lower = !moving && limits && q(j) <= friction.lower(j) + friction.limit_tolerance;
-    const bool at_upper = !moving && limits && q(j) >= friction.upper(j) - friction.limit_tolerance;
-    if (f > 0.0 || at_lower || at_upper) {
-      lo_(k) = at_lower ? -kInf : -f;
-      hi_(k) = at_upper ? kInf : f;
-      fbound_(j) = f;
+    if (jf.unknown(dt_)) {
+      lo_(k) = jf.at_lower ? -kInf : -jf.f;
+      hi_(k) = jf.at_upper ? kInf : jf.f;
+      fbound_(j) = jf.f;
       rest_(k++) = static_cast<int>(j);
     }
   }
