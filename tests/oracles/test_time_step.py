@@ -148,3 +148,13 @@ def test_the_step_converges_to_the_instant_as_dt_goes_to_zero(case):
     # the step's conditions are the instant's: the mean acceleration is the instant's qdd.
     assert errors[-1] <= 1e-8 * scale, errors
     assert np.all(np.diff(errors) <= 1e-8 * scale), errors
+
+
+@pytest.mark.parametrize("bad", [0.0, -1e-3, float("nan"), float("inf"), True, "1e-3", None])
+def test_a_bad_time_step_is_refused_with_a_message(bad):
+    solver = vs.Solver(vs.robots.gen3())
+    with pytest.raises(vs.SolverError, match="time_step"):
+        solver.step(GEN3_Q, np.zeros(7), bad)
+    if bad is not None and not isinstance(bad, str) and not (isinstance(bad, float) and bad == 0.0):
+        with pytest.raises(vs.SolverError, match="time_step"):
+            solver.solve(GEN3_Q, np.zeros(7), time_step=bad)
