@@ -21,7 +21,8 @@
    DIR/benchmarks/bench_pv (Gen3, tip held: ours vs Pinocchio's pv and constrainedABA, about 5 s)
    and DIR/benchmarks/bench_contacts_pinocchio (the contacts of bench_contacts vs Pinocchio's ADMM
    and PGS at 1e-10, about 70 s); then benchmarks/bench_contacts_pinocchio.py (the same from
-   Python, about 3 min);
+   Python, about 3 min) and benchmarks/bench_hold_creep.py (a friction-held Gen3's creep: ours
+   against MuJoCo and Pinocchio's ADMM, about 5 s);
 6. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
    the method, the target checks and all reports.
 """
@@ -255,6 +256,11 @@ def main():
         [sys.executable, REPO / "benchmarks" / "bench_contacts_pinocchio.py", "--out", pypin_file],
         stdout=subprocess.DEVNULL,
     ).returncode
+    hold_file = build / "bench_hold_creep.md"
+    hold_file.unlink(missing_ok=True)
+    hold_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_hold_creep.py", "--out", hold_file], stdout=subprocess.DEVNULL
+    ).returncode
     load_end = loadavg()
 
     cpp_md, py_md = cpp_file.read_text(), py_file.read_text()
@@ -346,17 +352,15 @@ def main():
         if pv_file.exists()
         else f"**bench_pv was not built (Pinocchio's C++ headers not found) or wrote no report (exit code {pv_rc}).**",
         "",
+        hold_file.read_text().rstrip()
+        if hold_file.exists()
+        else f"**bench_hold_creep.py exited with code {hold_rc} and wrote no report.**",
+        "",
     ]
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
-    return (
-        0
-        if all(
-            rc == 0
-            for rc in (cpp_rc, py_rc, fr_rc, frpy_rc, seg_rc, face_rc, tree_rc, kkt_rc, pv_rc, ct_rc, cpin_rc, pypin_rc)
-        )
-        else 1
-    )
+    codes = (cpp_rc, py_rc, fr_rc, frpy_rc, seg_rc, face_rc, tree_rc, kkt_rc, pv_rc, ct_rc, cpin_rc, pypin_rc)
+    return 0 if all(rc == 0 for rc in (*codes, hold_rc)) else 1
 
 
 if __name__ == "__main__":
