@@ -34,7 +34,7 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     out_dir : str or Path
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
-    case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "all"}
+    case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "all"}
         ``contact``: the three use cases of W. K. Lau (2023) in MuJoCo (:mod:`vereshchagin_experiments.contact.report`);
         ``dual-arm``: one hand of a dual-arm Gen3 resting on a table while the other slides, tree
         solver against separate chains (:mod:`vereshchagin_experiments.contact.dual_arm_report`);
@@ -115,6 +115,10 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
         from .friction_energy_report import run as run_energy
 
         ok &= _section("friction-energy experiment (MuJoCo Gen3)", run_energy, out, quick, index)
+    if case in ("wiping", "all"):
+        from .contact.wiping_report import run as run_wiping
+
+        ok &= _section("wiping case (discrete time)", run_wiping, out, quick, index)
     index_path = out / "index.md"
     index_path.write_text("\n".join(index), encoding="utf-8")
     _say(f"[reproduce] wrote {index_path}")
@@ -146,7 +150,7 @@ def main(argv=None) -> int:
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
     rep.add_argument(
         "--case",
-        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "all"),
+        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "all"),
         default="all",
         help="which experiments to run (default: all)",
     )

@@ -14,6 +14,7 @@ CASE_NEEDS = {
     "contact": ("mujoco", "matplotlib"),
     "dual-arm": ("mujoco", "matplotlib"),
     "friction-energy": ("mujoco", "matplotlib"),
+    "wiping": ("matplotlib",),
 }
 
 

@@ -15,12 +15,14 @@ controllers differ only in how joint friction enters the command
   it separates "do not fight friction at rest" from "let friction hold";
 - ``maxmin``: the solver's exact max-min with the least-command rule (``friction=``), joints with
   |qd| <= eps_v at rest;
-- ``maxmin_band``: the same, plus a hold band: while the pose error is within :data:`HOLD_BAND`
-  the task asks for zero acceleration instead of the P correction. The exact max-min lets
-  friction hold only joints whose commanded acceleration is exactly zero; the P loop's tiny
-  corrections never are, so without the band it pays friction in the direction of each
-  correction, like the naive scheme. This variant differs from the others also in the task
-  feedback (inside the band), which is why it is listed separately.
+- ``maxmin_step``: the same solve over the next control period (``time_step`` = 1 ms, the
+  discrete-time mode of :class:`~vereshchagin_experiments.contact.controller.CascadedController`):
+  friction acts on the joint velocities at the end of the period, so a joint that stays at rest
+  gets the friction that holds it, continuous in the P loop's corrections. At the instant
+  (``maxmin``) the max-min lets friction hold only joints whose commanded acceleration is exactly
+  zero; the P loop's tiny corrections never are, so it pays friction in the direction of each
+  correction, like the naive scheme. (It replaces a hold band, zero task acceleration inside
+  0.05 mm / 0.5 mrad, which also changed the task feedback.)
 
 Plant: :func:`vereshchagin_experiments.contact.use_cases.gen3_model` (joint friction
 :data:`~vereshchagin_experiments.contact.use_cases.JOINT_FRICTION`, scaled by 0.5, 1, 2), 1 kHz. The
@@ -54,7 +56,6 @@ from vereshchagin import Solver
 __all__ = [
     "CONTROLLERS",
     "FRICTION_SCALES",
-    "HOLD_BAND",
     "PARTIAL_POSE",
     "PAYLOAD",
     "REST_TOLERANCE",
@@ -74,11 +75,10 @@ CONTROLLERS = {
     "sign": "naive sign compensation",
     "smooth": "smoothed (tanh) compensation",
     "maxmin": "exact max-min (least command)",
-    "maxmin_band": "exact max-min + hold band",
+    "maxmin_step": "exact max-min over the step (discrete time)",
 }
-"""Controller key -> label (the key without ``_band`` is :attr:`ControllerConfig.friction_mode`)."""
-HOLD_BAND = (5e-5, 5e-4)
-"""(m, rad): pose error inside which ``maxmin_band`` asks for zero acceleration."""
+"""Controller key -> label (the key without ``_step`` is :attr:`ControllerConfig.friction_mode`;
+``_step``: the discrete-time mode, :attr:`ControllerConfig.time_step` = the plant's period)."""
 PARTIAL_POSE = (0.0029, 1.9681, 3.1165, 1.8318, -0.0127, -1.4350, 0.5956)
 """Joint angles (rad) of the partial task: the start pose's tool height and orientation, the
 arm 96 % of the way (in joint space, projected back onto that height and orientation) from the
@@ -253,7 +253,9 @@ def _recorder(robot: MujocoGen3, total: int, n: int, keep_inputs: bool):
         log.model_command[k] = res.tau_command
         log.error[k] = info.error
         log.plant_stick[k], log.plant_friction[k] = robot.joint_friction_state()
-        if res.status is not None:  # at rest and no commanded acceleration: friction (partly) holds it
+        if res.status is not None and "time_step" in info.inputs:  # over a step: 1 = ends the step held
+            log.model_stick[k] = np.asarray(res.status) == 1
+        elif res.status is not None:  # at rest and no commanded acceleration: friction (partly) holds it
             log.model_stick[k] = (np.asarray(res.status) != 0) & (np.abs(np.asarray(res.qdd)) <= 1e-9)
         if keep_inputs:
             log.inputs.append(info.inputs)
@@ -276,15 +278,15 @@ def simulate(task: TaskSpec, controller: str, friction_scale: float = 1.0, keep_
     robot = MujocoGen3(build_model(urdf, chain, Scene()), q0)
     if controller not in CONTROLLERS:
         raise ValueError(f"controller must be one of {list(CONTROLLERS)}, got {controller!r}")
-    band = controller.endswith("_band")
+    step = controller.endswith("_step")
     config = ControllerConfig(
         free_gains=FREE_GAINS,
-        friction_mode=controller.removesuffix("_band"),
+        friction_mode=controller.removesuffix("_step"),
         v_max=task.v_max,
         friction_velocity_tolerance=REST_TOLERANCE,
         posture_gains=task.posture_gains,
         free_directions=task.directions,
-        hold_band=HOLD_BAND if band else None,
+        time_step=robot.period if step else None,
     )
     ctl = CascadedController(chain, Solver(chain, gravity=[0.0, 0.0, -9.81]), config)
     phases = task.phases(np.asarray(chain.fk(q0)))
@@ -324,7 +326,8 @@ def outcome(run: Run) -> dict:
     free directions), ``stick_plant`` / ``stick_model`` (mean number of joints the plant's friction
     holds / the max-min holds with friction, :class:`Log`), ``friction_share`` (mean over the hold phase of
     sum |plant friction torque| / sum |motor + friction torque|: the share of the holding torque that
-    friction supplied), ``saturated`` (fraction of samples with a command beyond the effort limits).
+    friction supplied), ``saturated`` (fraction of samples with a command beyond the effort limits),
+    ``chatter`` (mean |tau_k+1 - tau_k| of the command over joints and steps, N m per 1 ms step).
     """
     from .contact import metrics
 
@@ -351,6 +354,7 @@ def outcome(run: Run) -> dict:
         stick_model=float(log.model_stick.sum(1).mean()),
         friction_share=float(np.abs(log.plant_friction[hold]).sum() / max(held.sum(), 1e-12)),
         saturated=float((np.abs(log.command) > limit).any(1).mean()),
+        chatter=float(np.abs(np.diff(log.command, axis=0)).mean()),
     )
 
 

@@ -127,6 +127,7 @@ SUMMARY_HEADER = [
     "joints friction holds (max-min model)",
     "friction share of holding torque [%]",
     "samples saturated [%]",
+    "command chatter [N m/step]",
 ]
 
 
@@ -154,6 +155,7 @@ def summary_rows(results) -> list[list]:
                 f"{o['stick_model']:.2f}",
                 f"{100 * o['friction_share']:.1f}",
                 f"{100 * o['saturated']:.1f}",
+                f"{o['chatter']:.4f}",
             ]
         )
     return rows
@@ -175,6 +177,7 @@ def task_table(results, task: str) -> list[str]:
         "drift [mm]",
         "joints stuck (plant)",
         "friction's share of holding",
+        "chatter [N m/step]",
     ]
     rows = []
     for c, r in runs.items():
@@ -192,6 +195,7 @@ def task_table(results, task: str) -> list[str]:
                 f"{1e3 * o['drift']:.2f}",
                 f"{o['stick_plant']:.1f}",
                 f"{100 * o['friction_share']:.1f} %",
+                f"{o['chatter']:.4f}",
             ]
         )
     return md_table(header, rows)
@@ -254,19 +258,20 @@ def findings(results) -> list[str]:
     """Sentences explaining the mechanisms behind the nominal-friction numbers."""
     hold = _select(results, "hold", 1.0)
     lines = []
-    mm, band = hold["maxmin"]["outcome"], hold["maxmin_band"]["outcome"]
+    mm, step = hold["maxmin"]["outcome"], hold["maxmin_step"]["outcome"]
     base = hold[BASE]["outcome"]
     ideal = ideal_saving(*fe.gravity_torques(fe.tasks()[0], fe.tasks()[0].q0))
     lines.append(
-        f"- Holding, the exact max-min alone changes ∫τ² by {_pct(mm['tau2'], base['tau2']):+.1f} % (the ideal with "
-        f"every joint held by friction: {-100 * ideal:+.1f} %): it lets friction hold only joints whose commanded "
-        "acceleration is exactly zero; the P loop's corrections never are, so it let friction hold on average "
-        f"{mm['stick_model']:.1f} of 7 joints and added the full friction towards each correction to the others, "
-        "the naive scheme's command (the torques chatter by ±f). With the hold band (zero acceleration asked inside "
-        f"0.05 mm / 0.5 mrad) ∫τ² changes by {_pct(band['tau2'], base['tau2']):+.1f} % at an RMS error of "
-        f"{1e3 * band['rms_error']:.3f} mm (unaware {1e3 * base['rms_error']:.3f} mm): inside the band it commands "
-        "the least torque, which asks friction for its full breakaway value; the plant's friction then sits at its "
-        "bound, the joints creep out of the band, and each correction from rest pays +f again (figure)."
+        f"- Holding, the exact max-min at the instant changes ∫τ² by {_pct(mm['tau2'], base['tau2']):+.1f} % (the "
+        f"ideal with every joint held by friction: {-100 * ideal:+.1f} %): it lets friction hold only joints whose "
+        "commanded acceleration is exactly zero; the P loop's corrections never are, so it let friction hold on "
+        f"average {mm['stick_model']:.1f} of 7 joints and added the full friction towards each correction to the "
+        f"others, the naive scheme's command (chatter {mm['chatter']:.3f} N m per step). Over the step (the "
+        "discrete-time mode: the same solve with `time_step=` 1 ms, friction on the end-of-period velocities) "
+        f"∫τ² changes by {_pct(step['tau2'], base['tau2']):+.1f} %, the command chatters {step['chatter']:.4f} N m "
+        f"per step, friction holds {step['stick_model']:.1f} of 7 joints in the model, at an RMS error of "
+        f"{1e3 * step['rms_error']:.3f} mm (instant {1e3 * mm['rms_error']:.3f} mm, unaware "
+        f"{1e3 * base['rms_error']:.3f} mm)."
     )
     stalls = [
         t.name
@@ -356,9 +361,9 @@ def _intro(quick: bool) -> list[str]:
         "enters: friction-unaware (plain solve), naive sign compensation (+f sign(q̇), at rest the sign of the "
         "commanded q̈), smoothed compensation (+f tanh(q̇/0.01 rad/s): the chatter-free scheme a reviewer "
         'would ask for; it separates "do not fight friction at rest" from "let friction hold"), the exact '
-        "max-min with the least-command rule (`friction=`, rest below 0.01 rad/s), and the max-min with a hold "
-        "band (inside 0.05 mm / 0.5 mrad the task asks for zero acceleration; this one also changes the task "
-        "feedback).",
+        "max-min with the least-command rule (`friction=`, rest below 0.01 rad/s) at the instant (the before of "
+        "issue 27), and the same max-min over the next 1 ms control period (`time_step=`, the discrete-time mode, "
+        "the after).",
         "",
         f"Joint friction (plant frictionloss and model): {list(JOINT_FRICTION)} N m (joints 1-4, 5-7), viscous damping "
         f"{list(JOINT_DAMPING)} N m s/rad. **These are assumptions**: Kinova publishes no friction, damping or rotor "

@@ -195,10 +195,13 @@ def test_report_section_table_csv_and_figure(report, tmp_path, monkeypatch):
     assert "Dual-arm Gen3 on a torso" in (tmp_path / "index.md").read_text(encoding="utf-8")
 
 
-def test_hold_band_keeps_the_command_from_chattering(report, runs):
-    """Chosen setting (max-min + hold band): chatter below the bound; without the band above it."""
+def test_step_mode_keeps_the_command_from_chattering(report, runs):
+    """Chosen setting (max-min over the step): chatter below the bound; at the instant above it, band or not."""
     opts = report[0]["options"]
-    chosen, plain, smooth, none = (opts[k] for k in dual_arm_report.OPTIONS)
+    chosen, band, plain, smooth, none = (opts[k] for k in dual_arm_report.OPTIONS)
+    assert band["chatter"] < 0.7 * plain["chatter"]  # the hold band (before) helps at the instant ...
+    assert chosen["chatter"] < 0.1 * band["chatter"] and dual_arm_report.CHATTER_BOUND < band["chatter"]  # ... far less
+    assert chosen["chatter_joints"].max() < 5 * dual_arm_report.CHATTER_BOUND
     ch = dual_arm_report.chatter(runs["table"], runs["table"].window("slide"))
     assert ch.mean() == pytest.approx(chosen["chatter"], rel=1e-12)  # the module-scoped run is the chosen one
     assert chosen["chatter"] < dual_arm_report.CHATTER_BOUND < plain["chatter"]
@@ -207,9 +210,10 @@ def test_hold_band_keeps_the_command_from_chattering(report, runs):
     assert smooth["chatter"] < 0.1 * plain["chatter"]  # the tanh compensation is about chatter-free ...
     assert smooth["outcome"]["max_off_line"] > 2.0 * chosen["outcome"]["max_off_line"]  # ... and tracks worse
     assert none["outcome"]["final_error_x"] < -0.02  # no compensation: the slide stalls
-    # the plant's table force follows the model more closely with the band than without
+    # the plant's table force follows the model more closely with the chosen setting than at the instant
+    # without the band (the band itself is closer still: inside it the task asks for zero acceleration)
     gap = {k: abs(o["outcome"]["table_force"] - o["outcome"]["table_force_model"]) for k, o in opts.items()}
-    assert gap[next(iter(opts))] < gap[list(opts)[1]]
+    assert gap[next(iter(opts))] < gap[list(opts)[2]]
 
 
 def test_bad_variant_and_contact_mode_raise(model):

@@ -72,6 +72,9 @@ def _expected_command(run, k: int, solver, friction) -> np.ndarray:
     log = run.info["log"]
     inp = log.inputs[k]
     args = dict(alpha=inp["alpha"], beta=inp["beta"], f_ext=inp["f_ext"], tau_ff=inp["tau_ff"])
+    if "time_step" in inp:  # the discrete-time mode: the same solve over the control period
+        assert inp["time_step"] == 1e-3
+        args["time_step"] = inp["time_step"]
     mode = run.info["config"].friction_mode
     res = solver.solve(inp["q"], inp["qd"], friction=friction if mode == "maxmin" else None, **args)
     f, eps, qd = np.asarray(run.info["chain"].friction), fe.REST_TOLERANCE, inp["qd"]

@@ -28,10 +28,10 @@ from typing import Callable
 import numpy as np
 
 from . import metrics
-from .dual_arm import CONTACT_VARIANT, dual_arm
+from .dual_arm import BAND_CONFIG as DUAL_BAND_CONFIG, CONTACT_VARIANT, dual_arm
 from .elbow import CONTACT_VARIANTS, elbow
 from .report import md_table, write_csv
-from .surfaces import WRITING_FORCE
+from .surfaces import BAND_CONFIG, WRITING_FORCE
 from .use_cases import grasp, writing
 
 __all__ = ["SURFACES", "chatter", "dual_arm_section", "section"]
@@ -104,7 +104,7 @@ def _rows(pairs) -> tuple[list, list, dict]:
                 f"{n['tau2']:.1f}",
                 f"{n['shoulder']:.2f}",
                 f"{n['plant']:.1f} / {n['model']:.1f}",
-                f"{n['chatter']:.3f}",
+                f"{n['chatter']:.4f}",
             ]
         )
     return header, rows, nums
@@ -127,6 +127,8 @@ def _after_runs(quick: bool, say) -> dict:
     jobs = {
         ("grasp", "solver-contacts"): lambda: grasp(True, quick, solver_contacts=True),
         ("writing", "solver-contacts"): lambda: writing(True, quick, solver_contacts=True),
+        ("grasp", "instant + band"): lambda: grasp(True, quick, solver_contacts=True, settings=BAND_CONFIG),
+        ("writing", "instant + band"): lambda: writing(True, quick, solver_contacts=True, settings=BAND_CONFIG),
     }
     jobs.update({("elbow", v): (lambda v=v: elbow(v, quick)) for v in CONTACT_VARIANTS})
     for mu in SURFACES:
@@ -210,6 +212,7 @@ def _text(nums: dict, surf: dict, checks: dict, quick: bool) -> list[str]:
     g0, g1 = nums[("grasp", "before")], nums[("grasp", "after")]
     w0, w1 = nums[("writing", "before")], nums[("writing", "after")]
     e0, e1, e2 = nums[("elbow", "before")], nums[("elbow", "after")], nums[("elbow", "elbow+wrist")]
+    gb, wb = nums[("grasp", "after, instant + band")], nums[("writing", "after, instant + band")]
     lo, hi = min(surf), max(surf)
     return [
         f"- Grasp: slide x error {g0['accuracy']:+.2f} -> {g1['accuracy']:+.2f} mm, ∫τ² {g0['tau2']:.1f} -> "
@@ -228,6 +231,12 @@ def _text(nums: dict, surf: dict, checks: dict, quick: bool) -> list[str]:
         f"{e2['shoulder']:.2f} vs {e1['shoulder']:.2f} N m; elbow support plant / model {e2['plant']:.1f} / "
         f"{e2['model']:.1f} N, wrist table {e2['wrist_plant']:.1f} / {e2['wrist_model']:.1f} N; tool x error "
         f"{e2['accuracy']:+.2f} mm.",
+        "- The discrete-time mode (the after runs' friction-aware solve posed over the next 1 ms control period, "
+        "`time_step=`) against the same runs at the instant with a hold band of 1 mm / 0.01 rad (the before of "
+        f"issue 27): chatter grasp {gb['chatter']:.3f} -> {g1['chatter']:.3f}, writing {wb['chatter']:.3f} -> "
+        f"{w1['chatter']:.3f} N m/step; accuracy grasp {gb['accuracy']:+.2f} -> {g1['accuracy']:+.2f} mm, writing "
+        f"{wb['accuracy']:.2f} -> {w1['accuracy']:.2f} mm. The elbow with the wrist on a table keeps its band "
+        "(`elbow.ELBOW_WRIST_CONFIG`).",
         f"- Surfaces: sliding the gripper on a table of μ = {lo} costs ∫τ² {surf[lo]['tau2']:.1f} N² m² s, on μ = "
         f"{hi} {surf[hi]['tau2']:.1f} (slid {1e3 * surf[lo]['distance']:.1f} and {1e3 * surf[hi]['distance']:.1f} mm); "
         "the solver's support carries the friction μ f_n against the sliding, the motors the rest. "
@@ -278,6 +287,8 @@ def section(runs: dict, out: Path, quick: bool = False, say: Callable[[str], Non
         ("elbow", "before", runs[("elbow", "constraint")]),
         ("elbow", "after", after[("elbow", "support")]),
         ("elbow", "elbow+wrist", after[("elbow", "elbow+wrist")]),
+        ("grasp", "after, instant + band", after[("grasp", "instant + band")]),
+        ("writing", "after, instant + band", after[("writing", "instant + band")]),
     ]
     header, rows, nums = _rows(pairs)
     two = after[("elbow", "elbow+wrist")]
@@ -342,7 +353,11 @@ def _checks(nums: dict, surf: dict, after: dict) -> dict:
 def dual_arm_section(before, quick: bool = False, say: Callable[[str], None] = lambda s: None):
     """The dual-arm case before (``table``: share removed by hand) and after (``contacts``); ``(lines, ok, run)``."""
     after = _timed(say, "dual-arm contacts", lambda: dual_arm(CONTACT_VARIANT, quick))
-    header, rows, nums = _rows([("dual-arm", "before", before), ("dual-arm", "after", after)])
+    band = _timed(
+        say, "dual-arm contacts, instant + band", lambda: dual_arm(CONTACT_VARIANT, quick, config=DUAL_BAND_CONFIG)
+    )
+    pairs = [("dual-arm", "before", before), ("dual-arm", "after", after), ("dual-arm", "after, instant + band", band)]
+    header, rows, nums = _rows(pairs)
     o = metrics.dual_arm_outcome(after)
     ok = o["table_fraction"] > 0.99 and abs(o["final_error_x"]) < 0.005 and o["rest_drift"] < 0.005
     ok = ok and _force_ok(nums[("dual-arm", "after")])
@@ -355,7 +370,8 @@ def dual_arm_section(before, quick: bool = False, say: Callable[[str], None] = l
         *md_table(header, rows),
         "",
         f"Resting hand drift {1e3 * o['rest_drift']:.2f} mm after; ∫τ² {n0['tau2']:.1f} -> {n1['tau2']:.1f} N² m² s; "
-        f"chatter {n0['chatter']:.3f} -> {n1['chatter']:.3f} N m/step. Check (hand on the table, slide done, "
+        f"chatter {n0['chatter']:.3f} -> {n1['chatter']:.3f} N m/step (the after run at the instant with the "
+        f"hold band: {nums[('dual-arm', 'after, instant + band')]['chatter']:.3f}). Check (hand on the table, slide done, "
         f"resting hand within 5 mm, plant vs model force within x0.5..2): {'ok' if ok else 'FAILED'}.",
         "",
     ]

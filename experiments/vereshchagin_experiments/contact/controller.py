@@ -22,6 +22,11 @@ One cycle (:meth:`CascadedController.command`):
    makes resting joints get the max-min static friction and moving ones Coulomb friction, so
    ``tau_command`` is the motor torque with friction acting (friction compensation).
    The motor torque sent is ``tau_command`` + the motor-side part of ``tau_ff``.
+   ``ControllerConfig.time_step`` (the control period, s) makes it the discrete-time mode: the
+   same solve with ``time_step=``, i.e. friction, joint limits and contacts posed on the joint
+   velocities at the end of the next control period (docs/time-step.md, "Controllers over a
+   step"): a joint that will stay at rest gets the friction that holds it (continuous in the
+   P correction) instead of the full breakaway torque against the sign of its acceleration.
    ``ControllerConfig.friction_mode`` selects how joint friction enters (the friction-energy
    experiment compares them): ``"maxmin"`` (the above, default), ``"none"`` (plain solve, friction
    left to feedback), ``"sign"`` (plain solve + ``f_j sign(qd_j)``, at rest the sign of the
@@ -44,6 +49,7 @@ from vereshchagin.task import beta_for, directions, pose_error
 
 __all__ = [
     "CONTACT_GAINS",
+    "CONTROL_PERIOD",
     "FREE_GAINS",
     "REPORT_CONTACT_GAINS",
     "REPORT_FREE_GAINS",
@@ -55,6 +61,9 @@ __all__ = [
 ]
 
 G = 9.81
+CONTROL_PERIOD = 1e-3
+"""s: the experiments' control period (the MuJoCo plant's time step, :mod:`.mujoco_plant`), the
+``time_step`` of the discrete-time controller mode (:attr:`ControllerConfig.time_step`)."""
 
 
 @dataclass(frozen=True)
@@ -156,7 +165,13 @@ class ControllerConfig:
     hold_band : (float, float) or None
         ``(m, rad)``: while the translational and rotational pose errors along the constrained
         directions are both inside, the task asks for zero acceleration (``a_des = 0``: "stay", so resting joints may stick)
-        instead of the P correction. None (default): no band.
+        instead of the P correction. None (default): no band. The step mode (``time_step``)
+        replaces it in the experiments; kept as their "before" variant.
+    time_step : float or None
+        The discrete-time controller mode: the control period ``dt`` (s) passed to the
+        friction-aware solve as ``time_step=dt`` (friction and contact conditions on the
+        velocities ``qd + dt qdd`` at the end of the period; ``tau_command`` is then the motor
+        torque over the period). None (default): the solve at the instant.
     """
 
     free_gains: Gains = FREE_GAINS
@@ -172,6 +187,7 @@ class ControllerConfig:
     posture_gains: tuple = (20.0, 3.0)
     free_directions: tuple = FREE_DIRECTIONS
     hold_band: Optional[tuple] = None
+    time_step: Optional[float] = None
 
 
 @dataclass
@@ -394,6 +410,8 @@ class CascadedController:
             f_ext[-1] = np.concatenate([F, np.cross(r, F)])
         if cts:
             kw["contacts"] = cts
+        if cfg.time_step is not None and (self.friction is not None or cts):
+            kw["time_step"] = cfg.time_step  # the discrete-time mode: the conditions at the period's end
         res = self.solver.solve(q, qd_solve, alpha, beta, f_ext=f_ext, tau_ff=tau_ff, friction=self.friction, **kw)
         if cts:  # the model's upward force of the surfaces, N
             N = float(np.asarray(res.contact_force)[:, 2].sum())

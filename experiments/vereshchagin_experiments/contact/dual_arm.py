@@ -10,8 +10,8 @@ Task (base frame, m):
 
 - the **left hand rests**: a 6-D segment constraint on :data:`REST_FRAME`, a frame fixed to the
   left gripper at the middle of its box's lowest edge (where it touches the table), holds the
-  start pose (cascaded P of :mod:`.controller`; zero acceleration inside the hold band of
-  :data:`CONFIG`, which lets joint friction hold the resting arm). Its third column
+  start pose (cascaded P of :mod:`.controller`, in the discrete-time mode of :data:`CONFIG`,
+  which lets joint friction hold the resting arm). Its third column
   (linear base z, the table normal) is the table's: when the solver's ``nu_z < 0`` (the
   constraint pushes the hand up), the share ``-J_r^T e_z nu_z`` of the command is left to the
   table, as the ``constraint`` variant of :mod:`.elbow` does for the elbow;
@@ -43,7 +43,8 @@ With the 6-D hold the support is redundant with the task and gets the forces of 
 effort: the P loop's corrections then asked the held point to accelerate into the table, which
 the solve rightly refuses ("no consistent contact forces"). Holding x and y as well (5 columns)
 ran, but the least-effort share of the friction jumped from cycle to cycle (chatter 0.37 N m per
-step at the torso and the left shoulder, against 0.12 with the orientation alone).
+step at the torso and the left shoulder, against 0.12 with the orientation alone; both with the
+hold band at the instant, before the discrete-time mode).
 
 Open-loop task error (:func:`open_loop_error`): the torques a solve intends for every joint
 (motors, the table's share, the joint friction the solve predicted, ``tau_ff`` with the viscous
@@ -65,7 +66,7 @@ from vereshchagin import Chain, Tree
 from vereshchagin.friction import Friction
 from vereshchagin import Solver
 from vereshchagin.task import beta_for, pose_error
-from .controller import ControllerConfig, CycleInfo, cascaded_acceleration
+from .controller import CONTROL_PERIOD, ControllerConfig, CycleInfo, cascaded_acceleration
 from .mujoco_plant import MujocoGen3, Scene, build_model
 from .surfaces import SceneContacts, point_jacobian, tool_support
 from .use_cases import (
@@ -83,6 +84,7 @@ __all__ = [
     "REST_FRAME",
     "TASK_FRAME",
     "VARIANTS",
+    "BAND_CONFIG",
     "CONFIG",
     "FRICTION_MODES",
     "DualArmController",
@@ -96,14 +98,18 @@ CONTACT_VARIANT = "contacts"
 """The tree solver with the resting hand as the solver's contact (module doc)."""
 FRICTION_MODES = ("maxmin", "none", "smooth")
 """``ControllerConfig.friction_mode`` s the dual-arm controller takes (see :data:`CONFIG`)."""
-CONFIG = ControllerConfig(hold_band=(1e-3, 1e-2))
+CONFIG = ControllerConfig(time_step=CONTROL_PERIOD)
 """The controller settings of the case: the exact max-min (``friction_mode="maxmin"``, joints with
-|qd| <= 0.01 rad/s at rest) and a hold band of 1 mm / 0.01 rad on each hand's pose error, inside
-which that hand's task asks for zero acceleration ("stay"), as ``hold_band`` does in
-:class:`~.controller.CascadedController`. Without the band the P loop's tiny
-corrections give resting joints small commanded accelerations whose sign changes almost every
-cycle; the max-min charges the full breakaway friction against each (its ``f_j |qdd_j|`` term), so
-the command jumps by up to ``2 f_j`` per cycle (docs/trees.md has the measured comparison)."""
+|qd| <= 0.01 rad/s at rest) in the discrete-time mode: each cycle's friction-aware solve is posed
+over the next 1 ms control period (``time_step``, :class:`~.controller.CascadedController`), so a
+joint that friction keeps at rest gets the friction torque that holds it, continuous in the P
+loop's corrections. At the instant the corrections give resting joints small commanded
+accelerations whose sign changes almost every cycle; the max-min charges the full breakaway
+friction against each (its ``f_j |qdd_j|`` term), so the command jumps by up to ``2 f_j`` per
+cycle. :data:`BAND_CONFIG` is the earlier fix, kept as the report's "before"."""
+BAND_CONFIG = ControllerConfig(hold_band=(1e-3, 1e-2))
+"""Before the discrete-time mode: the solve at the instant and a hold band of 1 mm / 0.01 rad on
+each hand's pose error, inside which that hand's task asks for zero acceleration ("stay")."""
 REST_FRAME = "left_rest_point"
 """Frame of the resting hand: fixed to ``left_end_effector_link`` at the gripper box's lowest edge."""
 TASK_FRAME = "right_end_effector_link"
@@ -195,7 +201,8 @@ class DualArmController:
         Free-space gains, twist saturation, posture gains, ``friction_mode`` (one of
         :data:`FRICTION_MODES`: ``"maxmin"`` the friction-aware solve, ``"none"`` a plain solve,
         ``"smooth"`` a plain solve plus ``f_j tanh(qd_j / eps)``), ``friction_velocity_tolerance``
-        (``eps``, rad/s) and ``hold_band`` (applied to each hand's pose error); the contact
+        (``eps``, rad/s), ``time_step`` (the discrete-time mode) and ``hold_band`` (applied to
+        each hand's pose error); the contact
         settings are unused. Default :data:`CONFIG`.
 
     Raises
@@ -294,6 +301,8 @@ class DualArmController:
             ff = motor_ff[p.idx] * p.torso_scale
             tau_ff = ff - np.asarray(p.model.damping) * qdp
             kw = {"contacts": cts} if cts else {}
+            if self.config.time_step is not None and (p.friction is not None or cts):
+                kw["time_step"] = self.config.time_step  # the discrete-time mode (controller module doc)
             args = dict(tau_ff=tau_ff, constraints={f: cons[f] for f in p.frames}, **kw)
             res = p.solver.solve(qp, qd_solve[p.idx], friction=p.friction, **args)
             if cts:  # the table's force on the resting hand, and its joint torque in the intended total

@@ -32,7 +32,7 @@ the same support, no elbow constraint, no share removed by hand:
   solve; the self-motion is left to the dynamics, and the support holds it;
 - ``elbow+wrist``: also a table under the gripper (its lowest edge rests on it and slides along
   with the tool): two resting points at once. The tool's task releases z (the table holds it, as
-  in the grasp), the hold band of :data:`~.surfaces.CONTACT_CONFIG` ends the slide, and the
+  in the grasp), the discrete-time mode and a hold band end the slide (:data:`ELBOW_WRIST_CONFIG`), and the
   gripper's friction is set against the desired motion (``reference``, :mod:`.surfaces`). Holding
   z as well made the wrist's support redundant with the task: the P loop's corrections then asked
   the held point to accelerate into the table, which the solve refuses (no forces meet the
@@ -48,7 +48,7 @@ from vereshchagin.task import beta_for
 from .controller import CascadedController, ControllerConfig
 from vereshchagin import robots
 from .mujoco_plant import ELBOW_RADIUS, Scene, build_model
-from .surfaces import CONTACT_CONFIG, SceneContacts, elbow_support, wrist_support
+from .surfaces import BAND_CONFIG, CONTACT_CONFIG, SceneContacts, elbow_support, wrist_support
 from .use_cases import SLIDE, Phase, _plant, _shifted, gen3_model, run_loop
 
 __all__ = ["CONTACT_VARIANTS", "ELBOW_POSE", "ELBOW_SEGMENT", "VARIANTS", "elbow"]
@@ -68,6 +68,14 @@ ALPHA_ELBOW = np.array([[0.0], [0.0], [1.0], [0.0], [0.0], [0.0]])
 """Elbow constraint direction: linear base z (6, 1)."""
 N_TOOL = 6
 """Columns of the tool's ``alpha`` in free space; the elbow's ``nu`` follows them in ``result.nu``."""
+
+
+ELBOW_WRIST_CONFIG = {**CONTACT_CONFIG, **BAND_CONFIG}
+"""Controller settings of ``elbow+wrist``: the discrete-time mode of the contact runs and, unlike the
+others, still the hold band. Its command chatters about 0.2 N m per step over the whole slide in
+every mode (two points in contact, the gripper sliding); what the band adds is the end of the
+slide: without it the gripper's sliding friction flips against the arrival's corrections and the
+chatter there rises to 1 N m per step (quick run, measured with the step mode alone)."""
 
 
 def elbow_constraint(chain, seg: int, z_ref: float, gains=(40.0, 30.0), v_max: float = 0.05):
@@ -190,8 +198,10 @@ def elbow(variant: str, quick: bool = False, progress=None, perturb=None):
     robot, plant_error = _plant(urdf, chain, scene, q0, perturb)
     solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
     config = ControllerConfig(posture_gains=(0.0, 3.0))
+    if variant == "support":  # the solver's contacts: the discrete-time mode of the contact runs
+        config = ControllerConfig(posture_gains=(0.0, 3.0), **CONTACT_CONFIG)
     if variant == "elbow+wrist":  # the table holds the gripper's height: the task the other five
-        config = ControllerConfig(posture_gains=(0.0, 3.0), free_directions=WRIST_DIRECTIONS, **CONTACT_CONFIG)
+        config = ControllerConfig(posture_gains=(0.0, 3.0), free_directions=WRIST_DIRECTIONS, **ELBOW_WRIST_CONFIG)
     ctl = CascadedController(chain, solver, config)
     if variant in ("unsupported", "constraint"):
         g = ctl.config.free_gains

@@ -48,6 +48,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from vereshchagin import Contact
+from .controller import CONTROL_PERIOD
 
 __all__ = [
     "RESTING_SPEED",
@@ -71,13 +72,17 @@ FACETS = 32
 opposed to its velocity: with the default 4 the friction of a gripper sliding diagonally points
 up to 45 degrees off its velocity, and in the grasp's slide that error grew into a sideways drift
 (the tool ended 46 mm off its line, 55 mm short). 32 vertices: at most 5.6 degrees off."""
-CONTACT_CONFIG = {"hold_band": (1e-3, 1e-2)}
-"""Controller settings (:class:`~.controller.ControllerConfig` fields) of the runs with contacts: a
-hold band of 1 mm / 0.01 rad. At the end of a slide the P loop's tiny corrections change sign
-every few cycles; each needs the full sliding friction (mu f_n, 11 N on the gripper) the other
-way, and the command jumped by 5 N m per step at the shoulder. Inside the band the task asks for
-zero acceleration and the resting point sticks (the old ``f_ext`` compensation faded its friction
-out near the goal instead)."""
+CONTACT_CONFIG = {"time_step": CONTROL_PERIOD}
+"""Controller settings (:class:`~.controller.ControllerConfig` fields) of the runs with contacts: the
+discrete-time mode (the solve over the next 1 ms control period). At the end of a slide the P
+loop's tiny corrections change sign every few cycles; at the instant each needs the full sliding
+friction (mu f_n, 11 N on the gripper) the other way, and the command jumped by 5 N m per step at
+the shoulder. Over a step the point whose end velocity friction can stop gets the force that
+holds it, continuous in the correction (the earlier fix, a hold band of 1 mm / 0.01 rad inside
+which the task asked for zero acceleration, is :data:`BAND_CONFIG`)."""
+BAND_CONFIG = {"hold_band": (1e-3, 1e-2)}
+"""The contact runs' settings before the discrete-time mode: the solve at the instant and a hold band
+of 1 mm / 0.01 rad (zero task acceleration inside), for the before / after comparison."""
 STICK_MARGIN = 0.5
 """Factor on a resting point's friction coefficient in the solve. Where the contact forces are not
 unique (a resting point whose motion the task also fixes) the solver takes those of least motor

@@ -385,6 +385,11 @@ def _gripper_low_point(model, q, T_frame, body: str = "bracelet_link") -> np.nda
     return (np.linalg.inv(np.asarray(T_frame)) @ np.append(corner, 1.0))[:3]
 
 
+def _settings(settings: Optional[dict]) -> dict:
+    """The controller settings of a run with the solver's contacts (default :data:`~.surfaces.CONTACT_CONFIG`)."""
+    return dict(CONTACT_CONFIG if settings is None else settings)
+
+
 def _controller(chain, tool_point, **overrides):
     solver = Solver(chain, gravity=[0.0, 0.0, -9.81])
     return CascadedController(chain, solver, ControllerConfig(contact_point=tuple(tool_point), **overrides))
@@ -408,6 +413,7 @@ def grasp(
     solver_contacts: bool = False,
     mu: Optional[float] = None,
     perturb: Optional[Callable[[Any], dict]] = None,
+    settings: Optional[dict] = None,
 ) -> Run:
     """Use case 1: approach the table, slide 0.10 m along +x (in contact or 0.03 m above), grasp.
 
@@ -437,6 +443,9 @@ def grasp(
         ``perturb(mujoco.MjModel) -> dict``: changes the compiled plant in place before the run
         (model error, :mod:`.model_error`); its result is stored as ``info["plant_error"]``.
         None: the plant is the controller's model.
+    settings : dict, optional
+        With ``solver_contacts``: the controller's :class:`~.controller.ControllerConfig` fields;
+        None: :data:`~.surfaces.CONTACT_CONFIG` (the discrete-time mode).
 
     Returns
     -------
@@ -455,7 +464,7 @@ def grasp(
     z_low = (np.asarray(chain.fk(q0)) @ np.append(low, 1.0))[2]
     scene = Scene(table_top=float(z_low - descent), **_friction(mu))
     robot, plant_error = _plant(urdf, chain, scene, q0, perturb)
-    ctl = _controller(chain, low, **(CONTACT_CONFIG if contact and solver_contacts else {}))
+    ctl = _controller(chain, low, **(_settings(settings) if contact and solver_contacts else {}))
     if contact and solver_contacts:
         points = [tool_support(robots.GEN3_TIP_LINK, low, scene.friction)]
         ctl.contacts = SceneContacts(chain, points, active=lambda: ctl.in_contact, reference=lambda: ctl.v_des[:3])
@@ -497,6 +506,7 @@ def writing(
     progress=None,
     solver_contacts: bool = False,
     perturb: Optional[Callable[[Any], dict]] = None,
+    settings: Optional[dict] = None,
 ) -> Run:
     """Use case 2: draw a 0.10 m line along +x with the pen on the table, or 0.10 m above it.
 
@@ -517,6 +527,8 @@ def writing(
         estimated table force in ``f_ext``; variant ``"solver-contacts"``.
     perturb : callable, optional
         Model error of the plant, as in :func:`grasp`.
+    settings : dict, optional
+        As in :func:`grasp`.
 
     Returns
     -------
@@ -538,7 +550,7 @@ def writing(
     # Tracked point: the end-effector origin, as in the report (the pen tip, 0.12 m below the grip,
     # moves with orientation errors). Tracking the pen tip itself (``with_tool_link``) made the
     # free-space variant drift in the self-motion; not pursued.
-    ctl = _controller(chain, tip_ee, **(CONTACT_CONFIG if contact and solver_contacts else {}))
+    ctl = _controller(chain, tip_ee, **(_settings(settings) if contact and solver_contacts else {}))
     if contact and solver_contacts:
         points = [pen_setpoint(robots.GEN3_TIP_LINK, tip_ee, scene.friction)]
         ctl.contacts = SceneContacts(chain, points, active=lambda: ctl.in_contact, reference=lambda: ctl.v_des[:3])
