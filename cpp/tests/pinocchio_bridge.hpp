@@ -13,9 +13,18 @@
 #include <kdl/frames.hpp>
 #include <kdl/segment.hpp>
 
+#include "random_tree.hpp"
 #include "vereshchagin/model.hpp"
 
 namespace testutil {
+
+// Random robots of the Pinocchio oracle tests: chains (even trials) and trees, 1 to 12 moving joints.
+inline vereshchagin::Model randomOracleModel(RandomGen& g, int trial) {
+  if (trial % 2 == 0) return vereshchagin::Model(g.chain(g.integer(1, 12)));
+  TreeSpec spec;
+  spec.n_joints = g.integer(2, 12);
+  return vereshchagin::Model(randomTree(g, spec));
+}
 
 inline pinocchio::SE3 toSE3(const KDL::Frame& f) {
   Eigen::Matrix3d r;

@@ -24,13 +24,6 @@ using testutil::relErr;
 constexpr double kTol = 1e-9;
 const KDL::Vector kGravity(0.4, -0.3, -9.81);
 
-Model randomModel(testutil::RandomGen& g, int trial) {
-  if (trial % 2 == 0) return Model(g.chain(g.integer(1, 12)));
-  testutil::TreeSpec spec;
-  spec.n_joints = g.integer(2, 12);
-  return Model(testutil::randomTree(g, spec));
-}
-
 double relScalar(double a, double b) {
   return std::abs(a - b) / std::max(1.0, std::abs(b));
 }
@@ -40,7 +33,7 @@ double relScalar(double a, double b) {
 TEST_CASE("kinetic energy, potential energy and dT/dq equal Pinocchio's") {
   testutil::RandomGen g(31);
   for (int trial = 0; trial < 40; ++trial) {
-    const Model ours = randomModel(g, trial);
+    const Model ours = testutil::randomOracleModel(g, trial);
     testutil::PinRobot pin(ours, kGravity);
     pinocchio::Data pdata(pin.model);
     const unsigned n = ours.nrOfJoints();

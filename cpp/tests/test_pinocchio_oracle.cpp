@@ -26,20 +26,13 @@ using testutil::relErr;
 constexpr double kTol = 1e-9;
 const KDL::Vector kGravity(0.4, -0.3, -9.81);
 
-// Random robots: chains (every other one) and trees, 1 to 12 moving joints.
-Model randomModel(testutil::RandomGen& g, int trial) {
-  if (trial % 2 == 0) return Model(g.chain(g.integer(1, 12)));
-  testutil::TreeSpec spec;
-  spec.n_joints = g.integer(2, 12);
-  return Model(testutil::randomTree(g, spec));
-}
-
 struct Case {
   Model ours;
   testutil::PinRobot pin;
   pinocchio::Data pdata;
   Eigen::VectorXd q, qd, qdd, pq, pv, pa;
-  Case(testutil::RandomGen& g, int trial) : ours(randomModel(g, trial)), pin(ours, kGravity), pdata(pin.model) {
+  Case(testutil::RandomGen& g, int trial)
+      : ours(testutil::randomOracleModel(g, trial)), pin(ours, kGravity), pdata(pin.model) {
     const unsigned n = ours.nrOfJoints();
     q = g.q(n).data;
     qd = g.qdot(n).data;

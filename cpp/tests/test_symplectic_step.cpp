@@ -79,117 +79,108 @@ TEST_CASE("symplectic step without friction equals a dense symplectic Euler") {
   }
 }
 
-TEST_CASE("a passive chain's energy stays bounded under the symplectic step, grows under step()") {
-  RandomGen g(42);
-  const Model m(g.chain(7, /*allow_prismatic=*/false));  // revolute: a bounded motion
-  const int n = 7;
-  Data data(m);
-  detail::SymplecticWorkspace ws(m);
-  DynamicsData dd(m);
-  SolveInput in(m);
-  in.time_step = 1e-3;
-  const Eigen::VectorXd q0 = g.q(n).data, v0 = Eigen::VectorXd::Constant(n, 2.0);
-  const double E0 = energy(m, dd, q0, mass(m, dd, q0) * v0);
-  Eigen::VectorXd q = q0, u = v0, p = mass(m, dd, q0) * v0, q1(n), u1(n), p1(n);
-  double sym_worst = 0.0;
-  for (int k = 0; k < 10000; ++k) {  // 10 s
-    in.q = q;
-    in.q_dot = u;
-    REQUIRE(detail::symplecticStep(m, data, ws, in, p, q1, u1, p1).code() == Error::None);
-    q = q1, u = u1, p = p1;
-    sym_worst = std::max(sym_worst, std::abs(energy(m, dd, q, p) - E0));
-  }
-  q = q0, u = v0;
-  double semi_gain = 0.0;
-  for (int k = 0; k < 10000; ++k) {
-    in.q = q;
-    in.q_dot = u;
-    REQUIRE(step(m, data, in, q, u));
-    semi_gain = std::max(semi_gain, energy(m, dd, q, mass(m, dd, q) * u) - E0);
-  }
-  MESSAGE("E0 " << E0 << " J; symplectic max |E - E0| " << sym_worst << " J; semi-implicit gain " << semi_gain);
-  CHECK(sym_worst < 0.03 * E0);  // measured 1.9 % (4.8 J of 253 J)
-  CHECK(semi_gain > 3.0 * sym_worst);
-}
-
 namespace {
 
-// Breakaway friction 1.5 |g(q)| + 0.2 at every joint, kinetic 0.8 of it.
-FrictionModel holding(const Model& m, const Eigen::VectorXd& q) {
+// A revolute chain with everything a symplectic step needs; advance() takes one step and moves
+// the state (q, u in `in`, the momentum p) on.
+struct Rig {
+  Model m;
+  Data data;
+  detail::SymplecticWorkspace ws;
+  DynamicsData dd;
+  SolveInput in;
+  Eigen::VectorXd p, q1, u1, p1;
+  Rig(RandomGen& g, int n)
+      : m(g.chain(n, /*allow_prismatic=*/false)), data(m), ws(m), dd(m), in(m), p(n), q1(n), u1(n), p1(n) {
+    in.q = g.q(n).data;
+    in.time_step = 1e-3;
+  }
+  void setVelocity(const Eigen::VectorXd& v) {
+    in.q_dot = v;
+    p = mass(m, dd, in.q) * v;
+  }
+  Status advance(int max_iterations = 100) {
+    const Status s = detail::symplecticStep(m, data, ws, in, p, q1, u1, p1, max_iterations);
+    if (s) in.q = q1, in.q_dot = u1, p = p1;
+    return s;
+  }
+};
+
+// Breakaway friction factor (1.5 |g(q)| + 0.2) at every joint, kinetic 0.8 of it.
+FrictionModel holding(const Model& m, const Eigen::VectorXd& q, double factor) {
   DynamicsData dd(m);
   Eigen::VectorXd g(q.size());
   REQUIRE(gravityTorques(m, dd, JointPositions(q), kGravity, g));
   FrictionModel fm;
-  fm.static_friction = 1.5 * g.cwiseAbs() + Eigen::VectorXd::Constant(q.size(), 0.2);
+  fm.static_friction = factor * (1.5 * g.cwiseAbs() + Eigen::VectorXd::Constant(q.size(), 0.2));
   fm.kinetic_friction = 0.8 * fm.static_friction;
   return fm;
 }
 
 }  // namespace
 
+TEST_CASE("a passive chain's energy stays bounded under the symplectic step, grows under step()") {
+  RandomGen g(42);
+  Rig r(g, 7);
+  const Eigen::VectorXd q0 = r.in.q, v0 = Eigen::VectorXd::Constant(7, 2.0);
+  r.setVelocity(v0);
+  const double E0 = energy(r.m, r.dd, q0, r.p);
+  double sym_worst = 0.0;
+  for (int k = 0; k < 10000; ++k) {  // 10 s
+    REQUIRE(r.advance().code() == Error::None);
+    sym_worst = std::max(sym_worst, std::abs(energy(r.m, r.dd, r.in.q, r.p) - E0));
+  }
+  Eigen::VectorXd q = q0, u = v0;
+  double semi_gain = 0.0;
+  for (int k = 0; k < 10000; ++k) {
+    r.in.q = q;
+    r.in.q_dot = u;
+    REQUIRE(step(r.m, r.data, r.in, q, u));
+    semi_gain = std::max(semi_gain, energy(r.m, r.dd, q, mass(r.m, r.dd, q) * u) - E0);
+  }
+  MESSAGE("E0 " << E0 << " J; symplectic max |E - E0| " << sym_worst << " J; semi-implicit gain " << semi_gain);
+  CHECK(sym_worst < 0.03 * E0);  // measured 1.1 % (2.8 J of 253 J)
+  CHECK(semi_gain > 3.0 * sym_worst);
+}
+
 TEST_CASE("symplectic step: a chain held by friction keeps q bitwise with one solve per step") {
   RandomGen g(43);
-  const Model m(g.chain(7, false));
-  Data data(m);
-  detail::SymplecticWorkspace ws(m);
-  SolveInput in(m);
-  in.q = g.q(7).data;
-  const FrictionModel fm = holding(m, in.q);
-  in.friction = &fm;
-  in.time_step = 1e-3;
-  const Eigen::VectorXd q0 = in.q;
-  Eigen::VectorXd p = Eigen::VectorXd::Zero(7), q1(7), u1(7), p1(7);
+  Rig r(g, 7);
+  const FrictionModel fm = holding(r.m, r.in.q, 1.0);
+  r.in.friction = &fm;
+  r.setVelocity(Eigen::VectorXd::Zero(7));
+  const Eigen::VectorXd q0 = r.in.q;
   for (int k = 0; k < 10000; ++k) {
-    REQUIRE(detail::symplecticStep(m, data, ws, in, p, q1, u1, p1).code() == Error::None);
-    REQUIRE(ws.iterations == 1);
-    in.q = q1, in.q_dot = u1, p = p1;
+    REQUIRE(r.advance().code() == Error::None);
+    REQUIRE(r.ws.iterations == 1);
   }
-  CHECK(in.q == q0);
-  CHECK(in.q_dot.isZero(0.0));
+  CHECK(r.in.q == q0);
+  CHECK(r.in.q_dot.isZero(0.0));
 }
 
 TEST_CASE("symplectic step: a moving chain friction can stop comes to exact rest") {
   RandomGen g(44);
-  const Model m(g.chain(6, false));
-  Data data(m);
-  detail::SymplecticWorkspace ws(m);
-  DynamicsData dd(m);
-  SolveInput in(m);
-  in.q = g.q(6).data;
-  FrictionModel fm = holding(m, in.q);
-  fm.static_friction *= 3.0;
-  fm.kinetic_friction *= 3.0;
-  in.friction = &fm;
-  in.time_step = 1e-3;
-  in.q_dot = Eigen::VectorXd::Constant(6, 0.05);
-  Eigen::VectorXd p = mass(m, dd, in.q) * in.q_dot, q1(6), u1(6), p1(6);
-  for (int k = 0; k < 6000; ++k) {  // joint 0 decelerates slowly (its friction is the 0.2 floor)
-    REQUIRE(detail::symplecticStep(m, data, ws, in, p, q1, u1, p1));
-    in.q = q1, in.q_dot = u1, p = p1;
-  }
-  CHECK(in.q_dot.isZero(0.0));
-  const Eigen::VectorXd rest = in.q;
-  REQUIRE(detail::symplecticStep(m, data, ws, in, p, q1, u1, p1));
-  CHECK(q1 == rest);
+  Rig r(g, 6);
+  const FrictionModel fm = holding(r.m, r.in.q, 3.0);
+  r.in.friction = &fm;
+  r.setVelocity(Eigen::VectorXd::Constant(6, 0.05));
+  for (int k = 0; k < 6000; ++k) REQUIRE(r.advance());  // joint 0 decelerates slowly (friction 0.2 floor)
+  CHECK(r.in.q_dot.isZero(0.0));
+  const Eigen::VectorXd rest = r.in.q;
+  REQUIRE(r.advance());
+  CHECK(r.in.q == rest);
 }
 
 TEST_CASE("symplectic step: the iteration bound's fallback is Degraded, bad input an error") {
   RandomGen g(45);
-  const Model m(g.chain(5, false));
-  Data data(m);
-  detail::SymplecticWorkspace ws(m);
-  DynamicsData dd(m);
-  SolveInput in(m);
-  in.q = g.q(5).data;
-  in.q_dot = Eigen::VectorXd::Constant(5, 3.0);
-  in.time_step = 1e-3;
-  const Eigen::VectorXd p = mass(m, dd, in.q) * in.q_dot;
-  Eigen::VectorXd q1(5), u1(5), p1(5), short_p(4);
-  const Status s = detail::symplecticStep(m, data, ws, in, p, q1, u1, p1, /*max_iterations=*/1);
+  Rig r(g, 5);
+  r.setVelocity(Eigen::VectorXd::Constant(5, 3.0));
+  const Eigen::VectorXd short_p(4);
+  CHECK(detail::symplecticStep(r.m, r.data, r.ws, r.in, short_p, r.q1, r.u1, r.p1).code() == Error::SizeMismatch);
+  const Status s = r.advance(/*max_iterations=*/1);
   CHECK(s.code() == Error::Degraded);
   CHECK(s.ok());
-  CHECK(ws.iterations == 1);
-  CHECK(detail::symplecticStep(m, data, ws, in, short_p, q1, u1, p1).code() == Error::SizeMismatch);
-  in.time_step = 0.0;
-  CHECK(detail::symplecticStep(m, data, ws, in, p, q1, u1, p1).code() == Error::OutOfRange);
+  CHECK(r.ws.iterations == 1);
+  r.in.time_step = 0.0;
+  CHECK(r.advance().code() == Error::OutOfRange);
 }
