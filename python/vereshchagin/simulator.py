@@ -11,6 +11,8 @@ from .solver import Solver
 _RECORDABLE = ("tau_command", "friction_torque", "contact_force", "status")
 # Arguments of Solver.solve that the simulator sets itself.
 _OWN_ARGS = frozenset(("q", "qd", "time_step", "out"))
+# The integrators (C++: vereshchagin::Integrator); one today.
+_INTEGRATORS = ("semi_implicit_euler",)
 
 
 def _check_dt(dt) -> float:
@@ -51,12 +53,15 @@ class Simulator:
         The initial state (default: zeros), rad or m and rad/s or m/s.
     t : float
         The initial time, s (default 0).
+    integrator : str
+        ``"semi_implicit_euler"`` (the only one today, C++ ``Integrator::SemiImplicitEuler``): the
+        velocity terms at the start of the step, friction, limits and contacts at its end.
 
     Raises
     ------
     SolverError
-        A ``dt`` that is not a finite number > 0, a state of the wrong shape or not finite, or what
-        :class:`Solver` raises.
+        A ``dt`` that is not a finite number > 0, an unknown integrator, a state of the wrong shape
+        or not finite, or what :class:`Solver` raises.
     """
 
     def __init__(
@@ -72,7 +77,11 @@ class Simulator:
         q=None,
         qd=None,
         t=0.0,
+        integrator="semi_implicit_euler",
     ):
+        if integrator not in _INTEGRATORS:
+            raise _core.SolverError(f"Simulator: integrator must be one of {_INTEGRATORS}, got {integrator!r}")
+        self._integrator = integrator
         self._dt = _check_dt(dt)
         self._solver = Solver(model, gravity, rcond, damping, inertia_check, max_constraints)
         n = self._solver.n_joints
@@ -226,6 +235,11 @@ class Simulator:
     def dt(self) -> float:
         """The time step, s."""
         return self._dt
+
+    @property
+    def integrator(self) -> str:
+        """The integrator's name (see the class description)."""
+        return self._integrator
 
     @property
     def solver(self) -> Solver:

@@ -244,7 +244,8 @@ class Solver(_core.Solver):
     def step(self, q, qd, time_step, **solve_args):
         """One step of semi-implicit Euler over ``time_step`` with friction and contacts solved exactly.
 
-        :meth:`solve` with ``time_step``: the conditions of joint friction, joint limits and
+        The C++ ``step()`` (``data.hpp``; GIL released), as :class:`Simulator` steps: :meth:`solve`
+        with ``time_step``: the conditions of joint friction, joint limits and
         contacts hold for the velocities at the end of the step, ``qd_next = qd + dt qdd``; then
         ``q_next = q + dt qd_next``. A joint that friction holds (status 1, sticking) ends the
         step exactly at rest, so a held arm keeps ``q`` bitwise (docs: "Friction in discrete

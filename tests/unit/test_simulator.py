@@ -131,6 +131,9 @@ def test_a_bad_dt_is_refused_with_a_message(chain, dt):
 
 
 def test_bad_input_messages(chain):
+    with pytest.raises(vs.SolverError, match="integrator must be one of"):
+        vs.Simulator(chain, DT, integrator="rk4")
+    assert vs.Simulator(chain, DT).integrator == "semi_implicit_euler"
     sim = vs.Simulator(chain, DT, q=GEN3_Q)
     with pytest.raises(vs.SolverError, match=r"q must have shape \(7,\)"):
         sim.reset(np.zeros(6), np.zeros(7))
