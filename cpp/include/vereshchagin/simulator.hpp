@@ -65,8 +65,8 @@ struct RolloutRecord {
 
 /// Fills the input of the next step from the state: joint positions q (rad or m), velocities
 /// q_dot (rad/s or m/s), the time t (s) at the start of the step. It may change anything in the
-/// input but its sizes' capacity (no allocation: reserve beforehand); q, q_dot and time_step it
-/// sets are ignored (the simulator's state and dt are used).
+/// input (within its reserved capacity, for steps without allocation); what it writes to q, q_dot
+/// and time_step is ignored (the simulator's state and dt are used).
 using Controller =
     std::function<void(const Eigen::VectorXd& q, const Eigen::VectorXd& q_dot, double t, SolveInput& input)>;
 
