@@ -15,7 +15,9 @@
    solve, out=, solve_batch per row and with threads=2, about 15 s) and benchmarks/bench_tree.py
    (trees: Baxter with one or two hands constrained and random trees of 15-60 joints vs Pinocchio's
    pipeline, from Python, about 60 s) and DIR/benchmarks/bench_contacts (the Gen3 with 4 point
-   contacts and a 3-D task vs plain solves, about 15 s);
+   contacts and a 3-D task vs plain solves, about 15 s) and DIR/benchmarks/bench_step and
+   benchmarks/bench_step.py (the time step and the Simulator vs friction-aware solves, C++ and
+   Python, about 10 s each);
    and, when CMake found Pinocchio's C++ headers, DIR/benchmarks/bench_tree_kkt (Baxter: our
    TreeHdSolver vs a dense KKT solve from Pinocchio's C++ pieces, about 20 s) and
    DIR/benchmarks/bench_pv (Gen3, tip held: ours vs Pinocchio's pv and constrainedABA, about 5 s)
@@ -244,6 +246,13 @@ def main():
     ct_file = build / "bench_contacts.md"
     ct_file.unlink(missing_ok=True)
     ct_rc = run([build / "benchmarks" / "bench_contacts", ct_file], stdout=subprocess.DEVNULL).returncode
+    step_file, steppy_file = build / "bench_step.md", build / "bench_step_py.md"
+    step_file.unlink(missing_ok=True)
+    steppy_file.unlink(missing_ok=True)
+    step_rc = run([build / "benchmarks" / "bench_step", step_file], stdout=subprocess.DEVNULL).returncode
+    steppy_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_step.py", "--out", steppy_file], stdout=subprocess.DEVNULL
+    ).returncode
     pv_file, pv_exe = build / "bench_pv.md", build / "benchmarks" / "bench_pv"
     pv_file.unlink(missing_ok=True)
     pv_rc = run([pv_exe, pv_file], stdout=subprocess.DEVNULL).returncode if pv_exe.exists() else 0
@@ -348,6 +357,16 @@ def main():
         if pypin_file.exists()
         else f"**bench_contacts_pinocchio.py exited with code {pypin_rc} and wrote no report.**",
         "",
+        "## Time step",
+        "",
+        step_file.read_text().rstrip()
+        if step_file.exists()
+        else f"**bench_step exited with code {step_rc} and wrote no report.**",
+        "",
+        steppy_file.read_text().rstrip()
+        if steppy_file.exists()
+        else f"**bench_step.py exited with code {steppy_rc} and wrote no report.**",
+        "",
         pv_file.read_text().rstrip()
         if pv_file.exists()
         else f"**bench_pv was not built (Pinocchio's C++ headers not found) or wrote no report (exit code {pv_rc}).**",
@@ -360,7 +379,7 @@ def main():
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
     codes = (cpp_rc, py_rc, fr_rc, frpy_rc, seg_rc, face_rc, tree_rc, kkt_rc, pv_rc, ct_rc, cpin_rc, pypin_rc)
-    return 0 if all(rc == 0 for rc in (*codes, hold_rc)) else 1
+    return 0 if all(rc == 0 for rc in (*codes, hold_rc, step_rc, steppy_rc)) else 1
 
 
 if __name__ == "__main__":

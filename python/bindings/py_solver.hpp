@@ -60,8 +60,9 @@ class PySolver {
   PySolver(const py::object& model, const py::object& gravity, const py::object& rcond, const py::object& damping,
            const py::object& inertia_check, const py::object& max_constraints);
 
-  // solve(): parses, solves on workspace 0 and returns a SolveResult (new, or `out`).
-  py::object solve(PyObject* const* args, PyObject* out);
+  // solve(): parses, solves on workspace 0 and returns a SolveResult (new, or `out`); with `step`,
+  // vereshchagin::step() over args' time_step instead, returning (q_next, qd_next, result).
+  py::object solve(PyObject* const* args, PyObject* out, bool step = false);
   // Seconds per C++ solve of the parsed row, reading every output solve() returns.
   double timeCpp(PyObject* const* args, long reps);
   // Benchmarks only (BENCHMARKS.md, "Call mechanism"): solve() returning a dict of new numpy
@@ -101,8 +102,9 @@ class PySolver {
 
  private:
   vereshchagin::BatchWorkspace& workspace(std::size_t k);
-  // Parses `args` into args_ and solves them on workspace 0 (the caller holds the Lock).
-  void solveArgs(PyObject* const* args, bool frictionless);
+  // Parses `args` into args_ and solves them on workspace 0 (the caller holds the Lock); given
+  // next = {q_next, qd_next} (nj doubles each), steps instead (vereshchagin::step).
+  void solveArgs(PyObject* const* args, bool frictionless, double* const* next = nullptr);
 
   std::unique_ptr<PyChain> chain_;  // the model: one of these two
   std::unique_ptr<PyTree> tree_;

@@ -1,4 +1,4 @@
-// Solver.solve (one row on workspace 0, its result new or written into `out`), its benchmark
+// Solver.solve (one row on workspace 0, its result new or written into `out`) and _step, its benchmark
 // hooks (_solve_dict, _time_cpp) and Solver.solve_batch (vereshchagin::solveBatch over one
 // workspace per thread), each on the arguments SolveArgs parsed.
 #include <algorithm>
@@ -10,7 +10,7 @@ namespace vsbind {
 
 using namespace pybind11::literals;
 
-void PySolver::solveArgs(PyObject* const* args, bool frictionless) {
+void PySolver::solveArgs(PyObject* const* args, bool frictionless, double* const* next) {
   last_state_ = false;
   args_.parse(*this, args, /*batch=*/false);
   if (frictionless && args_.any_friction) raise("_solve_dict benchmarks the frictionless call: no friction");
@@ -19,22 +19,28 @@ void PySolver::solveArgs(PyObject* const* args, bool frictionless) {
     py::gil_scoped_release release;
     vereshchagin::BatchWorkspace& w = *workspaces_[0];
     args_.input.fillRow(0, w.input);
-    st = vereshchagin::solve(cpp_model_, w.data, w.input);
+    using Vec = Eigen::Map<Eigen::VectorXd>;
+    st = next ? vereshchagin::step(cpp_model_, w.data, w.input, Vec(next[0], nj), Vec(next[1], nj))
+              : vereshchagin::solve(cpp_model_, w.data, w.input);
   }
   if (!st) raise(st.message());
   last_state_ = true;
 }
 
-py::object PySolver::solve(PyObject* const* args, PyObject* out) {
+py::object PySolver::solve(PyObject* const* args, PyObject* out, bool step) {
   Lock lk(*this);
-  solveArgs(args, false);
+  py::object q_next, qd_next;  // step's (no arrays made for a solve)
+  double* next[2] = {};
+  if (step) q_next = newDoubles({nj}), qd_next = newDoubles({nj});
+  if (step) next[0] = doubles(py::array(q_next)), next[1] = doubles(py::array(qd_next));
+  solveArgs(args, false, step ? next : nullptr);
   const bool fr = args_.any_friction;
   const long k = static_cast<long>(args_.input.contacts.size());
   py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr, k}, out);
   if (!resultOutput(r.ptr()).write(0, workspaces_[0]->data, args_.columns, fr))
     raise("the results overflow: gauss_value is beyond the double range");
   if (!args_.layout.empty()) setSegmentLayout(r.ptr(), py::tuple(args_.layout));
-  return r;
+  return step ? py::object(py::make_tuple(q_next, qd_next, r)) : r;
 }
 
 py::dict PySolver::solveDict(PyObject* const* args) {

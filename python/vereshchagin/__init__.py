@@ -13,6 +13,7 @@ from ._version import __version__ as __version__  # written once: CMakeLists.txt
 from .contacts import Contact, ContactOutcome, ContactStatus
 from .friction import Friction
 from .kdl_interop import chain_from_kdl as _chain_from_kdl, chain_to_kdl as _chain_to_kdl
+from .simulator import Simulator
 from .solver import BatchResult, Solver
 
 
@@ -45,6 +46,7 @@ __all__ = [
     "ContactStatus",
     "Friction",
     "Joint",
+    "Simulator",
     "SolveResult",
     "Solver",
     "SolverError",

@@ -612,6 +612,8 @@ DOCS["_core.Solver._time_cpp"] = r"""_time_cpp(reps, q, qd, ...) -> float: secon
 
 DOCS["_core.Solver._solve_dict"] = r"""_solve_dict(q, qd, ...) -> dict: solve() returning a dict of new arrays instead of a SolveResult (benchmarks)."""
 
+DOCS["_core.Solver._step"] = r"""_step(q, qd, ..., time_step=dt) -> (q_next, qd_next, SolveResult): the C++ step() (Solver.step, Simulator)."""
+
 DOCS["_core.Solver._solve_pybind"] = r"""_solve_pybind(q, qd, ...) -> SolveResult: solve() through pybind11's argument dispatch (benchmarks)."""
 
 # ---- SolveResult (result_type.cpp) ----

@@ -244,7 +244,8 @@ class Solver(_core.Solver):
     def step(self, q, qd, time_step, **solve_args):
         """One step of semi-implicit Euler over ``time_step`` with friction and contacts solved exactly.
 
-        :meth:`solve` with ``time_step``: the conditions of joint friction, joint limits and
+        The C++ ``step()`` (``data.hpp``; GIL released), as :class:`Simulator` steps: :meth:`solve`
+        with ``time_step``: the conditions of joint friction, joint limits and
         contacts hold for the velocities at the end of the step, ``qd_next = qd + dt qdd``; then
         ``q_next = q + dt qd_next``. A joint that friction holds (status 1, sticking) ends the
         step exactly at rest, so a held arm keeps ``q`` bitwise (docs: "Friction in discrete
@@ -275,11 +276,7 @@ class Solver(_core.Solver):
         dt = time_step
         if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating, np.integer)) or not dt > 0.0:
             raise _core.SolverError(f"time_step must be a number > 0 (s), got {time_step!r}")
-        result = self.solve(q, qd, time_step=dt, **solve_args)
-        qd_next = np.asarray(qd, dtype=np.float64) + float(dt) * result.qdd
-        if result.status is not None:  # held by friction: exactly at rest
-            qd_next[result.status == 1] = 0.0
-        return np.asarray(q, dtype=np.float64) + float(dt) * qd_next, qd_next, result
+        return self._step(q, qd, time_step=dt, **solve_args)  # the C++ step(), GIL released
 
     @property
     def chain(self) -> _core.Chain:

@@ -1,0 +1,122 @@
+// The Simulator (simulator.hpp): its state, one step through step() of data.hpp on a copy of the
+// caller's input carrying the simulator's state and dt, and rollout() with a controller callback
+// recording into the caller's buffers. Nothing allocates per step once the sizes are settled.
+#include "vereshchagin/simulator.hpp"
+
+#include <cmath>
+
+namespace vereshchagin {
+
+namespace {
+
+bool finite(const Eigen::Ref<const Eigen::VectorXd>& v) {
+  return v.allFinite();
+}
+
+}  // namespace
+
+void RolloutRecord::resize(int n_joints, int n_steps, bool tau_cmd, bool friction, int n_contacts) {
+  t.resize(n_steps + 1);
+  q.resize(n_joints, n_steps + 1);
+  q_dot.resize(n_joints, n_steps + 1);
+  tau_command.resize(n_joints, tau_cmd ? n_steps : 0);
+  friction_torque.resize(n_joints, friction ? n_steps : 0);
+  contact_force.resize(3 * n_contacts, n_contacts > 0 ? n_steps : 0);
+}
+
+Simulator::Simulator(const Model& model, double dt, Integrator integrator, const SolverOptions& options)
+    : model_(model),
+      data_(model_, options),
+      work_(model_),
+      q_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      qd_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      dt_(dt),
+      integrator_(integrator) {
+  if (!model_.status())
+    status_ = model_.status();
+  else if (!data_.status())
+    status_ = data_.status();
+  else if (!(dt > 0.0) || !std::isfinite(dt))
+    status_ = Status(Error::OutOfRange, "Simulator: the time step dt must be finite and > 0 (s)");
+  else if (integrator != Integrator::SemiImplicitEuler)
+    status_ = Status(Error::OutOfRange, "Simulator: unknown integrator");
+}
+
+Status Simulator::status() const noexcept {
+  return status_;
+}
+
+Status Simulator::setState(const JointPositions& q, const JointVelocities& q_dot, double t) {
+  const long n = static_cast<long>(model_.nrOfJoints());
+  if (q.value().size() != n || q_dot.value().size() != n)
+    return Status(Error::SizeMismatch, "Simulator::setState: q and q_dot must have one entry per joint");
+  if (!finite(*q) || !finite(*q_dot) || !std::isfinite(t))
+    return Status(Error::NonfiniteInput, "Simulator::setState: q, q_dot and t must be finite");
+  q_ = *q;
+  qd_ = *q_dot;
+  t0_ = t;
+  steps_ = 0;
+  return Status();
+}
+
+Status Simulator::step(const SolveInput& input) {
+  if (!status_) return status_;
+  work_ = input;  // every field of the caller's input (no allocation at equal sizes and capacity)
+  work_.q = q_;
+  work_.q_dot = qd_;
+  work_.time_step = dt_;
+  // Integrator::SemiImplicitEuler (the only one): step() writes q_, qd_ only on success.
+  const Status s = vereshchagin::step(model_, data_, work_, q_, qd_);
+  if (s) ++steps_;
+  return s;
+}
+
+Status Simulator::checkRecord(int n_steps, const SolveInput& input, const RolloutRecord& r) const {
+  const long n = static_cast<long>(model_.nrOfJoints()), states = n_steps + 1L;
+  if (n_steps < 0) return Status(Error::OutOfRange, "Simulator::rollout: n_steps must be >= 0");
+  if (r.t.size() != states || r.q.rows() != n || r.q.cols() != states || r.q_dot.rows() != n ||
+      r.q_dot.cols() != states)
+    return Status(Error::SizeMismatch,
+                  "Simulator::rollout: record t, q, q_dot must have n_steps + 1 entries (columns) of n_joints");
+  const auto optional = [&](const Eigen::MatrixXd& m, long rows) {
+    return m.cols() == 0 || (m.rows() == rows && m.cols() == n_steps);
+  };
+  const long contacts = 3 * static_cast<long>(input.contacts.size());
+  if (!optional(r.tau_command, n) || !optional(r.friction_torque, n) || !optional(r.contact_force, contacts))
+    return Status(Error::SizeMismatch,
+                  "Simulator::rollout: record tau_command, friction_torque (n_joints rows) and contact_force "
+                  "(3 per contact) must have n_steps columns or none");
+  return Status();
+}
+
+void Simulator::recordStep(int k, RolloutRecord& r) const {
+  r.t(k + 1) = time();
+  r.q.col(k + 1) = q_;
+  r.q_dot.col(k + 1) = qd_;
+  if (r.tau_command.cols() > 0) r.tau_command.col(k) = data_.commandTorques();
+  if (r.friction_torque.cols() > 0) r.friction_torque.col(k) = data_.frictionTorques();
+  if (r.contact_force.cols() > 0)
+    r.contact_force.col(k) = Eigen::Map<const Eigen::VectorXd>(data_.contactForces().data(), r.contact_force.rows());
+}
+
+Status Simulator::rollout(int n_steps, const Controller& controller, SolveInput& input, RolloutRecord& record,
+                          int* steps_done) {
+  if (steps_done) *steps_done = 0;
+  if (!status_) return status_;
+  if (const Status s = checkRecord(n_steps, input, record); !s) return s;
+  record.t(0) = time();
+  record.q.col(0) = q_;
+  record.q_dot.col(0) = qd_;
+  for (int k = 0; k < n_steps; ++k) {
+    if (controller) controller(q_, qd_, time(), input);
+    if (record.contact_force.cols() > 0 && record.contact_force.rows() != 3 * static_cast<long>(input.contacts.size()))
+      return Status(Error::SizeMismatch, "Simulator::rollout: the controller changed the number of contacts");
+    const Status s = step(input);
+    if (!s) return s;
+    recordStep(k, record);
+    if (steps_done) *steps_done = k + 1;
+  }
+  return Status();
+}
+
+}  // namespace vereshchagin
