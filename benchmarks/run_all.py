@@ -24,7 +24,8 @@
    and DIR/benchmarks/bench_contacts_pinocchio (the contacts of bench_contacts vs Pinocchio's ADMM
    and PGS at 1e-10, about 70 s); then benchmarks/bench_contacts_pinocchio.py (the same from
    Python, about 3 min) and benchmarks/bench_hold_creep.py (a friction-held Gen3's creep: ours
-   against MuJoCo and Pinocchio's ADMM, about 5 s);
+   against MuJoCo and Pinocchio's ADMM, about 5 s) and benchmarks/bench_energy.py (passive energy of a
+   swinging Gen3: our integrators against MuJoCo's, about 5 s);
 6. writes FILE (default: BENCHMARKS.md) with the machine, compiler, flags, library versions,
    the method, the target checks and all reports.
 """
@@ -265,6 +266,11 @@ def main():
         [sys.executable, REPO / "benchmarks" / "bench_contacts_pinocchio.py", "--out", pypin_file],
         stdout=subprocess.DEVNULL,
     ).returncode
+    energy_file = build / "bench_energy.md"
+    energy_file.unlink(missing_ok=True)
+    energy_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_energy.py", "--out", energy_file], stdout=subprocess.DEVNULL
+    ).returncode
     hold_file = build / "bench_hold_creep.md"
     hold_file.unlink(missing_ok=True)
     hold_rc = run(
@@ -375,11 +381,15 @@ def main():
         if hold_file.exists()
         else f"**bench_hold_creep.py exited with code {hold_rc} and wrote no report.**",
         "",
+        energy_file.read_text().rstrip()
+        if energy_file.exists()
+        else f"**bench_energy.py exited with code {energy_rc} and wrote no report.**",
+        "",
     ]
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
     codes = (cpp_rc, py_rc, fr_rc, frpy_rc, seg_rc, face_rc, tree_rc, kkt_rc, pv_rc, ct_rc, cpin_rc, pypin_rc)
-    return 0 if all(rc == 0 for rc in (*codes, hold_rc, step_rc, steppy_rc)) else 1
+    return 0 if all(rc == 0 for rc in (*codes, hold_rc, energy_rc, step_rc, steppy_rc)) else 1
 
 
 if __name__ == "__main__":

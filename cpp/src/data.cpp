@@ -8,6 +8,7 @@
 #include "entry_guard.hpp"
 #include "friction_core.hpp"
 #include "model_impl.hpp"
+#include "symplectic_step.hpp"
 
 namespace vereshchagin {
 

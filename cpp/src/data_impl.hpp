@@ -14,6 +14,7 @@ namespace detail {
 
 class FrictionCore;
 class ContactStage;
+struct SymplecticWorkspace;
 
 struct DataImpl {
   DataImpl(const Model& model, const SolverOptions& options);
@@ -43,6 +44,7 @@ struct DataImpl {
   std::unique_ptr<ContactStage> contact_stage;
   bool contacts_last = false;  // the last successful solve had contacts (or friction over a time step)
   bool stage_joints = false;   // ... with joint friction or over a time step: the joint outputs are the stage's
+  std::unique_ptr<SymplecticWorkspace> symplectic;  // stepSymplectic()'s, built at its first call
 };
 
 // Assembles `in` into the core's arguments and runs the sweeps (with the friction stage when it

@@ -30,6 +30,11 @@ Simulator::Simulator(const Model& model, double dt, Integrator integrator, const
       work_(model_),
       q_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
       qd_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      p_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      q_next_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      qd_next_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      p_next_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      dynamics_(model_),
       dt_(dt),
       integrator_(integrator) {
   if (!model_.status())
@@ -38,8 +43,13 @@ Simulator::Simulator(const Model& model, double dt, Integrator integrator, const
     status_ = data_.status();
   else if (!(dt > 0.0) || !std::isfinite(dt))
     status_ = Status(Error::OutOfRange, "Simulator: the time step dt must be finite and > 0 (s)");
-  else if (integrator != Integrator::SemiImplicitEuler)
+  else if (integrator != Integrator::SemiImplicitEuler && integrator != Integrator::Symplectic)
     status_ = Status(Error::OutOfRange, "Simulator: unknown integrator");
+  else if (integrator == Integrator::Symplectic) {  // its workspace now: no step allocates
+    SolveInput rest(model_);
+    rest.time_step = dt_;
+    status_ = stepSymplectic(model_, data_, rest, p_, q_next_, qd_next_, p_next_);
+  }
 }
 
 Status Simulator::status() const noexcept {
@@ -52,6 +62,13 @@ Status Simulator::setState(const JointPositions& q, const JointVelocities& q_dot
     return Status(Error::SizeMismatch, "Simulator::setState: q and q_dot must have one entry per joint");
   if (!finite(*q) || !finite(*q_dot) || !std::isfinite(t))
     return Status(Error::NonfiniteInput, "Simulator::setState: q, q_dot and t must be finite");
+  if (integrator_ == Integrator::Symplectic) {  // p = H(q) q_dot: Newton-Euler at (q, 0, q_dot), no gravity
+    qd_next_.setZero();                         // scratch: the zero velocity
+    const Status s = inverseDynamics(model_, dynamics_, q, JointVelocities(qd_next_), JointAccelerations(*q_dot),
+                                     Eigen::Map<const Matrix6X>(nullptr, 6, 0), KDL::Vector::Zero(), p_next_);
+    if (!s) return s;
+    p_ = p_next_;
+  }
   q_ = *q;
   qd_ = *q_dot;
   t0_ = t;
@@ -65,7 +82,14 @@ Status Simulator::step(const SolveInput& input) {
   work_.q = q_;
   work_.q_dot = qd_;
   work_.time_step = dt_;
-  // Integrator::SemiImplicitEuler (the only one): step() writes q_, qd_ only on success.
+  if (integrator_ == Integrator::Symplectic) {
+    const Status s = stepSymplectic(model_, data_, work_, p_, q_next_, qd_next_, p_next_);
+    if (!s) return s;
+    q_.swap(q_next_), qd_.swap(qd_next_), p_.swap(p_next_);
+    ++steps_;
+    return s;
+  }
+  // Integrator::SemiImplicitEuler: step() writes q_, qd_ only on success.
   const Status s = vereshchagin::step(model_, data_, work_, q_, qd_);
   if (s) ++steps_;
   return s;

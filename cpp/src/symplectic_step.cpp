@@ -9,6 +9,8 @@
 #include <cmath>
 
 #include "symplectic_step.hpp"
+
+#include "data_impl.hpp"
 #include "vereshchagin/energy.hpp"
 
 namespace vereshchagin {
@@ -93,4 +95,14 @@ Status symplecticStep(const Model& model, Data& data, SymplecticWorkspace& ws, c
 }
 
 }  // namespace detail
+Status stepSymplectic(const Model& model, Data& data, const SolveInput& input,
+                      const Eigen::Ref<const Eigen::VectorXd>& momentum, Eigen::Ref<Eigen::VectorXd> q_next,
+                      Eigen::Ref<Eigen::VectorXd> qd_next, Eigen::Ref<Eigen::VectorXd> momentum_next) {
+  if (!data.model().sameAs(model))
+    return Status(Error::NotUpToDate, "stepSymplectic(): the Data was built for another model");
+  detail::DataImpl& d = data.impl();
+  if (!d.symplectic) d.symplectic = std::make_unique<detail::SymplecticWorkspace>(model);
+  return detail::symplecticStep(model, data, *d.symplectic, input, momentum, q_next, qd_next, momentum_next);
+}
+
 }  // namespace vereshchagin

@@ -487,51 +487,54 @@ TEST_CASE_FIXTURE(Fixture, "redundant resting contacts (the least-effort guess) 
 TEST_CASE_FIXTURE(Fixture, "Simulator steps and rollouts with friction and contacts do not allocate once warm") {
   // A moving arm with joint friction, then with a support with friction under its last segment,
   // stepped one by one and by rollout() with a controller writing ff_torques; the first step of
-  // each kind sizes the friction and contact stages.
+  // each kind sizes the friction and contact stages. Both integrators.
   const vereshchagin::Model model(chain);
-  vereshchagin::Simulator sim(model, 1e-3);
-  sim.reserveFriction();
-  vereshchagin::SolveInput in(model);
-  vereshchagin::FrictionModel fm;
-  fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
-  fm.kinetic_friction = 0.5 * fm.static_friction;
-  vereshchagin::PointContact pc;
-  pc.segment = static_cast<int>(ns) - 1;
-  pc.mu = 0.6;
-  in.contacts.reserve(1);
-  vereshchagin::RolloutRecord rec;
-  rec.resize(static_cast<int>(n), 20, true, true, 1);
-  const vereshchagin::Controller controller = [&](const Eigen::VectorXd& qs, const Eigen::VectorXd& qds, double,
-                                                  vereshchagin::SolveInput& input) {
-    input.ff_torques = -2.0 * qs - 0.1 * qds;
-  };
-  int sfail = 0;
-  double ssum = 0.0;
-  std::string last_error;
-  const auto run = [&](int s, bool contact) {
-    if (!sim.setState(vereshchagin::JointPositions(q[s].data), vereshchagin::JointVelocities(qd[s].data))) ++sfail;
-    in.friction = &fm;
-    in.contacts.clear();
-    if (contact) in.contacts.push_back(pc);
-    in.ff_torques = ff[s].data;
-    for (int k = 0; k < 5; ++k) {
-      const vereshchagin::Status st = sim.step(in);
+  for (const auto integrator : {vereshchagin::Integrator::SemiImplicitEuler, vereshchagin::Integrator::Symplectic}) {
+    CAPTURE(static_cast<int>(integrator));
+    vereshchagin::Simulator sim(model, 1e-3, integrator);
+    sim.reserveFriction();
+    vereshchagin::SolveInput in(model);
+    vereshchagin::FrictionModel fm;
+    fm.static_friction = Eigen::VectorXd::LinSpaced(n, 0.5, 3.0);
+    fm.kinetic_friction = 0.5 * fm.static_friction;
+    vereshchagin::PointContact pc;
+    pc.segment = static_cast<int>(ns) - 1;
+    pc.mu = 0.6;
+    in.contacts.reserve(1);
+    vereshchagin::RolloutRecord rec;
+    rec.resize(static_cast<int>(n), 20, true, true, 1);
+    const vereshchagin::Controller controller = [&](const Eigen::VectorXd& qs, const Eigen::VectorXd& qds, double,
+                                                    vereshchagin::SolveInput& input) {
+      input.ff_torques = -2.0 * qs - 0.1 * qds;
+    };
+    int sfail = 0;
+    double ssum = 0.0;
+    std::string last_error;
+    const auto run = [&](int s, bool contact) {
+      if (!sim.setState(vereshchagin::JointPositions(q[s].data), vereshchagin::JointVelocities(qd[s].data))) ++sfail;
+      in.friction = &fm;
+      in.contacts.clear();
+      if (contact) in.contacts.push_back(pc);
+      in.ff_torques = ff[s].data;
+      for (int k = 0; k < 5; ++k) {
+        const vereshchagin::Status st = sim.step(in);
+        if (!st && st.code() != vereshchagin::Error::NoContactSolution) ++sfail, last_error = st.message();
+      }
+      rec.contact_force.resize(contact ? 3 : 0, contact ? 20 : 0);  // measured: always 3 x 20, no allocation
+      const vereshchagin::Status st = sim.rollout(20, controller, in, rec);
       if (!st && st.code() != vereshchagin::Error::NoContactSolution) ++sfail, last_error = st.message();
-    }
-    rec.contact_force.resize(contact ? 3 : 0, contact ? 20 : 0);  // measured: always 3 x 20, no allocation
-    const vereshchagin::Status st = sim.rollout(20, controller, in, rec);
-    if (!st && st.code() != vereshchagin::Error::NoContactSolution) ++sfail, last_error = st.message();
-    ssum += sim.q()(0) + sim.data().frictionTorques()(1);
-  };
-  for (int s = 0; s < kSets; ++s)
-    for (const bool contact : {false, true}) run(s, contact);  // warm
-  rec.contact_force.resize(3, 20);
-  const Counts c0 = now();
-  for (int it = 0; it < 40; ++it) run(it % kSets, true);
-  const Counts c1 = now();
-  CHECK_MESSAGE(sfail == 0, "Simulator steps failed: " << str(sfail) << " (" << last_error << ")");
-  CHECK_MESSAGE(std::isfinite(ssum), "non-finite Simulator results");
-  CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "Simulator steps allocated: operator new "
-                                                                      << str(c1.news - c0.news) << ", malloc "
-                                                                      << str(c1.mallocs - c0.mallocs));
+      ssum += sim.q()(0) + sim.data().frictionTorques()(1);
+    };
+    for (int s = 0; s < kSets; ++s)
+      for (const bool contact : {false, true}) run(s, contact);  // warm
+    rec.contact_force.resize(3, 20);
+    const Counts c0 = now();
+    for (int it = 0; it < 40; ++it) run(it % kSets, true);
+    const Counts c1 = now();
+    CHECK_MESSAGE(sfail == 0, "Simulator steps failed: " << str(sfail) << " (" << last_error << ")");
+    CHECK_MESSAGE(std::isfinite(ssum), "non-finite Simulator results");
+    CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "Simulator steps allocated: operator new "
+                                                                        << str(c1.news - c0.news) << ", malloc "
+                                                                        << str(c1.mallocs - c0.mallocs));
+  }
 }

@@ -1,6 +1,7 @@
 // The Simulator (simulator.hpp): a 7-joint arm held by friction keeps q bitwise over 10^5 steps;
 // its steps equal step() of data.hpp bitwise; rollout() equals repeated step() bitwise, records
-// what it is asked for and stops at a failing step; bad dt, state, sizes give error statuses.
+// what it is asked for and stops at a failing step; bad dt, state, sizes give error statuses; the
+// symplectic integrator holds bitwise, equals stepSymplectic() and starts from p = H(q) q_dot.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -169,4 +170,43 @@ TEST_CASE("the Simulator refuses bad input with a status, never a crash") {
   CHECK(done == 3);
   CHECK(sim.time() == 3e-3);
   CHECK(sim.q().allFinite());
+}
+
+TEST_CASE("the symplectic Simulator: held bitwise, equal to stepSymplectic(), momentum H(q) q_dot at the start") {
+  RandomGen g(84);
+  const Model model(g.chain(7));
+  const Eigen::VectorXd q0 = g.q(7).data, v0 = g.qdot(7).data;
+  const FrictionModel fm = holdingFriction(model, q0);
+  SolveInput in(model);
+  Simulator held(model, 1e-3, Integrator::Symplectic);
+  REQUIRE(held.status());
+  REQUIRE(held.setState(JointPositions(q0), JointVelocities(Eigen::VectorXd::Zero(7))));
+  in.friction = &fm;
+  bool ok = true;
+  for (int k = 0; k < 100000 && ok; ++k) ok = held.step(in).code() == Error::None;
+  REQUIRE(ok);
+  CHECK(same(held.q(), q0));
+  CHECK((held.qDot().array() == 0.0).all());
+  CHECK((held.momentum().array() == 0.0).all());
+
+  Simulator sim(model, 1e-3, Integrator::Symplectic);
+  REQUIRE(sim.setState(JointPositions(q0), JointVelocities(v0)));
+  DynamicsData dd(model);
+  Eigen::MatrixXd H(7, 7);
+  REQUIRE(massMatrix(model, dd, JointPositions(q0), H));
+  CHECK((sim.momentum() - H * v0).norm() <= 1e-12 * (1.0 + (H * v0).norm()));
+  Data data(model);
+  Eigen::VectorXd q = q0, u = v0, p = sim.momentum(), q1(7), u1(7), p1(7);
+  in.time_step = 1e-3;
+  for (int k = 0; k < 300; ++k) {
+    in.ff_torques = Eigen::VectorXd::Constant(7, 0.01 * k);
+    REQUIRE(sim.step(in));
+    in.q = q, in.q_dot = u;
+    REQUIRE(stepSymplectic(model, data, in, p, q1, u1, p1));
+    q = q1, u = u1, p = p1;
+  }
+  CHECK(same(sim.q(), q));
+  CHECK(same(sim.qDot(), u));
+  CHECK(same(sim.momentum(), p));
+  CHECK(same(sim.data().frictionTorques(), data.frictionTorques()));
 }

@@ -7,7 +7,7 @@ namespace vsbind {
 void bindChain(py::module_& mod);       // model_chain.cpp: Joint and Chain
 void bindTree(py::module_& mod);        // model_bindings.cpp
 void bindSolver(py::module_& mod);      // solver_bindings.cpp
-void bindResultType(py::module_& mod);  // result_type.cpp
+void bindResultType(py::module_& mod);  // result_type.cpp: SolveResult and _result_from_parts (pickling)
 void bindDynamics(py::module_& mod);    // companions.cpp: the companions of Chain and Tree, _beta_for
 }  // namespace vsbind
 

@@ -60,9 +60,10 @@ class PySolver {
   PySolver(const py::object& model, const py::object& gravity, const py::object& rcond, const py::object& damping,
            const py::object& inertia_check, const py::object& max_constraints);
 
-  // solve(): parses, solves on workspace 0 and returns a SolveResult (new, or `out`); with `step`,
-  // vereshchagin::step() over args' time_step instead, returning (q_next, qd_next, result).
-  py::object solve(PyObject* const* args, PyObject* out, bool step = false);
+  // solve(): parses, solves on workspace 0 and returns a SolveResult (new, or `out`); step 1:
+  // vereshchagin::step() over args' time_step, (q_next, qd_next, result); step 2: stepSymplectic()
+  // from the momentum `out`, (q_next, qd_next, momentum_next, result).
+  py::object solve(PyObject* const* args, PyObject* out, int step = 0);
   // Seconds per C++ solve of the parsed row, reading every output solve() returns.
   double timeCpp(PyObject* const* args, long reps);
   // Benchmarks only (BENCHMARKS.md, "Call mechanism"): solve() returning a dict of new numpy
@@ -103,8 +104,8 @@ class PySolver {
  private:
   vereshchagin::BatchWorkspace& workspace(std::size_t k);
   // Parses `args` into args_ and solves them on workspace 0 (the caller holds the Lock); given
-  // next = {q_next, qd_next} (nj doubles each), steps instead (vereshchagin::step).
-  void solveArgs(PyObject* const* args, bool frictionless, double* const* next = nullptr);
+  // next = {q_next, qd_next, p_next} (nj doubles each), steps instead (step(), stepSymplectic() from p).
+  void solveArgs(PyObject* const* args, bool frictionless, double* const* next = nullptr, const double* p = nullptr);
 
   std::unique_ptr<PyChain> chain_;  // the model: one of these two
   std::unique_ptr<PyTree> tree_;

@@ -11,10 +11,6 @@ namespace vsbind {
 
 namespace py = pybind11;
 
-// Registers the type on `mod` (as SolveResult) and _result_from_parts, the storage side of
-// pickling (vereshchagin/_results.py).
-void bindResultType(py::module_& mod);
-
 // A new result for `layout` (data uninitialised), or `out` after checking that it is a
 // SolveResult of the same layout (raises SolverError otherwise). Returns a new reference.
 py::object newResult(const vereshchagin::PackedRow& layout, PyObject* out);

@@ -1,4 +1,5 @@
-// Solver.solve (one row on workspace 0, its result new or written into `out`) and _step, its benchmark
+// Solver.solve (one row on workspace 0, its result new or written into `out`), _step and
+// _step_symplectic, its benchmark
 // hooks (_solve_dict, _time_cpp) and Solver.solve_batch (vereshchagin::solveBatch over one
 // workspace per thread), each on the arguments SolveArgs parsed.
 #include <algorithm>
@@ -10,7 +11,7 @@ namespace vsbind {
 
 using namespace pybind11::literals;
 
-void PySolver::solveArgs(PyObject* const* args, bool frictionless, double* const* next) {
+void PySolver::solveArgs(PyObject* const* args, bool frictionless, double* const* next, const double* p) {
   last_state_ = false;
   args_.parse(*this, args, /*batch=*/false);
   if (frictionless && args_.any_friction) raise("_solve_dict benchmarks the frictionless call: no friction");
@@ -19,28 +20,31 @@ void PySolver::solveArgs(PyObject* const* args, bool frictionless, double* const
     py::gil_scoped_release release;
     vereshchagin::BatchWorkspace& w = *workspaces_[0];
     args_.input.fillRow(0, w.input);
-    using Vec = Eigen::Map<Eigen::VectorXd>;
-    st = next ? vereshchagin::step(cpp_model_, w.data, w.input, Vec(next[0], nj), Vec(next[1], nj))
-              : vereshchagin::solve(cpp_model_, w.data, w.input);
+    const auto P = [&](int k) { return Eigen::Map<Eigen::VectorXd>(next[k], nj); };
+    st = !next ? vereshchagin::solve(cpp_model_, w.data, w.input)
+         : p ? vereshchagin::stepSymplectic(cpp_model_, w.data, w.input, Eigen::Map<const Eigen::VectorXd>(p, nj), P(0),
+                                            P(1), P(2))
+             : vereshchagin::step(cpp_model_, w.data, w.input, P(0), P(1));
   }
   if (!st) raise(st.message());
   last_state_ = true;
 }
 
-py::object PySolver::solve(PyObject* const* args, PyObject* out, bool step) {
+py::object PySolver::solve(PyObject* const* args, PyObject* out, int step) {
   Lock lk(*this);
-  py::object q_next, qd_next;  // step's (no arrays made for a solve)
-  double* next[2] = {};
-  if (step) q_next = newDoubles({nj}), qd_next = newDoubles({nj});
-  if (step) next[0] = doubles(py::array(q_next)), next[1] = doubles(py::array(qd_next));
-  solveArgs(args, false, step ? next : nullptr);
+  py::object next_arrays[3];  // the step's (no arrays made for a solve)
+  double* next[3] = {};
+  for (int k = 0; k < (step == 2 ? 3 : step ? 2 : 0); ++k) next[k] = doubles(next_arrays[k] = newDoubles({nj}));
+  const F64View p = step == 2 ? vectorView(out ? out : Py_None, "momentum (out=)", nj) : F64View();
+  solveArgs(args, false, step ? next : nullptr, step == 2 ? p.data : nullptr);
   const bool fr = args_.any_friction;
   const long k = static_cast<long>(args_.input.contacts.size());
-  py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr, k}, out);
+  py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr, k}, step ? nullptr : out);
   if (!resultOutput(r.ptr()).write(0, workspaces_[0]->data, args_.columns, fr))
     raise("the results overflow: gauss_value is beyond the double range");
   if (!args_.layout.empty()) setSegmentLayout(r.ptr(), py::tuple(args_.layout));
-  return step ? py::object(py::make_tuple(q_next, qd_next, r)) : r;
+  if (step == 2) return py::make_tuple(next_arrays[0], next_arrays[1], next_arrays[2], r);
+  return step ? py::object(py::make_tuple(next_arrays[0], next_arrays[1], r)) : r;
 }
 
 py::dict PySolver::solveDict(PyObject* const* args) {

@@ -65,14 +65,15 @@ PyObject* guarded(Body&& body) {
   return nullptr;
 }
 
-enum Entry { kSolve, kTimeCpp, kSolveDict, kSolveBatch, kStep };
-constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict", "solve_batch", "_step"};
+enum Entry { kSolve, kTimeCpp, kSolveDict, kSolveBatch, kStep, kStepSymplectic };
+constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict", "solve_batch", "_step", "_step_symplectic"};
 
 // The METH_FASTCALL methods: solve(q, qd, ...); _time_cpp(reps, q, qd, ...): seconds per C++
 // solve (outputs read as solve() reads them), for benchmarks that compare the Python call with
 // the C++ work in the same process; _solve_dict(q, qd, ...): solve() returning a dict of arrays;
 // solve_batch(q, qd, ..., threads, a_desired, contacts): a dict of the batch's arrays (solver.py wraps it);
-// _step(q, qd, ..., time_step=dt): vereshchagin::step(), (q_next, qd_next, SolveResult).
+// _step(q, qd, ..., time_step=dt): vereshchagin::step(), (q_next, qd_next, SolveResult);
+// _step_symplectic(..., out=momentum): stepSymplectic(), (q_next, qd_next, momentum_next, SolveResult).
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
@@ -84,7 +85,8 @@ PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyO
     if (kind == kTimeCpp) return py::float_(solverOf(self).timeCpp(a, reps));
     if (kind == kSolveDict) return solverOf(self).solveDict(a);
     if (kind == kSolveBatch) return solverOf(self).solveBatch(a, a[kOutArg]);
-    return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg], kind == kStep);
+    return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg],
+                                kind == kSolve ? 0 : kind - kSolveBatch);
   });
 }
 
@@ -94,8 +96,8 @@ PyMethodDef fastDef() {  // the doc is set in bindSolver()
           METH_FASTCALL | METH_KEYWORDS, nullptr};
 }
 
-PyMethodDef g_fast_defs[] = {fastDef<kSolve>(), fastDef<kTimeCpp>(), fastDef<kSolveDict>(), fastDef<kSolveBatch>(),
-                             fastDef<kStep>()};
+PyMethodDef g_fast_defs[] = {fastDef<kSolve>(),      fastDef<kTimeCpp>(), fastDef<kSolveDict>(),
+                             fastDef<kSolveBatch>(), fastDef<kStep>(),    fastDef<kStepSymplectic>()};
 
 using O = const py::object&;
 

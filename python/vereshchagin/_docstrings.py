@@ -614,6 +614,8 @@ DOCS["_core.Solver._solve_dict"] = r"""_solve_dict(q, qd, ...) -> dict: solve() 
 
 DOCS["_core.Solver._step"] = r"""_step(q, qd, ..., time_step=dt) -> (q_next, qd_next, SolveResult): the C++ step() (Solver.step, Simulator)."""
 
+DOCS["_core.Solver._step_symplectic"] = r"""_step_symplectic(q, qd, ..., time_step=dt, out=p) -> (q_next, qd_next, p_next, SolveResult): the C++ stepSymplectic() from the momentum p (Simulator)."""
+
 DOCS["_core.Solver._solve_pybind"] = r"""_solve_pybind(q, qd, ...) -> SolveResult: solve() through pybind11's argument dispatch (benchmarks)."""
 
 # ---- SolveResult (result_type.cpp) ----

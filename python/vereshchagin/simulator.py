@@ -11,8 +11,8 @@ from .solver import Solver
 _RECORDABLE = ("tau_command", "friction_torque", "contact_force", "status")
 # Arguments of Solver.solve that the simulator sets itself.
 _OWN_ARGS = frozenset(("q", "qd", "time_step", "out"))
-# The integrators (C++: vereshchagin::Integrator); one today.
-_INTEGRATORS = ("semi_implicit_euler",)
+# The integrators (C++: vereshchagin::Integrator).
+_INTEGRATORS = ("semi_implicit_euler", "symplectic")
 
 
 def _check_dt(dt) -> float:
@@ -54,8 +54,13 @@ class Simulator:
     t : float
         The initial time, s (default 0).
     integrator : str
-        ``"semi_implicit_euler"`` (the only one today, C++ ``Integrator::SemiImplicitEuler``): the
-        velocity terms at the start of the step, friction, limits and contacts at its end.
+        ``"semi_implicit_euler"`` (default, C++ ``Integrator::SemiImplicitEuler``): the velocity
+        terms at the start of the step, friction, limits and contacts at its end. ``"symplectic"``
+        (C++ ``Integrator::Symplectic``, ``stepSymplectic()``): symplectic Euler in momentum form,
+        ``H(q) qd_next = p + dt (tau - g(q) + dT/dq(q, qd_next))`` plus the impulses, solved by
+        fixed-point iteration (each iteration one exact solve; one at rest); it carries the
+        momentum :attr:`momentum`, and its passive energy error stays bounded where semi-implicit
+        Euler gains energy (docs: "Friction in discrete time", "Passive energy").
 
     Raises
     ------
@@ -84,6 +89,7 @@ class Simulator:
         self._integrator = integrator
         self._dt = _check_dt(dt)
         self._solver = Solver(model, gravity, rcond, damping, inertia_check, max_constraints)
+        self._model = self._solver.model  # the momentum H(q) qd at reset (symplectic)
         n = self._solver.n_joints
         self.reset(np.zeros(n) if q is None else q, np.zeros(n) if qd is None else qd, t)
 
@@ -101,6 +107,7 @@ class Simulator:
         if isinstance(t, bool) or not isinstance(t, (int, float, np.floating, np.integer)) or not np.isfinite(t):
             raise _core.SolverError(f"Simulator: t must be a finite number (s), got {t!r}")
         self._q, self._qd, self._t0, self._steps = q, qd, float(t), 0
+        self._p = self._model.mass_matrix(q) @ qd if self._integrator == "symplectic" else None
 
     def step(self, **solve_args):
         """Advances the state by one step and returns the step's :class:`SolveResult`.
@@ -127,7 +134,14 @@ class Simulator:
         """
         if _OWN_ARGS.intersection(solve_args):
             self._check_own(solve_args)
-        self._q, self._qd, result = self._solver._step(self._q, self._qd, time_step=self._dt, **solve_args)
+        return self._advance(solve_args)
+
+    def _advance(self, args):
+        if self._p is None:
+            self._q, self._qd, result = self._solver._step(self._q, self._qd, time_step=self._dt, **args)
+        else:
+            step = self._solver._step_symplectic
+            self._q, self._qd, self._p, result = step(self._q, self._qd, time_step=self._dt, out=self._p, **args)
         self._steps += 1
         return result
 
@@ -173,14 +187,13 @@ class Simulator:
         if controller is not None and not callable(controller):
             raise _core.SolverError("Simulator.rollout: controller must be a callable (t, q, qd) -> dict, or None")
         self._check_own(solve_args)
-        n, dt, step = self._solver.n_joints, self._dt, self._solver._step
+        n, dt = self._solver.n_joints, self._dt
         q_out, qd_out = np.empty((n_steps + 1, n)), np.empty((n_steps + 1, n))
         q_out[0], qd_out[0], first = self._q, self._qd, self._steps
         rows = {name: [] for name in record}
         for k in range(n_steps):
             args = solve_args if controller is None else self._controller_args(controller, solve_args)
-            self._q, self._qd, result = step(self._q, self._qd, time_step=dt, **args)
-            self._steps += 1
+            result = self._advance(args)
             q_out[k + 1], qd_out[k + 1] = self._q, self._qd
             for name in record:
                 rows[name].append(getattr(result, name))
@@ -225,6 +238,16 @@ class Simulator:
     def qd(self) -> np.ndarray:
         """Joint velocities at the current time, rad/s or m/s (a copy)."""
         return self._qd.copy()
+
+    @property
+    def momentum(self):
+        """The symplectic integrator's momentum ``p`` (N m s or N s, a copy), None for the other.
+
+        ``H(q) qd`` after :meth:`reset`; after a step ``H(q_prev) qd``, the momentum the step left
+        (``qd`` is the step's velocity, the one that moved ``q``); ``H(q)^-1 p`` is the velocity of
+        the momentum state (the energy a symplectic step keeps bounded is the one of ``(q, H(q)^-1 p)``).
+        """
+        return None if self._p is None else self._p.copy()
 
     @property
     def t(self) -> float:

@@ -139,4 +139,23 @@ Status solve(const Model& model, Data& data, const SolveInput& input);
 Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,
             Eigen::Ref<Eigen::VectorXd> qd_next);
 
+/// One step of symplectic Euler in momentum form over input.time_step = dt > 0 (s), from the state
+/// (q, u) = (input.q, input.q_dot) and the momentum p = `momentum` (n_joints; N m s or N s): the
+/// momentum the previous step left, H(q_prev) u, or H(q) u at the start). It finds u+ with
+///     H(q) u+ = p + dt (tau - g(q) + dT/dq(q, u+)) + the impulses of friction, limits, contacts
+/// (tau the input's torques and wrenches; dT/dq of energy.hpp), the impulses' conditions those of
+/// solve() over the time step at the start velocity u, by fixed-point iteration on dT/dq(q, u+)
+/// (each iteration one solve(); a few per step, one for a robot at rest); then q_next = q + dt u+,
+/// qd_next = u+ (exactly 0 for a joint friction holds) and momentum_next = H(q) u+. Its energy
+/// error stays bounded where step()'s grows (docs "Friction in discrete time", "Passive energy").
+/// The results in data are those of the last iteration's solve (commandTorques() the motors' part,
+/// the feed-forward torques not included, as always). After 100 iterations without convergence
+/// (max |change of u+| <= 1e-12 max(1, |u+|)) the last iterate is taken: Error::Degraded. The
+/// first call on a Data allocates its workspace (O(n)); later ones allocate nothing. Outputs
+/// must not alias the inputs. Errors: those of step(), SizeMismatch for a momentum of the wrong
+/// size, NonfiniteInput for one that is not finite.
+Status stepSymplectic(const Model& model, Data& data, const SolveInput& input,
+                      const Eigen::Ref<const Eigen::VectorXd>& momentum, Eigen::Ref<Eigen::VectorXd> q_next,
+                      Eigen::Ref<Eigen::VectorXd> qd_next, Eigen::Ref<Eigen::VectorXd> momentum_next);
+
 }  // namespace vereshchagin

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "vereshchagin/data.hpp"
+#include "vereshchagin/dynamics.hpp"
 #include "vereshchagin/hd_solver.hpp"  // SolverOptions
 #include "vereshchagin/input.hpp"
 #include "vereshchagin/model.hpp"
@@ -37,6 +38,12 @@ enum class Integrator : signed char {
   /// q+ = q + dt qd+, with every condition of friction, limits and contacts on qd+. The velocity
   /// terms (Coriolis, centrifugal, gravity's dependence on q) are taken at the start of the step.
   SemiImplicitEuler = 0,
+  /// stepSymplectic() of data.hpp: symplectic Euler in momentum form, the velocity terms through
+  /// dT/dq at the END velocity (a few solves per step, one at rest). The simulator carries the
+  /// momentum p = H(q_prev) u (momentum()); q_dot is the step's velocity u (exactly 0 for a joint
+  /// friction holds). Its passive energy error stays bounded where SemiImplicitEuler's grows
+  /// (docs "Friction in discrete time", "Passive energy").
+  Symplectic = 1,
 };
 
 /// What rollout() records, owned and sized by the caller (resize() once; rollout() checks the
@@ -90,6 +97,9 @@ class Simulator {
   Status setState(const JointPositions& q, const JointVelocities& q_dot, double t = 0.0);
   const Eigen::VectorXd& q() const noexcept { return q_; }      ///< joint positions, n_joints
   const Eigen::VectorXd& qDot() const noexcept { return qd_; }  ///< joint velocities, n_joints
+  /// Integrator::Symplectic's carried momentum (N m s or N s, n_joints): H(q) q_dot after
+  /// setState(), H(q_prev) u after a step. Zeros under SemiImplicitEuler (not used).
+  const Eigen::VectorXd& momentum() const noexcept { return p_; }
   /// s: the t of setState() plus dt times the steps since (a product, not a running sum).
   double time() const noexcept { return t0_ + static_cast<double>(steps_) * dt_; }
   /// Sizes the friction workspace now (Data::reserveFriction()), so that no step allocates.
@@ -123,10 +133,12 @@ class Simulator {
 
   Model model_;
   Data data_;
-  SolveInput work_;  // the step's input: the caller's with the simulator's state and dt
-  Eigen::VectorXd q_, qd_;
-  double dt_ = 0.0, t0_ = 0.0;  // t0_: the time setState() gave
-  long steps_ = 0;              // steps since setState()
+  SolveInput work_;                            // the step's input: the caller's with the simulator's state and dt
+  Eigen::VectorXd q_, qd_, p_;                 // the state (p_: Integrator::Symplectic's momentum)
+  Eigen::VectorXd q_next_, qd_next_, p_next_;  // a symplectic step's results until it succeeds
+  DynamicsData dynamics_;                      // setState()'s momentum H(q) q_dot
+  double dt_ = 0.0, t0_ = 0.0;                 // t0_: the time setState() gave
+  long steps_ = 0;                             // steps since setState()
   Integrator integrator_;
   Status status_;
 };
