@@ -54,6 +54,8 @@ struct WrenchSources {
 int HdCore::checkResponseArgs(const Eigen::Ref<const Eigen::VectorXi>& joints, const Eigen::Ref<Eigen::MatrixXd>& dqdd,
                               const Eigen::Ref<Eigen::MatrixXd>& dtau_cmd, bool want_tau) {
   if (!res.solved) return fail(HdSolver::E_NO_SOLUTION, "responseColumns() needs a successful solve() first");
+  if (model.floating)
+    return fail(HdSolver::E_INVALID_OPTIONS, "responseColumns() is not supported on a floating base yet");
   const long k = joints.size(), nj = model.nj;
   constexpr int E_SIZE = KDL::SolverI::E_SIZE_MISMATCH;
   if (dqdd.rows() != nj || dqdd.cols() != k)
@@ -99,6 +101,8 @@ int HdCore::wrenchResponse(const Eigen::Ref<const Eigen::VectorXi>& segments,
                            const Eigen::Ref<const Matrix6X>& wrenches, Eigen::Ref<Eigen::MatrixXd> dqdd,
                            Eigen::Ref<Eigen::MatrixXd>* dnu_out) {
   if (!res.solved) return fail(HdSolver::E_NO_SOLUTION, "wrenchResponse() needs a successful solve() first");
+  if (model.floating)
+    return fail(HdSolver::E_INVALID_OPTIONS, "wrenchResponse() is not supported on a floating base yet");
   const long k = segments.size();
   if (wrenches.cols() != k || dqdd.rows() != static_cast<long>(model.nj) || dqdd.cols() != k)
     return fail(KDL::SolverI::E_SIZE_MISMATCH, "wrenchResponse(): %ld segments, %ld wrenches, dqdd %ldx%ld", k,

@@ -124,3 +124,18 @@ setattr(Tree, "__repr__", _tree_repr)  # noqa: B010
 for _cls in (Chain, Tree):
     for _field, _name in enumerate(_JOINT_FIELDS):
         setattr(_cls, _name, _joint_property(_cls.__name__, _field))
+
+# State sizes of a model's base (docs/floating-base.md): (nq, nv) entries the base adds.
+_BASE_SIZES = {"fixed": (0, 0), "free": (7, 6), "planar": (4, 3)}
+
+
+def _tree_nq(self: Tree) -> int:
+    return self.n_joints + _BASE_SIZES[self.base][0]
+
+
+def _tree_nv(self: Tree) -> int:
+    return self.n_joints + _BASE_SIZES[self.base][1]
+
+
+setattr(Tree, "nq", property(_tree_nq, doc=DOCS["Tree.nq"]))  # noqa: B010
+setattr(Tree, "nv", property(_tree_nv, doc=DOCS["Tree.nv"]))  # noqa: B010
