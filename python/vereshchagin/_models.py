@@ -52,6 +52,8 @@ def _state(model: Chain | Tree, records: tuple) -> tuple:
         ``StateRecords``; a chain's parent indices are dropped).
     """
     root, segments, joints, links, notes = records
+    if isinstance(model, Tree) and model.base != "fixed":  # (the state has no base kind yet)
+        raise SolverError(f"a Tree on a '{model.base}' base does not pickle yet: load it again with from_urdf")
     if isinstance(model, Tree):
         return (1, root, segments, joints, links, notes, model.inertia_check)
     return (1, [segment for segment, _ in segments], joints, links, root, notes, model.inertia_check)

@@ -190,7 +190,8 @@ def _kkt_points(c, q, v, tau, feet, fext):
     pq, pv, ptau = c.pin_q(q), c.pin_v(v), c.pin_v(tau)
     M = pin.crba(c.model, c.data, pq)
     M = np.triu(M) + np.triu(M, 1).T
-    b = pin.rnea(c.model, c.data, pq, pv, np.zeros(c.model.nv), fext)
+    zero = np.zeros(c.model.nv)
+    b = pin.rnea(c.model, c.data, pq, pv, zero, fext) if fext else pin.rnea(c.model, c.data, pq, pv, zero)
     pin.computeJointJacobians(c.model, c.data, pq)
     pin.forwardKinematics(c.model, c.data, pq, pv, np.zeros(c.model.nv))
     pin.updateFramePlacements(c.model, c.data)

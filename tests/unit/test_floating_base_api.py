@@ -27,6 +27,16 @@ def test_base_kinds_and_sizes(urdf):
         vs.Tree.from_urdf(urdf, base="floating")
 
 
+def test_copies_keep_the_base_and_pickle_refuses(urdf):
+    import copy
+    import pickle
+
+    tree = vs.Tree.from_urdf(urdf, base="planar")
+    assert copy.copy(tree).base == copy.deepcopy(tree).base == "planar"
+    with pytest.raises(vs.SolverError, match="does not pickle yet"):
+        pickle.dumps(tree)
+
+
 def test_solve_sizes(urdf):
     tree = vs.Tree.from_urdf(urdf, base="free")
     solver = vs.Solver(tree)
