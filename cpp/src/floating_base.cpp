@@ -163,6 +163,47 @@ void HdCore::finalBaseStep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) 
   b.xdd = b.a_world + S * qdd;
 }
 
+// Response columns (response_columns.cpp) at the base. Inward: each column's apparent force
+// change, about its root segment's tip origin in world axes, moved to the base origin in base
+// axes; its joint-axis share S^T dp kept, the base's free acceleration change D^-1 (-S^T dp)
+// adds e^T of it to the column's energy change (no torque on the base's own rows).
+void HdCore::responseBaseInward(long kc) {
+  ResponseWorkspace& r = ws.response;
+  const BaseState& b = ws.base;
+  const int m = res.m;
+  for (long c = 0; c < kc; ++c) {
+    const double* dp = r.force.col(c).data();
+    const Vector3 f(dp[0], dp[1], dp[2]);
+    const Vector3 n = Vector3(dp[3], dp[4], dp[5]) + Vector3(r.offset.col(r.holder(c))).cross(f);
+    Vector6 dp_base;
+    dp_base.head<3>().noalias() = b.X.R.transpose() * f;
+    dp_base.tail<3>().noalias() = b.X.R.transpose() * n;
+    r.base_sdp.col(c).noalias() = model.S_base.transpose() * dp_base;
+    if (m == 0) continue;
+    const BaseVector dfree = b.llt.solve(-r.base_sdp.col(c));
+    r.energy.col(c).head(m).noalias() += b.e.leftCols(m).transpose().lazyProduct(dfree);
+  }
+}
+
+// Outward: the base's acceleration change of each column, D^-1 (-S^T dp - e dnu), into dqdd's
+// base rows, and as the segments' starting acceleration change (world axes, base origin) into
+// the pass's accumulator and base_acc (for later root segments).
+void HdCore::responseBaseOutward(long c0, long kc, Eigen::Ref<Eigen::MatrixXd> dqdd) {
+  ResponseWorkspace& r = ws.response;
+  const BaseState& b = ws.base;
+  const int m = res.m, k = model.nbv;
+  for (long c = 0; c < kc; ++c) {
+    BaseVector rhs = -r.base_sdp.col(c);
+    if (m > 0) rhs.noalias() -= b.e.leftCols(m).lazyProduct(r.dnu.col(c).head(m));
+    const BaseVector dq = b.llt.solve(rhs);
+    dqdd.col(c0 + c).head(k) = dq;
+    const Vector6 da = model.S_base * dq;
+    r.base_acc.col(c).head<3>().noalias() = b.X.R * da.head<3>();
+    r.base_acc.col(c).tail<3>().noalias() = b.X.R * da.tail<3>();
+  }
+  r.force.leftCols(kc) = r.base_acc.leftCols(kc);
+}
+
 // The several-segment path on a floating base: solveGeneral's steps with the base step between
 // the inward sweep and the coupling, and the base's acceleration before the final sweep.
 int HdCore::solveFloating(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,

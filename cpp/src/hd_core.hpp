@@ -152,7 +152,7 @@ struct ResponseWorkspace {
   // stays O(n) for long robots (a full n x n response is computed chunk by chunk).
   static constexpr long kMaxWidth = 64;
   long width = 1;
-  Eigen::MatrixXd cmd_per_nu;   // d tau_cmd / d nu (n_joints x mcap)
+  Eigen::MatrixXd cmd_per_nu;   // d tau_cmd / d nu (nv x mcap)
   Eigen::MatrixXd energy;       // d U per requested column (mcap x width)
   Eigen::MatrixXd dnu;          // d nu per requested column (mcap x width)
   Eigen::MatrixXd sdp;          // S_i^T (apparent force change from the child), n_segments x width
@@ -160,8 +160,10 @@ struct ResponseWorkspace {
   Matrix3X offset;              // tip origin - parent's tip origin, base axes
   Matrix6X force;               // per requested column: apparent force change, then acceleration change
   Matrix3X tmp3;
-  Eigen::VectorXi holder;  // per requested column: the segment whose tip its force change is about
-  Matrix6X branch_acc;     // per branching segment: its accelerations of every column (6 x width slots)
+  Eigen::VectorXi holder;    // per requested column: the segment whose tip its force change is about
+  Matrix6X branch_acc;       // per branching segment: its accelerations of every column (6 x width slots)
+  Eigen::MatrixXd base_sdp;  // floating base: per column S^T (its force change at the base), base axes (nbv x width)
+  Matrix6X base_acc;         // floating base: per column its acceleration change, world axes, base origin
 };
 
 // Driver pass-through weights per constraint column (hd_solver.hpp): a facade's state
@@ -360,6 +362,10 @@ class HdCore {
   void basePose(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot);
   int closeAtBase(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
   void finalBaseStep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  // Response columns [0, kc) at the base: the inward pass's base step (energy changes) and the
+  // outward pass's start (the base's acceleration changes into dqdd's first rows and ACC).
+  void responseBaseInward(long kc);
+  void responseBaseOutward(long c0, long kc, Eigen::Ref<Eigen::MatrixXd> dqdd);
 
   // Fast path: m <= 6 columns on the last segment of a chain (hd_core.cpp).
   int inwardSweep(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);

@@ -100,7 +100,9 @@ void HdCore::allocateWorkspace() {
   g.work_v = Eigen::MatrixXd::Zero(mcap, 4);  // smallestEigenvalue's scratch: 4 columns
   g.seg_force = Matrix6X::Zero(6, ns);
   ws.base.e = ws.base.De = Eigen::MatrixXd::Zero(model.nbv, mcap);
-  r.cmd_per_nu = Eigen::MatrixXd::Zero(nj, mcap);
+  r.cmd_per_nu = Eigen::MatrixXd::Zero(nj + model.nbv, mcap);
+  r.base_sdp = Eigen::MatrixXd::Zero(model.nbv, r.width);
+  r.base_acc = Matrix6X::Zero(6, model.floating ? r.width : 0);
   r.energy = Eigen::MatrixXd::Zero(mcap, r.width);
   r.dnu = Eigen::MatrixXd::Zero(mcap, r.width);
   res.m = 0;

@@ -240,6 +240,29 @@ def test_planar_base_constraint_matches_kkt():
         assert_rel(r.qdd, expected, f"gen3 planar trial {trial}: qdd")
 
 
+@pytest.mark.parametrize("name", ["solo12", "talos", "gen3_planar"])
+def test_response_columns_are_the_exact_affine_response(name):
+    # qdd and tau_command are affine in tau_ff: each response column equals the difference of two
+    # solves, the base's rows included, free and with foot constraints.
+    c = case(name)
+    rng = np.random.default_rng(2803)
+    q, v = c.random_state(rng)
+    tau = np.r_[np.zeros(c.nb), rng.uniform(-3.0, 3.0, c.tree.n_joints)]
+    feet = FEET.get(name, [c.tree.segment_names[-1]])[:2]
+    for cons in ({}, {f: (np.eye(6), np.r_[-GRAVITY, 0.0, 0.0, 0.0]) for f in feet}):
+        joints = [0, c.tree.n_joints // 2, c.tree.n_joints - 1]
+        base = c.solver.solve(q, v, tau_ff=tau, constraints=cons)
+        qdd0, cmd0 = base.qdd.copy(), base.tau_command.copy()
+        dqdd, dcmd = c.solver.response_columns(joints)
+        assert dqdd.shape == (c.tree.nv, 3)
+        for col, j in enumerate(joints):
+            unit = np.zeros(c.tree.nv)
+            unit[c.nb + j] = 1.0
+            r = c.solver.solve(q, v, tau_ff=tau + unit, constraints=cons)
+            assert_rel(dqdd[:, col], r.qdd - qdd0, f"{name} joint {j}: dqdd", 1e-8)
+            assert_rel(dcmd[:, col], r.tau_command - cmd0, f"{name} joint {j}: dtau_command", 1e-8)
+
+
 def test_sizes_and_messages():
     c = case("solo12")
     q, v = c.random_state(np.random.default_rng(1))

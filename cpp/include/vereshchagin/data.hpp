@@ -102,6 +102,8 @@ class Data {
   Status frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const;  ///< see framePose()
 
   /// Affine response to unit joint torques (hd_solver.hpp, "Affine structure"), after a solve.
+  /// dqdd, dtau_cmd: model.nv() x joints.size() (joints: joint indices; on a floating base the
+  /// base's rows first, base axes, as qdd).
   Status responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                          Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
   /// The same around a friction solve's sticking state: the joints that stuck in the last solve
@@ -114,7 +116,7 @@ class Data {
   /// real-time loop). dqdd, dtau_cmd: n_joints x joints.size().
   Status responseColumnsHoldingSticking(const Eigen::Ref<const Eigen::VectorXi>& joints,
                                         Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
-  /// Affine response to wrenches, after a solve: column c of dqdd (n_joints x k) is the change of
+  /// Affine response to wrenches, after a solve: column c of dqdd (model.nv() x k) is the change of
   /// qdd per the wrench wrenches.col(c) added to f_ext ([force; moment] ON segment segments(c) BY
   /// the environment, base axes, moment about that segment's tip origin), the constraints held
   /// (their magnitudes change with it). O(n) per column, allocation-free; the results of the solve
