@@ -33,11 +33,18 @@ inline void HdCore::passToParent(int i, const Vector6& pa) {
   addForceToParent(s.X, pa, p.pA);
 }
 
+inline void HdCore::passToBase(int i, const Vector6& pa) {
+  SegmentState& s = ws.seg[i];
+  if (model.seg[i].joint >= 0) s.IA.noalias() -= s.Dinv * s.u * s.u.transpose();
+  addInertiaToParent(s.X, s.IA, ws.base.IA);
+  addForceToParent(s.X, pa, ws.base.pA);
+}
+
 // Segment i's acceleration before its own joint's: the parent's (root_acc at the base) in i's
 // tip frame plus the velocity-product term c_i.
 inline Vector6 HdCore::incomingAcceleration(int i) const {
   const int p = model.parent(i);
-  Vector6 a = motionToChild(ws.seg[i].X, p >= 0 ? ws.seg[p].xdd : root_acc);
+  Vector6 a = motionToChild(ws.seg[i].X, p >= 0 ? ws.seg[p].xdd : model.floating ? ws.base.xdd : root_acc);
   a += ws.seg[i].c;
   return a;
 }
@@ -49,6 +56,7 @@ template <typename ConstraintForce>
 inline void HdCore::finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
                                const ConstraintForce& constraint_force) {
   const bool has_tau = ff_torques.size() != 0;
+  double* const qdd_joints = res.qdd.data() + model.nbv;  // the joints' entries (after a floating base's)
   res.link_acc_known = false;
   for (unsigned int i = 0; i < model.ns; ++i) {
     const SegmentModel& sm = model.seg[i];
@@ -58,7 +66,7 @@ inline void HdCore::finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torqu
       const double tau = has_tau ? ff_torques(sm.joint) : 0.0;
       const double f = sm.S.dot(s.pA) + s.u.dot(a) + constraint_force(i);  // S^T IA a = u^T a
       const double qdd = s.Dinv * (tau - f);
-      res.qdd(sm.joint) = qdd;
+      qdd_joints[sm.joint] = qdd;
       a += sm.S * qdd;
     }
     s.xdd = a;

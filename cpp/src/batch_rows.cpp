@@ -22,10 +22,10 @@ const FrictionModel* BatchInput::frictionOf(std::ptrdiff_t b) const {
 
 void BatchInput::fillRow(std::ptrdiff_t b, SolveInput& in) const {
   using MapV = Eigen::Map<const Eigen::VectorXd>;
-  const auto nj = in.q.size(), ns = in.f_ext.cols();
+  const auto nq = in.q.size(), nv = in.q_dot.size(), ns = in.f_ext.cols();  // (nq, nv: base_kind.hpp)
   in.clear();
-  in.q = MapV(q.row(b), nj);
-  in.q_dot = MapV(q_dot.row(b), nj);
+  in.q = MapV(q.row(b), nq);
+  in.q_dot = MapV(q_dot.row(b), nv);
   if (f_ext.data) in.f_ext = Eigen::Map<const Matrix6X>(f_ext.row(b), 6, ns);  // (ns, 6) rows
   for (const WrenchRows& w : wrenches) {
     const Eigen::Map<const Vector6> wrench(w.wrench.row(b));
@@ -38,7 +38,7 @@ void BatchInput::fillRow(std::ptrdiff_t b, SolveInput& in) const {
     out.wrench = wrench;
     out.point = w.point;
   }
-  if (ff_torques.data) in.ff_torques = MapV(ff_torques.row(b), nj);
+  if (ff_torques.data) in.ff_torques = MapV(ff_torques.row(b), nv);
   in.friction = frictionOf(b);
   in.contacts = contacts;  // within in.contacts' capacity after the first row
   in.contact_velocity_tolerance = contact_velocity_tolerance;

@@ -154,6 +154,9 @@ Status Data::inverseInertiaTimes(const Eigen::Ref<const Eigen::VectorXd>& tau, E
   if (!guard) return Status(Error::ConcurrentCall, "another thread is inside a call on this Data");
   if (!c.res.solved)
     return impl_->status(c.fail(HdSolver::E_NO_SOLUTION, "inverseInertiaTimes() needs a successful solve() first"));
+  if (c.model.floating)
+    return impl_->status(
+        c.fail(HdSolver::E_INVALID_OPTIONS, "inverseInertiaTimes() is not supported on a floating base yet"));
   const auto n = static_cast<Eigen::Index>(c.model.nj);
   if (tau.size() != n || out.size() != n)
     return impl_->status(c.fail(KDL::SolverI::E_SIZE_MISMATCH, "tau has %ld and out %ld entries, expected %u (joints)",

@@ -1,6 +1,6 @@
 // Data's kinematics at the last solve's state (data.hpp): from the poses X_i (tip in parent tip)
 // and rotations R_base_i the outward sweep stored, walking from the frame's segment to the base:
-// O(depth), no allocation.
+// O(depth), no allocation. On a floating base, in the world frame (the base's pose included).
 #include "vereshchagin/data.hpp"
 
 #include "data_impl.hpp"
@@ -15,16 +15,22 @@ Vector3 toVector3(const KDL::Vector& v) {
   return Vector3(v.x(), v.y(), v.z());
 }
 
-// Rotation of a segment's parent tip frame in the base (identity for the base itself).
-Matrix3 parentRotation(const HdCore& c, int i) {
-  const int p = c.model.parent(i);
-  return p >= 0 ? c.ws.seg[p].R_base : Matrix3::Identity();
+// Rotation of the base frame: the identity, or a floating base's orientation in the world.
+Matrix3 baseRotation(const HdCore& c) {
+  return c.model.floating ? c.ws.base.X.R : Matrix3::Identity();
 }
 
-// Origin of frame (segment, in_tip) in base coordinates.
+// Rotation of a segment's parent tip frame in the base (the world on a floating base).
+Matrix3 parentRotation(const HdCore& c, int i) {
+  const int p = c.model.parent(i);
+  return p >= 0 ? c.ws.seg[p].R_base : baseRotation(c);
+}
+
+// Origin of frame (segment, in_tip) in base coordinates (world coordinates on a floating base).
 Vector3 frameOrigin(const HdCore& c, const FrameRef& frame) {
-  if (frame.segment < 0) return toVector3(frame.in_tip.p);
-  Vector3 p = c.ws.seg[frame.segment].R_base * toVector3(frame.in_tip.p);
+  const Vector3 base = c.model.floating ? c.ws.base.X.p : Vector3::Zero();
+  if (frame.segment < 0) return base + baseRotation(c) * toVector3(frame.in_tip.p);
+  Vector3 p = base + c.ws.seg[frame.segment].R_base * toVector3(frame.in_tip.p);
   for (int i = frame.segment; i >= 0; i = c.model.parent(i)) p += parentRotation(c, i) * c.ws.seg[i].X.p;
   return p;
 }
@@ -33,7 +39,7 @@ Vector3 frameOrigin(const HdCore& c, const FrameRef& frame) {
 
 KDL::Frame Data::framePose(const FrameRef& frame) const {
   const HdCore& c = impl_->core;
-  const Matrix3 R = frame.segment >= 0 ? c.ws.seg[frame.segment].R_base : Matrix3::Identity();
+  const Matrix3 R = frame.segment >= 0 ? c.ws.seg[frame.segment].R_base : baseRotation(c);
   const Vector3 p = frameOrigin(c, frame);
   const KDL::Rotation Rb(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2));
   return KDL::Frame(Rb * frame.in_tip.M, KDL::Vector(p(0), p(1), p(2)));
@@ -41,12 +47,14 @@ KDL::Frame Data::framePose(const FrameRef& frame) const {
 
 // The tip's spatial velocity (tip axes, tip origin) in base axes, moved to the frame's origin.
 KDL::Twist Data::frameTwist(const FrameRef& frame) const {
-  if (frame.segment < 0) return KDL::Twist::Zero();
   const HdCore& c = impl_->core;
-  const detail::SegmentState& s = c.ws.seg[frame.segment];
-  const Vector3 w = s.R_base * s.v.tail<3>();
-  const Vector3 r = s.R_base * toVector3(frame.in_tip.p);
-  const Vector3 v = s.R_base * s.v.head<3>() + w.cross(r);
+  if (frame.segment < 0 && !c.model.floating) return KDL::Twist::Zero();
+  const bool base = frame.segment < 0;  // a floating base's own frames
+  const Matrix3& R = base ? c.ws.base.X.R : c.ws.seg[frame.segment].R_base;
+  const Vector6& vel = base ? c.ws.base.v : c.ws.seg[frame.segment].v;
+  const Vector3 w = R * vel.tail<3>();
+  const Vector3 r = R * toVector3(frame.in_tip.p);
+  const Vector3 v = R * vel.head<3>() + w.cross(r);
   return KDL::Twist(KDL::Vector(v(0), v(1), v(2)), KDL::Vector(w(0), w(1), w(2)));
 }
 

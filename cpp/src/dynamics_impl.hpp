@@ -32,6 +32,11 @@ struct DynamicsImpl {
   Status start(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q) {
     KinematicsImpl& ki = k();
     if (const Status s = ki.checkModel(model); !s) return s;
+    if (model.baseKind() != BaseKind::Fixed)  // (a fixed-base answer would be silently wrong)
+      return ki.fail(Error::InvalidOptions,
+                     "the dynamics companions (inverse_dynamics, mass_matrix, gravity_torques, coriolis_torques) do "
+                     "not support a floating base yet (docs/floating-base.md); the kinematics companions work in the "
+                     "base frame");
     return ki.checkVector(q, "q");
   }
   Status checkOut(Eigen::Index rows, Eigen::Index cols, Eigen::Index want_cols, const char* name) {

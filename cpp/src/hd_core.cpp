@@ -65,6 +65,9 @@ void HdCore::outwardSweep(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
     if (p >= 0) {
       s.R_base.noalias() = ws.seg[p].R_base * s.X.R;
       s.v = motionToChild(s.X, ws.seg[p].v);
+    } else if (model.floating) {  // R_base: world axes; the base's velocity (floating_base.cpp)
+      s.R_base.noalias() = ws.base.X.R * s.X.R;
+      s.v = motionToChild(s.X, ws.base.v);
     } else {
       s.R_base = s.X.R;
       s.v = motionToChild(s.X, Vector6::Zero());
@@ -363,7 +366,12 @@ void HdCore::accelerationsOf(const Eigen::Ref<const Eigen::VectorXd>& qdd) {
 // Link accelerations in base axes, computed from the tip-frame ones on first request.
 const Matrix6X& HdCore::linkAccelerations() const {
   if (!res.link_acc_known) {
-    res.link_acc.col(0) = root_acc;
+    if (model.floating) {  // the base body's, world axes
+      res.link_acc.col(0).head<3>().noalias() = ws.base.X.R * ws.base.xdd.head<3>();
+      res.link_acc.col(0).tail<3>().noalias() = ws.base.X.R * ws.base.xdd.tail<3>();
+    } else {
+      res.link_acc.col(0) = root_acc;
+    }
     for (unsigned int i = 0; i < model.ns; ++i) {
       const SegmentState& s = ws.seg[i];
       res.link_acc.col(i + 1).head<3>().noalias() = s.R_base * s.xdd.head<3>();

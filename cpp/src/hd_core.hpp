@@ -22,10 +22,13 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <kdl/rigidbodyinertia.hpp>
 #include <kdl/segment.hpp>
 
+#include "vereshchagin/base_kind.hpp"
 #include "vereshchagin/hd_solver.hpp"
 #include "vereshchagin/input.hpp"
 #include "vereshchagin/spatial.hpp"
@@ -53,8 +56,16 @@ struct ModelSource {
   std::vector<KDL::Segment> segments;
   std::vector<int> parent;
   std::vector<int> joint;
-  std::string problem;  // non-empty: the source itself is invalid (unknown root, ...)
+  std::string problem;              // non-empty: the source itself is invalid (unknown root, ...)
+  BaseKind base = BaseKind::Fixed;  // how the base moves (base_kind.hpp)
+  KDL::RigidBodyInertia base_inertia = KDL::RigidBodyInertia::Zero();  // the floating base body's
 };
+
+// The floating base joint (base_kind.hpp): its motion axes in the base frame, 6 x k (k = 6: the
+// identity, a free-flyer; k = 3: x, y translation and z rotation, planar).
+using BaseAxes = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
+using BaseSquare = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+using BaseVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 
 // Constant data of one segment.
 struct SegmentModel {
@@ -77,6 +88,14 @@ struct HdModel {
   int n_branch = 0;                // segments with >= 2 children
   std::vector<int> joint_segment;  // segment index of each joint
   unsigned int nj = 0, ns = 0;
+  // The base (floating_base.cpp): fixed, or a floating body of inertia I_base (base frame, about
+  // its origin) on a k-DOF joint to the world with axes S_base; q and q_dot start with its
+  // nbq / nbv entries, the joints follow (qdd, tau_cmd: joint j at nbv + j).
+  bool floating = false;
+  BaseKind base = BaseKind::Fixed;
+  int nbq = 0, nbv = 0;
+  Matrix6 I_base = Matrix6::Zero();
+  BaseAxes S_base;
   bool is_chain = true;                                 // parent[i] = i - 1 for every i: the chain's fast path applies
   InertiaCheck inertia_check = InertiaCheck::Physical;  // what the segments were validated against
   int error = 0;                                        // 0, or why the robot is invalid (message)
@@ -133,7 +152,7 @@ struct ResponseWorkspace {
   // stays O(n) for long robots (a full n x n response is computed chunk by chunk).
   static constexpr long kMaxWidth = 64;
   long width = 1;
-  Eigen::MatrixXd cmd_per_nu;   // d tau_cmd / d nu (n_joints x mcap)
+  Eigen::MatrixXd cmd_per_nu;   // d tau_cmd / d nu (nv x mcap)
   Eigen::MatrixXd energy;       // d U per requested column (mcap x width)
   Eigen::MatrixXd dnu;          // d nu per requested column (mcap x width)
   Eigen::MatrixXd sdp;          // S_i^T (apparent force change from the child), n_segments x width
@@ -141,8 +160,10 @@ struct ResponseWorkspace {
   Matrix3X offset;              // tip origin - parent's tip origin, base axes
   Matrix6X force;               // per requested column: apparent force change, then acceleration change
   Matrix3X tmp3;
-  Eigen::VectorXi holder;  // per requested column: the segment whose tip its force change is about
-  Matrix6X branch_acc;     // per branching segment: its accelerations of every column (6 x width slots)
+  Eigen::VectorXi holder;    // per requested column: the segment whose tip its force change is about
+  Matrix6X branch_acc;       // per branching segment: its accelerations of every column (6 x width slots)
+  Eigen::MatrixXd base_sdp;  // floating base: per column S^T (its force change at the base), base axes (nbv x width)
+  Matrix6X base_acc;         // floating base: per column its acceleration change, world axes, base origin
 };
 
 // Driver pass-through weights per constraint column (hd_solver.hpp): a facade's state
@@ -164,7 +185,23 @@ struct PassThroughState {
   const Eigen::VectorXd* driver = nullptr;      // ff driver if not ff_torques (FrictionSolver)
 };
 
+// Per-solve state of the floating base body (floating_base.cpp), base axes.
+struct BaseState {
+  Pose X;                             // pose of the base frame in the world frame at q
+  Vector6 v = Vector6::Zero();        // its velocity
+  Vector6 a_world = Vector6::Zero();  // the world's acceleration (root_acc) in base axes
+  Vector6 xdd = Vector6::Zero();      // its acceleration (with the world's, as the segments')
+  Matrix6 IA = Matrix6::Zero();       // articulated inertia, closed over every root segment
+  Vector6 pA = Vector6::Zero();       // articulated bias force
+  BaseAxes U;                         // IA S
+  BaseSquare D;                       // S^T IA S
+  Eigen::LLT<BaseSquare> llt;         // of D
+  BaseVector free;                    // D^-1 (tau - S^T pA): the base's acceleration, world at rest
+  Eigen::MatrixXd e, De;              // S^T A_base and D^-1 S^T A_base (k x mcap)
+};
+
 struct HdWorkspace {
+  BaseState base;
   std::vector<SegmentState> seg;
   CouplingFast fast;
   CouplingGeneral general;
@@ -201,6 +238,10 @@ struct FrameLoads {
   Eigen::VectorXd* beta = nullptr;    // their set-points: written for classical blocks
   bool wrenches = false, points = false, classical = false;
 };
+
+// The base of a model from its source's kind and inertia (floating_base.cpp): 0, or model.error
+// and model.message. Construction-time only.
+int buildBase(HdModel& model);
 
 // Constraint columns a solve may have (SolverOptions::max_constraints, hd_solver.hpp): the
 // workspace of the coupling matrix is sized for them.
@@ -304,10 +345,27 @@ class HdCore {
   inline bool articulate(int i, double tau, Vector6& pa, double& free);
   // Apparent inertia and bias force of segment i added to its parent (which must exist).
   inline void passToParent(int i, const Vector6& pa);
+  // The same for a root segment on a floating base: into the base body's (floating_base.cpp).
+  inline void passToBase(int i, const Vector6& pa);
   inline Vector6 incomingAcceleration(int i) const;
   // Final outward sweep; constraint_force(i) gives segment i's S^T A nu.
   template <typename ConstraintForce>
   inline void finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const ConstraintForce& constraint_force);
+
+  // Floating base (floating_base.cpp): the several-segment path closed at the base body.
+  int solveFloating(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                    const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
+                    const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
+                    const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  int checkFloatingInputs(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
+                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void basePose(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot);
+  int closeAtBase(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  void finalBaseStep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques);
+  // Response columns [0, kc) at the base: the inward pass's base step (energy changes) and the
+  // outward pass's start (the base's acceleration changes into dqdd's first rows and ACC).
+  void responseBaseInward(long kc);
+  void responseBaseOutward(long c0, long kc, Eigen::Ref<Eigen::MatrixXd> dqdd);
 
   // Fast path: m <= 6 columns on the last segment of a chain (hd_core.cpp).
   int inwardSweep(const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& ff_torques);

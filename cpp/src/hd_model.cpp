@@ -65,7 +65,7 @@ int HdCore::fail(int code, const char* fmt, ...) {
 void HdCore::allocateWorkspace() {
   const unsigned int nj = model.nj, ns = model.ns;
   ws.seg.assign(ns, SegmentState());
-  res.qdd = res.tau_cmd = Eigen::VectorXd::Zero(nj);
+  res.qdd = res.tau_cmd = Eigen::VectorXd::Zero(nj + model.nbv);  // nv: a floating base's entries first
   ws.zero_joints = Eigen::VectorXd::Zero(nj);
   ResponseWorkspace& r = ws.response;
   r.width = std::max<long>(1, std::min<long>(nj, ResponseWorkspace::kMaxWidth));
@@ -99,7 +99,10 @@ void HdCore::allocateWorkspace() {
   g.kg = g.cholg = g.vg = g.work_g = Eigen::MatrixXd::Zero(mcap, mcap);
   g.work_v = Eigen::MatrixXd::Zero(mcap, 4);  // smallestEigenvalue's scratch: 4 columns
   g.seg_force = Matrix6X::Zero(6, ns);
-  r.cmd_per_nu = Eigen::MatrixXd::Zero(nj, mcap);
+  ws.base.e = ws.base.De = Eigen::MatrixXd::Zero(model.nbv, mcap);
+  r.cmd_per_nu = Eigen::MatrixXd::Zero(nj + model.nbv, mcap);
+  r.base_sdp = Eigen::MatrixXd::Zero(model.nbv, r.width);
+  r.base_acc = Matrix6X::Zero(6, model.floating ? r.width : 0);
   r.energy = Eigen::MatrixXd::Zero(mcap, r.width);
   r.dnu = Eigen::MatrixXd::Zero(mcap, r.width);
   res.m = 0;

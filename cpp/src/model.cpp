@@ -21,6 +21,8 @@ std::shared_ptr<const ModelImpl> finish(detail::ModelSource source, const ModelO
                                         std::vector<JointInfo> joints, std::vector<LinkPlacement> links) {
   auto m = std::make_shared<ModelImpl>();
   m->options = options;
+  source.base = options.base;
+  source.base_inertia = options.base_inertia;
   m->base_name = std::move(base);
   m->joint_infos = std::move(joints);
   const std::size_t ns = source.segments.size();
@@ -50,6 +52,13 @@ std::shared_ptr<const ModelImpl> finish(detail::ModelSource source, const ModelO
   return m;
 }
 
+// A tree load's own base kind unless the options name one; its base inertia added to theirs.
+ModelOptions treeOptions(const RobotTree& robot, ModelOptions options) {
+  if (options.base == BaseKind::Fixed) options.base = robot.base;
+  options.base_inertia = options.base_inertia + robot.base_inertia;
+  return options;
+}
+
 }  // namespace
 
 Model::Model() : Model(KDL::Chain()) {}
@@ -65,8 +74,8 @@ Model::Model(const RobotChain& robot, const ModelOptions& options)
     : impl_(finish(detail::chainModelSource(robot.chain), options, robot.root_link, robot.joints, robot.links)) {}
 
 Model::Model(const RobotTree& robot, const ModelOptions& options)
-    : impl_(finish(detail::treeModelSource(robot.tree, std::string()), options, robot.root_link, robot.joints,
-                   robot.links)) {}
+    : impl_(finish(detail::treeModelSource(robot.tree, std::string()), treeOptions(robot, options), robot.root_link,
+                   robot.joints, robot.links)) {}
 
 Model detail::ModelAccess::withOptions(const Model& model, const ModelOptions& options) {
   const ModelImpl& old = model.impl();
@@ -91,6 +100,15 @@ const ModelOptions& Model::options() const noexcept {
 }
 unsigned int Model::nrOfJoints() const noexcept {
   return static_cast<unsigned int>(impl_->segment_of_joint.size());
+}
+unsigned int Model::nq() const noexcept {
+  return nrOfJoints() + static_cast<unsigned int>(impl_->hd->nbq);
+}
+unsigned int Model::nv() const noexcept {
+  return nrOfJoints() + static_cast<unsigned int>(impl_->hd->nbv);
+}
+BaseKind Model::baseKind() const noexcept {
+  return impl_->hd->base;
 }
 unsigned int Model::nrOfSegments() const noexcept {
   return static_cast<unsigned int>(impl_->source().segments.size());

@@ -159,6 +159,8 @@ int ModelBuilder::build() {
   model.joint_segment.assign(model.nj, 0);
   topology();
   if (!src.problem.empty()) return fail(HdSolver::E_INVALID_MODEL, "%s", src.problem.c_str());
+  if (const int rc = buildBase(model)) return rc;
+  if (model.floating) model.is_chain = false;  // the base closes the several-segment path
   for (unsigned int i = 0; i < model.ns; ++i) {
     const int rc = segment(static_cast<int>(i));
     if (rc != 0) return rc;

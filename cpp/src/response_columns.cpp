@@ -54,12 +54,12 @@ struct WrenchSources {
 int HdCore::checkResponseArgs(const Eigen::Ref<const Eigen::VectorXi>& joints, const Eigen::Ref<Eigen::MatrixXd>& dqdd,
                               const Eigen::Ref<Eigen::MatrixXd>& dtau_cmd, bool want_tau) {
   if (!res.solved) return fail(HdSolver::E_NO_SOLUTION, "responseColumns() needs a successful solve() first");
-  const long k = joints.size(), nj = model.nj;
+  const long k = joints.size(), nj = model.nj, nv = nj + model.nbv;  // rows: nv (a floating base's first)
   constexpr int E_SIZE = KDL::SolverI::E_SIZE_MISMATCH;
-  if (dqdd.rows() != nj || dqdd.cols() != k)
-    return fail(E_SIZE, "dqdd is %ldx%ld, expected %ldx%ld", (long)dqdd.rows(), (long)dqdd.cols(), nj, k);
-  if (want_tau && (dtau_cmd.rows() != nj || dtau_cmd.cols() != k))
-    return fail(E_SIZE, "dtau_cmd is %ldx%ld, expected %ldx%ld", (long)dtau_cmd.rows(), (long)dtau_cmd.cols(), nj, k);
+  if (dqdd.rows() != nv || dqdd.cols() != k)
+    return fail(E_SIZE, "dqdd is %ldx%ld, expected %ldx%ld", (long)dqdd.rows(), (long)dqdd.cols(), nv, k);
+  if (want_tau && (dtau_cmd.rows() != nv || dtau_cmd.cols() != k))
+    return fail(E_SIZE, "dtau_cmd is %ldx%ld, expected %ldx%ld", (long)dtau_cmd.rows(), (long)dtau_cmd.cols(), nv, k);
   for (long c = 0; c < k; ++c) {
     if (joints(c) < 0 || joints(c) >= static_cast<int>(nj))
       return fail(KDL::SolverI::E_OUT_OF_RANGE, "joint index %d out of range [0, %ld)", joints(c), nj);
@@ -100,7 +100,7 @@ int HdCore::wrenchResponse(const Eigen::Ref<const Eigen::VectorXi>& segments,
                            Eigen::Ref<Eigen::MatrixXd>* dnu_out) {
   if (!res.solved) return fail(HdSolver::E_NO_SOLUTION, "wrenchResponse() needs a successful solve() first");
   const long k = segments.size();
-  if (wrenches.cols() != k || dqdd.rows() != static_cast<long>(model.nj) || dqdd.cols() != k)
+  if (wrenches.cols() != k || dqdd.rows() != static_cast<long>(model.nj + model.nbv) || dqdd.cols() != k)
     return fail(KDL::SolverI::E_SIZE_MISMATCH, "wrenchResponse(): %ld segments, %ld wrenches, dqdd %ldx%ld", k,
                 (long)wrenches.cols(), (long)dqdd.rows(), (long)dqdd.cols());
   for (long c = 0; c < k; ++c)
@@ -162,6 +162,8 @@ void HdCore::baseAxes() {
     const int p = model.parent(i);
     if (p >= 0) {
       r.offset.col(i).noalias() = ws.seg[p].R_base * s.X.p;
+    } else if (model.floating) {  // world axes
+      r.offset.col(i).noalias() = ws.base.X.R * s.X.p;
     } else {
       r.offset.col(i) = s.X.p;
     }
@@ -235,6 +237,7 @@ void HdCore::responseInward(const Sources& src, long c0, long kc) {
     }
     for (long c = 0; c < lo; ++c) SDP(i, c) = 0.0;  // not alive yet
   }
+  if (model.floating) responseBaseInward(kc);
 }
 
 // d nu = K^+ dU for every column; into dnu_out (caller's row order) if given.
@@ -267,7 +270,12 @@ void HdCore::responseOutward(const Sources& src, long c0, long kc, Eigen::Ref<Ei
   auto ACC = r.force.leftCols(kc);  // per column: linear part a, angular part w
   const auto SDP = r.sdp.leftCols(kc);
   const auto DNU = r.dnu.topLeftCorner(m, kc);
-  ACC.setZero();
+  double* const dqdd_joints = dqdd.data() + model.nbv;  // joint j's row: nbv + j (after a floating base's)
+  if (model.floating) {
+    responseBaseOutward(c0, kc, dqdd);
+  } else {
+    ACC.setZero();
+  }
   long first = 0;  // first alive column
   for (unsigned int i = 0; i < model.ns; ++i) {
     const SegmentModel& sm = model.seg[i];
@@ -275,6 +283,8 @@ void HdCore::responseOutward(const Sources& src, long c0, long kc, Eigen::Ref<Ei
     if (i > 0 && p != static_cast<int>(i) - 1) {  // a later child: its parent's accelerations again
       if (p >= 0) {
         ACC = r.branch_acc.middleCols(model.branch_slot[p] * r.width, kc);
+      } else if (model.floating) {
+        ACC = r.base_acc.leftCols(kc);
       } else {
         ACC.setZero();
       }
@@ -296,7 +306,7 @@ void HdCore::responseOutward(const Sources& src, long c0, long kc, Eigen::Ref<Ei
       const double* dnu = DNU.col(c).data();
       for (int t = felt.first; t < felt.second; ++t) v -= eg[t] * dnu[t];
       v *= Dinv;
-      dqdd(sm.joint, c0 + c) = v;
+      dqdd_joints[sm.joint + (c0 + c) * dqdd.outerStride()] = v;
       for (int t = 0; t < 3; ++t) acc[t] = a(t) + S0(t) * v, acc[3 + t] = w(t) + S0(3 + t) * v;
     }
     if (model.branch_slot[i] >= 0) r.branch_acc.middleCols(model.branch_slot[i] * r.width, kc) = ACC;

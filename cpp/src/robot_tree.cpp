@@ -45,7 +45,9 @@ RobotTree::RobotTree(const RobotTree& other)
       joints(other.joints),
       links(other.links),
       root_link(other.root_link),
-      notes(other.notes) {
+      notes(other.notes),
+      base(other.base),
+      base_inertia(other.base_inertia) {
   copyTree(other.tree, tree);
 }
 
@@ -55,7 +57,9 @@ RobotTree::RobotTree(RobotTree&& other)
       joints(std::move(other.joints)),
       links(std::move(other.links)),
       root_link(std::move(other.root_link)),
-      notes(std::move(other.notes)) {
+      notes(std::move(other.notes)),
+      base(other.base),
+      base_inertia(other.base_inertia) {
   copyTree(other.tree, tree);  // KDL::Tree cannot be moved
 }
 
@@ -68,6 +72,8 @@ RobotTree& RobotTree::operator=(const RobotTree& other) {
   links = other.links;
   root_link = other.root_link;
   notes = other.notes;
+  base = other.base;
+  base_inertia = other.base_inertia;
   return *this;
 }
 
@@ -80,6 +86,8 @@ RobotTree& RobotTree::operator=(RobotTree&& other) {
   links = std::move(other.links);
   root_link = std::move(other.root_link);
   notes = std::move(other.notes);
+  base = other.base;
+  base_inertia = other.base_inertia;
   return *this;
 }
 

@@ -41,6 +41,7 @@ int HdCore::solveGeneral(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
                          const Eigen::Ref<const Matrix6X>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
                          const Eigen::Ref<const Eigen::VectorXi>& segments, const Eigen::Ref<const Matrix6X>& f_ext,
                          const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
+  if (model.floating) return solveFloating(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
   res.solved = false;
   res.general = false;
   state_q = &q;
@@ -101,6 +102,10 @@ int HdCore::sortColumns(const Eigen::Ref<const Eigen::VectorXi>& segments) {
 template <typename F>
 void HdCore::forEachCouplingBlock(const F& f) const {
   const CouplingGeneral& g = ws.general;
+  if (model.floating) {  // every column is felt by the base: one block
+    if (res.m > 0) f(0, res.m);
+    return;
+  }
   for (int r = 0; r < static_cast<int>(model.ns); r = model.subtree_end[r]) {
     const int lo = g.lo(model, r), w = g.active[r] - lo;
     if (w > 0) f(lo, w);
@@ -161,6 +166,8 @@ int HdCore::inwardSweepGeneral(const Eigen::Ref<const Matrix6X>& alfa,
     }
     if (model.parent(i) >= 0) {
       passToParent(i, pa);
+    } else if (model.floating) {
+      passToBase(i, pa);  // the columns stay in acur, in base axes (closeAtBase)
     } else if (w > 0) {
       g.ug.segment(lo, w).noalias() += g.acur.middleCols(lo, w).transpose().lazyProduct(root_acc);
     }
@@ -341,16 +348,21 @@ void HdCore::commandFromNuGeneral(const Eigen::Ref<const Eigen::VectorXd>& nu_so
   tau_cmd.setZero();
   if (res.m == 0) return;
   f.setZero();
+  double* const joints = tau_cmd.data() + model.nbv;  // after a floating base's entries
+  Vector6 base = Vector6::Zero();                     // the wrench felt by a floating base
   for (int i = static_cast<int>(model.ns) - 1; i >= 0; --i) {
     const SegmentModel& sm = model.seg[i];
     const int c0 = g.active[i + 1], c = g.active[i];
     if (c > c0) f.col(i).noalias() -= g.anew.middleCols(c0, c - c0).lazyProduct(nu_sorted.segment(c0, c - c0));
-    if (sm.joint >= 0) tau_cmd(sm.joint) = sm.S.dot(f.col(i));
+    if (sm.joint >= 0) joints[sm.joint] = sm.S.dot(f.col(i));
     if (model.parent(i) >= 0) {
       auto fp = f.col(model.parent(i));
       addForceToParent(ws.seg[i].X, f.col(i), fp);
+    } else if (model.floating) {
+      addForceToParent(ws.seg[i].X, f.col(i), base);
     }
   }
+  if (model.floating) tau_cmd.head(model.nbv).noalias() = model.S_base.transpose() * base;
 }
 
 }  // namespace detail

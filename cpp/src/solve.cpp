@@ -70,6 +70,10 @@ int checkInput(HdCore& c, const SolveInput& in) {
   }
   if (!(std::isfinite(in.time_step) && in.time_step >= 0.0))
     return c.fail(E_RANGE, "time_step must be finite and >= 0 (s; 0: the instant), got %g", in.time_step);
+  if (c.model.floating && (moving_base || in.friction != nullptr || !in.contacts.empty()))
+    return c.fail(E_RANGE,
+                  "on a floating base, base_acceleration must be zero and joint friction and contacts are not "
+                  "supported yet (docs/floating-base.md)");
   if (classical && moving_base)
     return c.fail(E_RANGE,
                   "a classical set-point (ConstraintBlock::classical) needs a base at rest: base_acceleration "

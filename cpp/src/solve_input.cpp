@@ -6,10 +6,10 @@
 namespace vereshchagin {
 
 SolveInput::SolveInput(const Model& model, int blocks, int wrench_count)
-    : q(Eigen::VectorXd::Zero(model.nrOfJoints())),
-      q_dot(Eigen::VectorXd::Zero(model.nrOfJoints())),
+    : q(Eigen::VectorXd::Zero(model.nq())),
+      q_dot(Eigen::VectorXd::Zero(model.nv())),
       f_ext(Matrix6X::Zero(6, model.nrOfSegments())),
-      ff_torques(Eigen::VectorXd::Zero(model.nrOfJoints())),
+      ff_torques(Eigen::VectorXd::Zero(model.nv())),
       segments_(static_cast<int>(model.nrOfSegments())) {
   reserve(blocks, wrench_count);
 }

@@ -65,20 +65,25 @@ int RigidGroup::tipIndex() const {
 
 class TreeBuilder {
  public:
-  TreeBuilder(const urdf::ModelInterface& model, RobotTree& out, InertiaCheck check)
-      : model_(model), out_(out), check_(check) {}
+  TreeBuilder(const urdf::ModelInterface& model, RobotTree& out, InertiaCheck check, BaseKind base)
+      : model_(model), out_(out), check_(check), base_(base) {}
 
   void build(const std::string& root_name) {
     urdf::LinkConstSharedPtr root = model_.getLink(root_name);
     if (!root) throw LoadError("root link '" + root_name + "' not found in the URDF");
     out_.root_link = root_name;
     out_.tree = KDL::Tree(root_name);
-    const std::string base_note = urdfparts::baseMassNote(*root);
+    const std::string base_note = base_ == BaseKind::Fixed ? urdfparts::baseMassNote(*root) : std::string();
     if (!base_note.empty()) out_.notes.push_back(base_note);
     const RigidGroup base = collectGroup(*root);
-    urdfparts::RigidBody body;  // the base: placements in the root frame, inertia irrelevant
-    for (std::size_t i = 0; i < base.links.size(); ++i)
+    urdfparts::RigidBody body;  // the base: placements in the root frame, inertia below
+    out_.base = base_;
+    out_.base_inertia = KDL::RigidBodyInertia::Zero();
+    for (std::size_t i = 0; i < base.links.size(); ++i) {
       urdfparts::foldLink(*base.links[i], base.in_first[i], check_, body, out_.links);
+      if (base_ != BaseKind::Fixed)  // (a fixed base's links are not checked: their inertia is unused)
+        out_.base_inertia = out_.base_inertia + base.in_first[i] * urdfparts::linkInertia(*base.links[i], check_);
+    }
     std::vector<Pending> first;
     for (const RigidGroup::Exit& e : base.exits)
       first.push_back({e.joint, base.in_first[static_cast<std::size_t>(e.from)], -1});
@@ -174,6 +179,7 @@ class TreeBuilder {
   const urdf::ModelInterface& model_;
   RobotTree& out_;
   InertiaCheck check_;
+  BaseKind base_;
 };
 
 UrdfTreeResult loadTree(const std::string& xml, const std::string& root, const UrdfOptions& options) {
@@ -181,7 +187,8 @@ UrdfTreeResult loadTree(const std::string& xml, const std::string& root, const U
   urdf::ModelInterfaceSharedPtr model = urdfparts::parseModel(xml, result.message);
   if (!model) return result;
   try {
-    TreeBuilder(*model, result.robot, options.inertia_check).build(root.empty() ? model->getRoot()->name : root);
+    TreeBuilder(*model, result.robot, options.inertia_check, options.base)
+        .build(root.empty() ? model->getRoot()->name : root);
   } catch (const LoadError& e) {
     result.message = e.what();
     result.robot = RobotTree();

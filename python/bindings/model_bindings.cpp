@@ -49,12 +49,16 @@ M modelFromState(const py::tuple& state) {
 // Chain.from_urdf / Tree.from_urdf: `source` is URDF XML text (str holding '<') or a readable file
 // path (str or os.PathLike); `tip` is unused for a Tree. Raises SolverError otherwise.
 template <class M>
-M modelFromUrdf(O source, const std::string& root, const std::string& tip, const std::string& inertia_check) {
+M modelFromUrdf(O source, const std::string& root, const std::string& tip, const std::string& inertia_check,
+                const std::string& base = "fixed") {
   M model;
   model.inertia_check = inertiaCheckArg(inertia_check, "");
+  vereshchagin::UrdfOptions options{model.inertia_check};
+  if (!vereshchagin::baseKindFromName(base, options.base))
+    raise("base must be 'fixed', 'free' or 'planar', got " + base);
   const std::string text = pyModels("_urdf_text")(source).cast<std::string>();  // raises for another source
   std::string message;
-  if (!vereshchagin::loadUrdf(text, root, tip, {model.inertia_check}, model.robot, message)) raise(message);
+  if (!vereshchagin::loadUrdf(text, root, tip, options, model.robot, message)) raise(message);
   return model;
 }
 
@@ -166,13 +170,18 @@ void bindChain(py::module_& mod) {
            py::arg("inertia") = py::none(), py::arg("rotor_inertia") = 0.0, py::arg("joint_name") = "",
            py::arg("inertia_check") = "physical")
       .def("segment_spec", &segmentSpec, py::arg("segment"), doc("Chain.segment_spec"))
-      .def_static("from_urdf", &modelFromUrdf<PyChain>, py::arg("source"), py::arg("root") = "", py::arg("tip") = "",
-                  py::arg("inertia_check") = "physical", doc("Chain.from_urdf"));
+      .def_static(
+          "from_urdf",
+          [](O s, const std::string& r, const std::string& t, const std::string& c) {
+            return modelFromUrdf<PyChain>(s, r, t, c);
+          },
+          py::arg("source"), py::arg("root") = "", py::arg("tip") = "", py::arg("inertia_check") = "physical",
+          doc("Chain.from_urdf"));
 }
 
 void bindTree(py::module_& mod) {
-  const auto fromUrdf = [](O source, O root, const std::string& inertia_check) {
-    return modelFromUrdf<PyTree>(source, root.is_none() ? "" : root.cast<std::string>(), "", inertia_check);
+  const auto fromUrdf = [](O source, O root, const std::string& inertia_check, const std::string& base) {
+    return modelFromUrdf<PyTree>(source, root.is_none() ? "" : root.cast<std::string>(), "", inertia_check, base);
   };
   const auto parent = [](const PyTree& t) { return py::array_t<std::int64_t>(py::cast(t.robot.parent)); };
   const auto chain = [](const PyTree& t, O tip) {
@@ -183,7 +192,9 @@ void bindTree(py::module_& mod) {
   };
   bindModel<PyTree>(mod, "Tree")
       .def_static("from_urdf", fromUrdf, py::arg("source"), py::arg("root") = py::none(),
-                  py::arg("inertia_check") = "physical", doc("Tree.from_urdf"))
+                  py::arg("inertia_check") = "physical", py::arg("base") = "fixed", doc("Tree.from_urdf"))
+      .def_property_readonly(
+          "base", [](const PyTree& t) { return vereshchagin::baseKindName(t.robot.base); }, doc("Tree.base"))
       .def_property_readonly(
           "base_name", [](const PyTree& t) { return t.robot.root_link; }, doc("Tree.base_name"))
       .def_property_readonly("parent", parent, doc("Tree.parent"))

@@ -97,7 +97,7 @@ class PySolver {
     PySolver& s_;
   };
 
-  unsigned int nj = 0, ns = 0;
+  unsigned int nj = 0, ns = 0, nq = 0;  // nj: the model's nv, nq: its nq (base_kind.hpp)
   const Addressable* addressing = nullptr;
   vereshchagin::FrictionModel model_friction;  // friction=True's
 

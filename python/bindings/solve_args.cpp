@@ -99,7 +99,7 @@ const vereshchagin::FrictionModel* SolveArgs::friction(PyObject* obj, vereshchag
   const F64View st = asF64(item(0), "friction.static"), kv = view(1, "friction.kinetic"),
                 lo = view(3, "friction.lower"), up = view(4, "friction.upper");
   auto opt = [&](int k, const F64View& v) { return item(k) == Py_None ? nullptr : &v; };
-  check(vereshchagin::frictionFromArrays(fm, solver_->nj, st, opt(1, kv),
+  check(vereshchagin::frictionFromArrays(fm, solver_->cppModel().nrOfJoints(), st, opt(1, kv),
                                          scalarArg(item(2), "friction.velocity_tolerance"), opt(3, lo), opt(4, up),
                                          scalarArg(item(5), "friction.limit_tolerance")));
   if (cacheable) cache_key_ = f;
@@ -174,7 +174,7 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   if (!layout.empty()) PyList_SetSlice(layout.ptr(), 0, PY_SSIZE_T_MAX, nullptr);
   keep_.clear();
   if (a[0] == nullptr || a[1] == nullptr) raise("solve() needs q and qd");
-  input.q = vector(a[0], "q", solver_->nj);
+  input.q = vector(a[0], "q", solver_->nq);
   input.q_dot = vector(a[1], "qd", solver_->nj);
   const bool classical = given(a[kADesiredArg]);
   check(vereshchagin::endBlockArgs(given(a[2]), given(a[3]), classical, s.isTree()));

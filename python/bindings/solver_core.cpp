@@ -29,13 +29,15 @@ PySolver::PySolver(const py::object& model, const py::object& gravity, const py:
   }
   if (!max_constraints.is_none()) options_.max_constraints = max_constraints.cast<int>();  // checked by solver.py
   gravity_ = vec3(gravity, "gravity");
-  const vereshchagin::ModelOptions model_options{options_.inertia_check};
+  vereshchagin::ModelOptions model_options{options_.inertia_check};
+  if (tree_) model_options.base = tree_->robot.base, model_options.base_inertia = tree_->robot.base_inertia;
   cpp_model_ = tree_ ? vereshchagin::Model(tree_->robot.tree, tree_->robot.root_link, model_options)
                      : vereshchagin::Model(chain_->robot.chain, model_options);
   const char* invalid = tree_ ? "invalid tree: " : "invalid chain: ";
   if (const vereshchagin::Status s = cpp_model_.status(); !s) raise(invalid + std::string(s.message()));
   if (const vereshchagin::Status s = workspace(0).data.status(); !s) raise(invalid + std::string(s.message()));
-  nj = cpp_model_.nrOfJoints();
+  nj = cpp_model_.nv();  // the size of qd, tau_ff and the results (= n_joints on a fixed base)
+  nq = cpp_model_.nq();
   ns = cpp_model_.nrOfSegments();
   model_friction = vereshchagin::frictionOfJoints(addressing->jointInfos());
 }

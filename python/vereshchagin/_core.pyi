@@ -101,8 +101,17 @@ class Chain:
 class Tree:
     @staticmethod
     def from_urdf(
-        source: str | os.PathLike[str], root: Optional[str] = None, inertia_check: str = "physical"
+        source: str | os.PathLike[str],
+        root: Optional[str] = None,
+        inertia_check: str = "physical",
+        base: str = "fixed",
     ) -> Tree: ...
+    @property
+    def base(self) -> str: ...
+    @property
+    def nq(self) -> int: ...
+    @property
+    def nv(self) -> int: ...
     @property
     def n_joints(self) -> int: ...
     @property

@@ -183,6 +183,12 @@ root : str, optional
 inertia_check : {'physical', 'joint_space'}
     As for :meth:`Chain.from_urdf`: 'physical' (default) rejects link inertias that no rigid
     body has; 'joint_space' accepts identified models (any symmetric inertia).
+base : {'fixed', 'free', 'planar'}
+    How the root link moves (docs/floating-base.md): 'fixed' (default) welds it to the world;
+    'free' is a free-flyer (q = (x, y, z, qx, qy, qz, qw, joints), qd = (v, omega in the base
+    frame, joints): :attr:`nq` = n + 7, :attr:`nv` = n + 6); 'planar' moves it in the world's
+    x-y plane (q = (x, y, cos yaw, sin yaw, joints), qd = (v_x, v_y in the base frame, omega_z,
+    joints)). The root link and the links fixed to it are then the base body, with their mass.
 
 Returns
 -------
@@ -202,6 +208,12 @@ DOCS["Tree.n_joints"] = r"""int: number of moving joints n (the length of q, qd)
 DOCS["Tree.n_segments"] = r"""int: number of segments (one per moving joint)."""
 
 DOCS["Tree.segment_names"] = r"""list of str: segment names in segment order (a segment is named after its tip link)."""
+
+DOCS["Tree.base"] = r"""str: how the base moves: 'fixed', 'free' (free-flyer) or 'planar' (``from_urdf(base=...)``)."""
+
+DOCS["Tree.nq"] = r"""int: length of q: n_joints, plus 7 on a free-flyer base, 4 on a planar base."""
+
+DOCS["Tree.nv"] = r"""int: length of qd, tau_ff, qdd and tau_command: n_joints, plus 6 (free-flyer) or 3 (planar)."""
 
 DOCS["Tree.base_name"] = r"""str: the same as :attr:`root_link`."""
 
@@ -504,6 +516,8 @@ Parameters
 ----------
 q, qd : array_like, shape (n,)
     Joint positions (rad or m) and velocities (rad/s or m/s), in ``chain.joint_names`` order.
+    On a floating base (``Tree.from_urdf(..., base='free' | 'planar')``) q has ``tree.nq``
+    entries and qd, tau_ff and the results ``tree.nv``, the base's first (docs/floating-base.md).
 alpha : array_like, shape (6, m) or (6,), optional
     m <= 6 unit constraint wrenches on the **last** segment, one per column, rows
     ``[fx, fy, fz, mx, my, mz]``: base-frame axes, moment about the last segment's tip origin.

@@ -52,6 +52,8 @@ def _state(model: Chain | Tree, records: tuple) -> tuple:
         ``StateRecords``; a chain's parent indices are dropped).
     """
     root, segments, joints, links, notes = records
+    if isinstance(model, Tree) and model.base != "fixed":  # (the state has no base kind yet)
+        raise SolverError(f"a Tree on a '{model.base}' base does not pickle yet: load it again with from_urdf")
     if isinstance(model, Tree):
         return (1, root, segments, joints, links, notes, model.inertia_check)
     return (1, [segment for segment, _ in segments], joints, links, root, notes, model.inertia_check)
@@ -124,3 +126,18 @@ setattr(Tree, "__repr__", _tree_repr)  # noqa: B010
 for _cls in (Chain, Tree):
     for _field, _name in enumerate(_JOINT_FIELDS):
         setattr(_cls, _name, _joint_property(_cls.__name__, _field))
+
+# State sizes of a model's base (docs/floating-base.md): (nq, nv) entries the base adds.
+_BASE_SIZES = {"fixed": (0, 0), "free": (7, 6), "planar": (4, 3)}
+
+
+def _tree_nq(self: Tree) -> int:
+    return self.n_joints + _BASE_SIZES[self.base][0]
+
+
+def _tree_nv(self: Tree) -> int:
+    return self.n_joints + _BASE_SIZES[self.base][1]
+
+
+setattr(Tree, "nq", property(_tree_nq, doc=DOCS["Tree.nq"]))  # noqa: B010
+setattr(Tree, "nv", property(_tree_nv, doc=DOCS["Tree.nv"]))  # noqa: B010

@@ -342,6 +342,7 @@ class Solver(_core.Solver):
         Returns
         -------
         dqdd, dtau_command : ndarray, shape (n, k)
+            ``(tree.nv, k)`` on a floating base: the base's rows first (docs/floating-base.md).
         """
         return super().response_columns(_joint_indices(self.model, joints), hold_sticking)
 

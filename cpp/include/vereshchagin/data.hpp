@@ -62,14 +62,20 @@ class Data {
   /// The model this Data was built for (solve() with another one: Error::NotUpToDate).
   const Model& model() const noexcept;
 
-  /// Results of the last successful solve (unspecified before one).
+  /// Results of the last successful solve (unspecified before one). qdd: model.nv() entries (rad/s^2,
+  /// m/s^2); on a floating base its first entries are the base's acceleration in base axes
+  /// (base_kind.hpp), then the joints'.
   const Eigen::VectorXd& qdd() const noexcept;
-  const Eigen::VectorXd& commandTorques() const noexcept;  ///< tau_cmd (n_joints), hd_solver.hpp
-  Eigen::Map<const Eigen::VectorXd> nu() const noexcept;   ///< input.columns(), the input's column order
-  int constraintRank() const noexcept;                     ///< rank of the coupling matrix K, hd_solver.hpp
-  double smallestSingularValue() const;                    ///< computed on first request
+  /// tau_cmd (model.nv(); hd_solver.hpp). On a floating base: the generalized force of the
+  /// constraint forces, its base rows a wrench on the base (base axes) that no motor produces
+  /// (docs/floating-base.md).
+  const Eigen::VectorXd& commandTorques() const noexcept;
+  Eigen::Map<const Eigen::VectorXd> nu() const noexcept;  ///< input.columns(), the input's column order
+  int constraintRank() const noexcept;                    ///< rank of the coupling matrix K, hd_solver.hpp
+  double smallestSingularValue() const;                   ///< computed on first request
   /// 6 x (n_segments + 1): column 0 the root acceleration, column i + 1 segment i's tip (base axes,
-  /// tip origin, root acceleration included). Computed on first request.
+  /// tip origin, root acceleration included). Computed on first request. On a floating base:
+  /// world axes, column 0 the base body's acceleration at its origin.
   const Matrix6X& linkAccelerations() const;
   /// With friction (zero / Moving without): friction and limit torques, joint status, Gauss value.
   /// Over a time step (SolveInput::time_step) they are the step's: the torques of the impulses
@@ -88,12 +94,16 @@ class Data {
 
   /// Kinematics at the last solve's state, base axes (allocation-free, O(depth) per call):
   /// the pose of a frame in the base frame, its twist [linear velocity of its origin; angular],
-  /// and its Jacobian (6 x n_joints, columns in joint order; twist = J q_dot).
+  /// and its Jacobian (6 x n_joints, columns in joint order; twist = J q_dot). On a floating base
+  /// the pose and twist are in the world frame (the base's motion included); the Jacobian has the
+  /// joints' columns only (world axes), the base's are not there yet.
   KDL::Frame framePose(const FrameRef& frame) const;
   KDL::Twist frameTwist(const FrameRef& frame) const;                                       ///< see framePose()
   Status frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const;  ///< see framePose()
 
   /// Affine response to unit joint torques (hd_solver.hpp, "Affine structure"), after a solve.
+  /// dqdd, dtau_cmd: model.nv() x joints.size() (joints: joint indices; on a floating base the
+  /// base's rows first, base axes, as qdd).
   Status responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
                          Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
   /// The same around a friction solve's sticking state: the joints that stuck in the last solve
@@ -106,7 +116,7 @@ class Data {
   /// real-time loop). dqdd, dtau_cmd: n_joints x joints.size().
   Status responseColumnsHoldingSticking(const Eigen::Ref<const Eigen::VectorXi>& joints,
                                         Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Eigen::MatrixXd> dtau_cmd);
-  /// Affine response to wrenches, after a solve: column c of dqdd (n_joints x k) is the change of
+  /// Affine response to wrenches, after a solve: column c of dqdd (model.nv() x k) is the change of
   /// qdd per the wrench wrenches.col(c) added to f_ext ([force; moment] ON segment segments(c) BY
   /// the environment, base axes, moment about that segment's tip origin), the constraints held
   /// (their magnitudes change with it). O(n) per column, allocation-free; the results of the solve

@@ -76,12 +76,14 @@ struct SolveInput {
   explicit SolveInput(const Model& model, int blocks = 8, int wrenches = 8);
 
   /// Joint positions q (rad or m) and velocities q_dot (rad/s or m/s).
-  Eigen::VectorXd q, q_dot;  ///< n_joints
+  /// q: model.nq() entries, q_dot: model.nv() (n_joints on a fixed base; a floating base's
+  /// entries first, in the layout of base_kind.hpp: unit quaternion, velocities in base axes).
+  Eigen::VectorXd q, q_dot;
   /// Wrench on each segment BY the environment (6 x n_segments): base axes, moment about the
   /// segment's tip origin. Gravity does not go here.
   Matrix6X f_ext;
   std::vector<FrameWrench> wrenches;         ///< more wrenches, on any frame (added to f_ext)
-  Eigen::VectorXd ff_torques;                ///< n_joints, added as-is
+  Eigen::VectorXd ff_torques;                ///< model.nv(), added as-is (a floating base's rows: a wrench on it)
   std::vector<ConstraintBlock> constraints;  ///< the columns of nu, in this order
   /// Static friction, kinetic friction and joint limits (friction_solver.hpp); nullptr: none.
   /// Not owned: it must outlive the solve.

@@ -29,9 +29,11 @@
 
 #include <kdl/chain.hpp>
 #include <kdl/frames.hpp>
+#include <kdl/rigidbodyinertia.hpp>
 #include <kdl/segment.hpp>
 #include <kdl/tree.hpp>
 
+#include "vereshchagin/base_kind.hpp"
 #include "vereshchagin/inertia_check.hpp"
 #include "vereshchagin/robot_chain.hpp"
 #include "vereshchagin/robot_tree.hpp"
@@ -48,6 +50,16 @@ struct ModelAccess;
 struct ModelOptions {
   /// Which inertial parameters the robot may have (inertia_check.hpp).
   InertiaCheck inertia_check = InertiaCheck::Physical;
+  /// How the base moves (base_kind.hpp: the state layout). Fixed (default): welded to the world,
+  /// every result as before. For a RobotTree whose `base` is not Fixed (a URDF load with a
+  /// floating base), Fixed here means "the tree's own base kind".
+  BaseKind base = BaseKind::Fixed;
+  /// Inertia of the floating base body: mass (kg), centre of mass and rotational inertia (kg m^2)
+  /// about the base frame's origin, in base axes. Added to the root link's (a RobotTree's
+  /// base_inertia: the URDF root link and the links fixed to it); the only source of the base's
+  /// inertia for KDL chains and trees (a KDL::Tree's root segment has none). Ignored on a fixed
+  /// base.
+  KDL::RigidBodyInertia base_inertia = KDL::RigidBodyInertia::Zero();
 };
 
 /// A named frame resolved on a model: the segment whose rigid body it moves with (-1: the base)
@@ -76,7 +88,13 @@ class Model {
   Status status() const noexcept;
   const ModelOptions& options() const noexcept;  ///< the options given to the constructor
 
-  unsigned int nrOfJoints() const noexcept;    ///< number of moving joints (n_joints)
+  unsigned int nrOfJoints() const noexcept;  ///< number of moving joints (n_joints)
+  /// Entries of q: n_joints + 7 (free-flyer), + 4 (planar), + 0 (fixed). Layout: base_kind.hpp.
+  unsigned int nq() const noexcept;
+  /// Entries of q_dot, qdd, ff_torques and tau_command: n_joints + 6, + 3 or + 0 (base_kind.hpp).
+  unsigned int nv() const noexcept;
+  /// How the base moves: options().base, or a RobotTree's own base kind.
+  BaseKind baseKind() const noexcept;
   unsigned int nrOfSegments() const noexcept;  ///< number of segments (n_segments)
   /// parent(i) == i - 1 for every segment.
   bool isChain() const noexcept;

@@ -15,6 +15,7 @@
 
 #include <kdl/tree.hpp>
 
+#include "vereshchagin/base_kind.hpp"
 #include "vereshchagin/robot_chain.hpp"  // JointInfo, LinkPlacement
 
 namespace vereshchagin {
@@ -36,6 +37,12 @@ struct RobotTree {
   std::vector<LinkPlacement> links;        ///< every link folded into a segment or into the base (segment -1)
   std::string root_link;                   ///< the base frame
   std::vector<std::string> notes;          ///< approximations made while building
+  /// How the base moves (base_kind.hpp); a URDF load's UrdfOptions::base. Model(RobotTree) uses it
+  /// unless ModelOptions::base says otherwise.
+  BaseKind base = BaseKind::Fixed;
+  /// Inertia of the root link and of the links fixed to it, about the root frame's origin in root
+  /// axes (kg, m, kg m^2): the floating base body of a URDF load (unused on a fixed base).
+  KDL::RigidBodyInertia base_inertia = KDL::RigidBodyInertia::Zero();
 };
 
 /// The segments of `tree` in segment order (root excluded) and their parent indices (-1: the

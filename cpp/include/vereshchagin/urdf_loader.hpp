@@ -73,6 +73,10 @@ struct UrdfOptions {
   /// symmetric inertia with mass >= 0 (identified models) and leaves the check of the joint-space
   /// inertia to the solver (whose SolverOptions::inertia_check must then be JointSpace too).
   InertiaCheck inertia_check = InertiaCheck::Physical;
+  /// The base of a tree load (RobotTree::base; chains ignore it): Fixed (default) welds the root
+  /// link to the world; FreeFlyer or Planar keep the root link and the links fixed to it as the
+  /// floating base body (RobotTree::base_inertia), without the note on the dropped base mass.
+  BaseKind base = BaseKind::Fixed;
 };
 
 /// xml: the URDF document. root / tip: link names; empty root = the URDF's root link, empty tip =

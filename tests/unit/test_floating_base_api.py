@@ -1,0 +1,58 @@
+"""The floating-base face of the Python package (docs/floating-base.md): base kinds from URDF,
+nq / nv, the sizes Solver.solve takes and returns, and what is refused with a message."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import vereshchagin as vs
+from vereshchagin.robots import gen3_urdf
+
+
+@pytest.fixture(scope="module")
+def urdf():
+    return gen3_urdf(gripper=False)
+
+
+def test_base_kinds_and_sizes(urdf):
+    fixed = vs.Tree.from_urdf(urdf)
+    n = fixed.n_joints
+    assert (fixed.base, fixed.nq, fixed.nv) == ("fixed", n, n)
+    free = vs.Tree.from_urdf(urdf, base="free")
+    assert (free.base, free.nq, free.nv) == ("free", n + 7, n + 6)
+    planar = vs.Tree.from_urdf(urdf, base="planar")
+    assert (planar.base, planar.nq, planar.nv) == ("planar", n + 4, n + 3)
+    with pytest.raises(vs.SolverError, match="base must be 'fixed', 'free' or 'planar'"):
+        vs.Tree.from_urdf(urdf, base="floating")
+
+
+def test_copies_keep_the_base_and_pickle_refuses(urdf):
+    import copy
+    import pickle
+
+    tree = vs.Tree.from_urdf(urdf, base="planar")
+    assert copy.copy(tree).base == copy.deepcopy(tree).base == "planar"
+    with pytest.raises(vs.SolverError, match="does not pickle yet"):
+        pickle.dumps(tree)
+
+
+def test_solve_sizes(urdf):
+    tree = vs.Tree.from_urdf(urdf, base="free")
+    solver = vs.Solver(tree)
+    q = np.r_[0.1, -0.2, 0.3, 0.0, 0.0, 0.0, 1.0, np.zeros(tree.n_joints)]
+    r = solver.solve(q, np.zeros(tree.nv), tau_ff=np.zeros(tree.nv))
+    assert r.qdd.shape == (tree.nv,) and r.tau_command.shape == (tree.nv,)
+    np.testing.assert_allclose(r.qdd[:3], [0.0, 0.0, -9.81], atol=1e-12)  # free fall
+    with pytest.raises(vs.SolverError, match="qd"):
+        solver.solve(q, np.zeros(tree.n_joints))
+    with pytest.raises(vs.SolverError, match="not supported yet"):
+        solver.solve(q, np.zeros(tree.nv), friction=vs.Friction(static=np.ones(tree.n_joints)))
+
+
+def test_fixed_base_unchanged(urdf):
+    # base="fixed" is the default load, bit for bit.
+    a, b = vs.Tree.from_urdf(urdf), vs.Tree.from_urdf(urdf, base="fixed")
+    q = np.linspace(-1.0, 1.0, a.n_joints)
+    qd = np.linspace(0.5, -0.5, a.n_joints)
+    np.testing.assert_array_equal(vs.Solver(a).solve(q, qd).qdd, vs.Solver(b).solve(q, qd).qdd)
