@@ -38,6 +38,8 @@ void ContactStage::stepKinds(const SolveInput& in) {
 Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,
             Eigen::Ref<Eigen::VectorXd> qd_next) {
   const long n = static_cast<long>(model.nrOfJoints());
+  if (model.baseKind() != BaseKind::Fixed)
+    return Status(Error::InvalidOptions, "step() is not supported on a floating base yet (its SE(3) position update)");
   if (!(input.time_step > 0.0) || !std::isfinite(input.time_step))
     return Status(Error::OutOfRange, "step() needs a finite SolveInput::time_step > 0 (s)");
   if (q_next.size() != n || qd_next.size() != n)

@@ -41,6 +41,8 @@ Simulator::Simulator(const Model& model, double dt, Integrator integrator, const
     status_ = model_.status();
   else if (!data_.status())
     status_ = data_.status();
+  else if (model_.baseKind() != BaseKind::Fixed)
+    status_ = Status(Error::InvalidOptions, "Simulator: a floating base is not supported yet (its SE(3) step)");
   else if (!(dt > 0.0) || !std::isfinite(dt))
     status_ = Status(Error::OutOfRange, "Simulator: the time step dt must be finite and > 0 (s)");
   else if (integrator != Integrator::SemiImplicitEuler && integrator != Integrator::Symplectic)

@@ -100,6 +100,8 @@ Status stepSymplectic(const Model& model, Data& data, const SolveInput& input,
                       Eigen::Ref<Eigen::VectorXd> qd_next, Eigen::Ref<Eigen::VectorXd> momentum_next) {
   if (!data.model().sameAs(model))
     return Status(Error::NotUpToDate, "stepSymplectic(): the Data was built for another model");
+  if (model.baseKind() != BaseKind::Fixed)
+    return Status(Error::InvalidOptions, "stepSymplectic() is not supported on a floating base yet");
   detail::DataImpl& d = data.impl();
   if (!d.symplectic) d.symplectic = std::make_unique<detail::SymplecticWorkspace>(model);
   return detail::symplecticStep(model, data, *d.symplectic, input, momentum, q_next, qd_next, momentum_next);
