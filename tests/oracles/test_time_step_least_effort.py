@@ -72,7 +72,7 @@ def _qp(P, E, e, lo, hi):
         bounds=list(zip(lo, hi)),
         constraints=[{"type": "eq", "fun": lambda x: E @ x - e, "jac": lambda x: E}],
         method="SLSQP",
-        options=dict(ftol=1e-16, maxiter=2000),
+        options=dict(ftol=1e-15, maxiter=300),
     )
     x = res.x
     scale = max(1.0, np.abs(x).max())
