@@ -7,6 +7,9 @@
 // sticking joints (within their bounds) are coordinates too: the friction solver's least-command
 // rule, together with the contacts. A small convex programme in the free coordinates (lemke.hpp,
 // ConvexQp); skipped when their response columns are independent (the forces are then unique).
+// Over a time step the same programme on the step's problem: the impulses that keep qdd (so the
+// end velocities) and meet the velocity-level conditions, a point's row being its end velocity
+// over dt, a + v / dt, and a joint's qdd_j + qd_j / dt.
 #include <algorithm>
 #include <cmath>
 
@@ -39,10 +42,12 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
     const Vector3 f = forces.col(c);
     const double fn = pt.n.dot(f);
     const int ci = static_cast<int>(c);
-    // The point's acceleration in the solved motion: a support whose normal acceleration is not
-    // zero leaves its surface (no force); one at rest with zero tangential acceleration may stick.
+    // The point's row in the solved motion (its acceleration; over a time step its end velocity
+    // over dt, a + v / dt): a support whose normal row is not zero leaves its surface (no force);
+    // one with a zero tangential row may stick.
     Vector3 bias;
-    const Vector3 a = pointAcceleration(pc, qdd, bias);
+    Vector3 a = pointAcceleration(pc, qdd, bias);
+    if (dt_ > 0.0) a += pt.v / dt_;
     const double an = pt.n.dot(a), a_tol = 1e-9 * std::max(1.0, a.norm());
     const Vector3 at_ = a - an * pt.n;
     const bool resting = pt.kind == kTouching || pt.kind == kSetPointRest;
@@ -100,12 +105,13 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
 int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   HdCore& c = d.core;
   const int n = static_cast<int>(model_.nrOfJoints()), m = c.res.m;
+  if (m == 0) return 0;  // no motor columns: nothing to trade (before any work: a cheap exit)
   const int nj = static_cast<int>(joints_.size());
   int k_max = 2 * nj;
   for (const PointContact& pc : in.contacts) k_max += 1 + pc.facets;
   reserveEffort(3 * static_cast<int>(in.contacts.size()) + nj, k_max, m);
   const int p = effortCoordinates(in, c.res.qdd), pc = eff_contacts_;
-  if (p == 0 || m == 0) return 0;  // no motor columns: nothing to trade
+  if (p == 0) return 0;
   for (int i = 0; i < pc; ++i) {
     const int ci = eff_contact_(i);
     const Vector3 e = eff_dir_.col(i);

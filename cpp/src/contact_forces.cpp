@@ -236,8 +236,7 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
 }
 
 int ContactStage::finish(DataImpl& d, const SolveInput& in) {
-  if (dt_ == 0.0)  // (no least-effort programme over a time step yet)
-    if (int rc = leastEffort(d, in)) return rc;
+  if (int rc = leastEffort(d, in)) return rc;  // (at the instant and over a time step)
   if (joint_friction_ || dt_ > 0.0) jointOutputs(d, in);
   return 0;
 }

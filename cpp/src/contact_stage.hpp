@@ -137,7 +137,7 @@ class ContactStage {
   void stepKinds(const SolveInput& in);
   // The joints' outputs and statuses (into d.status_per_joint) of the last sweep.
   void jointOutputs(DataImpl& d, const SolveInput& in);
-  // The least-effort programme (at the instant), then the joints' outputs.
+  // The least-effort programme (at the instant and over a time step), then the joints' outputs.
   int finish(DataImpl& d, const SolveInput& in);
   // Roles and sizes of one problem: the sticking trial (every resting point with friction held
   // tangentially by two constraint columns) or the full polygonal problem.

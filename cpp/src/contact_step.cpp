@@ -8,9 +8,10 @@
 // ends the step with zero normal velocity, and every joint with friction is an unknown bounded by
 // its static friction at rest and its kinetic friction while moving: a joint whose holding torque
 // stays within the bound ends the step at zero velocity, a sliding one gets the full friction
-// against its end velocity, which friction alone cannot reverse. The sticking trial, the
-// all-active guess and the least-effort programme are instant-only; the joint outputs (friction
-// and limit torques, statuses) are this stage's (contact_joints.cpp).
+// against its end velocity, which friction alone cannot reverse. The sticking trial and the
+// all-active guess are instant-only; where the impulses are not unique the least-effort programme
+// picks them as at the instant, on the end-velocity rows (contact_effort.cpp); the joint outputs
+// (friction and limit torques, statuses) are this stage's (contact_joints.cpp).
 #include <algorithm>
 #include <cmath>
 

@@ -484,6 +484,56 @@ TEST_CASE_FIXTURE(Fixture, "redundant resting contacts (the least-effort guess) 
                                                                       << str(c1.mallocs - c0.mallocs));
 }
 
+TEST_CASE_FIXTURE(Fixture, "redundant supports over a time step (the least-effort rule) do not allocate once warm") {
+  // Four supports with friction, joint friction and a task, stepped at rest and moving: where the
+  // supports and the sticking joints share the load the least-effort programme runs on the step's
+  // problem (contact_effort.cpp), elsewhere the impulses are unique and it stops early.
+  const vereshchagin::Model model(chain);
+  vereshchagin::Data data(model);
+  vereshchagin::SolveInput in(model);
+  in.constraints.reserve(2);
+  const int segments[4] = {static_cast<int>(ns) - 1, static_cast<int>(ns) - 2, 3, 2};
+  for (int k = 0; k < 4; ++k) {
+    vereshchagin::PointContact pc;
+    pc.segment = segments[k];
+    pc.point = vereshchagin::Vector3(0.03 * (k % 2 ? 1 : -1), 0.02, -0.05);
+    pc.normal = vereshchagin::Vector3(0.1 * k, -0.1, 1.0).normalized();
+    pc.mu = 0.9;
+    in.contacts.push_back(pc);
+  }
+  vereshchagin::FrictionModel fm;
+  fm.static_friction = Eigen::VectorXd::LinSpaced(n, 3.0, 0.5);
+  fm.kinetic_friction = 0.7 * fm.static_friction;
+  in.friction = &fm;
+  in.time_step = 1e-3;
+  Eigen::VectorXd q_next(n), qd_next(n);
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
+  std::vector<Eigen::VectorXd> creeping;  // slow enough for friction to stop some joints within the step
+  for (int s = 0; s < kSets; ++s) creeping.push_back(1e-3 * qd[s].data);
+  double csum = 0.0;
+  int cfail = 0;
+  const auto run = [&](int s, int columns, bool moving) {
+    in.setState(vereshchagin::JointPositions(q[s].data), vereshchagin::JointVelocities(moving ? creeping[s] : rest));
+    in.ff_torques = ff[s].data;
+    in.constraints.clear();
+    if (columns > 0 && !in.addConstraint(static_cast<int>(ns) - 1, alfa_m[columns], beta[columns].data)) ++cfail;
+    const vereshchagin::Status st = vereshchagin::step(model, data, in, q_next, qd_next);
+    if (!st && st.code() != vereshchagin::Error::NoContactSolution) ++cfail;
+    if (st) csum += q_next(0) + data.contactForces()(2, 0);
+  };
+  for (int s = 0; s < kSets; ++s)
+    for (int columns = 0; columns <= 2; ++columns)
+      for (const bool moving : {false, true}) run(s, columns, moving);  // warm: every size once
+  const Counts c0 = now();
+  for (int it = 0; it < 300; ++it) run(it % kSets, it % 3, it % 4 >= 2);
+  const Counts c1 = now();
+  CHECK_MESSAGE(cfail == 0, "steps failed: " << str(cfail));
+  CHECK_MESSAGE(std::isfinite(csum), "non-finite step results");
+  CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "steps allocated: operator new "
+                                                                      << str(c1.news - c0.news) << ", malloc "
+                                                                      << str(c1.mallocs - c0.mallocs));
+}
+
 TEST_CASE_FIXTURE(Fixture, "Simulator steps and rollouts with friction and contacts do not allocate once warm") {
   // A moving arm with joint friction, then with a support with friction under its last segment,
   // stepped one by one and by rollout() with a controller writing ff_torques; the first step of

@@ -1,0 +1,382 @@
+"""The least-effort rule over a time step (``solve(..., time_step=dt)``, docs/time-step.md) against
+an independent formulation with scipy, at 1e-9 relative.
+
+Where the step's impulses are not unique (redundant supports, supports and friction-held joints
+sharing a load, a redundant task with joint friction) the step's end velocities still are, and the
+solve picks, as at the instant, the impulses of least motor effort ``||tau_command||^2`` and among
+those the least contact forces ``sum_c ||f_c||^2``. The oracle takes the step's ``qdd`` (so its end
+velocities) and writes every admissible impulse as linear constraints in the motors' multipliers
+``nu`` (``tau_command = A^T nu``, A the task's rows from Pinocchio's Jacobians), the contact forces
+as non-negative weights on their friction polygon's edges (a sticking point: every edge ``n + mu
+d_j``; sliding: the edges most opposed to its end sliding velocity; frictionless: ``n``; leaving:
+none) and the torques of the joints with friction (sticking: within their bounds; slipping: the
+bound against their end velocity), with the equation of motion ``H qdd - h = A^T nu + sum_c J_c^T
+f_c + tau_joints`` (Pinocchio's ``crba`` and ``rnea``). The two programmes, least effort and then
+least contact force with the effort kept, are solved by ``scipy.optimize.minimize`` (SLSQP) and
+polished to the exact KKT solution of their active set (numpy), independently of the solver.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.optimize import minimize, nnls
+
+import vereshchagin as vs
+from support.chains import G_EARTH, pin_configuration, random_chain, random_state
+from support.contact_oracle import contact_problem, facet_directions, point_jacobian
+from vereshchagin.robots import gen3_urdf
+
+RTOL = 1e-9
+GEN3_Q = np.array([0.0, 0.6, 0.0, 2.1, 0.0, 0.45, 1.57])
+TOOL = "end_effector_link"
+LWA = pin.LOCAL_WORLD_ALIGNED
+
+
+def _rel(a, b):
+    return np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(1.0, np.linalg.norm(b))
+
+
+def _generators(c, row, scale):
+    """The edges (3, g) whose non-negative weights span the admissible forces of contact ``c``
+    given its row (end velocity over dt) in the solved motion: leaving (no force), sticking (the
+    whole polygon cone), sliding (the polygon's edges most opposed to the sliding) or frictionless."""
+    tol = 1e-9 * scale
+    wn = c.normal @ row
+    if wn > tol:
+        return np.zeros((3, 0))
+    if c.mu == 0.0:
+        return c.normal[:, None]
+    D = facet_directions(c.normal, c.facets)
+    wt = row - wn * c.normal
+    if np.linalg.norm(wt) <= tol:
+        return np.array([c.normal + c.mu * d for d in D]).T
+    score = D @ wt
+    best = np.flatnonzero(score <= score.min() + 1e-9 * np.linalg.norm(wt))
+    return np.array([c.normal + c.mu * D[j] for j in best]).T
+
+
+def _qp(P, E, e, lo, hi):
+    """min 1/2 x^T P x subject to E x = e and lo <= x <= hi: SLSQP, then the exact KKT solution of
+    the equality-constrained programme on the bounds it found active."""
+    N = P.shape[0]
+    U, sv, _ = np.linalg.svd(E, full_matrices=False)  # independent equality rows (SLSQP needs them)
+    rank = int(np.sum(sv > 1e-12 * max(1.0, sv.max())))
+    E, e = U[:, :rank].T @ E, U[:, :rank].T @ e
+    x0 = np.clip(np.linalg.lstsq(E, e, rcond=None)[0], lo, hi)
+    res = minimize(
+        lambda x: 0.5 * x @ P @ x,
+        x0,
+        jac=lambda x: P @ x,
+        bounds=list(zip(lo, hi)),
+        constraints=[{"type": "eq", "fun": lambda x: E @ x - e, "jac": lambda x: E}],
+        method="SLSQP",
+        options=dict(ftol=1e-15, maxiter=300),
+    )
+    x = res.x
+    scale = max(1.0, np.abs(x).max())
+    fixed = np.flatnonzero((x <= lo + 1e-7 * scale) | (x >= hi - 1e-7 * scale))
+    B = np.zeros((len(fixed), N))
+    B[np.arange(len(fixed)), fixed] = 1.0
+    C = np.vstack([E, B])
+    d = np.concatenate([e, np.where(x[fixed] <= lo[fixed] + 1e-7 * scale, lo[fixed], hi[fixed])])
+    K = np.block([[P, C.T], [C, np.zeros((C.shape[0], C.shape[0]))]])
+    sol = np.linalg.lstsq(K, np.concatenate([np.zeros(N), d]), rcond=None)[0]
+    return sol[:N]
+
+
+def _oracle(prob, A, qdd):
+    """The least-effort impulses given the step's qdd: (tau_command, forces (k, 3), joint torques (n,)).
+    ``prob``: contact_problem over the time step (rows a + v / dt, joints' offsets qd / dt)."""
+    n, m = prob.H.shape[0], A.shape[0]
+    rhs = prob.H @ qdd - prob.h
+    scale_a = max(1.0, np.abs(qdd).max(), *(np.abs(c.J @ qdd + c.bias).max() for c in prob.contacts))
+    gens = [_generators(c, c.J @ qdd + c.bias, scale_a) for c in prob.contacts]
+    cols = [A.T] + [c.J.T @ G for c, G in zip(prob.contacts, gens)]
+    lo, hi = [np.full(m, -np.inf)] + [np.zeros(G.shape[1]) for G in gens], [np.full(m, np.inf)]
+    hi += [np.full(G.shape[1], np.inf) for G in gens]
+    fixed = np.zeros(n)
+    for j in prob.joints:  # sticking: a torque within its bounds; slipping: the bound against its row
+        row = qdd[j.index] + j.offset
+        if abs(row) <= 1e-9 * scale_a:
+            cols.append(np.eye(n)[:, [j.index]])
+            lo.append(np.array([j.lo])), hi.append(np.array([j.hi]))
+        else:
+            fixed[j.index] = j.lo if row > 0 else j.hi
+    E, lo, hi = np.hstack(cols), np.concatenate(lo), np.concatenate(hi)
+    e = rhs - fixed
+    sizes = np.cumsum([0, m] + [G.shape[1] for G in gens])
+    # Least effort: 1/2 ||A^T nu||^2.
+    T = np.zeros((n, E.shape[1]))
+    T[:, :m] = A.T
+    x1 = _qp(T.T @ T, E, e, lo, hi)
+    tau_cmd = T @ x1
+    # Then the least contact forces with the motors' torques kept.
+    F = np.zeros((3 * len(gens), E.shape[1]))
+    for i, G in enumerate(gens):
+        F[3 * i : 3 * i + 3, sizes[i + 1] : sizes[i + 2]] = G
+    x2 = _qp(F.T @ F, np.vstack([E, T]), np.concatenate([e, tau_cmd]), lo, hi)
+    forces = (F @ x2).reshape(-1, 3)
+    joint = rhs - A.T @ x2[:m] - sum((c.J.T @ f for c, f in zip(prob.contacts, forces)), np.zeros(n))
+    return T @ x2, forces, joint
+
+
+def _redundant(prob, A, qdd):
+    """True when the step's impulses are not unique: the response columns of the free coordinates
+    (sticking joints' torques, the contacts' admissible directions) are dependent."""
+    scale_a = max(1.0, np.abs(qdd).max(), *(np.abs(c.J @ qdd + c.bias).max() for c in prob.contacts))
+    cols = []
+    for c in prob.contacts:
+        G = _generators(c, c.J @ qdd + c.bias, scale_a)
+        if G.shape[1]:
+            cols.append(c.J.T @ np.linalg.qr(G)[0][:, : np.linalg.matrix_rank(G)])
+    n = prob.H.shape[0]
+    cols += [np.eye(n)[:, [j.index]] for j in prob.joints if abs(qdd[j.index] + j.offset) <= 1e-9 * scale_a]
+    if not cols:
+        return False
+    M = np.hstack(cols)
+    # Modulo the task: the directions the motors hold do not move qdd either.
+    if A.shape[0]:
+        Pa = np.eye(n) - A.T @ np.linalg.pinv(A.T)
+        M = Pa @ M
+    return np.linalg.matrix_rank(M, tol=1e-9 * max(1.0, np.abs(M).max())) < M.shape[1]
+
+
+# The least contact force (the second programme) is not reached in these cases, at the instant
+# either (the step at rest gives the instant's answer): with the sticking joints' torques among
+# the coordinates the second programme is only positive semi-definite, and its pivoting
+# (LexicographicQp, lemke.cpp) ends on a ray, so the least-effort forces of the first programme
+# stand. The effort itself is the least; the forces are admissible. Listed so that a fix shows.
+KNOWN_SECOND_STAGE_GAPS = {"chain seed 9", "baxter: 4 supports, mu 0.6, qd 0.0"}
+
+
+def _admissible(prob, qdd, forces, joint):
+    """The solver's impulses meet the step's conditions: each force in its admissible cone, each
+    joint's torque within its bounds (at the bound against a slipping joint's end velocity)."""
+    scale_a = max(1.0, np.abs(qdd).max(), *(np.abs(c.J @ qdd + c.bias).max() for c in prob.contacts))
+    for c, f in zip(prob.contacts, forces):
+        G = _generators(c, c.J @ qdd + c.bias, scale_a)
+        resid = np.linalg.norm(f) if G.shape[1] == 0 else nnls(G, f)[1]
+        assert resid <= 1e-9 * max(1.0, np.linalg.norm(f)), (f, resid)
+    for j in prob.joints:
+        t, row, tol = joint[j.index], qdd[j.index] + j.offset, 1e-9 * max(1.0, abs(joint[j.index]))
+        assert j.lo - tol <= t <= j.hi + tol
+        if abs(row) > 1e-9 * scale_a:
+            assert abs(t - (j.lo if row > 0 else j.hi)) <= tol
+
+
+def _check(r, prob, A, what, tau_cmd=None, forces=None, joint=None, order=lambda x: x):
+    """The solver's least effort, then its least contact forces, against the oracle's."""
+    if tau_cmd is None:
+        tau_cmd, forces, joint = _oracle(prob, A, order(r.qdd))
+    scale = max(1.0, np.linalg.norm(tau_cmd), np.linalg.norm(forces), np.linalg.norm(joint))
+    mine = order(r.friction_torque + r.limit_torque)
+    assert np.linalg.norm(order(r.tau_command) - tau_cmd) <= RTOL * scale, f"{what}: {r.tau_command} vs {tau_cmd}"
+    _admissible(prob, order(r.qdd), r.contact_force, mine)
+    error = max(np.linalg.norm(r.contact_force - forces), np.linalg.norm(mine - joint))
+    if what in KNOWN_SECOND_STAGE_GAPS:
+        assert error > RTOL * scale, f"{what}: the least contact force is now reached: drop it from the gaps"
+        assert np.sum(r.contact_force**2) >= np.sum(forces**2)  # the oracle's is the least
+        pytest.xfail(f"{what}: least effort met, least contact force not (second programme ends on a ray)")
+    assert np.linalg.norm(r.contact_force - forces) <= RTOL * scale, f"{what}: forces {r.contact_force} vs {forces}"
+    assert np.linalg.norm(mine - joint) <= RTOL * scale, f"{what}: joints {mine} vs {joint}"
+
+
+def _gen3():
+    urdf = gen3_urdf(gripper=False, use_external_cable=True)
+    model = pin.buildModelFromXML(urdf)
+    model.gravity = pin.Motion(np.r_[G_EARTH, 0.0, 0.0, 0.0])
+    return vs.Solver(vs.Chain.from_urdf(urdf), gravity=G_EARTH), model
+
+
+def _task_rows(model, data, q, frame_id, alpha):
+    """A = alpha^T J (the frame's origin, base axes: linear rows 0..2, angular 3..5)."""
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    return alpha.T @ pin.getFrameJacobian(model, data, frame_id, LWA)
+
+
+@pytest.mark.parametrize("qd_scale", [0.0, 0.02])
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+def test_gen3_pressed_on_a_table_by_two_supports_with_joints_holding(qd_scale, dt):
+    """Hold test B with a second support and the tool's orientation held by the motors: the tool
+    and the wrist on a table (mu 0.8), the tool pushed by (8, 0, -20) N, joint friction half the
+    gravity torque plus 0.3 N m: the table, the joints and the motors share the load."""
+    solver, model = _gen3()
+    data = model.createData()
+    tool, wrist = model.getFrameId(TOOL), model.getFrameId("spherical_wrist_2_link")
+    pin.computeJointJacobians(model, data, GEN3_Q)
+    pin.forwardKinematics(model, data, GEN3_Q, np.zeros(7), np.zeros(7))
+    J_tool, _, _ = point_jacobian(model, data, tool, np.zeros(3))
+    N = np.array([J_tool[2], point_jacobian(model, data, wrist, np.zeros(3))[0][2]])
+    qd = np.random.default_rng(3).normal(size=7) * qd_scale
+    qd -= np.linalg.pinv(N) @ (N @ qd)  # moving along the table, not away from it
+    tau = J_tool.T @ np.array([8.0, 0.0, -20.0])  # the push, as joint torques
+    g = pin.computeGeneralizedGravity(model, data, GEN3_Q)
+    fs = 0.5 * np.abs(g) + 0.3
+    fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+    contacts = [
+        vs.Contact(TOOL, normal=[0.0, 0.0, 1.0], mu=0.8),
+        vs.Contact("spherical_wrist_2_link", normal=[0.0, 0.0, 1.0], mu=0.8),
+    ]
+    alpha = np.zeros((6, 3))
+    alpha[3:, :] = np.eye(3)  # the tool's angular acceleration held at zero
+    r = solver.solve(
+        GEN3_Q, qd, alpha=alpha, beta=np.zeros(3), tau_ff=tau, friction=fr, contacts=contacts, time_step=dt
+    )
+    specs = [dict(frame=model.getFrameId(c.segment), point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+    prob = contact_problem(
+        model, data, GEN3_Q, qd, tau, specs, friction=dict(static=fs, kinetic=0.7 * fs), time_step=dt
+    )
+    A = _task_rows(model, model.createData(), GEN3_Q, tool, alpha)
+    assert r.contact_force[:, 2].sum() > 1.0  # the table carries
+    if qd_scale == 0.0:
+        assert _redundant(prob, A, r.qdd) and np.all(r.status == 1)  # held: the split is the rule's
+        inst = solver.solve(GEN3_Q, qd, alpha=alpha, beta=np.zeros(3), tau_ff=tau, friction=fr, contacts=contacts)
+        assert _rel(r.contact_force, inst.contact_force) <= RTOL  # at rest the step's problem is the instant's
+        assert _rel(r.tau_command, inst.tau_command) <= RTOL
+    _check(r, prob, A, f"dt {dt}, qd {qd_scale}")
+
+
+def _chain_case(rng, k, mu, moving):
+    """A random 7-joint chain at rest or creeping (joints at 1e-3 rad/s: friction can stop them
+    within the step), friction on every joint 0.5 to 1.5 times its load (the gravity and
+    feed-forward torques), k supports on the last segments whose normals oppose the points' motion
+    without them (so that they carry), a 2-D task on the tip."""
+    n = 7
+    rc = random_chain(rng, n, prismatic=False)
+    q, qd = random_state(rng, rc, qd_scale=1e-3)
+    if not moving:
+        qd[:] = 0.0
+    tau = rng.normal(size=n) * 3
+    model = rc.model
+    data = model.createData()
+    pq = pin_configuration(model, q)
+    h = tau - pin.rnea(model, data, pq, qd, np.zeros(n))
+    fs = np.abs(h) * rng.uniform(0.5, 1.5, size=n) + 0.05
+    minv_h = np.linalg.solve(pin.crba(model, data, pq), h)
+    pin.computeJointJacobians(model, data, pq)
+    pin.forwardKinematics(model, data, pq, qd, np.zeros(n))
+    contacts = []
+    for s in rng.choice(np.arange(n - 3, rc.n_segments), size=k, replace=False):
+        point = rng.normal(size=3) * 0.1
+        J, bias, v = point_jacobian(model, data, rc.tip_frames[s], point)
+        a = J @ minv_h + bias
+        normal = -(a + v) / np.linalg.norm(a + v) + 0.2 * rng.normal(size=3)
+        contacts.append(vs.Contact(int(s), point=point, normal=normal / np.linalg.norm(normal), mu=mu))
+    alpha = rng.normal(size=(6, 2))
+    alpha /= np.linalg.norm(alpha, axis=0)
+    return rc, q, qd, tau, fs, contacts, alpha, alpha[:3].T @ -G_EARTH
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_redundant_supports_on_random_chains(seed):
+    """Two or three supports (with friction, or frictionless) on random chains with friction on
+    every joint and a 2-D task, at rest or moving, dt 1 ms or 10 ms."""
+    rng = np.random.default_rng(4200 + seed)
+    k, mu, moving, dt = 2 + seed % 2, (0.8, 0.0, 0.5)[seed % 3], seed % 4 >= 2, (1e-3, 1e-2)[seed % 2]
+    rc, q, qd, tau, fs, contacts, alpha, beta = _chain_case(rng, k, mu, moving)
+    fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+    r = rc.solver().solve(q, qd, alpha=alpha, beta=beta, tau_ff=tau, friction=fr, contacts=contacts, time_step=dt)
+    model = rc.model
+    pq = pin_configuration(model, q)
+    specs = [dict(frame=rc.tip_frames[c.segment], point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+    prob = contact_problem(
+        model, model.createData(), pq, qd, tau, specs, friction=dict(static=fs, kinetic=0.7 * fs), time_step=dt
+    )
+    A = _task_rows(model, model.createData(), pq, rc.tip_frames[-1], alpha)
+    _check(r, prob, A, f"chain seed {seed}")
+
+
+def test_some_random_chain_cases_are_redundant():
+    """The cases above do exercise the rule: in several of them the impulses are not unique."""
+    count = 0
+    for seed in range(12):
+        rng = np.random.default_rng(4200 + seed)
+        k, mu, moving, dt = 2 + seed % 2, (0.8, 0.0, 0.5)[seed % 3], seed % 4 >= 2, (1e-3, 1e-2)[seed % 2]
+        rc, q, qd, tau, fs, contacts, alpha, beta = _chain_case(rng, k, mu, moving)
+        fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+        r = rc.solver().solve(q, qd, alpha=alpha, beta=beta, tau_ff=tau, friction=fr, contacts=contacts, time_step=dt)
+        model = rc.model
+        pq = pin_configuration(model, q)
+        specs = [dict(frame=rc.tip_frames[c.segment], point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+        fric = dict(static=fs, kinetic=0.7 * fs)
+        prob = contact_problem(model, model.createData(), pq, qd, tau, specs, friction=fric, time_step=dt)
+        count += _redundant(prob, _task_rows(model, model.createData(), pq, rc.tip_frames[-1], alpha), r.qdd)
+    assert count >= 4, count
+
+
+@pytest.mark.parametrize("name", ["baxter", "random_8"])
+def test_redundant_supports_on_trees(name):
+    """Three to five supports (frictionless and with friction) on a tree, friction on every
+    joint, a 3-D angular task on one segment, at rest and moving."""
+    from support.trees import robot
+
+    case = robot(name)
+    model = case.model
+    names = list(case.tree.segment_names)
+    n = case.n
+    rng = np.random.default_rng([77, len(name)])
+    failures = []
+    for k, mu, qd_scale in ((3, 0.0, 0.0), (4, 0.6, 0.0), (5, 0.0, 0.2), (5, 0.6, 0.0)):
+        q, qd = case.random_state(rng, qd_scale=max(qd_scale, 1e-3))
+        qd *= qd_scale > 0.0
+        tau = rng.normal(size=n) * 2
+        fs = rng.uniform(0.2, 2.0, size=n)
+        pq, pqd, ptau = case.pin_q(q), case.pin_v(qd), case.pin_v(tau)
+        data = model.createData()
+        minv_h = np.linalg.solve(pin.crba(model, data, pq), ptau - pin.rnea(model, data, pq, pqd, np.zeros(n)))
+        pin.computeJointJacobians(model, data, pq)
+        pin.forwardKinematics(model, data, pq, pqd, np.zeros(n))
+        contacts = []
+        for s in rng.choice(len(names), size=k, replace=False):
+            point = rng.normal(size=3) * 0.05
+            J, bias, v = point_jacobian(model, data, model.getFrameId(names[s]), point)
+            d = J @ minv_h + bias + v
+            normal = -d / max(np.linalg.norm(d), 1e-9) + 0.2 * rng.normal(size=3)
+            contacts.append(vs.Contact(names[s], point=point, normal=normal / np.linalg.norm(normal), mu=mu))
+        seg = names[int(rng.integers(len(names)))]
+        alpha = np.zeros((6, 3))
+        alpha[3:, :] = np.eye(3)
+        fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+        dt = 1e-3
+        r = case.solver().solve(
+            q, qd, tau_ff=tau, friction=fr, contacts=contacts, constraints={seg: (alpha, np.zeros(3))}, time_step=dt
+        )
+        specs = [dict(frame=model.getFrameId(c.segment), point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+        fric = dict(static=case.pin_v(fs), kinetic=case.pin_v(0.7 * fs))
+        prob = contact_problem(model, model.createData(), pq, pqd, ptau, specs, friction=fric, time_step=dt)
+        A = _task_rows(model, model.createData(), pq, model.getFrameId(seg), alpha)
+        what = f"{name}: {k} supports, mu {mu}, qd {qd_scale}"
+        try:
+            _check(r, prob, A, what, order=case.pin_v)
+        except pytest.xfail.Exception as gap:  # (the other configurations still run)
+            failures.append(str(gap))
+    if failures:
+        pytest.xfail("; ".join(failures))
+
+
+@pytest.mark.parametrize("m", [1, 3])
+@pytest.mark.parametrize("qd_scale", [0.0, 0.3])
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+def test_a_redundant_task_with_friction_over_a_step(m, qd_scale, dt):
+    """The Gen3 with friction on every joint and an m-D task on the tool (friction alone, no
+    contacts): the sticking joints and the motors share the load by the least-command rule."""
+    solver, model = _gen3()
+    rng = np.random.default_rng([m, int(10 * qd_scale), int(1e3 * dt)])
+    qd = rng.normal(size=7) * qd_scale
+    g = pin.computeGeneralizedGravity(model, model.createData(), GEN3_Q)
+    fs = 0.6 * np.abs(g) + 0.2
+    fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+    alpha = np.zeros((6, m))
+    alpha[np.arange(m) + 3, np.arange(m)] = 1.0  # the tool's angular acceleration, m axes
+    r = solver.solve(GEN3_Q, qd, alpha=alpha, beta=np.zeros(m), friction=fr, time_step=dt)
+    tau = np.zeros(7)
+    prob = contact_problem(
+        model, model.createData(), GEN3_Q, qd, tau, [], friction=dict(static=fs, kinetic=0.7 * fs), time_step=dt
+    )
+    A = _task_rows(model, model.createData(), GEN3_Q, model.getFrameId(TOOL), alpha)
+    if qd_scale == 0.0:
+        assert _redundant(prob, A, r.qdd)
+    _check(r, prob, A, f"m {m}, qd {qd_scale}, dt {dt}")
