@@ -66,9 +66,6 @@ class PySolver {
   py::object solve(PyObject* const* args, PyObject* out, int step = 0);
   // Seconds per C++ solve of the parsed row, reading every output solve() returns.
   double timeCpp(PyObject* const* args, long reps);
-  // Benchmarks only (BENCHMARKS.md, "Call mechanism"): solve() returning a dict of new numpy
-  // arrays, as a result made of plain arrays would (no friction).
-  py::dict solveDict(PyObject* const* args);
   // solve_batch(): args as solve()'s (`out` not read); threads: None (1) or an int, 0: one per core.
   py::dict solveBatch(PyObject* const* args, PyObject* threads);
   // joints: joint indices in range (solver.py resolves names and negative indices).
@@ -105,7 +102,7 @@ class PySolver {
   vereshchagin::BatchWorkspace& workspace(std::size_t k);
   // Parses `args` into args_ and solves them on workspace 0 (the caller holds the Lock); given
   // next = {q_next, qd_next, p_next} (nj doubles each), steps instead (step(), stepSymplectic() from p).
-  void solveArgs(PyObject* const* args, bool frictionless, double* const* next = nullptr, const double* p = nullptr);
+  void solveArgs(PyObject* const* args, double* const* next = nullptr, const double* p = nullptr);
 
   std::unique_ptr<PyChain> chain_;  // the model: one of these two
   std::unique_ptr<PyTree> tree_;

@@ -1,7 +1,6 @@
 // Solver.solve (one row on workspace 0, its result new or written into `out`), _step and
-// _step_symplectic, its benchmark
-// hooks (_solve_dict, _time_cpp) and Solver.solve_batch (vereshchagin::solveBatch over one
-// workspace per thread), each on the arguments SolveArgs parsed.
+// _step_symplectic, the benchmark hook _time_cpp and Solver.solve_batch (vereshchagin::solveBatch
+// over one workspace per thread), each on the arguments SolveArgs parsed.
 #include <algorithm>
 
 #include "py_solver.hpp"
@@ -11,10 +10,9 @@ namespace vsbind {
 
 using namespace pybind11::literals;
 
-void PySolver::solveArgs(PyObject* const* args, bool frictionless, double* const* next, const double* p) {
+void PySolver::solveArgs(PyObject* const* args, double* const* next, const double* p) {
   last_state_ = false;
   args_.parse(*this, args, /*batch=*/false);
-  if (frictionless && args_.any_friction) raise("_solve_dict benchmarks the frictionless call: no friction");
   vereshchagin::Status st;
   {
     py::gil_scoped_release release;
@@ -36,7 +34,7 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out, int step) {
   double* next[3] = {};
   for (int k = 0; k < (step == 2 ? 3 : step ? 2 : 0); ++k) next[k] = doubles(next_arrays[k] = newDoubles({nj}));
   const F64View p = step == 2 ? vectorView(out ? out : Py_None, "momentum (out=)", nj) : F64View();
-  solveArgs(args, false, step ? next : nullptr, step == 2 ? p.data : nullptr);
+  solveArgs(args, step ? next : nullptr, step == 2 ? p.data : nullptr);
   const bool fr = args_.any_friction;
   const long k = static_cast<long>(args_.input.contacts.size());
   py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr, k}, step ? nullptr : out);
@@ -45,19 +43,6 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out, int step) {
   if (!args_.layout.empty()) setSegmentLayout(r.ptr(), py::tuple(args_.layout));
   if (step == 2) return py::make_tuple(next_arrays[0], next_arrays[1], next_arrays[2], r);
   return step ? py::object(py::make_tuple(next_arrays[0], next_arrays[1], r)) : r;
-}
-
-py::dict PySolver::solveDict(PyObject* const* args) {
-  Lock lk(*this);
-  solveArgs(args, true);
-  py::array qdd = newDoubles({nj}), tau = newDoubles({nj}), nu = newDoubles({args_.columns}),
-            acc = newDoubles({ns + 1, 6});
-  int rank;
-  double smin;
-  vereshchagin::BatchOutput{doubles(qdd), doubles(tau), doubles(nu), doubles(acc), &smin, &rank}.write(
-      0, workspaces_[0]->data, args_.columns, false);
-  return py::dict("qdd"_a = qdd, "tau_command"_a = tau, "nu"_a = nu, "link_acc"_a = acc, "constraint_rank"_a = rank,
-                  "smallest_singular_value"_a = smin);
 }
 
 double PySolver::timeCpp(PyObject* const* args, long reps) {

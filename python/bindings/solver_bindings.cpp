@@ -65,14 +65,13 @@ PyObject* guarded(Body&& body) {
   return nullptr;
 }
 
-enum Entry { kSolve, kTimeCpp, kSolveDict, kSolveBatch, kStep, kStepSymplectic };
-constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "_solve_dict", "solve_batch", "_step", "_step_symplectic"};
+enum Entry { kSolve, kTimeCpp, kSolveBatch, kStep, kStepSymplectic };
+constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "solve_batch", "_step", "_step_symplectic"};
 
 // The METH_FASTCALL methods: solve(q, qd, ...); _time_cpp(reps, q, qd, ...): seconds per C++
 // solve (outputs read as solve() reads them), for benchmarks that compare the Python call with
-// the C++ work in the same process; _solve_dict(q, qd, ...): solve() returning a dict of arrays;
-// solve_batch(q, qd, ..., threads, a_desired, contacts): a dict of the batch's arrays (solver.py wraps it);
-// _step(q, qd, ..., time_step=dt): vereshchagin::step(), (q_next, qd_next, SolveResult);
+// the C++ work in the same process; solve_batch(q, qd, ..., threads, a_desired, contacts): a dict of the batch's arrays
+// (solver.py wraps it); _step(q, qd, ..., time_step=dt): vereshchagin::step(), (q_next, qd_next, SolveResult);
 // _step_symplectic(..., out=momentum): stepSymplectic(), (q_next, qd_next, momentum_next, SolveResult).
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
@@ -83,7 +82,6 @@ PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyO
     PyObject* a[kNumSolveArgs] = {};
     bindArguments(kEntryNames[kind], g_names[kind == kSolveBatch], args + first, nargs - first, kwnames, a);
     if (kind == kTimeCpp) return py::float_(solverOf(self).timeCpp(a, reps));
-    if (kind == kSolveDict) return solverOf(self).solveDict(a);
     if (kind == kSolveBatch) return solverOf(self).solveBatch(a, a[kOutArg]);
     return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg],
                                 kind == kSolve ? 0 : kind - kSolveBatch);
@@ -96,20 +94,8 @@ PyMethodDef fastDef() {  // the doc is set in bindSolver()
           METH_FASTCALL | METH_KEYWORDS, nullptr};
 }
 
-PyMethodDef g_fast_defs[] = {fastDef<kSolve>(),      fastDef<kTimeCpp>(), fastDef<kSolveDict>(),
-                             fastDef<kSolveBatch>(), fastDef<kStep>(),    fastDef<kStepSymplectic>()};
-
-using O = const py::object&;
-
-// _solve_pybind: solve() bound the plain pybind11 way (named arguments with defaults), the
-// benchmark of the fast call's gain.
-py::object solvePybind(PySolver& s, O q, O qd, O alpha, O beta, O f_ext, O tau_ff, O friction, O constraints, O f_pass,
-                       O t_pass, O out, O a_desired, O contacts, O time_step, O v_tol) {
-  PyObject* a[kNumSolveArgs] = {q.ptr(),      qd.ptr(),        alpha.ptr(),       beta.ptr(),      f_ext.ptr(),
-                                tau_ff.ptr(), friction.ptr(),  constraints.ptr(), f_pass.ptr(),    t_pass.ptr(),
-                                out.ptr(),    a_desired.ptr(), contacts.ptr(),    time_step.ptr(), v_tol.ptr()};
-  return s.solve(a, out.is_none() ? nullptr : out.ptr());
-}
+PyMethodDef g_fast_defs[] = {fastDef<kSolve>(), fastDef<kTimeCpp>(), fastDef<kSolveBatch>(), fastDef<kStep>(),
+                             fastDef<kStepSymplectic>()};
 
 }  // namespace
 
@@ -119,6 +105,7 @@ void bindSolver(py::module_& mod) {
     g_names[1][k] = PyUnicode_InternFromString(k == kOutArg ? "threads" : kSolveParams[k]);
   }
 
+  using O = const py::object&;
   py::class_<PySolver> cls(mod, "Solver", doc("_core.Solver"));
   cls.def(py::init<O, O, O, O, O, O>(), py::arg("model"), py::arg("gravity") = std::vector<double>{0.0, 0.0, -9.81},
           py::arg("rcond") = 1e-12, py::arg("damping") = py::none(), py::arg("inertia_check") = py::none(),
@@ -136,12 +123,6 @@ void bindSolver(py::module_& mod) {
     if (descr == nullptr) throw py::error_already_set();
     cls.attr(def.ml_name) = py::reinterpret_steal<py::object>(descr);
   }
-  const py::object none = py::none();
-  cls.def("_solve_pybind", &solvePybind, py::arg("q"), py::arg("qd"), py::arg("alpha") = none, py::arg("beta") = none,
-          py::arg("f_ext") = none, py::arg("tau_ff") = none, py::arg("friction") = none, py::arg("constraints") = none,
-          py::arg("f_ext_pass_through") = none, py::arg("tau_ff_pass_through") = none, py::arg("out") = none,
-          py::arg("a_desired") = none, py::arg("contacts") = none, py::arg("time_step") = none,
-          py::arg("contact_velocity_tolerance") = none, doc("_core.Solver._solve_pybind"));
 }
 
 }  // namespace vsbind

@@ -624,13 +624,9 @@ DOCS["_core.Solver.inertia_check"] = r"""str: 'physical' or 'joint_space' (see S
 
 DOCS["_core.Solver._time_cpp"] = r"""_time_cpp(reps, q, qd, ...) -> float: seconds per C++ solve of these arguments (benchmarks)."""
 
-DOCS["_core.Solver._solve_dict"] = r"""_solve_dict(q, qd, ...) -> dict: solve() returning a dict of new arrays instead of a SolveResult (benchmarks)."""
-
 DOCS["_core.Solver._step"] = r"""_step(q, qd, ..., time_step=dt) -> (q_next, qd_next, SolveResult): the C++ step() (Solver.step, Simulator)."""
 
 DOCS["_core.Solver._step_symplectic"] = r"""_step_symplectic(q, qd, ..., time_step=dt, out=p) -> (q_next, qd_next, p_next, SolveResult): the C++ stepSymplectic() from the momentum p (Simulator)."""
-
-DOCS["_core.Solver._solve_pybind"] = r"""_solve_pybind(q, qd, ...) -> SolveResult: solve() through pybind11's argument dispatch (benchmarks)."""
 
 # ---- SolveResult (result_type.cpp) ----
 
