@@ -154,15 +154,25 @@ namespace {
 
 constexpr int kPrimalDualRounds = 4;
 
-// boxQp's iteration bound (derivation there): (P + 1) (k + 1) 3^k + P, capped at 1e8.
-long boxQpIterationBound(int k) {
+}  // namespace
+
+// boxQp's exhaustive iteration bound (derivation there): (P + 1) (k + 1) 3^k + P, capped at 1e8.
+long exhaustiveIterationBound(int k) {
   long bound = k + 1;
   for (int i = 0; i < k && bound < 100000000L; ++i) bound *= 3;
   bound = (kPrimalDualRounds + 1) * bound + kPrimalDualRounds;
   return std::min(bound, 100000000L);
 }
 
-}  // namespace
+// The iterations one stage may spend (FrictionModel::max_iterations): the real-time default
+// kDefaultIterationsPerJoint k + kDefaultIterationsBase (docs/friction.md, "Real-time bound"), the
+// exhaustive bound for 0, else the number given (at most the exhaustive bound, which suffices).
+long FrictionCore::iterationBound(int k) const {
+  const long exhaustive = exhaustiveIterationBound(k);
+  if (max_iterations_ == 0) return exhaustive;
+  const long cap = max_iterations_ > 0 ? max_iterations_ : kDefaultIterationsPerJoint * k + kDefaultIterationsBase;
+  return std::min(cap, exhaustive);
+}
 
 int FrictionCore::boxQp(int k) {
   auto x = x_.head(k);
@@ -196,7 +206,7 @@ int FrictionCore::boxQp(int k) {
   // rounds when the whole Q is singular (a task fixes accelerations): its nearly singular faces
   // have minimisers far outside the box, and the rounds then cost more than the primal steps.
   // (The free-set factor updates of factorDelete() change how a step is computed, not which.)
-  const long max_iterations = boxQpIterationBound(k);
+  const long max_iterations = iterationBound(k);
   int rounds_left = kPrimalDualRounds;
   bool face_optimal = false, bland = false;
   double last_face_value = kInf;
@@ -235,7 +245,24 @@ int FrictionCore::boxQp(int k) {
     factor_valid_ = false;
     face_optimal = false;
   }
-  return fail(E_NOT_CONVERGED, "friction optimisation did not converge in %ld active-set iterations", max_iterations);
+  degraded_ = 1;  // the bound is hit: the fallback (boxQpFallback) on the feasible iterate x
+  boxQpFallback(k);
+  return ChainHdSolver::E_NOERROR;
+}
+
+// The real-time fallback when boxQp hits its bound: the last iterate x (inside the box: primal
+// steps stop at bounds, primal-dual rounds clamp back into it) scaled by s in [0, 1] to the
+// maximiser of the dual g(s x) = s c^T x - s^2/2 x^T Q x along the ray from 0, s = clip(c^T x /
+// x^T Q x). The box contains 0 and is convex, so s x stays in it (every |mu_j| <= f_j, a limit's
+// reaction on its side only); g(s x) >= max(g(0), g(x)); and c^T (s x) - (s x)^T Q (s x) >= 0: the
+// friction torques do no positive work on the resulting accelerations (or end velocities over a
+// step) in sum, sum_j mu_j (qdd_j + qd_j / dt) >= 0. docs/friction.md, "Real-time bound".
+void FrictionCore::boxQpFallback(int k) {
+  auto x = x_.head(k);
+  gradient(k);  // Q x - c
+  const double cx = c_.head(k).dot(x), xqx = x.dot(grad_.head(k)) + cx;
+  const double s = xqx > 0.0 ? std::min(1.0, std::max(0.0, cx / xqx)) : (cx > 0.0 ? 1.0 : 0.0);
+  if (s < 1.0) x *= s;
 }
 
 // A primal-dual round from the free set's minimiser p_ (boxQp): take the full step, re-guess the

@@ -24,6 +24,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kZeroCurvature = 1e-10;
 // Gradient entries (accelerations) below this fraction of the gradient's scale are zero.
 constexpr double kGradientTolerance = 1e-11;
+// The real-time default of FrictionModel::max_iterations = -1: this many iterations per resting
+// joint plus the base, per stage (docs/friction.md, "Real-time bound", has the measurements).
+constexpr long kDefaultIterationsPerJoint = 6;
+constexpr long kDefaultIterationsBase = 16;
+// The exhaustive bound (P + 1) (k + 1) 3^k + P of the box QP (friction_box_qp.cpp), capped at 1e8.
+long exhaustiveIterationBound(int k);
 
 // One joint's friction in a solve (shared by the friction stage and the contact stage so that both
 // read a FrictionModel alike): moving when |qd_j| exceeds the velocity tolerance; f its bound, the
@@ -85,12 +91,14 @@ class FrictionCore {
                     const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
   int optimiseResting(int k);
   void frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_dot, const FrictionModel& friction, int k);
-  int boxQp(int k);          // stage 1 on Q_, c_, lo_, hi_ -> x_
-  void leastCommand(int k);  // stage 2: tie-break on the optimal face
+  int boxQp(int k);                  // stage 1 on Q_, c_, lo_, hi_ -> x_
+  long iterationBound(int k) const;  // iterations a stage on k unknowns may spend (max_iterations_)
+  void boxQpFallback(int k);         // stage 1's real-time fallback at its bound (sets x_)
+  void leastCommand(int k);          // stage 2: tie-break on the optimal face
   // Stage 2's solvers on the sticking set (ns joints, Q_StSt = V_ V_^T of rank r < ns), from
   // ys_ = x*_St with target ts_ and bounds p_ / eig_ (see leastCommand).
   void leastOnLine(int ns, int r);                    // ns - r = 1: closed form
-  void leastActiveSet(int ns, int r, double yscale);  // range-space primal active set
+  bool leastActiveSet(int ns, int r, double yscale);  // range-space primal active set (false: bound hit)
   int projectOffRange(int ns, int r);                 // its steps (friction_least_command.cpp)
   bool stepToBound(int ns, double step_tol);
   void faceMultipliers(int r, int rf);
@@ -115,6 +123,8 @@ class FrictionCore {
   bool link_acc_known_ = false;
   std::vector<signed char> status_;
   int iterations_ = 0;
+  int max_iterations_ = -1;      // FrictionModel::max_iterations of the current solve
+  int degraded_ = 0;             // the bound was hit: 0 no, 1 in the box QP, 2 in the least command
   double qscale_ = 0.0;          // scale of Q (see solve())
   double gscale_ = 0.0;          // scale of the QP gradient (see boxQp())
   bool free_full_rank_ = false;  // the last free-set factorisation had full rank

@@ -72,8 +72,8 @@ void FrictionCore::leastCommand(int k) {
   }
   if (r == ns - 1)
     leastOnLine(ns, r);
-  else
-    leastActiveSet(ns, r, yscale);
+  else if (!leastActiveSet(ns, r, yscale))
+    degraded_ = 2;  // its bound hit: the iterate so far (the motion is the optimum's regardless)
   // x_St <- y, clipped to the box (round-off overshoot of non-blocking entries); kept only if not
   // worse than x* (a safety net: the iteration never increases the objective).
   double v_start = 0.0, v_end = 0.0;
@@ -273,7 +273,8 @@ int FrictionCore::releaseIndex(int ns, int r, double mult_tol, bool bland) const
 // Stage 2 by the range-space primal active set (see leastCommand): on ys_ (from x*_St, feasible),
 // ts_, the St bounds in p_ / eig_ and Q_StSt = V V^T (V_, rank r). Rows of the working set are
 // masked (tmp_ = 0) rather than gathered: every loop runs over all ns rows without indirection.
-void FrictionCore::leastActiveSet(int ns, int r, double yscale) {
+// False when the iteration bound was hit (the iterate so far is kept).
+bool FrictionCore::leastActiveSet(int ns, int r, double yscale) {
   for (int a = 0; a < ns; ++a) side_(a) = 0, tmp_(a) = 1.0;  // working set empty
   // A step entry at or below step_tol is round-off (a coordinate the equality pins): it does not
   // block; the overshoot it may cause (<= step_tol) is clipped at the end.
@@ -284,12 +285,14 @@ void FrictionCore::leastActiveSet(int ns, int r, double yscale) {
   // convex and never increases along a step; from one face optimum to the next it strictly
   // decreases (a released coordinate has a multiplier of the wrong sign) unless a zero-length step
   // intervenes, so no working set (3^ns with sides) is face-optimal twice: (ns + 1) 3^ns. When a
-  // face-optimal value fails to decrease, releases use Bland's smallest-index rule. At the bound
-  // the iterate is returned as is: feasible and never worse than x*. (Observed on a 7-joint arm
-  // at rest under a 6-D tool task: 3.5 iterations mean.)
+  // face-optimal value fails to decrease, releases use Bland's smallest-index rule. That is the
+  // exhaustive bound (max_iterations = 0); by default the real-time bound of iterationBound(ns)
+  // (at most the exhaustive one). At the bound the iterate is returned as is (false): feasible,
+  // never worse than x*, with the optimum's motion. (Observed on a 7-joint arm at rest under a 6-D
+  // tool task: 3.5 iterations mean.)
   long bound = ns + 1;
   for (int i = 0; i < ns && bound < 100000000L; ++i) bound *= 3;
-  const long max_iterations = std::min(bound, 100000000L);
+  const long max_iterations = std::min({bound, 100000000L, iterationBound(ns)});
   bool bland = false;
   double last_face_value = kInf;
   for (long it = 0; it < max_iterations; ++it) {
@@ -302,10 +305,11 @@ void FrictionCore::leastActiveSet(int ns, int r, double yscale) {
     if (!(value < last_face_value)) bland = true;
     last_face_value = value;
     const int release = releaseIndex(ns, r, mult_tol, bland);
-    if (release < 0) break;
+    if (release < 0) return true;
     side_(release) = 0;
     tmp_(release) = 1.0;
   }
+  return false;
 }
 
 }  // namespace detail

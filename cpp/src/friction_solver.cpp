@@ -215,6 +215,10 @@ int FrictionCore::hdSolve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eige
 // Stage 0: the friction model's sizes and values (0 or E_INVALID_FRICTION with a message).
 int FrictionCore::checkFriction(const FrictionModel& friction) {
   const long n = nj_;
+  if (friction.max_iterations < -1)
+    return fail(E_INVALID_FRICTION,
+                "friction.max_iterations must be -1 (the real-time default), 0 (exhaustive) or > 0, got %d",
+                friction.max_iterations);
   if (friction.empty()) return ChainHdSolver::E_NOERROR;  // no friction (restingJoints reads zeros)
   const Eigen::VectorXd& fs = friction.static_friction;
   const Eigen::VectorXd& fk = friction.kinetic_friction.size() ? friction.kinetic_friction : friction.static_friction;
@@ -307,7 +311,7 @@ int FrictionCore::optimiseResting(int k) {
   rc = boxQp(k);
   if (rc != ChainHdSolver::E_NOERROR) return rc;
   tau_cmd_known_ = false;
-  leastCommand(k);
+  if (degraded_ == 0) leastCommand(k);  // (the tie-break is for the optimal face only)
   qdd_ = qdd0_;
   qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
   const int m = hd_->res.m;
@@ -370,6 +374,8 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
   rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
   if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   iterations_ = 0;
+  max_iterations_ = friction.max_iterations;
+  degraded_ = 0;
   if (k > 0) {
     rc = optimiseResting(k);
     if (rc != ChainHdSolver::E_NOERROR) return rc;
@@ -389,7 +395,17 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
                 n ? friction.static_friction.cwiseAbs().maxCoeff() : 0.0);
   solved_ = true;
   message_[0] = '\0';
-  return ChainHdSolver::E_NOERROR;
+  if (degraded_ == 0) return ChainHdSolver::E_NOERROR;
+  if (degraded_ == 1)
+    std::snprintf(message_.data(), message_.size(),
+                  "friction: the real-time bound of %ld active-set iterations (friction.max_iterations) was hit: the "
+                  "fallback friction is taken (the last iterate, scaled so that friction does no positive work)",
+                  iterationBound(k));
+  else
+    std::snprintf(message_.data(), message_.size(),
+                  "friction: the real-time iteration bound (friction.max_iterations) was hit in the least-command "
+                  "tie-break: the motion is the optimum's, the split between motors and friction the last iterate's");
+  return FrictionSolver::E_DEGRADED;
 }
 
 const ChainHdSolver::Matrix6X& FrictionCore::linkAccelerations() {

@@ -171,9 +171,9 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
   if (rc == 0) rc = with_contacts ? d.contacts().solve(d, input) : detail::runInput(d, input);
   d.contacts_last = with_contacts && rc == 0;
   const bool stage_joints = with_contacts && rc == 0 && (with_friction || input.time_step > 0.0);
-  if (!stage_joints) recordStatus(d, with_friction && rc == 0);  // (else written by the stage)
+  if (!stage_joints) recordStatus(d, with_friction && rc >= 0);  // (else written by the stage)
   d.stage_joints = stage_joints;
-  d.friction_last = with_friction && rc == 0 && !stage_joints;
+  d.friction_last = with_friction && rc >= 0 && !stage_joints;  // (rc 1: Degraded, a result)
   if (rc == 0) {
     c.message[0] = '\0';
     return Status();

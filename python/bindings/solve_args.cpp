@@ -91,7 +91,7 @@ const vereshchagin::FrictionModel* SolveArgs::friction(PyObject* obj, vereshchag
                                  : py::handle(module).attr("_friction_fields")(py::handle(obj));
   if (!f) throw py::error_already_set();
   if (cacheable && f.ptr() == cache_key_.ptr()) return &cache_;
-  if (!PyTuple_Check(f.ptr()) || PyTuple_GET_SIZE(f.ptr()) != 6) raise("friction._fields is not a tuple of 6");
+  if (!PyTuple_Check(f.ptr()) || PyTuple_GET_SIZE(f.ptr()) != 7) raise("friction._fields is not a tuple of 7");
   vereshchagin::FrictionModel& fm = cacheable ? cache_ : scratch;
   if (cacheable) cache_key_ = py::object();  // invalid until parsed
   auto item = [&](int k) { return PyTuple_GET_ITEM(f.ptr(), k); };
@@ -102,6 +102,7 @@ const vereshchagin::FrictionModel* SolveArgs::friction(PyObject* obj, vereshchag
   check(vereshchagin::frictionFromArrays(fm, solver_->cppModel().nrOfJoints(), st, opt(1, kv),
                                          scalarArg(item(2), "friction.velocity_tolerance"), opt(3, lo), opt(4, up),
                                          scalarArg(item(5), "friction.limit_tolerance")));
+  fm.max_iterations = static_cast<int>(PyLong_AsLong(item(6)));  // (an int in [-1, 2^31) by friction.py)
   if (cacheable) cache_key_ = f;
   return &fm;
 }

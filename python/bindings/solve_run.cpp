@@ -26,6 +26,8 @@ void PySolver::solveArgs(PyObject* const* args, double* const* next, const doubl
   }
   if (!st) raise(st.message());
   last_state_ = true;
+  if (st.code() == vereshchagin::Error::Degraded && PyErr_WarnEx(PyExc_RuntimeWarning, st.message(), 1) != 0)
+    throw py::error_already_set();  // (warnings as errors)
 }
 
 py::object PySolver::solve(PyObject* const* args, PyObject* out, int step) {

@@ -673,7 +673,8 @@ DOCS["SolveResult.status"] = r"""ndarray of int32, shape (n,) or None: 0 moving,
 
 DOCS["SolveResult.gauss_value"] = r"""float or None: Gauss' function at the optimum, ``Z0(qdd) + sum f_j |qdd_j|`` over resting joints."""
 
-DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max-min (bounded; see the docs)."""
+DOCS["SolveResult.iterations"] = r"""int or None: iterations of the friction max-min (bounded by ``Friction.max_iterations``;
+see docs/friction.md, "Real-time bound")."""
 
 DOCS["SolveResult.contact_force"] = r"""ndarray, shape (k, 3): the force each contact's surface applies to the robot at its point, base axes, N.
 

@@ -47,27 +47,44 @@ def _real(value, name: str) -> float:
     raise SolverError(f"friction.{name} must be a real number, got {type(value).__name__}")
 
 
-def _fields_of(static, kinetic, velocity_tolerance, lower, upper, limit_tolerance) -> tuple:
-    """What a solver reads of a friction model: ``(static, kinetic, velocity_tolerance, lower,
-    upper, limit_tolerance)``, the arrays as given (the solver checks their shapes and values),
-    the tolerances as floats: None gives the default, and without limits ``limit_tolerance`` is
-    not read (0.0).
+def _iteration_bound(value) -> int:
+    """``max_iterations`` as an int: -1 (the real-time default), 0 (exhaustive) or a positive count.
 
     Raises
     ------
     SolverError
-        A tolerance that is not a real number.
+        A bool, a non-integer, or a value outside [-1, 2**31 - 1].
+    """
+    if value is None:
+        return -1
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool) and -1 <= value < 2**31:
+        return int(value)
+    raise SolverError(
+        f"friction.max_iterations must be an int: -1 (default), 0 (exhaustive) or a positive count, got {value!r}"
+    )
+
+
+def _fields_of(static, kinetic, velocity_tolerance, lower, upper, limit_tolerance, max_iterations=None) -> tuple:
+    """What a solver reads of a friction model: ``(static, kinetic, velocity_tolerance, lower,
+    upper, limit_tolerance, max_iterations)``, the arrays as given (the solver checks their shapes
+    and values), the tolerances as floats: None gives the default, and without limits
+    ``limit_tolerance`` is not read (0.0); ``max_iterations`` as an int (None: -1).
+
+    Raises
+    ------
+    SolverError
+        A tolerance that is not a real number, or a ``max_iterations`` that is not an int >= -1.
     """
     limits = lower is not None or upper is not None
     vt = 1e-6 if velocity_tolerance is None else _real(velocity_tolerance, "velocity_tolerance")
     lt = 1e-9 if limit_tolerance is None else _real(limit_tolerance, "limit_tolerance")
-    return (static, kinetic, vt, lower, upper, lt if limits else 0.0)
+    return (static, kinetic, vt, lower, upper, lt if limits else 0.0, _iteration_bound(max_iterations))
 
 
 def _friction_fields(obj) -> tuple:
     """``_fields_of`` any ``friction=`` object: a Friction's (cached) or the attributes of any object
-    that has ``static`` (``kinetic``, ``velocity_tolerance``, ``lower``, ``upper`` and
-    ``limit_tolerance`` are optional). The solvers call it for objects that are not exactly a Friction.
+    that has ``static`` (``kinetic``, ``velocity_tolerance``, ``lower``, ``upper``,
+    ``limit_tolerance`` and ``max_iterations`` are optional). The solvers call it for objects that are not exactly a Friction.
 
     Raises
     ------
@@ -82,7 +99,8 @@ def _friction_fields(obj) -> tuple:
         raise SolverError(
             "friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)"
         ) from None
-    rest = [getattr(obj, name, None) for name in ("kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance")]
+    names = ("kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance", "max_iterations")
+    rest = [getattr(obj, name, None) for name in names]
     return _fields_of(static, *rest)
 
 
@@ -137,12 +155,20 @@ class Friction:
         ``friction=True`` uses the chain's URDF limits.
     limit_tolerance : float
         Distance to a limit (rad or m) at which the joint counts as on it.
+    max_iterations : int
+        Real-time bound on the active-set iterations of each friction optimisation stage of one
+        solve, at the instant and over a step: -1 (default) for 6 k + 16 (k the joints whose
+        friction is unknown), 0 for the exhaustive bound 5 (k + 1) 3^k + 4, or a positive count.
+        At the bound the solve returns the documented fallback (friction torques within their
+        bounds that do no positive work in sum; docs/friction.md, "Real-time bound") and warns
+        with a ``RuntimeWarning``.
 
     Raises
     ------
     SolverError
-        Non-numeric or non-1-D arrays, NaN (or Inf in ``static``/``kinetic``). Sizes and signs
-        are checked against the chain by the solve.
+        Non-numeric or non-1-D arrays, NaN (or Inf in ``static``/``kinetic``), a
+        ``max_iterations`` that is not an int >= -1. Sizes and signs are checked against the chain
+        by the solve.
     """
 
     static: np.ndarray
@@ -151,6 +177,7 @@ class Friction:
     lower: Optional[np.ndarray] = None
     upper: Optional[np.ndarray] = None
     limit_tolerance: float = 1e-9
+    max_iterations: int = -1
 
     def __post_init__(self):
         object.__setattr__(self, "static", _frozen_vector(self.static, "static"))
@@ -162,18 +189,32 @@ class Friction:
     def _fields(self) -> tuple:
         """What solvers read (``_fields_of``), cached until a field is replaced."""
         return _fields_of(
-            self.static, self.kinetic, self.velocity_tolerance, self.lower, self.upper, self.limit_tolerance
+            self.static,
+            self.kinetic,
+            self.velocity_tolerance,
+            self.lower,
+            self.upper,
+            self.limit_tolerance,
+            self.max_iterations,
         )
 
     def __reduce__(self):
         # Rebuilt through the constructor, so copies and unpickled objects stay read-only.
         return (
             Friction,
-            (self.static, self.kinetic, self.velocity_tolerance, self.lower, self.upper, self.limit_tolerance),
+            (
+                self.static,
+                self.kinetic,
+                self.velocity_tolerance,
+                self.lower,
+                self.upper,
+                self.limit_tolerance,
+                self.max_iterations,
+            ),
         )
 
 
 # The fields become _Field descriptors once the dataclass has made its methods (whose defaults stay
 # those above).
-for _name in ("static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance"):
+for _name in ("static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance", "max_iterations"):
     setattr(Friction, _name, _Field(_name, Friction.__dict__.get(_name, _Field)))

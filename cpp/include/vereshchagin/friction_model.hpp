@@ -18,6 +18,14 @@ struct FrictionModel {
   /// bound on its size). Empty vectors: no limits; +-infinity entries: no limit on that side.
   Eigen::VectorXd lower, upper;   ///< lower and upper joint position limits (rad or m)
   double limit_tolerance = 1e-9;  ///< distance (rad or m) from a limit at which a joint counts as on it
+  /// Real-time bound on the active-set iterations of each optimisation stage of one solve (the box
+  /// QP over the k joints with unknown friction, then the least-command tie-break), at the
+  /// instant and over a time step (docs/friction.md, "Real-time bound"): -1 (default) for
+  /// 6 k + 16, 0 for the exhaustive bound 5 (k + 1) 3^k + 4 (capped at 1e8), n > 0 for n (at most
+  /// the exhaustive bound). Hitting it is not a failure: the solve returns Error::Degraded
+  /// (FrictionSolver::E_DEGRADED) with its documented fallback: friction torques within their
+  /// bounds that do no positive work on the motion in sum. Other values: E_INVALID_FRICTION.
+  int max_iterations = -1;
 
   /// Every vector empty: zero friction and no limits on every joint, as an empty f_ext means no
   /// external wrench (the solve's motion is the frictionless one; the friction outputs are zero).

@@ -46,9 +46,13 @@
 ///    inertias (HdSolver::inverseInertiaTimes; a fraction of a solve). NaN before a successful
 ///    solve; Inf or NaN when the value is beyond the double range (friction or torques times
 ///    accelerations near 1e300). The Python API raises then.
-///  * iterations(): active-set iterations of the last solve (at most 5 (k + 1) 3^k + 4, k the
-///    resting joints with friction or on a limit; the argument is in friction_box_qp.cpp's
+///  * iterations(): active-set iterations of the last solve's box QP (at most 5 (k + 1) 3^k + 4, k
+///    the resting joints with friction or on a limit; the argument is in friction_box_qp.cpp's
 ///    boxQp()). Bland's smallest-index rule takes over if a face-optimal value fails to decrease.
+///    FrictionModel::max_iterations bounds them for real time (default 6 k + 16): at the bound
+///    solve() returns E_DEGRADED (1, a result) with the fallback of docs/friction.md, "Real-time
+///    bound": the last iterate scaled along the ray from zero to the dual's best point on it, so
+///    every friction torque stays within its bound and friction does no positive work in sum.
 /// No heap allocation in solve() or gaussValue().
 /// Threads: as HdSolver (hd_solver.hpp, "Threads"): solve(), setRootAcceleration(),
 /// setPassThrough(), clearPassThrough() and setOptions() entered while another thread is inside a
@@ -81,6 +85,7 @@ class FrictionSolver {
   /// SlipPositive (qdd_j > 0) or SlipNegative (qdd_j < 0).
   enum JointStatus : signed char { Moving = 0, Stick = 1, SlipPositive = 2, SlipNegative = 3 };
   enum {
+    E_DEGRADED = 1,             ///< a result with the documented fallback: FrictionModel::max_iterations was hit
     E_INVALID_FRICTION = -110,  ///< sizes, negative or non-finite values, kinetic > static
     E_NOT_CONVERGED = -111,     ///< the iteration bound was exceeded (not expected), or the task
                                 ///< drives a joint into its limit (unbounded reaction)
@@ -95,8 +100,9 @@ class FrictionSolver {
                  const std::string& root_segment = std::string());
 
   /// alfa (6 x m) and f_ext (6 x n_segments or empty) as in HdSolver::solve(): any column-major
-  /// matrix with 6 rows (or no columns), else E_SIZE_MISMATCH naming the argument. Returns 0 or an
-  /// error code (message in errorMessage(), emptied by a successful solve).
+  /// matrix with 6 rows (or no columns), else E_SIZE_MISMATCH naming the argument. Returns 0,
+  /// E_DEGRADED (a result with the real-time fallback; errorMessage() says so) or an error code
+  /// (message in errorMessage(), emptied by a successful solve).
   int solve(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
             const Eigen::Ref<const Eigen::MatrixXd>& alfa, const Eigen::Ref<const Eigen::VectorXd>& beta,
             const Eigen::Ref<const Eigen::MatrixXd>& f_ext, const Eigen::Ref<const Eigen::VectorXd>& ff_torques,
