@@ -75,10 +75,12 @@ struct SolveInput {
   /// for `blocks` constraint blocks and `wrenches` frame wrenches without allocating.
   explicit SolveInput(const Model& model, int blocks = 8, int wrenches = 8);
 
-  /// Joint positions q (rad or m) and velocities q_dot (rad/s or m/s).
-  /// q: model.nq() entries, q_dot: model.nv() (n_joints on a fixed base; a floating base's
-  /// entries first, in the layout of base_kind.hpp: unit quaternion, velocities in base axes).
-  Eigen::VectorXd q, q_dot;
+  /// Joint positions q (rad or m), model.nq() entries (n_joints on a fixed base; a floating
+  /// base's entries first, in the layout of base_kind.hpp: position and unit quaternion).
+  Eigen::VectorXd q;
+  /// Joint velocities q_dot (rad/s or m/s), model.nv() entries (n_joints on a fixed base; a
+  /// floating base's first, in the layout of base_kind.hpp: velocities in base axes).
+  Eigen::VectorXd q_dot;
   /// Wrench on each segment BY the environment (6 x n_segments): base axes, moment about the
   /// segment's tip origin. Gravity does not go here.
   Matrix6X f_ext;
