@@ -459,3 +459,40 @@ def _sliding_chain(seed, k=5, mu=0.6, dt=2e-3):
         normal = -(J @ a * dt + v) / np.linalg.norm(J @ a * dt + v) + 0.2 * rng.normal(size=3)
         contacts.append(vs.Contact(int(s), point=point, normal=normal / np.linalg.norm(normal), mu=mu))
     return rc, q, qd, tau, contacts
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("dt", [0.0, 1e-3])
+def test_least_contact_force_without_motor_columns(seed, dt):
+    """No task and no force set-point (m == 0): every split of the load costs the motors nothing,
+    and the least contact forces pick it (docs/contacts.md). Random chains at rest with friction
+    on every joint and two or three supports, at the instant and over a step (the same problem at
+    rest): before, the complementarity problem's own split stood (the programme was skipped)."""
+    rng = np.random.default_rng(4300 + seed)
+    rc, q, qd, tau, fs, contacts, _, _ = _chain_case(rng, 2 + seed % 2, 0.8, False)
+    fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+    r = rc.solver().solve(q, qd, tau_ff=tau, friction=fr, contacts=contacts, time_step=dt)
+    model = rc.model
+    pq = pin_configuration(model, q)
+    specs = [dict(frame=rc.tip_frames[c.segment], point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+    fric = dict(static=fs, kinetic=0.7 * fs)
+    prob = contact_problem(model, model.createData(), pq, qd, tau, specs, friction=fric, time_step=dt or None)
+    A = np.zeros((0, rc.n_joints))
+    assert r.tau_command.size == 0 or not r.tau_command.any()  # no motors
+    _check(r, prob, A, f"m 0, seed {seed}, dt {dt}")
+
+
+def test_some_cases_without_motor_columns_are_redundant():
+    """The cases above do exercise the rule: in several of them the forces are not unique."""
+    count = 0
+    for seed in range(6):
+        rng = np.random.default_rng(4300 + seed)
+        rc, q, qd, tau, fs, contacts, _, _ = _chain_case(rng, 2 + seed % 2, 0.8, False)
+        fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+        r = rc.solver().solve(q, qd, tau_ff=tau, friction=fr, contacts=contacts)
+        model = rc.model
+        pq = pin_configuration(model, q)
+        specs = [dict(frame=rc.tip_frames[c.segment], point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+        prob = contact_problem(model, model.createData(), pq, qd, tau, specs, friction=dict(static=fs))
+        count += _redundant(prob, np.zeros((0, rc.n_joints)), r.qdd)
+    assert count >= 3, count
