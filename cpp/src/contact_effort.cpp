@@ -161,6 +161,11 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   eff_x_.head(p) += dx;
   for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) = points_[eff_contact_(i)].fixed;  // known part
   for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) += eff_x_(i) * eff_dir_.col(i);
+  for (int i = 0; i < pc; ++i) {  // f_n >= 0 holds to the programme's round-off: no pulling at all
+    const int ci = eff_contact_(i);
+    const double fn = points_[ci].n.dot(forces.col(ci));
+    if (in.contacts[ci].isSupport() && fn < 0.0) forces.col(ci) -= fn * points_[ci].n;
+  }
   for (int i = pc; i < p; ++i) joint_tau_(eff_joint_(i - pc)) = eff_x_(i);
   if (const int rc = solveWithForces(d, in)) return rc;
   for (int i = 0; i < pc; ++i) {  // the supports' statuses with their new forces
