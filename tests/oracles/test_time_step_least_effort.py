@@ -18,8 +18,6 @@ polished to the exact KKT solution of their active set (numpy), independently of
 
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -388,15 +386,6 @@ def test_a_redundant_task_with_friction_over_a_step(m, qd_scale, dt):
     _check(r, prob, A, f"m {m}, qd {qd_scale}, dt {dt}")
 
 
-def _without_bias(prob, qd, dt):
-    """The step's problem on the rows J qd+ / dt alone (the points' bias accelerations left out):
-    the velocity-level problem of Stewart-Trinkle and Anitescu-Potra, the solver's retry."""
-    out = copy.deepcopy(prob)
-    for c in out.contacts:
-        c.bias = c.J @ qd / dt
-    return out
-
-
 @pytest.mark.parametrize("seed", [89, 127, 173])
 def test_baxter_steps_that_found_no_impulses(seed):
     """Baxter with three supports with friction (mu 0.6), joints moving at up to 0.2 rad/s, joint
@@ -438,27 +427,6 @@ def test_baxter_steps_that_found_no_impulses(seed):
     f = r.contact_force.copy()  # a leaving support's force is zero to round-off of the largest
     f[np.linalg.norm(f, axis=1) <= 1e-9 * np.abs(f).max()] = 0.0
     _admissible(prob, qdd, f, joint)
-
-
-def _sliding_chain(seed, k=5, mu=0.6, dt=2e-3):
-    """A random 6-joint chain moving at about 1 rad/s, no joint friction, k supports with friction
-    on its segments whose normals oppose the points' motion."""
-    rng = np.random.default_rng([2026, seed])
-    rc = random_chain(rng, 6, prismatic=False)
-    q, qd = random_state(rng, rc, qd_scale=1.0)
-    tau = rng.normal(size=6) * 3
-    model, data = rc.model, rc.model.createData()
-    pq = pin_configuration(model, q)
-    a = np.linalg.solve(pin.crba(model, data, pq), tau - pin.rnea(model, data, pq, qd, np.zeros(6)))
-    pin.computeJointJacobians(model, data, pq)
-    pin.forwardKinematics(model, data, pq, qd, np.zeros(6))
-    contacts = []
-    for s in rng.choice(rc.n_segments, size=k, replace=False):
-        point = rng.normal(size=3) * 0.1
-        J, bias, v = point_jacobian(model, data, rc.tip_frames[s], point)
-        normal = -(J @ a * dt + v) / np.linalg.norm(J @ a * dt + v) + 0.2 * rng.normal(size=3)
-        contacts.append(vs.Contact(int(s), point=point, normal=normal / np.linalg.norm(normal), mu=mu))
-    return rc, q, qd, tau, contacts
 
 
 @pytest.mark.parametrize("seed", range(6))
