@@ -48,6 +48,7 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
     Vector3 bias;
     Vector3 a = pointAcceleration(pc, qdd, bias);
     if (dt_ > 0.0) a += pt.v / dt_;
+    if (step_without_bias_) a -= bias;  // the velocity-level retry's rows (contact_step.cpp)
     const double an = pt.n.dot(a), a_tol = 1e-9 * std::max(1.0, a.norm());
     const Vector3 at_ = a - an * pt.n;
     const bool resting = pt.kind == kTouching || pt.kind == kSetPointRest;
@@ -105,7 +106,6 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
 int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   HdCore& c = d.core;
   const int n = static_cast<int>(model_.nrOfJoints()), m = c.res.m;
-  if (m == 0) return 0;  // no motor columns: nothing to trade (before any work: a cheap exit)
   const int nj = static_cast<int>(joints_.size());
   int k_max = 2 * nj;
   for (const PointContact& pc : in.contacts) k_max += 1 + pc.facets;
@@ -140,9 +140,12 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   r.head(2 * n).setConstant(-tol);  // G dx = 0 to round-off
   r.tail(k) = eff_r_.head(k);       // (two statements: no temporary)
   r.tail(k).noalias() -= eff_rows_.topLeftCorner(k, p) * eff_x_.head(p);
-  // tau_cmd is linear in nu: its change per coordinate, column by column.
-  auto T = eff_dtau_.topLeftCorner(n, p);
-  for (int i = 0; i < p; ++i)
+  // tau_cmd is linear in nu: its change per coordinate, column by column. Without motor columns
+  // (m == 0) every distribution costs no effort: the first programme has no rows, and the least
+  // contact forces alone pick the split.
+  const int tr = m == 0 ? 0 : n;
+  auto T = eff_dtau_.topLeftCorner(tr, p);
+  for (int i = 0; i < p && m > 0; ++i)
     if (c.commandTorquesOf(N.col(i), T.col(i)) != 0) return 0;
   // Then the least contact forces: 1/2 sum_c ||f_c||^2, f_c = fixed_c + sum_i x_i e_i over its
   // coordinates (their Gram matrix per contact; the gradient at x* is e_i . f_c).
@@ -154,10 +157,15 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
     pv(i) = i < pc ? eff_dir_.col(i).dot(forces.col(eff_contact_(i))) : 0.0;
   }
   auto dx = eff_dx_.head(p);
-  if (lqp_.solve(T, c.res.tau_cmd, P, pv, R, r, dx) != Lemke::kSolved) return 0;  // keep the forces found
+  if (lqp_.solve(T, c.res.tau_cmd.head(tr), P, pv, R, r, dx, n) != Lemke::kSolved) return 0;  // keep the forces
   eff_x_.head(p) += dx;
   for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) = points_[eff_contact_(i)].fixed;  // known part
   for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) += eff_x_(i) * eff_dir_.col(i);
+  for (int i = 0; i < pc; ++i) {  // f_n >= 0 holds to the programme's round-off: no pulling at all
+    const int ci = eff_contact_(i);
+    const double fn = points_[ci].n.dot(forces.col(ci));
+    if (in.contacts[ci].isSupport() && fn < 0.0) forces.col(ci) -= fn * points_[ci].n;
+  }
   for (int i = pc; i < p; ++i) joint_tau_(eff_joint_(i - pc)) = eff_x_(i);
   if (const int rc = solveWithForces(d, in)) return rc;
   for (int i = 0; i < pc; ++i) {  // the supports' statuses with their new forces

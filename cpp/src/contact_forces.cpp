@@ -51,7 +51,8 @@ void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
       // Over a time step the row is the end velocity over dt, v+ / dt = a + v / dt to first order
       // (a = J qdd + bias the point's acceleration, v = J qd).
       const double row_v = dt_ > 0.0 ? rows[first + c].dot(p.v) / dt_ : 0.0;
-      rows_bias_(p.row + c) = rows[first + c].dot(bias.head<3>()) + row_v;
+      // (The velocity-level retry leaves the bias out: contact_step.cpp.)
+      rows_bias_(p.row + c) = (step_without_bias_ ? 0.0 : rows[first + c].dot(bias.head<3>())) + row_v;
     }
   }
   auto dqdd = dqdd_.leftCols(ncol_);
@@ -120,7 +121,8 @@ int ContactStage::solveLcp(HdCore& c, bool convex) {
   auto z = z_.head(nz_), w = w_.head(nz_);
   int pivots = 0;
   const int limit = 50 + 20 * nz_;
-  const Lemke::Result r = lemke_.solve(M, q, z, w, limit, pivots);
+  Lemke::Result r = lemke_.solve(M, q, z, w, limit, pivots);
+  if (r == Lemke::kRay) r = perturbedLcp(limit);
   if (r == Lemke::kPivotLimit)
     return c.fail(E_NO_SOLUTION, "contacts: the complementarity problem did not finish within %d pivots", limit);
   if (r == Lemke::kRay)
@@ -136,6 +138,25 @@ int ContactStage::solveLcp(HdCore& c, bool convex) {
     if (w(i) < -tol || std::abs(w(i) * z(i)) > tol * std::max(1.0, std::abs(z(i))))
       return c.fail(E_NO_SOLUTION, "contacts: the certificate of the contact forces failed at unknown %d", i);
   return 0;
+}
+
+// Lemke's pivoting once more after a ray, on q + delta_i with delta_i = 1e-10 (i + 1) / N times the
+// problem's scale: distinct, positive and far below the certificate's tolerance (1e-9 of it). On
+// the degenerate problems of several supports with more force directions than the joints can tell
+// apart (many ties in the ratio test), round-off can decide a tie against the lexicographic order
+// and end the pivoting on a ray that exact arithmetic would not meet; the perturbation breaks the
+// ties. The answer is then the basis found evaluated at the problem's own q (B^-1 q: no trace of
+// the perturbation where that basis is feasible), and the certificate judges it.
+Lemke::Result ContactStage::perturbedLcp(int limit) {
+  const auto M = lcp_m_.topLeftCorner(nz_, nz_);
+  const auto q = lcp_q_.head(nz_);
+  auto qp = lcp_qp_.head(nz_), z = z_.head(nz_), w = w_.head(nz_);
+  const double delta = 1e-10 * std::max({1.0, q.cwiseAbs().maxCoeff(), M.cwiseAbs().maxCoeff()}) / nz_;
+  for (int i = 0; i < nz_; ++i) qp(i) = q(i) + delta * (i + 1);
+  int pivots = 0;
+  const Lemke::Result r = lemke_.solve(M, qp, z, w, limit, pivots);
+  if (r == Lemke::kSolved) lemke_.basicSolution(M, q, z, w);  // its basis at the problem's own q
+  return r;
 }
 
 // The known forces plus those of z, into `forces`; the unknown parts added to work_'s wrenches.
@@ -208,6 +229,7 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   joint_friction_ = in.friction != nullptr;
   dt_ = in.time_step;
   joints_.clear();
+  step_without_bias_ = false;
   if (dt_ > 0.0) stepKinds(in);
   if (joint_friction_) {
     if (int rc = checkJointFriction(d, in)) return rc;
@@ -226,9 +248,7 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
       return finish(d, in);
     }
   }
-  layout(in, false);
-  buildWorkInput(in, false);
-  if (int rc = forcesOfLcp(d, in, convexProblem(in))) return rc;
+  if (int rc = generalForces(d, in)) return rc;
   if (nz_ > 0)
     if (int rc = runWork(d)) return rc;
   reportStatus(in, false);

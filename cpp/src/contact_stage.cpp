@@ -224,7 +224,7 @@ void ContactStage::reserve(int contacts, int unknowns, int columns, int rows) {
   if (rows_per_z_.rows() < rows || rows_per_z_.cols() < unknowns) rows_per_z_.resize(rows, unknowns);
   if (lcp_m_.rows() < unknowns) {
     lcp_m_.resize(unknowns, unknowns);
-    lcp_q_.resize(unknowns), z_.resize(unknowns), w_.resize(unknowns);
+    lcp_q_.resize(unknowns), lcp_qp_.resize(unknowns), z_.resize(unknowns), w_.resize(unknowns);
   }
   lemke_.reserve(unknowns);
 }

@@ -146,7 +146,11 @@ class ContactStage {
   void prepareColumns(DataImpl& d, const SolveInput& in);
   void assembleLcp(const SolveInput& in);
   int solveLcp(HdCore& c, bool convex);
+  Lemke::Result perturbedLcp(int limit);  // solveLcp's second try after a ray (contact_forces.cpp)
   int forcesOfLcp(DataImpl& d, const SolveInput& in, bool convex);
+  // The general problem (not the sticking trial) and, over a time step when it has no answer, the
+  // velocity-level retry (step_without_bias_): 0 or an error code.
+  int generalForces(DataImpl& d, const SolveInput& in);
   void applyForces(const SolveInput& in);
   // The sticking trial: 1 if every resting point with friction sticks (forces and the final solve
   // done), 0 if not (fall back to the full problem), or an error code.
@@ -180,6 +184,7 @@ class ContactStage {
   Eigen::MatrixXd coef_;                // columns x unknowns: column force per unit unknown
   Eigen::MatrixXd lcp_m_, rows_per_z_;  // N x N; rows x N
   Eigen::VectorXd lcp_q_, z_, w_, rows0_;
+  Eigen::VectorXd lcp_qp_;  // N: perturbedLcp's q
   int nz_ = 0, ncol_ = 0, nrow_ = 0;
   // Least effort (contact_effort.cpp): per free force coordinate its direction, contact, value,
   // wrench and responses; the validity rows in the coordinates; the programme's matrices.
@@ -205,8 +210,12 @@ class ContactStage {
   int ncol_contacts_ = 0;        // the contacts' response columns (the joints' follow)
   bool joint_friction_ = false;  // this solve has joint friction
   double dt_ = 0.0;              // SolveInput::time_step (0: the instant)
-  double lcp_scale_ = 1.0;       // the last complementarity problem's scale (accelerations)
-  Eigen::VectorXd q_dot_;        // the input's q_dot (jointOutputs); gaussValue's buffers
+  // Over a time step, the retry when the problem with the points' bias accelerations (J' qd in
+  // their rows) has no answer: rows v+ / dt = J qdd + v / dt alone, the velocity-level problem of
+  // Stewart-Trinkle and Anitescu-Potra, which always has one (contact_step.cpp). Reset per solve.
+  bool step_without_bias_ = false;
+  double lcp_scale_ = 1.0;  // the last complementarity problem's scale (accelerations)
+  Eigen::VectorXd q_dot_;   // the input's q_dot (jointOutputs); gaussValue's buffers
   Eigen::VectorXd gauss_tau_, gauss_out_;
   // speed: the all-active guess on one base solve and the held directions' response
   // (contact_active.cpp). reserveActive(directions, rows) sizes these.

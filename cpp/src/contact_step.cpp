@@ -34,6 +34,26 @@ void ContactStage::stepKinds(const SolveInput& in) {
   }
 }
 
+// The general problem; over a time step, if it has no answer (Lemke's pivoting ends on a ray, or
+// the certificate fails), once more on the velocity-level rows alone. The points' rows a + v / dt
+// carry their bias acceleration J' qd, which is not in the range of the contact Jacobians: with
+// more force directions than joints some non-negative combination of them moves nothing yet meets
+// a negative bias, and the problem has no answer. Without it the rows are J qd+ / dt (the end
+// velocities at the start's Jacobian), the problem of Stewart-Trinkle and Anitescu-Potra, whose
+// matrix makes every such combination harmless (q^T z = v^T J^T z = 0): Lemke's pivoting always
+// finds an answer unless the task's constraints and the supports contradict each other.
+int ContactStage::generalForces(DataImpl& d, const SolveInput& in) {
+  layout(in, false);
+  buildWorkInput(in, false);
+  const bool convex = convexProblem(in);
+  const int rc = forcesOfLcp(d, in, convex);
+  if (rc == 0 || dt_ == 0.0 || rc != static_cast<int>(Error::NoContactSolution)) return rc;
+  step_without_bias_ = true;
+  layout(in, false);
+  buildWorkInput(in, false);
+  return forcesOfLcp(d, in, convex);
+}
+
 }  // namespace detail
 
 Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,

@@ -121,6 +121,19 @@ Lemke::Result Lemke::solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eig
   return kPivotLimit;
 }
 
+void Lemke::basicSolution(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eigen::Ref<const Eigen::VectorXd>& q,
+                          Eigen::Ref<Eigen::VectorXd> z, Eigen::Ref<Eigen::VectorXd> w) const {
+  const int n = static_cast<int>(q.size());
+  const auto Binv = tableau_.topLeftCorner(n, n);  // the first n columns: B^-1
+  z.setZero();
+  for (int i = 0; i < n; ++i) {
+    const int v = basis_(i);
+    if (v >= n && v < 2 * n) z(v - n) = std::max(0.0, Binv.row(i).dot(q));
+  }
+  w = q;
+  w.noalias() += M * z;
+}
+
 void ConvexQp::reserve(int p, int k) {
   const int n = 2 * p + k;
   if (m_.rows() < n) {
@@ -176,14 +189,18 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
                                      const Eigen::Ref<const Eigen::MatrixXd>& P,
                                      const Eigen::Ref<const Eigen::VectorXd>& pv,
                                      const Eigen::Ref<const Eigen::MatrixXd>& R,
-                                     const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> x) {
+                                     const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> x,
+                                     int eq) {
   const int p = static_cast<int>(C.cols()), k = static_cast<int>(r.size());
   auto Q = q_.topLeftCorner(p, p);
   Q.noalias() = C.transpose() * C;
   auto c = c_.head(p);
   c.noalias() = C.transpose() * t;
   const int limit = 100 + 40 * (2 * p + k);
-  if (const Lemke::Result res = qp_.solve(Q, c, R, r, x, limit); res != Lemke::kSolved) return res;
+  if (C.rows() == 0)  // no first objective: x1 = 0 (the caller's point, feasible), Z spans everything
+    x.setZero();
+  else if (const Lemke::Result res = qp_.solve(Q, c, R, r, x, limit); res != Lemke::kSolved)
+    return res;
   const int d = nullBasis(Q);
   if (d == 0) return Lemke::kSolved;
   const auto Z = z_.topLeftCorner(p, d);
@@ -202,10 +219,65 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
   r2 = r;
   r2.noalias() -= R * x;
   auto w = w_.head(d);
-  if (!strictSecond(Q2, c2, RZ, r2, w) && qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved)
-    return Lemke::kSolved;  // keep x1
+  if (!strictSecond(Q2, c2, RZ, r2, w) && qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved) {
+    if (eq > 0) (void)secondOnEqualities(P, pv, R, r, x, eq);  // else keep x1
+    return Lemke::kSolved;
+  }
   x.noalias() += Z * w;
   return Lemke::kSolved;
+}
+
+// The second programme on the null space of [C; E] (E = R's first eq rows): x = x1 + Z w keeps
+// C x and E x exactly, so only R's rows after the 2 eq of the pairs remain, and P is positive
+// definite there when the free coordinates it does not weigh (a joint's torque) cannot move
+// without the motors or qdd. Z from the pivoted Cholesky factor of C^T C / |C^T C| + E^T E / |E^T E|
+// (q_ holds C^T C). The answer is checked (every row of R, C's change within round-off): false
+// leaves x at x1.
+bool LexicographicQp::secondOnEqualities(const Eigen::Ref<const Eigen::MatrixXd>& P,
+                                         const Eigen::Ref<const Eigen::VectorXd>& pv,
+                                         const Eigen::Ref<const Eigen::MatrixXd>& R,
+                                         const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> x,
+                                         int eq) {
+  const int p = static_cast<int>(x.size()), k = static_cast<int>(r.size()) - 2 * eq;
+  const auto Q = q_.topLeftCorner(p, p);
+  const auto E = R.topRows(eq);
+  auto Qe = q2_.topLeftCorner(p, p);
+  Qe.noalias() = E.transpose() * E;
+  const double qs = std::max(1e-300, Q.diagonal().maxCoeff()), es = std::max(1e-300, Qe.diagonal().maxCoeff());
+  Qe /= es;
+  Qe += Q / qs;
+  const int d = nullBasis(Qe);
+  if (d == 0) return false;
+  const auto Z = z_.topLeftCorner(p, d);
+  const auto Ri = R.bottomRows(k);
+  auto PZ = v_.topLeftCorner(p, d);
+  PZ.noalias() = P * Z;
+  auto Q2 = q2_.topLeftCorner(d, d);
+  Q2.noalias() = Z.transpose() * PZ;
+  auto grad = w_.head(p);
+  grad.noalias() = P * x;
+  grad += pv;
+  auto c2 = c2_.head(d);
+  c2.noalias() = Z.transpose() * grad;
+  auto RZ = rz_.topLeftCorner(k, d);
+  RZ.noalias() = Ri * Z;
+  auto r2 = r2_.head(k);
+  r2 = r.tail(k);
+  r2.noalias() -= Ri * x;
+  auto w = w_.head(d);
+  if (!strictSecond(Q2, c2, RZ, r2, w) && qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved)
+    return false;
+  auto u = c_.head(p);  // the step Z w, checked before it is taken
+  u.noalias() = Z * w;
+  auto Qu = diag_.head(p);
+  Qu.noalias() = Q * u;
+  const double size = std::max(1.0, (x + u).cwiseAbs().maxCoeff());
+  if (u.dot(Qu) > 1e-18 * qs * size * size) return false;  // C x changed beyond round-off
+  const double row_tol = 1e-9 * std::max(1.0, R.cwiseAbs().maxCoeff()) * size;
+  for (int i = 0; i < static_cast<int>(r.size()); ++i)
+    if (R.row(i).dot(x) + R.row(i).dot(u) < r(i) - row_tol) return false;
+  x += u;
+  return true;
 }
 
 // A basis of C's null space into z_'s first columns (returns their number) from the pivoted

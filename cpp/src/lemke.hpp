@@ -24,6 +24,12 @@ class Lemke {
   Result solve(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eigen::Ref<const Eigen::VectorXd>& q,
                Eigen::Ref<Eigen::VectorXd> z, Eigen::Ref<Eigen::VectorXd> w, int max_pivots, int& pivots);
 
+  // After solve() returned kSolved: the complementary basis it ended on, evaluated at another q
+  // (n, the same size): the basic variables B^-1 q (clipped at 0), the others 0, into z and
+  // w = M z + q. For a q perturbed to break ties, this is the original problem's basic solution.
+  void basicSolution(const Eigen::Ref<const Eigen::MatrixXd>& M, const Eigen::Ref<const Eigen::VectorXd>& q,
+                     Eigen::Ref<Eigen::VectorXd> z, Eigen::Ref<Eigen::VectorXd> w) const;
+
  private:
   int ratioTest(int entering, int n, double tol) const;
   void pivot(int row, int col, int n);
@@ -57,18 +63,26 @@ class ConvexQp {
 // then, among its minimisers (x = x1 + Z w, Z spanning C's null space, from a pivoted Cholesky
 // factor of C^T C: C x is unique), the one
 // with the least 1/2 x^T P x + p^T x (P positive definite on Z's span, so the answer is unique).
-// Skips the second when C has independent columns; the second runs as the LCP of its dual (k
-// multipliers) when its Hessian is certainly positive definite. Workspace by reserve(p, k) (p
-// unknowns, k rows); solve() allocates nothing within it.
+// Skips the first when C has no rows (x1 = 0: the caller's point must be feasible), the second when
+// C has independent columns; the second runs as the LCP of its dual (k
+// multipliers) when its Hessian is certainly positive definite. When R's first 2 eq rows are an
+// equality E x = 0 written as two inequalities (E, then -E, each >= a round-off slack), and the
+// second programme does not finish (P only positive semi-definite on Z's span, and the doubled
+// primal's pivoting stalls on the degenerate pairs), it runs once more on the null space of
+// [C; E] with the other rows only (secondOnEqualities). Workspace by reserve(p, k) (p unknowns,
+// k rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:
   void reserve(int p, int k);
   Lemke::Result solve(const Eigen::Ref<const Eigen::MatrixXd>& C, const Eigen::Ref<const Eigen::VectorXd>& t,
                       const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
                       const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
-                      Eigen::Ref<Eigen::VectorXd> x);
+                      Eigen::Ref<Eigen::VectorXd> x, int eq = 0);
 
  private:
+  bool secondOnEqualities(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
+                          const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
+                          Eigen::Ref<Eigen::VectorXd> x, int eq);
   bool strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2, const Eigen::Ref<const Eigen::VectorXd>& c2,
                     const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
                     Eigen::Ref<Eigen::VectorXd> w);

@@ -143,12 +143,14 @@ def _redundant(prob, A, qdd):
     return np.linalg.matrix_rank(M, tol=1e-9 * max(1.0, np.abs(M).max())) < M.shape[1]
 
 
-# The least contact force (the second programme) is not reached in these cases, at the instant
-# either (the step at rest gives the instant's answer): with the sticking joints' torques among
-# the coordinates the second programme is only positive semi-definite, and its pivoting
-# (LexicographicQp, lemke.cpp) ends on a ray, so the least-effort forces of the first programme
-# stand. The effort itself is the least; the forces are admissible. Listed so that a fix shows.
-KNOWN_SECOND_STAGE_GAPS = {"chain seed 9", "baxter: 4 supports, mu 0.6, qd 0.0"}
+# "chain seed 9" was listed here too: with the sticking joints' torques among the coordinates the
+# second programme is only positive semi-definite and its pivoting ended on a ray; it now runs on
+# the null space of the motors' torques and qdd together (LexicographicQp::secondOnEqualities,
+# lemke.cpp) and reaches the oracle's least contact force. The Baxter case's second programme now
+# finishes too (its objective fell), but there the oracle's own programme is not solved: SLSQP's
+# answer, polished, puts the joints' torques far outside their bounds (e.g. -50.8 N m against
+# 1.69), so it is no reference. Listed until the oracle is.
+KNOWN_SECOND_STAGE_GAPS = {"baxter: 4 supports, mu 0.6, qd 0.0"}
 
 
 def _admissible(prob, qdd, forces, joint):
@@ -178,7 +180,9 @@ def _check(r, prob, A, what, tau_cmd=None, forces=None, joint=None, order=lambda
     if what in KNOWN_SECOND_STAGE_GAPS:
         assert error > RTOL * scale, f"{what}: the least contact force is now reached: drop it from the gaps"
         assert np.sum(r.contact_force**2) >= np.sum(forces**2)  # the oracle's is the least
-        pytest.xfail(f"{what}: least effort met, least contact force not (second programme ends on a ray)")
+        pytest.xfail(
+            f"{what}: least effort met; the oracle's least-force programme is not solved (joints beyond bounds)"
+        )
     assert np.linalg.norm(r.contact_force - forces) <= RTOL * scale, f"{what}: forces {r.contact_force} vs {forces}"
     assert np.linalg.norm(mine - joint) <= RTOL * scale, f"{what}: joints {mine} vs {joint}"
 
@@ -380,3 +384,83 @@ def test_a_redundant_task_with_friction_over_a_step(m, qd_scale, dt):
     if qd_scale == 0.0:
         assert _redundant(prob, A, r.qdd)
     _check(r, prob, A, f"m {m}, qd {qd_scale}, dt {dt}")
+
+
+@pytest.mark.parametrize("seed", [89, 127, 173])
+def test_baxter_steps_that_found_no_impulses(seed):
+    """Baxter with three supports with friction (mu 0.6), joints moving at up to 0.2 rad/s, joint
+    friction, dt 1 ms: the step raised "no consistent contact forces" (NoContactSolution); such a
+    velocity-level problem always has an answer. Now the impulses meet the step's conditions (each
+    force in its admissible cone, each joint's torque within its bounds, against its end velocity)
+    and the equation of motion. Lemke's pivoting ended on a ray there that exact arithmetic would
+    not meet (ties of a degenerate problem decided by round-off); ContactStage::perturbedLcp
+    breaks them."""
+    from support.trees import robot
+
+    case = robot("baxter")
+    model, names, n, dt = case.model, list(case.tree.segment_names), case.n, 1e-3
+    rng = np.random.default_rng([555, seed])
+    q, qd = case.random_state(rng, qd_scale=0.2)
+    tau = rng.normal(size=n) * 2
+    fs = rng.uniform(0.2, 2.0, size=n)
+    pq, pqd, ptau = case.pin_q(q), case.pin_v(qd), case.pin_v(tau)
+    data = model.createData()
+    minv_h = np.linalg.solve(pin.crba(model, data, pq), ptau - pin.rnea(model, data, pq, pqd, np.zeros(n)))
+    pin.computeJointJacobians(model, data, pq)
+    pin.forwardKinematics(model, data, pq, pqd, np.zeros(n))
+    contacts = []
+    for s in rng.choice(len(names), size=3, replace=False):  # normals against the free motion
+        point = rng.normal(size=3) * 0.05
+        J, bias, v = point_jacobian(model, data, model.getFrameId(names[s]), point)
+        d = J @ minv_h + bias + v
+        normal = -d / max(np.linalg.norm(d), 1e-9) + 0.2 * rng.normal(size=3)
+        contacts.append(vs.Contact(names[s], point=point, normal=normal / np.linalg.norm(normal), mu=0.6))
+    fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+    r = case.solver().solve(q, qd, tau_ff=tau, friction=fr, contacts=contacts, time_step=dt)
+    specs = [dict(frame=model.getFrameId(c.segment), point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+    fric = dict(static=case.pin_v(fs), kinetic=case.pin_v(0.7 * fs))
+    prob = contact_problem(model, model.createData(), pq, pqd, ptau, specs, friction=fric, time_step=dt)
+    qdd, joint = case.pin_v(r.qdd), case.pin_v(r.friction_torque + r.limit_torque)
+    gen = sum((c.J.T @ f for c, f in zip(prob.contacts, r.contact_force)), joint)
+    assert _rel(prob.H @ qdd - prob.h, gen) <= RTOL  # no motors: the environment alone
+    assert r.contact_force[:, :].any()  # the supports do carry
+    f = r.contact_force.copy()  # a leaving support's force is zero to round-off of the largest
+    f[np.linalg.norm(f, axis=1) <= 1e-9 * np.abs(f).max()] = 0.0
+    _admissible(prob, qdd, f, joint)
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("dt", [0.0, 1e-3])
+def test_least_contact_force_without_motor_columns(seed, dt):
+    """No task and no force set-point (m == 0): every split of the load costs the motors nothing,
+    and the least contact forces pick it (docs/contacts.md). Random chains at rest with friction
+    on every joint and two or three supports, at the instant and over a step (the same problem at
+    rest): before, the complementarity problem's own split stood (the programme was skipped)."""
+    rng = np.random.default_rng(4300 + seed)
+    rc, q, qd, tau, fs, contacts, _, _ = _chain_case(rng, 2 + seed % 2, 0.8, False)
+    fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+    r = rc.solver().solve(q, qd, tau_ff=tau, friction=fr, contacts=contacts, time_step=dt)
+    model = rc.model
+    pq = pin_configuration(model, q)
+    specs = [dict(frame=rc.tip_frames[c.segment], point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+    fric = dict(static=fs, kinetic=0.7 * fs)
+    prob = contact_problem(model, model.createData(), pq, qd, tau, specs, friction=fric, time_step=dt or None)
+    A = np.zeros((0, rc.n_joints))
+    assert r.tau_command.size == 0 or not r.tau_command.any()  # no motors
+    _check(r, prob, A, f"m 0, seed {seed}, dt {dt}")
+
+
+def test_some_cases_without_motor_columns_are_redundant():
+    """The cases above do exercise the rule: in several of them the forces are not unique."""
+    count = 0
+    for seed in range(6):
+        rng = np.random.default_rng(4300 + seed)
+        rc, q, qd, tau, fs, contacts, _, _ = _chain_case(rng, 2 + seed % 2, 0.8, False)
+        fr = vs.Friction(static=fs, kinetic=0.7 * fs)
+        r = rc.solver().solve(q, qd, tau_ff=tau, friction=fr, contacts=contacts)
+        model = rc.model
+        pq = pin_configuration(model, q)
+        specs = [dict(frame=rc.tip_frames[c.segment], point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+        prob = contact_problem(model, model.createData(), pq, qd, tau, specs, friction=dict(static=fs))
+        count += _redundant(prob, np.zeros((0, rc.n_joints)), r.qdd)
+    assert count >= 3, count
