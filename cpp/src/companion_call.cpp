@@ -122,6 +122,11 @@ Status dispatch(const Model& model, DynamicsData& dd, const CompanionCall& c, do
                                   Eigen::Map<Eigen::Vector3d>(out));
     case Companion::CentroidalMomentum:
       return centroidalMomentum(model, dd, JointPositions(vec(q)), JointVelocities(vec(qd)), Eigen::Map<Vector6>(out));
+    case Companion::Integrate: {
+      if (const Status s = dd.impl().start(model, vec(q)); !s) return s;
+      integrateConfiguration(model.baseKind(), vec(q), vec(qd), 1.0, Eigen::Map<Eigen::VectorXd>(out, q.size()));
+      return kd.impl().checkResult(Eigen::Map<Eigen::VectorXd>(out, q.size()));
+    }
   }
   return kd.impl().fail(Error::InvalidOptions, "unknown companion %d", static_cast<int>(c.kind));
 }
@@ -141,9 +146,10 @@ const char* companionName(Companion kind) noexcept {
                                       "center_of_mass",
                                       "center_of_mass_jacobian",
                                       "center_of_mass_velocity",
-                                      "centroidal_momentum"};
+                                      "centroidal_momentum",
+                                      "integrate"};
   const int k = static_cast<int>(kind);
-  return k >= 0 && k < 13 ? names[k] : "unknown companion";
+  return k >= 0 && k < 14 ? names[k] : "unknown companion";
 }
 
 Status checkCompanionArg(KinematicsData& kdata, const CompanionCall& call, CompanionArg arg) {
@@ -203,6 +209,8 @@ Status companionShape(KinematicsData& kdata, const CompanionCall& call, int& ndi
       return set({3});
     case Companion::CenterOfMassJacobian:
       return set({3, static_cast<long>(k.model.nv())});
+    case Companion::Integrate:
+      return set({static_cast<long>(k.model.nq())});
     default:  // the dynamics companions' nv rows
       return set({static_cast<long>(k.model.nv())});
   }

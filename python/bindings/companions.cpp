@@ -135,7 +135,8 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
       .def("center_of_mass_velocity", of_state(K::CenterOfMassVelocity), py::arg("q"), py::arg("qd"),
            key("center_of_mass_velocity"))
       .def("centroidal_momentum", of_state(K::CentroidalMomentum), py::arg("q"), py::arg("qd"),
-           key("centroidal_momentum"));
+           key("centroidal_momentum"))
+      .def("integrate", of_state(K::Integrate), py::arg("q"), py::arg("v"), key("integrate"));
 }
 
 }  // namespace

@@ -547,6 +547,23 @@ Returns
 -------
 ndarray, shape (6,)
 """
+DOCS["Chain.integrate"] = DOCS["Tree.integrate"] = rf"""The configuration ``q (+) v`` reached from q
+by moving with the constant velocity v for unit time (a time step: ``integrate(q, dt * qd)``).
+
+The joints ``q + v``; a floating base (docs/floating-base.md) moves by the exponential of its
+LOCAL twist: on SE(3) for a free-flyer (the quaternion stays unit), on SE(2) for a planar base.
+Pinocchio: ``pin.integrate`` with the same root joint. The position update of
+:meth:`Solver.step` and the :class:`Simulator`.
+
+Parameters
+----------
+{_COM_STATE}v : array_like, shape (nv,)
+    The velocity times the duration: rad or m, on a floating base the LOCAL twist's ``nv`` first.
+
+Returns
+-------
+ndarray, shape (nq,)
+"""
 _FLOATING_DYNAMICS = """
 Notes
 -----

@@ -41,6 +41,7 @@ enum class Companion {
   CenterOfMassJacobian,  ///< its Jacobian (3, nv), written COLUMN-major, from q
   CenterOfMassVelocity,  ///< its velocity (3,) from q, qd
   CentroidalMomentum,    ///< [linear; angular about the centre of mass] (6,) from q, qd
+  Integrate,             ///< q (+) qd (nq,): integrateConfiguration of base_kind.hpp with dt = 1
 };
 
 /// The arguments, in the order a companion reads and checks them (those it does not take are not
