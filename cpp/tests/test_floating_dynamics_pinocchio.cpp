@@ -3,11 +3,14 @@
 // (pinocchio_bridge.hpp) on random trees: the mass matrix against crba, inverse dynamics against
 // rnea, the kinetic energy against 1/2 v^T M v, the potential energy against
 // computePotentialEnergy and dT/dq (base rows included) against C(q, v)^T v of
-// computeCoriolisMatrix. Tolerance 1e-9 relative. Then: the companions do not allocate.
+// computeCoriolisMatrix, and Data::frameJacobian (base columns first) against getFrameJacobian in
+// LOCAL_WORLD_ALIGNED. Tolerance 1e-9 relative. Then: the companions do not allocate.
 #include <doctest/doctest.h>
 
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/energy.hpp>
+#include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 
@@ -17,6 +20,7 @@
 #include "pinocchio_bridge.hpp"
 #include "random_tree.hpp"
 #include "test_common.hpp"
+#include "vereshchagin/data.hpp"
 #include "vereshchagin/energy.hpp"
 
 namespace {
@@ -118,5 +122,37 @@ TEST_CASE("floating base: the dynamics and energy companions do not allocate") {
     bad(kind == BaseKind::FreeFlyer ? 6 : 2) *= 1.5;
     CHECK(massMatrix(m, dd, JointPositions(bad), H).code() == Error::NonfiniteInput);
     CHECK(massMatrix(m, dd, JointPositions(q.tail(m.nrOfJoints())), H).code() == Error::SizeMismatch);
+  }
+}
+
+TEST_CASE("floating base: Data::frameJacobian equals Pinocchio's getFrameJacobian") {
+  testutil::RandomGen g(30);
+  for (int trial = 0; trial < 6; ++trial) {
+    const Model ours = floatingModel(trial % 2 ? BaseKind::Planar : BaseKind::FreeFlyer, g);
+    testutil::PinRobot pin(ours, kGravity);
+    const int ns = static_cast<int>(ours.nrOfSegments()), nv = static_cast<int>(ours.nv());
+    std::vector<pinocchio::FrameIndex> frames;
+    for (int i = 0; i < ns; ++i)
+      frames.push_back(pin.model.addFrame(
+          pinocchio::Frame("tip" + std::to_string(i), pin.joint_of[i], pin.tip[i], pinocchio::FrameType::OP_FRAME)));
+    pinocchio::Data pdata(pin.model);
+    const Eigen::VectorXd q = floatingQ(ours, g), v = g.qdot(nv).data;
+    Data data(ours);
+    SolveInput in(ours);
+    in.q = q;
+    in.q_dot = v;
+    REQUIRE(solve(ours, data, in));
+    pinocchio::computeJointJacobians(pin.model, pdata, pin.toPinQ(q));
+    pinocchio::updateFramePlacements(pin.model, pdata);
+    Eigen::MatrixXd J(6, nv), Jp = Eigen::MatrixXd::Zero(6, nv), Jp_ours(6, nv);
+    for (int i = 0; i < ns; ++i) {
+      REQUIRE(data.frameJacobian(FrameRef{i, KDL::Frame::Identity()}, J).ok());
+      Jp.setZero();
+      pinocchio::getFrameJacobian(pin.model, pdata, frames[i], pinocchio::LOCAL_WORLD_ALIGNED, Jp);
+      for (int c = 0; c < nv; ++c) Jp_ours.col(c) = Jp * pin.toPin(Eigen::VectorXd::Unit(nv, c));
+      CHECK(relErr(J, Jp_ours) < kTol);
+    }
+    Eigen::MatrixXd short_J(6, ours.nrOfJoints());
+    CHECK(data.frameJacobian(FrameRef{0, KDL::Frame::Identity()}, short_J).code() == Error::SizeMismatch);
   }
 }

@@ -95,8 +95,9 @@ class Data {
   /// Kinematics at the last solve's state, base axes (allocation-free, O(depth) per call):
   /// the pose of a frame in the base frame, its twist [linear velocity of its origin; angular],
   /// and its Jacobian (6 x n_joints, columns in joint order; twist = J q_dot). On a floating base
-  /// the pose and twist are in the world frame (the base's motion included); the Jacobian has the
-  /// joints' columns only (world axes), the base's are not there yet.
+  /// the pose and twist are in the world frame (the base's motion included) and the Jacobian is
+  /// 6 x nv, world axes, the base's columns first (for its LOCAL velocity: twist = J q_dot, as
+  /// Pinocchio's getFrameJacobian in LOCAL_WORLD_ALIGNED).
   KDL::Frame framePose(const FrameRef& frame) const;
   KDL::Twist frameTwist(const FrameRef& frame) const;                                       ///< see framePose()
   Status frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const;  ///< see framePose()
