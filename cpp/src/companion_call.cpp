@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "dynamics_impl.hpp"
+#include "vereshchagin/momentum.hpp"
 
 namespace vereshchagin {
 
@@ -36,6 +37,13 @@ long firstNonfinite(const ArrayArg& a) {
   return -1;
 }
 
+// The dynamics companions take the whole state on a floating base (q: nq, qd and qdd: nv
+// entries) and return nv rows; the kinematics companions the joints' (base_kind.hpp).
+bool wholeState(Companion kind) {
+  return kind == Companion::InverseDynamics || kind == Companion::MassMatrix || kind == Companion::GravityTorques ||
+         kind == Companion::CoriolisTorques || kind >= Companion::CenterOfMass;
+}
+
 bool hasShape(const ArrayArg& a, long rows, long cols) {
   return rows < 0 ? a.ndim == 1 && a.shape[0] == cols : a.ndim == 2 && a.shape[0] == rows && a.shape[1] == cols;
 }
@@ -51,19 +59,31 @@ Status wrenchColumns(const Model& model, DynamicsData& dd, const CompanionCall& 
   }
   Matrix6X& sums = dd.impl().f_frames;
   sums.setZero();
-  if (const Status s = forwardKinematics(model, dd.kinematics(), JointPositions(vec(c.args[0]))); !s) return s;
-  for (const auto& [frame, wrench] : c.frame_wrenches)
-    if (const Status s = addFrameWrench(model, dd.kinematics(), frame, wrench, sums); !s) return s;
+  const detail::DynamicsImpl& di = dd.impl();
+  const Eigen::Map<const Eigen::VectorXd> q = vec(c.args[0]);
+  if (di.nb != 0)  // a floating base: q's base part read and checked; the wrenches in world axes
+    if (const Status s = dd.impl().start(model, q); !s) return s;
+  if (const Status s = forwardKinematics(model, dd.kinematics(), JointPositions(q.tail(q.size() - di.nbq))); !s)
+    return s;
+  for (const auto& [frame, wrench] : c.frame_wrenches) {
+    Vector6 w = wrench;  // base axes for addFrameWrench, then back to world axes
+    if (di.nb != 0) w << di.R_b.transpose() * wrench.head<3>(), di.R_b.transpose() * wrench.tail<3>();
+    if (const Status s = addFrameWrench(model, dd.kinematics(), frame, w, sums); !s) return s;
+  }
+  for (long i = 0; di.nb != 0 && i < 2 * ns; ++i) {
+    Eigen::Map<Vector3> half(sums.data() + 3 * i);
+    half = (di.R_b * half).eval();
+  }
   new (&f_ext) Eigen::Map<const Matrix6X>(sums.data(), 6, ns);
   return Status();
 }
 
 Status dispatch(const Model& model, DynamicsData& dd, const CompanionCall& c, double* out) {
   KinematicsData& kd = dd.kinematics();
-  const long n = kd.impl().nj, ns = kd.impl().ns;
+  const long n = kd.impl().nj, ns = kd.impl().ns, nv = n + dd.impl().nb;
   const ArrayArg &q = c.args[0], &qd = c.args[1], &g = c.args[3];
   const KDL::Vector gravity = g.data ? KDL::Vector(g.data[0], g.data[1], g.data[2]) : KDL::Vector::Zero();
-  Eigen::Map<Eigen::VectorXd> tau(out, n);
+  Eigen::Map<Eigen::VectorXd> tau(out, nv);
   switch (c.kind) {
     case Companion::InverseDynamics: {
       Eigen::Map<const Matrix6X> f_ext(nullptr, 6, 0);
@@ -72,7 +92,7 @@ Status dispatch(const Model& model, DynamicsData& dd, const CompanionCall& c, do
                              JointAccelerations(vec(c.args[2])), f_ext, gravity, tau);
     }
     case Companion::MassMatrix:
-      return massMatrix(model, dd, JointPositions(vec(q)), Eigen::Map<Eigen::MatrixXd>(out, n, n));
+      return massMatrix(model, dd, JointPositions(vec(q)), Eigen::Map<Eigen::MatrixXd>(out, nv, nv));
     case Companion::GravityTorques:
       return gravityTorques(model, dd, JointPositions(vec(q)), gravity, tau);
     case Companion::CoriolisTorques:
@@ -93,6 +113,20 @@ Status dispatch(const Model& model, DynamicsData& dd, const CompanionCall& c, do
       Eigen::Map<Vector6>{out} = bias;
       return s;
     }
+    case Companion::CenterOfMass:
+      return centerOfMass(model, dd, JointPositions(vec(q)), Eigen::Map<Eigen::Vector3d>(out));
+    case Companion::CenterOfMassJacobian:
+      return centerOfMassJacobian(model, dd, JointPositions(vec(q)), Eigen::Map<Eigen::MatrixXd>(out, 3, nv));
+    case Companion::CenterOfMassVelocity:
+      return centerOfMassVelocity(model, dd, JointPositions(vec(q)), JointVelocities(vec(qd)),
+                                  Eigen::Map<Eigen::Vector3d>(out));
+    case Companion::CentroidalMomentum:
+      return centroidalMomentum(model, dd, JointPositions(vec(q)), JointVelocities(vec(qd)), Eigen::Map<Vector6>(out));
+    case Companion::Integrate: {
+      if (const Status s = dd.impl().start(model, vec(q)); !s) return s;
+      integrateConfiguration(model.baseKind(), vec(q), vec(qd), 1.0, Eigen::Map<Eigen::VectorXd>(out, q.size()));
+      return kd.impl().checkResult(Eigen::Map<Eigen::VectorXd>(out, q.size()));
+    }
   }
   return kd.impl().fail(Error::InvalidOptions, "unknown companion %d", static_cast<int>(c.kind));
 }
@@ -100,11 +134,22 @@ Status dispatch(const Model& model, DynamicsData& dd, const CompanionCall& c, do
 }  // namespace
 
 const char* companionName(Companion kind) noexcept {
-  static const char* const names[] = {"inverse_dynamics", "mass_matrix", "gravity_torques",
-                                      "coriolis_torques", "fk",          "fk_all",
-                                      "jacobian",         "twist",       "jacobian_dot_times_qd"};
+  static const char* const names[] = {"inverse_dynamics",
+                                      "mass_matrix",
+                                      "gravity_torques",
+                                      "coriolis_torques",
+                                      "fk",
+                                      "fk_all",
+                                      "jacobian",
+                                      "twist",
+                                      "jacobian_dot_times_qd",
+                                      "center_of_mass",
+                                      "center_of_mass_jacobian",
+                                      "center_of_mass_velocity",
+                                      "centroidal_momentum",
+                                      "integrate"};
   const int k = static_cast<int>(kind);
-  return k >= 0 && k < 9 ? names[k] : "unknown companion";
+  return k >= 0 && k < 14 ? names[k] : "unknown companion";
 }
 
 Status checkCompanionArg(KinematicsData& kdata, const CompanionCall& call, CompanionArg arg) {
@@ -119,6 +164,11 @@ Status checkCompanionArg(KinematicsData& kdata, const CompanionCall& call, Compa
   } else if (arg == CompanionArg::Gravity) {
     if (!hasShape(a, -1, 3))
       return k.fail(Error::SizeMismatch, "gravity must have shape (3,), got %s", a.shapeString().c_str());
+  } else if (wholeState(call.kind) && k.nj != static_cast<int>(arg == CompanionArg::Q ? k.model.nq() : k.model.nv())) {
+    const long want = arg == CompanionArg::Q ? k.model.nq() : k.model.nv();  // a floating base
+    if (!hasShape(a, -1, want))
+      return k.fail(Error::SizeMismatch, "%s must have shape (%ld,) (the base's entries, then the joints'), got %s",
+                    name, want, a.shapeString().c_str());
   } else if (!hasShape(a, -1, k.nj) && !(state_rows && a.ndim == 2 && a.shape[1] == k.nj)) {
     return k.fail(Error::SizeMismatch, "%s must have shape (%d,), got %s", name, k.nj, a.shapeString().c_str());
   }
@@ -142,7 +192,7 @@ Status companionShape(KinematicsData& kdata, const CompanionCall& call, int& ndi
   };
   switch (call.kind) {
     case Companion::MassMatrix:
-      return set({k.nj, k.nj});
+      return set({static_cast<long>(k.model.nv()), static_cast<long>(k.model.nv())});
     case Companion::Fk:
       return set({rows, 4, 4});
     case Companion::FkAll:
@@ -152,9 +202,17 @@ Status companionShape(KinematicsData& kdata, const CompanionCall& call, int& ndi
     case Companion::Twist:
       return set({rows, 6});
     case Companion::JacobianDotTimesQd:
+    case Companion::CentroidalMomentum:
       return set({6});
-    default:
-      return set({k.nj});
+    case Companion::CenterOfMass:
+    case Companion::CenterOfMassVelocity:
+      return set({3});
+    case Companion::CenterOfMassJacobian:
+      return set({3, static_cast<long>(k.model.nv())});
+    case Companion::Integrate:
+      return set({static_cast<long>(k.model.nq())});
+    default:  // the dynamics companions' nv rows
+      return set({static_cast<long>(k.model.nv())});
   }
 }
 

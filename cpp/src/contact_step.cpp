@@ -59,16 +59,20 @@ int ContactStage::generalForces(DataImpl& d, const SolveInput& in) {
 Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,
             Eigen::Ref<Eigen::VectorXd> qd_next) {
   const long n = static_cast<long>(model.nrOfJoints());
-  if (model.baseKind() != BaseKind::Fixed)
-    return Status(Error::InvalidOptions, "step() is not supported on a floating base yet (its SE(3) position update)");
   if (!(input.time_step > 0.0) || !std::isfinite(input.time_step))
     return Status(Error::OutOfRange, "step() needs a finite SolveInput::time_step > 0 (s)");
-  if (q_next.size() != n || qd_next.size() != n)
-    return Status(Error::SizeMismatch, "step(): q_next and qd_next must have one entry per joint");
+  if (q_next.size() != model.nq() || qd_next.size() != model.nv())
+    return Status(Error::SizeMismatch,
+                  "step(): q_next and qd_next must have one entry per joint (nq and nv entries on a floating base)");
   const Status s = solve(model, data, input);
   if (!s) return s;
   const double dt = input.time_step;
   const Eigen::VectorXd& qdd = data.qdd();
+  if (model.baseKind() != BaseKind::Fixed) {  // no friction there: q (+) dt qd_next on SE(3) / SE(2)
+    qd_next = input.q_dot + dt * qdd;
+    integrateConfiguration(model.baseKind(), input.q, qd_next, dt, q_next);
+    return s;
+  }
   const std::vector<JointStatus>& status = data.jointStatus();
   for (long j = 0; j < n; ++j) {  // a joint held by friction ends the step exactly at rest
     qd_next(j) = status[j] == JointStatus::Stick ? 0.0 : input.q_dot(j) + dt * qdd(j);

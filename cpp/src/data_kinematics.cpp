@@ -60,15 +60,31 @@ KDL::Twist Data::frameTwist(const FrameRef& frame) const {
 
 // Column of joint j (segment k on the path): S_k in base axes, moved from k's tip origin to the
 // frame's origin: [R v + (R w) x d; R w], d = origin(k) - origin(frame).
+namespace {
+
+// A floating base's columns: its LOCAL twist S_b qd_b = (v, w) moves the frame's origin o by
+// R_b v + (R_b w) x (o - p_b) and turns the frame by R_b w (world axes).
+void baseColumns(const HdCore& c, const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> J) {
+  const Matrix3& R = c.ws.base.X.R;
+  const Vector3 r = frameOrigin(c, frame) - c.ws.base.X.p;
+  Matrix6 B;
+  B << R, -skew(r) * R, Matrix3::Zero(), R;
+  J.noalias() = B * c.model.S_base;
+}
+
+}  // namespace
+
 Status Data::frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const {
   HdCore& c = impl_->core;
-  if (jacobian.rows() != 6 || jacobian.cols() != static_cast<Eigen::Index>(c.model.nj))
+  const int nb = c.model.floating ? c.model.nbv : 0;  // a floating base's columns first
+  if (jacobian.rows() != 6 || jacobian.cols() != static_cast<Eigen::Index>(c.model.nj) + nb)
     return impl_->status(c.fail(KDL::SolverI::E_SIZE_MISMATCH, "jacobian is %ldx%ld, expected 6x%u",
-                                (long)jacobian.rows(), (long)jacobian.cols(), c.model.nj));
+                                (long)jacobian.rows(), (long)jacobian.cols(), c.model.nj + nb));
   if (frame.segment >= static_cast<int>(c.model.ns))
     return impl_->status(
         c.fail(KDL::SolverI::E_OUT_OF_RANGE, "frame.segment = %d is out of range [-1, %u)", frame.segment, c.model.ns));
   jacobian.setZero();
+  if (nb != 0) baseColumns(c, frame, jacobian.leftCols(nb));
   if (frame.segment < 0) return Status();
   // d: from the frame's origin to the current segment's tip origin, base axes.
   Vector3 d = -(c.ws.seg[frame.segment].R_base * toVector3(frame.in_tip.p));
@@ -77,8 +93,8 @@ Status Data::frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> ja
     const Matrix3& R = c.ws.seg[i].R_base;
     if (sm.joint >= 0) {
       const Vector3 w = R * sm.S.tail<3>();
-      jacobian.col(sm.joint).head<3>() = R * sm.S.head<3>() + w.cross(-d);
-      jacobian.col(sm.joint).tail<3>() = w;
+      jacobian.col(nb + sm.joint).head<3>() = R * sm.S.head<3>() + w.cross(-d);
+      jacobian.col(nb + sm.joint).tail<3>() = w;
     }
     d -= parentRotation(c, i) * c.ws.seg[i].X.p;  // to the parent's tip origin
   }

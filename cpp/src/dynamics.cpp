@@ -38,19 +38,24 @@ void DynamicsImpl::bodyWrench(int i) {
   out.tail<3>() += c.cross(F);
 }
 
-// Outward: velocities, accelerations and body wrenches; inward: joint torques. qd, qdd: nullptr for
-// zero; f_ext: 6 x 0 for none. Positions must be placed already.
+// Outward: velocities, accelerations and body wrenches; inward: joint torques. qd, qdd: the
+// joints' rates, nullptr for zero; f_ext: 6 x 0 for none. Positions must be placed already. On a
+// floating base the caller sets V_root and A_root (the base's own acceleration; -gravity is added
+// here); f_ext is in world axes there, and baseRows() then gives the base's rows from f_root.
 void DynamicsImpl::rnea(const double* qd, const double* qdd, const Eigen::Ref<const Matrix6X>& f_ext,
                         const Vector3& gravity, Eigen::Ref<Eigen::VectorXd> tau) {
   KinematicsImpl& ki = k();
   Vector6 root = Vector6::Zero();
   root.head<3>() = -gravity;
+  if (nb != 0) root += A_root;  // the base's own acceleration (set by the caller)
+  A_root = root;
+  f_root.setZero();
   for (int i = 0; i < ki.ns; ++i) {
     const KinSegment& s = ki.seg[static_cast<std::size_t>(i)];
     KinState& x = ki.st[static_cast<std::size_t>(i)];
     Vector6& a = A[static_cast<std::size_t>(i)];
     if (s.parent < 0) {
-      x.V.setZero();
+      x.V = V_root;
       a = root;
     } else {
       x.V = ki.st[static_cast<std::size_t>(s.parent)].V;
@@ -66,7 +71,11 @@ void DynamicsImpl::rnea(const double* qd, const double* qdd, const Eigen::Ref<co
     }
     bodyWrench(i);
     if (f_ext.cols() != 0) {
-      const auto fe = f_ext.col(i);
+      Vector6 fe = f_ext.col(i);
+      if (nb != 0) {  // world axes to base axes
+        fe.head<3>() = R_b.transpose() * Vector3(f_ext.col(i).head<3>());
+        fe.tail<3>() = R_b.transpose() * Vector3(f_ext.col(i).tail<3>());
+      }
       Vector6& out = f[static_cast<std::size_t>(i)];
       out.head<3>() -= fe.head<3>();
       out.tail<3>() -= fe.tail<3>() + x.X.p.cross(fe.head<3>());
@@ -77,7 +86,11 @@ void DynamicsImpl::rnea(const double* qd, const double* qdd, const Eigen::Ref<co
     const Vector6& fi = f[static_cast<std::size_t>(i)];
     if (s.joint >= 0)
       tau(s.joint) = ki.st[static_cast<std::size_t>(i)].S.dot(fi) + (qdd ? s.rotor * qdd[s.joint] : 0.0);
-    if (s.parent >= 0) f[static_cast<std::size_t>(s.parent)] += fi;
+    if (s.parent >= 0) {
+      f[static_cast<std::size_t>(s.parent)] += fi;
+    } else if (nb != 0) {
+      f_root += fi;
+    }
   }
 }
 
@@ -115,8 +128,8 @@ Status inverseDynamics(const Model& model, DynamicsData& ddata, const JointPosit
   detail::DynamicsImpl& d = ddata.impl();
   detail::KinematicsImpl& k = d.k();
   if (const Status s = d.start(model, *q); !s) return s;
-  if (const Status s = k.checkVector(*q_dot, "q_dot"); !s) return s;
-  if (const Status s = k.checkVector(*q_ddot, "q_ddot"); !s) return s;
+  if (const Status s = d.checkRate(*q_dot, "q_dot"); !s) return s;
+  if (const Status s = d.checkRate(*q_ddot, "q_ddot"); !s) return s;
   if (const Status s = checkGravity(k, gravity); !s) return s;
   if (f_ext.cols() != 0 && f_ext.cols() != k.ns)
     return k.fail(Error::SizeMismatch, "f_ext has %ld columns, expected %d (one per segment) or 0",
@@ -124,8 +137,12 @@ Status inverseDynamics(const Model& model, DynamicsData& ddata, const JointPosit
   if (!f_ext.allFinite()) return k.fail(Error::NonfiniteInput, "f_ext is not finite");
   if (const Status s = d.checkOut(tau.size(), 1, 1, "tau"); !s) return s;
   k.has_q = k.has_qd = false;
-  k.place(*q);
-  d.rnea(q_dot.value().data(), q_ddot.value().data(), f_ext, detail::toEigen(gravity), tau);
+  const int nb = d.nb;
+  k.place((*q).tail(k.nj));
+  d.baseVelocity(*q_dot);
+  if (nb != 0) d.A_root.noalias() = d.S_b * (*q_ddot).head(nb);
+  d.rnea((*q_dot).data() + nb, (*q_ddot).data() + nb, f_ext, d.localGravity(detail::toEigen(gravity)), tau.tail(k.nj));
+  if (nb != 0) d.baseRows(tau);
   k.has_q = k.has_qd = true;
   return k.checkResult(tau);
 }
@@ -135,11 +152,14 @@ Status coriolisTorques(const Model& model, DynamicsData& ddata, const JointPosit
   detail::DynamicsImpl& d = ddata.impl();
   detail::KinematicsImpl& k = d.k();
   if (const Status s = d.start(model, *q); !s) return s;
-  if (const Status s = k.checkVector(*q_dot, "q_dot"); !s) return s;
+  if (const Status s = d.checkRate(*q_dot, "q_dot"); !s) return s;
   if (const Status s = d.checkOut(tau.size(), 1, 1, "tau"); !s) return s;
   k.has_q = k.has_qd = false;
-  k.place(*q);
-  d.rnea(q_dot.value().data(), nullptr, kNoWrenches, Vector3::Zero(), tau);
+  k.place((*q).tail(k.nj));
+  d.baseVelocity(*q_dot);
+  d.A_root.setZero();
+  d.rnea((*q_dot).data() + d.nb, nullptr, kNoWrenches, Vector3::Zero(), tau.tail(k.nj));
+  if (d.nb != 0) d.baseRows(tau);
   k.has_q = k.has_qd = true;
   return k.checkResult(tau);
 }

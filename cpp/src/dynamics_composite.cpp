@@ -31,6 +31,22 @@ void addToParent(detail::DynamicsImpl& d, int i, int parent, bool rotational) {
   if (rotational) d.J[static_cast<std::size_t>(parent)] += d.J[static_cast<std::size_t>(i)];
 }
 
+// The floating base's block of H: S_b^T (I_base + every root composite) S_b.
+void baseBlock(detail::DynamicsImpl& d, Eigen::Ref<Eigen::MatrixXd> H) {
+  const detail::KinematicsImpl& k = d.k();
+  Matrix6 I = d.I_base;
+  for (int i = 0; i < k.ns; ++i) {
+    if (k.seg[static_cast<std::size_t>(i)].parent >= 0) continue;
+    const Vector3& h = d.h[static_cast<std::size_t>(i)];
+    const double m = d.mass[static_cast<std::size_t>(i)];
+    I.topLeftCorner<3, 3>().diagonal().array() += m;
+    I.topRightCorner<3, 3>() -= skew(h);  // force of w: w x h = -[h]x w
+    I.bottomLeftCorner<3, 3>() += skew(h);
+    I.bottomRightCorner<3, 3>() += d.J[static_cast<std::size_t>(i)];
+  }
+  H.topLeftCorner(d.nb, d.nb).noalias() = d.S_b.transpose() * I * d.S_b;
+}
+
 }  // namespace
 
 // H_jk = S_k . (Ic_i S_j) for the joint j of segment i and every joint k on i's path to the base
@@ -39,9 +55,10 @@ Status massMatrix(const Model& model, DynamicsData& ddata, const JointPositions&
   detail::DynamicsImpl& d = ddata.impl();
   detail::KinematicsImpl& k = d.k();
   if (const Status s = d.start(model, *q); !s) return s;
-  if (const Status s = d.checkOut(H.rows(), H.cols(), k.nj, "H"); !s) return s;
+  const int nb = d.nb;
+  if (const Status s = d.checkOut(H.rows(), H.cols(), k.nj + nb, "H"); !s) return s;
   k.has_q = k.has_qd = false;
-  k.place(*q);
+  k.place((*q).tail(k.nj));
   H.setZero();
   for (int i = 0; i < k.ns; ++i) placeBody(d, i, true);
   for (int i = k.ns - 1; i >= 0; --i) {  // composite i is complete: its children were added already
@@ -54,14 +71,18 @@ Status massMatrix(const Model& model, DynamicsData& ddata, const JointPositions&
       F.head<3>() = d.mass[static_cast<std::size_t>(i)] * v + w.cross(h);
       F.tail<3>().noalias() = d.J[static_cast<std::size_t>(i)] * w;
       F.tail<3>() += h.cross(v);
-      H(s.joint, s.joint) = S.dot(F) + s.rotor;
+      const int j = nb + s.joint;
+      H(j, j) = S.dot(F) + s.rotor;
       for (int a = s.parent; a >= 0; a = k.seg[static_cast<std::size_t>(a)].parent) {
         const int r = k.seg[static_cast<std::size_t>(a)].joint;
-        if (r >= 0) H(r, s.joint) = H(s.joint, r) = k.st[static_cast<std::size_t>(a)].S.dot(F);
+        if (r >= 0) H(nb + r, j) = H(j, nb + r) = k.st[static_cast<std::size_t>(a)].S.dot(F);
       }
+      if (nb != 0) H.col(j).head(nb).noalias() = d.S_b.transpose() * F;
+      if (nb != 0) H.row(j).head(nb) = H.col(j).head(nb).transpose();
     }
     if (s.parent >= 0) addToParent(d, i, s.parent, true);
   }
+  if (nb != 0) baseBlock(d, H);
   k.has_q = true;
   return k.checkResult(H);
 }
@@ -77,17 +98,28 @@ Status gravityTorques(const Model& model, DynamicsData& ddata, const JointPositi
     return k.fail(Error::NonfiniteInput, "gravity is not finite");
   if (const Status s = d.checkOut(tau.size(), 1, 1, "tau"); !s) return s;
   k.has_q = k.has_qd = false;
-  k.place(*q);
-  const Vector3 g(gravity.x(), gravity.y(), gravity.z());
+  k.place((*q).tail(k.nj));
+  const Vector3 g = d.localGravity(Vector3(gravity.x(), gravity.y(), gravity.z()));
   for (int i = 0; i < k.ns; ++i) placeBody(d, i, false);
   for (int i = k.ns - 1; i >= 0; --i) {
     const detail::KinSegment& s = k.seg[static_cast<std::size_t>(i)];
     if (s.joint >= 0) {
       const Vector6& S = k.st[static_cast<std::size_t>(i)].S;
-      tau(s.joint) = -d.mass[static_cast<std::size_t>(i)] * S.head<3>().dot(g) +
-                     S.tail<3>().dot(g.cross(d.h[static_cast<std::size_t>(i)]));
+      tau(d.nb + s.joint) = -d.mass[static_cast<std::size_t>(i)] * S.head<3>().dot(g) +
+                            S.tail<3>().dot(g.cross(d.h[static_cast<std::size_t>(i)]));
     }
     if (s.parent >= 0) addToParent(d, i, s.parent, false);
+  }
+  if (d.nb != 0) {  // the base's rows: the whole robot's weight held, as a wrench on the base
+    d.A_root << -g, Vector3::Zero();
+    d.f_root.setZero();
+    for (int i = 0; i < k.ns; ++i)
+      if (k.seg[static_cast<std::size_t>(i)].parent < 0) {
+        const double m = d.mass[static_cast<std::size_t>(i)];
+        d.f_root.head<3>() -= m * g;
+        d.f_root.tail<3>() += g.cross(d.h[static_cast<std::size_t>(i)]);
+      }
+    d.baseRows(tau);
   }
   k.has_q = true;
   return k.checkResult(tau);

@@ -24,31 +24,38 @@ void RolloutRecord::resize(int n_joints, int n_steps, bool tau_cmd, bool frictio
   contact_force.resize(3 * n_contacts, n_contacts > 0 ? n_steps : 0);
 }
 
+void RolloutRecord::resize(const Model& model, int n_steps, bool tau_cmd, bool friction, int n_contacts) {
+  resize(static_cast<int>(model.nrOfJoints()), n_steps, tau_cmd, friction, n_contacts);
+  q.resize(model.nq(), n_steps + 1);
+  q_dot.resize(model.nv(), n_steps + 1);
+  tau_command.resize(model.nv(), tau_cmd ? n_steps : 0);
+}
+
 Simulator::Simulator(const Model& model, double dt, Integrator integrator, const SolverOptions& options)
     : model_(model),
       data_(model_, options),
       work_(model_),
-      q_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
-      qd_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
-      p_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
-      q_next_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
-      qd_next_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
-      p_next_(Eigen::VectorXd::Zero(model_.nrOfJoints())),
+      q_(Eigen::VectorXd::Zero(model_.nq())),
+      qd_(Eigen::VectorXd::Zero(model_.nv())),
+      p_(Eigen::VectorXd::Zero(model_.nv())),
+      q_next_(Eigen::VectorXd::Zero(model_.nq())),
+      qd_next_(Eigen::VectorXd::Zero(model_.nv())),
+      p_next_(Eigen::VectorXd::Zero(model_.nv())),
       dynamics_(model_),
       dt_(dt),
       integrator_(integrator) {
+  setNeutralBase(model_.baseKind(), q_);  // a floating base at the origin, unrotated
   if (!model_.status())
     status_ = model_.status();
   else if (!data_.status())
     status_ = data_.status();
-  else if (model_.baseKind() != BaseKind::Fixed)
-    status_ = Status(Error::InvalidOptions, "Simulator: a floating base is not supported yet (its SE(3) step)");
   else if (!(dt > 0.0) || !std::isfinite(dt))
     status_ = Status(Error::OutOfRange, "Simulator: the time step dt must be finite and > 0 (s)");
   else if (integrator != Integrator::SemiImplicitEuler && integrator != Integrator::Symplectic)
     status_ = Status(Error::OutOfRange, "Simulator: unknown integrator");
   else if (integrator == Integrator::Symplectic) {  // its workspace now: no step allocates
     SolveInput rest(model_);
+    rest.q = q_;
     rest.time_step = dt_;
     status_ = stepSymplectic(model_, data_, rest, p_, q_next_, qd_next_, p_next_);
   }
@@ -59,9 +66,10 @@ Status Simulator::status() const noexcept {
 }
 
 Status Simulator::setState(const JointPositions& q, const JointVelocities& q_dot, double t) {
-  const long n = static_cast<long>(model_.nrOfJoints());
-  if (q.value().size() != n || q_dot.value().size() != n)
-    return Status(Error::SizeMismatch, "Simulator::setState: q and q_dot must have one entry per joint");
+  if (q.value().size() != model_.nq() || q_dot.value().size() != model_.nv())
+    return Status(Error::SizeMismatch,
+                  "Simulator::setState: q and q_dot must have one entry per joint (nq and nv entries on a floating "
+                  "base)");
   if (!finite(*q) || !finite(*q_dot) || !std::isfinite(t))
     return Status(Error::NonfiniteInput, "Simulator::setState: q, q_dot and t must be finite");
   if (integrator_ == Integrator::Symplectic) {  // p = H(q) q_dot: Newton-Euler at (q, 0, q_dot), no gravity
@@ -99,16 +107,18 @@ Status Simulator::step(const SolveInput& input) {
 
 Status Simulator::checkRecord(int n_steps, const SolveInput& input, const RolloutRecord& r) const {
   const long n = static_cast<long>(model_.nrOfJoints()), states = n_steps + 1L;
+  const long nq = static_cast<long>(model_.nq()), nv = static_cast<long>(model_.nv());
   if (n_steps < 0) return Status(Error::OutOfRange, "Simulator::rollout: n_steps must be >= 0");
-  if (r.t.size() != states || r.q.rows() != n || r.q.cols() != states || r.q_dot.rows() != n ||
+  if (r.t.size() != states || r.q.rows() != nq || r.q.cols() != states || r.q_dot.rows() != nv ||
       r.q_dot.cols() != states)
     return Status(Error::SizeMismatch,
-                  "Simulator::rollout: record t, q, q_dot must have n_steps + 1 entries (columns) of n_joints");
+                  "Simulator::rollout: record t, q, q_dot must have n_steps + 1 entries (columns) of n_joints (nq "
+                  "and nv on a floating base)");
   const auto optional = [&](const Eigen::MatrixXd& m, long rows) {
     return m.cols() == 0 || (m.rows() == rows && m.cols() == n_steps);
   };
   const long contacts = 3 * static_cast<long>(input.contacts.size());
-  if (!optional(r.tau_command, n) || !optional(r.friction_torque, n) || !optional(r.contact_force, contacts))
+  if (!optional(r.tau_command, nv) || !optional(r.friction_torque, n) || !optional(r.contact_force, contacts))
     return Status(Error::SizeMismatch,
                   "Simulator::rollout: record tau_command, friction_torque (n_joints rows) and contact_force "
                   "(3 per contact) must have n_steps columns or none");

@@ -19,10 +19,10 @@ namespace detail {
 SymplecticWorkspace::SymplecticWorkspace(const Model& model)
     : dynamics(model),
       scratch(model),
-      fixed(Eigen::VectorXd::Zero(model.nrOfJoints())),
-      gradient(Eigen::VectorXd::Zero(model.nrOfJoints())),
-      iterate(Eigen::VectorXd::Zero(model.nrOfJoints())),
-      zero(Eigen::VectorXd::Zero(model.nrOfJoints())) {}
+      fixed(Eigen::VectorXd::Zero(model.nv())),
+      gradient(Eigen::VectorXd::Zero(model.nv())),
+      iterate(Eigen::VectorXd::Zero(model.nv())),
+      zero(Eigen::VectorXd::Zero(model.nv())) {}
 
 namespace {
 
@@ -50,8 +50,11 @@ Status iterateOnce(const Model& model, Data& data, SymplecticWorkspace& ws, cons
   if (s = solve(model, data, ws.scratch); !s) return s;
   const std::vector<JointStatus>& status = data.jointStatus();
   const Eigen::VectorXd& qdd = data.qdd();
+  const Eigen::Index nb = u_next.size() - static_cast<Eigen::Index>(model.nrOfJoints());  // a floating base's rows
   for (Eigen::Index j = 0; j < u_next.size(); ++j)
-    u_next(j) = status[static_cast<std::size_t>(j)] == JointStatus::Stick ? 0.0 : in.q_dot(j) + in.time_step * qdd(j);
+    u_next(j) = j >= nb && status[static_cast<std::size_t>(j - nb)] == JointStatus::Stick
+                    ? 0.0
+                    : in.q_dot(j) + in.time_step * qdd(j);
   return s;
 }
 
@@ -61,12 +64,14 @@ Status symplecticStep(const Model& model, Data& data, SymplecticWorkspace& ws, c
                       const Eigen::Ref<const Eigen::VectorXd>& p, Eigen::Ref<Eigen::VectorXd> q_next,
                       Eigen::Ref<Eigen::VectorXd> u_next, Eigen::Ref<Eigen::VectorXd> p_next, int max_iterations,
                       double tol) {
-  const Eigen::Index n = static_cast<Eigen::Index>(model.nrOfJoints());
+  const Eigen::Index n = static_cast<Eigen::Index>(model.nv());
   const double dt = input.time_step;
   if (!(dt > 0.0) || !std::isfinite(dt))
     return Status(Error::OutOfRange, "the symplectic step needs a finite time step > 0 (s)");
-  if (p.size() != n || q_next.size() != n || u_next.size() != n || p_next.size() != n)
-    return Status(Error::SizeMismatch, "the symplectic step: p, q_next, u_next and p_next need one entry per joint");
+  if (p.size() != n || q_next.size() != model.nq() || u_next.size() != n || p_next.size() != n)
+    return Status(Error::SizeMismatch,
+                  "the symplectic step: p, q_next, u_next and p_next need one entry per joint (on a floating base "
+                  "q_next nq, the others nv entries)");
   if (!p.allFinite()) return Status(Error::NonfiniteInput, "the symplectic step: the momentum is not finite");
   Status s = fixedForce(model, ws, input, p);
   if (!s) return s;
@@ -86,7 +91,11 @@ Status symplecticStep(const Model& model, Data& data, SymplecticWorkspace& ws, c
   s = inverseDynamics(model, ws.dynamics, JointPositions(input.q), JointVelocities(ws.zero), JointAccelerations(u_next),
                       kNoWrenches, kNoGravity, p_next);
   if (!s) return s;
-  for (Eigen::Index j = 0; j < n; ++j) q_next(j) = input.q(j) + dt * u_next(j);
+  if (model.baseKind() != BaseKind::Fixed) {
+    integrateConfiguration(model.baseKind(), input.q, u_next, dt, q_next);  // on SE(3) / SE(2)
+  } else {
+    for (Eigen::Index j = 0; j < n; ++j) q_next(j) = input.q(j) + dt * u_next(j);
+  }
   if (!converged)
     return Status(Error::Degraded,
                   "the symplectic step did not converge within its iteration bound: the last "
@@ -100,8 +109,6 @@ Status stepSymplectic(const Model& model, Data& data, const SolveInput& input,
                       Eigen::Ref<Eigen::VectorXd> qd_next, Eigen::Ref<Eigen::VectorXd> momentum_next) {
   if (!data.model().sameAs(model))
     return Status(Error::NotUpToDate, "stepSymplectic(): the Data was built for another model");
-  if (model.baseKind() != BaseKind::Fixed)
-    return Status(Error::InvalidOptions, "stepSymplectic() is not supported on a floating base yet");
   detail::DataImpl& d = data.impl();
   if (!d.symplectic) d.symplectic = std::make_unique<detail::SymplecticWorkspace>(model);
   return detail::symplecticStep(model, data, *d.symplectic, input, momentum, q_next, qd_next, momentum_next);

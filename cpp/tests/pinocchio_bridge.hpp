@@ -69,10 +69,20 @@ struct PinRobot {
     tip.assign(ns, pinocchio::SE3::Identity());
     v_index.assign(ours.nrOfJoints(), -1);
     std::vector<double> rotor(ours.nrOfJoints(), 0.0);
+    pinocchio::JointIndex root = 0;  // a floating base: Pinocchio's free-flyer or planar joint
+    nb = static_cast<int>(ours.nv() - ours.nrOfJoints());
+    nbq = static_cast<int>(ours.nq() - ours.nrOfJoints());
+    if (nb != 0) {
+      const auto kind = ours.baseKind();
+      root = kind == vereshchagin::BaseKind::FreeFlyer
+                 ? model.addJoint(0, pinocchio::JointModelFreeFlyer(), pinocchio::SE3::Identity(), "base")
+                 : model.addJoint(0, pinocchio::JointModelPlanar(), pinocchio::SE3::Identity(), "base");
+      model.appendBodyToJoint(root, toInertia(ours.options().base_inertia), pinocchio::SE3::Identity());
+    }
     for (int i = 0; i < ns; ++i) {
       const KDL::Segment& seg = ours.segment(i);
       const int p = ours.parents()[i];
-      const pinocchio::JointIndex pj = p < 0 ? 0 : joint_of[p];
+      const pinocchio::JointIndex pj = p < 0 ? root : joint_of[p];
       const pinocchio::SE3 parent_tip = p < 0 ? pinocchio::SE3::Identity() : tip[p];
       const KDL::Joint& kj = seg.getJoint();
       const int j = ours.jointOfSegment()[i];
@@ -96,17 +106,27 @@ struct PinRobot {
       model.armature(v_index[j]) = rotor[j];
     }
   }
-  // A joint vector in our order -> Pinocchio's, and back.
+  // A joint vector in our order -> Pinocchio's, and back. On a floating base a velocity-sized
+  // vector (nv) keeps its base rows first; toPinQ maps a configuration (nq).
   Eigen::VectorXd toPin(const Eigen::VectorXd& x) const {
     Eigen::VectorXd out(x.size());
-    for (Eigen::Index j = 0; j < x.size(); ++j) out(v_index[j]) = x(j);
+    out.head(nb) = x.head(nb);
+    for (std::size_t j = 0; j < v_index.size(); ++j) out(v_index[j]) = x(nb + j);
     return out;
   }
   Eigen::VectorXd fromPin(const Eigen::VectorXd& x) const {
     Eigen::VectorXd out(x.size());
-    for (Eigen::Index j = 0; j < x.size(); ++j) out(j) = x(v_index[j]);
+    out.head(nb) = x.head(nb);
+    for (std::size_t j = 0; j < v_index.size(); ++j) out(nb + j) = x(v_index[j]);
     return out;
   }
+  Eigen::VectorXd toPinQ(const Eigen::VectorXd& q) const {
+    Eigen::VectorXd out(q.size());
+    out.head(nbq) = q.head(nbq);
+    for (std::size_t j = 0; j < v_index.size(); ++j) out(v_index[j] - nb + nbq) = q(nbq + j);
+    return out;
+  }
+  int nb = 0, nbq = 0;  // the base's entries of v and q (0 on a fixed base)
   pinocchio::Model model;
   std::vector<pinocchio::JointIndex> joint_of;  // per segment
   std::vector<pinocchio::SE3> tip;              // per segment: its tip in its joint's frame

@@ -64,7 +64,8 @@ py::array run(const CompanionModel& m, K kind, std::array<py::handle, 5> args, c
   int ndim = 0;
   py::ssize_t shape[3];
   check(vs::companionShape(d.kinematics(), call, ndim, shape));
-  py::array out = newArray(py::detail::npy_api::NPY_DOUBLE_, ndim, shape, /*fortran=*/kind == K::Jacobian);
+  py::array out = newArray(py::detail::npy_api::NPY_DOUBLE_, ndim, shape,
+                           /*fortran=*/kind == K::Jacobian || kind == K::CenterOfMassJacobian);
   check(vs::callCompanion(d.model(), d, call, doubles(out)));
   return out;
 }
@@ -105,11 +106,11 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
   // table costs about 5 % of this call); another shape, or a failure, through run() for its message.
   const auto mass = [](const M& m, O q) {
     vs::DynamicsData& d = m.companions();
-    const py::ssize_t n = static_cast<py::ssize_t>(d.model().nrOfJoints());
-    const F64View v = asF64(q.ptr(), "q");  // v.keep: a converted copy, alive for this call
-    if (v.ndim != 1 || v.shape[0] != n) return run(m, K::MassMatrix, {q});
+    const py::ssize_t nq = d.model().nq(), n = d.model().nv();  // a floating base's state too
+    const F64View v = asF64(q.ptr(), "q");                      // v.keep: a converted copy, alive for this call
+    if (v.ndim != 1 || v.shape[0] != nq) return run(m, K::MassMatrix, {q});
     py::array out = newDoubles({n, n});
-    const vs::JointPositions jq(Eigen::Map<const Eigen::VectorXd>(v.data, n));
+    const vs::JointPositions jq(Eigen::Map<const Eigen::VectorXd>(v.data, nq));
     if (!vs::massMatrix(d.model(), d, jq, Eigen::Map<Eigen::MatrixXd>(doubles(out), n, n)))
       return run(m, K::MassMatrix, {q});
     return out;
@@ -117,6 +118,8 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
   const auto grav = [](const M& m, O q, O g) { return run(m, K::GravityTorques, {q, {}, {}, g}); };
   const auto coriolis = [](const M& m, O q, O qd) { return run(m, K::CoriolisTorques, {q, qd}); };
   const auto fk_all = [](const M& m, O q) { return run(m, K::FkAll, {q}); };
+  const auto of_q = [](K kind) { return [kind](const M& m, O q) { return run(m, kind, {q}); }; };
+  const auto of_state = [](K kind) { return [kind](const M& m, O q, O qd) { return run(m, kind, {q, qd}); }; };
   cls.def("fk", fk, py::arg("q"), segment, key("fk"))
       .def("jacobian", jacobian, py::arg("q"), segment, key("jacobian"))
       .def("twist", twist, py::arg("q"), py::arg("qd"), segment, key("twist"))
@@ -126,7 +129,14 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
       .def("gravity_torques", grav, py::arg("q"), gravity, key("gravity_torques"))
       .def("coriolis_torques", coriolis, py::arg("q"), py::arg("qd"), key("coriolis_torques"))
       .def("jacobian_dot_times_qd", jdot, py::arg("q"), py::arg("qd"), segment, key("jacobian_dot_times_qd"))
-      .def("fk_all", fk_all, py::arg("q"), key("fk_all"));
+      .def("fk_all", fk_all, py::arg("q"), key("fk_all"))
+      .def("center_of_mass", of_q(K::CenterOfMass), py::arg("q"), key("center_of_mass"))
+      .def("center_of_mass_jacobian", of_q(K::CenterOfMassJacobian), py::arg("q"), key("center_of_mass_jacobian"))
+      .def("center_of_mass_velocity", of_state(K::CenterOfMassVelocity), py::arg("q"), py::arg("qd"),
+           key("center_of_mass_velocity"))
+      .def("centroidal_momentum", of_state(K::CentroidalMomentum), py::arg("q"), py::arg("qd"),
+           key("centroidal_momentum"))
+      .def("integrate", of_state(K::Integrate), py::arg("q"), py::arg("v"), key("integrate"));
 }
 
 }  // namespace

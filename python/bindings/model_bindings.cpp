@@ -7,6 +7,7 @@
 
 #include "model_class.hpp"
 #include "py_solver.hpp"  // inertiaCheckArg, the F64View helpers
+#include "vereshchagin/base_state.hpp"
 #include "vereshchagin/robot_edit.hpp"
 #include "vereshchagin/robot_state.hpp"
 #include "vereshchagin/urdf_loader.hpp"
@@ -42,6 +43,11 @@ M modelFromState(const py::tuple& state) {
   M model;
   std::string message;
   if (!vereshchagin::robotFromState(r, model.robot, message)) raise(message);
+  if constexpr (std::is_same_v<M, PyTree>)  // a floating base: (kind, inertia), checked by _records
+    if (const auto b = records[2].cast<py::object>(); !b.is_none()) {
+      const auto base = b.cast<std::pair<std::string, std::array<double, 13>>>();
+      if (!vereshchagin::setBaseState(model.robot, base.first, base.second, message)) raise(what + ": " + message);
+    }
   model.inertia_check = inertiaCheckArg(records[1].cast<std::string>(), what + ": ");
   return model;
 }
@@ -86,7 +92,11 @@ py::class_<M> bindModel(py::module_& mod, const char* name) {
   };
   const auto rotorInertia = [](const M& m) { return array(vereshchagin::rotorInertia(m.robot)); };
   const auto state = [](O self) {
-    return py::tuple(pyModels("_state")(self, vereshchagin::stateRecords(self.cast<const M&>().robot)));
+    const M& m = self.cast<const M&>();
+    py::object base = py::none();  // a Tree's base: (kind, the 13 doubles of its inertia)
+    if constexpr (std::is_same_v<M, PyTree>)
+      base = py::make_tuple(vereshchagin::baseKindName(m.robot.base), vereshchagin::baseInertiaDoubles(m.robot));
+    return py::tuple(pyModels("_state")(self, vereshchagin::stateRecords(m.robot), base));
   };
   const auto segmentIndex = [](const M& m, O which) { return m.resolveMoving(which.ptr(), "segment_index").segment; };
   const auto jointIndex = [](const M& m, O which) { return m.resolveJoint(which.ptr(), "joint_index"); };

@@ -487,6 +487,94 @@ DOCS["Tree.mass_matrix"] = _mass_matrix(
 DOCS["Chain.gravity_torques"] = _gravity_torques("chain")
 DOCS["Tree.gravity_torques"] = _gravity_torques("tree")
 DOCS["Chain.coriolis_torques"] = DOCS["Tree.coriolis_torques"] = _CORIOLIS_TORQUES
+_COM_FRAME = """the world frame on a floating base (``Tree.from_urdf(...,
+base='free' | 'planar')``, the base's pose from q), the base frame on a fixed base. Every body's
+mass counts (a floating base body's too), rotor inertias do not."""
+_COM_STATE = """q : array_like, shape (nq,)
+    Positions: ``n_joints`` entries (:attr:`joint_names` order), on a floating base ``nq`` (the
+    base's first, docs/floating-base.md).
+"""
+_COM_QD = """qd : array_like, shape (nv,)
+    Velocities: ``n_joints`` entries, on a floating base ``nv`` (the base's LOCAL twist first).
+"""
+DOCS["Chain.center_of_mass"] = DOCS["Tree.center_of_mass"] = rf"""Centre of mass of the robot, m.
+
+In {_COM_FRAME} Pinocchio: ``pin.centerOfMass``.
+
+Parameters
+----------
+{_COM_STATE}
+Returns
+-------
+ndarray, shape (3,)
+"""
+DOCS["Chain.center_of_mass_jacobian"] = DOCS["Tree.center_of_mass_jacobian"] = rf"""Jacobian ``J_c`` of
+the centre of mass: its velocity is ``J_c @ qd``.
+
+Axes of {_COM_FRAME} Pinocchio: ``pin.jacobianCenterOfMass``.
+
+Parameters
+----------
+{_COM_STATE}
+Returns
+-------
+ndarray, shape (3, nv)
+    m per rad or per m (per m/s and rad/s of the base's LOCAL twist on a floating base).
+"""
+DOCS["Chain.center_of_mass_velocity"] = DOCS["Tree.center_of_mass_velocity"] = rf"""Velocity of the
+centre of mass, m/s: ``center_of_mass_jacobian(q) @ qd``.
+
+Axes of {_COM_FRAME}
+
+Parameters
+----------
+{_COM_STATE}{_COM_QD}
+Returns
+-------
+ndarray, shape (3,)
+"""
+DOCS["Chain.centroidal_momentum"] = DOCS["Tree.centroidal_momentum"] = rf"""Centroidal momentum
+``[p; L_G]``: the linear momentum ``p`` (kg m/s, the total mass times the centre of mass's
+velocity) and the angular momentum ``L_G`` about the centre of mass (kg m^2/s).
+
+Axes of {_COM_FRAME} Pinocchio: ``pin.computeCentroidalMomentum`` (``data.hg``). Conserved by a
+free-floating robot without gravity and external forces.
+
+Parameters
+----------
+{_COM_STATE}{_COM_QD}
+Returns
+-------
+ndarray, shape (6,)
+"""
+DOCS["Chain.integrate"] = DOCS["Tree.integrate"] = rf"""The configuration ``q (+) v`` reached from q
+by moving with the constant velocity v for unit time (a time step: ``integrate(q, dt * qd)``).
+
+The joints ``q + v``; a floating base (docs/floating-base.md) moves by the exponential of its
+LOCAL twist: on SE(3) for a free-flyer (the quaternion stays unit), on SE(2) for a planar base.
+Pinocchio: ``pin.integrate`` with the same root joint. The position update of
+:meth:`Solver.step` and the :class:`Simulator`.
+
+Parameters
+----------
+{_COM_STATE}v : array_like, shape (nv,)
+    The velocity times the duration: rad or m, on a floating base the LOCAL twist's ``nv`` first.
+
+Returns
+-------
+ndarray, shape (nq,)
+"""
+_FLOATING_DYNAMICS = """
+Notes
+-----
+On a floating base (``Tree.from_urdf(..., base='free' | 'planar')``, docs/floating-base.md) q has
+``tree.nq`` entries, qd, qdd and the result ``tree.nv`` (the mass matrix ``(nv, nv)``), the base's
+first: its rows are the wrench on the base body in base axes (Pinocchio's LOCAL, as ``pin.rnea`` and
+``pin.crba`` with a ``JointModelFreeFlyer`` or ``JointModelPlanar``). Gravity and the f_ext rows
+are in world axes there, as in :meth:`Solver.solve`.
+"""
+for _name in ("inverse_dynamics", "mass_matrix", "gravity_torques", "coriolis_torques"):
+    DOCS["Tree." + _name] += _FLOATING_DYNAMICS
 DOCS["Chain.jacobian_dot_times_qd"] = _jacobian_dot_times_qd(
     "jacobian_dot_times_qd(q, qd)",
     "Computed from the joint axes and velocities of the frame's path to the base.",

@@ -8,7 +8,8 @@ damping, segment) tuple per moving joint, in q order.
 Their pickle states (``__getstate__``, ``__setstate__``: ``python/bindings/model_state.cpp``, which
 calls ``_state`` and ``_records`` below for the layout; the C++ library checks the records) are
 Chain: ``(1, segments, joints, links, root_link, notes, inertia_check)``; Tree: ``(1, root_link,
-[(segment, parent)], joints, links, notes, inertia_check)``. A segment: ``(name, joint name, joint
+[(segment, parent)], joints, links, notes, inertia_check)`` and, on a floating base, ``(kind, the
+13 stored doubles of the base inertia)`` last. A segment: ``(name, joint name, joint
 type, origin, axis, rotor inertia, damping, stiffness, tip frame (12), the 13 stored inertia
 doubles)``, restored bit for bit; a joint: ``(name, type, lower, upper, velocity_limit,
 effort_limit, friction, damping, segment)``; a link: ``(name, segment, frame (12))``; lists hold
@@ -40,7 +41,7 @@ _JOINT_FIELDS = (
 )
 
 
-def _state(model: Chain | Tree, records: tuple) -> tuple:
+def _state(model: Chain | Tree, records: tuple, base=None) -> tuple:
     """The pickle state of ``model`` from the C++ library's records of it.
 
     Parameters
@@ -50,41 +51,52 @@ def _state(model: Chain | Tree, records: tuple) -> tuple:
     records : tuple
         ``(root_link, [(segment, parent)], joints, links, notes)`` (``robot_state.hpp``'s
         ``StateRecords``; a chain's parent indices are dropped).
+    base : tuple or None
+        A Tree's base ``(kind, the 13 stored doubles of its inertia)`` (``base_state.hpp``); on a
+        floating base it is the state's eighth entry (a fixed base's state keeps seven).
     """
     root, segments, joints, links, notes = records
-    if isinstance(model, Tree) and model.base != "fixed":  # (the state has no base kind yet)
-        raise SolverError(f"a Tree on a '{model.base}' base does not pickle yet: load it again with from_urdf")
     if isinstance(model, Tree):
-        return (1, root, segments, joints, links, notes, model.inertia_check)
+        state = (1, root, segments, joints, links, notes, model.inertia_check)
+        return state if base is None or base[0] == "fixed" else (*state, (base[0], list(base[1])))
     return (1, [segment for segment, _ in segments], joints, links, root, notes, model.inertia_check)
 
 
 def _records(state: tuple, what: str) -> tuple:
-    """The inverse of ``_state``: ``(records, inertia_check)`` of a Chain or Tree state.
+    """The inverse of ``_state``: ``(records, inertia_check, base)`` of a Chain or Tree state.
 
     Parameters
     ----------
     state : tuple
         A state of either layout (``what`` says which), of six entries (no inertia_check: loads
-        as 'physical') or seven.
+        as 'physical') or seven; a Tree's on a floating base eight (its base last).
     what : str
         "Chain state" or "Tree state": the start of every message.
 
     Raises
     ------
     SolverError
-        "<what>: unknown format" for another length or version; the entries themselves are
-        checked by the caller (``model_state.cpp``) and the C++ library.
+        "<what>: unknown format" for another length or version, or a malformed base entry; the
+        other entries are checked by the caller (``model_bindings.cpp``) and the C++ library.
     """
-    if len(state) not in (6, 7) or not isinstance(state[0], int) or state[0] != 1:
+    lengths = (6, 7, 8) if what == "Tree state" else (6, 7)
+    if len(state) not in lengths or not isinstance(state[0], int) or state[0] != 1:
         raise SolverError(f"{what}: unknown format")
-    check = state[6] if len(state) == 7 else "physical"
+    check = state[6] if len(state) >= 7 else "physical"
     if what == "Tree state":
-        return (state[1], state[2], state[3], state[4], state[5]), check
+        base = state[7] if len(state) == 8 else None
+        if base is not None:
+            try:
+                base = (str(base[0]), [float(x) for x in base[1]])
+            except (TypeError, ValueError, IndexError):
+                base = None, []
+            if len(base) != 2 or not isinstance(base[0], str) or len(base[1]) != 13:
+                raise SolverError(f"{what}: malformed base entry (kind, 13 inertia doubles)")
+        return (state[1], state[2], state[3], state[4], state[5]), check, base
     segments = state[1]
     if isinstance(segments, Sequence) and not isinstance(segments, (str, bytes)):
         segments = [(segment, -1) for segment in segments]  # a chain's parent index is unused
-    return (state[4], segments, state[2], state[3], state[5]), check
+    return (state[4], segments, state[2], state[3], state[5]), check, None
 
 
 def _urdf_text(source) -> str:

@@ -50,7 +50,12 @@ class Simulator:
     gravity, rcond, damping, inertia_check, max_constraints
         As in :class:`Solver`.
     q, qd : array_like, shape (n,), optional
-        The initial state (default: zeros), rad or m and rad/s or m/s.
+        The initial state (default: zeros), rad or m and rad/s or m/s. On a floating base
+        (``Tree.from_urdf(..., base='free' | 'planar')``, docs/floating-base.md) q has ``nq``
+        entries and qd ``nv``, the base's first (default: the base at the world origin,
+        unrotated); each step moves the base on SE(3) (SE(2)) by its LOCAL twist,
+        ``q_next = model.integrate(q, dt * qd_next)``, as ``pin.integrate``; the symplectic
+        integrator there is C++ only for now.
     t : float
         The initial time, s (default 0).
     integrator : str
@@ -89,9 +94,20 @@ class Simulator:
         self._integrator = integrator
         self._dt = _check_dt(dt)
         self._solver = Solver(model, gravity, rcond, damping, inertia_check, max_constraints)
-        self._model = self._solver.model  # the momentum H(q) qd at reset (symplectic)
-        n = self._solver.n_joints
-        self.reset(np.zeros(n) if q is None else q, np.zeros(n) if qd is None else qd, t)
+        self._model = self._solver.model  # the momentum H(q) qd at reset (symplectic), integrate
+        self._base = getattr(self._model, "base", "fixed")
+        if self._base != "fixed" and integrator == "symplectic":
+            raise _core.SolverError(
+                "Simulator: the symplectic integrator on a floating base is not available from Python yet "
+                "(C++: stepSymplectic(), Simulator with Integrator::Symplectic); use 'semi_implicit_euler'"
+            )
+        nv = self._solver.n_joints  # nv: the base's entries first on a floating base
+        nq = getattr(self._model, "nq", nv)
+        if q is None:  # at rest, a floating base at the world origin, unrotated
+            q = np.zeros(nq)
+            if self._base != "fixed":
+                q[6 if self._base == "free" else 2] = 1.0  # the quaternion's w, or cos(yaw)
+        self.reset(q, np.zeros(nv) if qd is None else qd, t)
 
     def reset(self, q, qd, t=0.0):
         """Sets the state: positions ``q`` (rad or m), velocities ``qd`` (rad/s or m/s), time ``t`` (s).
@@ -103,7 +119,7 @@ class Simulator:
             is then unchanged.
         """
         n = self._solver.n_joints
-        q, qd = _state(q, n, "q"), _state(qd, n, "qd")
+        q, qd = _state(q, getattr(self._model, "nq", n), "q"), _state(qd, n, "qd")
         if isinstance(t, bool) or not isinstance(t, (int, float, np.floating, np.integer)) or not np.isfinite(t):
             raise _core.SolverError(f"Simulator: t must be a finite number (s), got {t!r}")
         self._q, self._qd, self._t0, self._steps = q, qd, float(t), 0
@@ -137,7 +153,11 @@ class Simulator:
         return self._advance(solve_args)
 
     def _advance(self, args):
-        if self._p is None:
+        if self._base != "fixed":  # C++ step(): the solve over the step, then q (+) dt qd_next
+            result = self._solver.solve(self._q, self._qd, time_step=self._dt, **args)
+            qd = self._qd + self._dt * result.qdd
+            self._q, self._qd = self._model.integrate(self._q, self._dt * qd), qd
+        elif self._p is None:
             self._q, self._qd, result = self._solver._step(self._q, self._qd, time_step=self._dt, **args)
         else:
             step = self._solver._step_symplectic
@@ -188,7 +208,7 @@ class Simulator:
             raise _core.SolverError("Simulator.rollout: controller must be a callable (t, q, qd) -> dict, or None")
         self._check_own(solve_args)
         n, dt = self._solver.n_joints, self._dt
-        q_out, qd_out = np.empty((n_steps + 1, n)), np.empty((n_steps + 1, n))
+        q_out, qd_out = np.empty((n_steps + 1, self._q.size)), np.empty((n_steps + 1, n))
         q_out[0], qd_out[0], first = self._q, self._qd, self._steps
         rows = {name: [] for name in record}
         for k in range(n_steps):

@@ -27,14 +27,30 @@ def test_base_kinds_and_sizes(urdf):
         vs.Tree.from_urdf(urdf, base="floating")
 
 
-def test_copies_keep_the_base_and_pickle_refuses(urdf):
+def test_copies_and_pickles_keep_the_base(urdf):
+    # (Round 1 refused to pickle a floating Tree; its state now carries the base kind and inertia.)
     import copy
     import pickle
 
-    tree = vs.Tree.from_urdf(urdf, base="planar")
-    assert copy.copy(tree).base == copy.deepcopy(tree).base == "planar"
-    with pytest.raises(vs.SolverError, match="does not pickle yet"):
-        pickle.dumps(tree)
+    for kind in ("planar", "free"):
+        tree = vs.Tree.from_urdf(urdf, base=kind)
+        assert copy.copy(tree).base == copy.deepcopy(tree).base == kind
+        back = pickle.loads(pickle.dumps(tree))
+        assert back.base == kind and (back.nq, back.nv) == (tree.nq, tree.nv)
+        q = np.r_[0.1, -0.2, np.zeros(tree.nq - 2)]
+        q[6 if kind == "free" else 2] = 1.0
+        qd = np.linspace(-0.5, 0.5, tree.nv)
+        np.testing.assert_array_equal(vs.Solver(back).solve(q, qd).qdd, vs.Solver(tree).solve(q, qd).qdd)
+        np.testing.assert_array_equal(back.mass_matrix(q), tree.mass_matrix(q))
+    fixed = vs.Tree.from_urdf(urdf)
+    assert len(fixed.__getstate__()) == 7  # a fixed base's state as before
+    state = list(tree.__getstate__())
+    state[7] = ("free", [1.0] * 12)
+    with pytest.raises(vs.SolverError, match="malformed base entry"):
+        vs.Tree.__new__(vs.Tree).__setstate__(tuple(state))
+    state[7] = ("floating", [1.0] * 13)
+    with pytest.raises(vs.SolverError, match="the base must be 'fixed', 'free' or 'planar'"):
+        vs.Tree.__new__(vs.Tree).__setstate__(tuple(state))
 
 
 def test_solve_sizes(urdf):

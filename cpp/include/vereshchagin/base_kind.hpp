@@ -21,6 +21,8 @@
 
 #include <string>
 
+#include <Eigen/Core>
+
 namespace vereshchagin {
 
 /// How the model's base (its root frame) moves: see the top of this file.
@@ -45,5 +47,20 @@ const char* baseKindName(BaseKind kind) noexcept;
 
 /// The kind named "fixed", "free" (or "free_flyer") or "planar"; false for any other name.
 bool baseKindFromName(const std::string& name, BaseKind& out) noexcept;
+
+/// q_next = q (+) dt v, the configuration reached from q (nq entries, this layout) by moving with
+/// the constant velocity v (nv entries; rad/s, m/s, the base's LOCAL twist) for dt (s), as
+/// Pinocchio's integrate(model, q, dt v) with the same root joint: the joints q_j + dt v_j; a
+/// free-flyer's base M_next = M exp(dt v_b), the SE(3) exponential of its twist (so the base
+/// moves along a screw: the translation in base axes, turned as the base turns), its quaternion
+/// times that of exp(dt omega) on the right, normalized; a planar base likewise with the SE(2)
+/// exponential of dt (v_x, v_y, omega_z), (cos, sin) normalized. q_next may alias q, not v. No
+/// allocation, no checks (sizes, finiteness and the unit norm are the caller's).
+void integrateConfiguration(BaseKind kind, const Eigen::Ref<const Eigen::VectorXd>& q,
+                            const Eigen::Ref<const Eigen::VectorXd>& v, double dt, Eigen::Ref<Eigen::VectorXd> q_next);
+
+/// Sets q's base part (nq entries) to the base at the world origin, unrotated: (0, 0, 0, 0, 0, 0,
+/// 1) for a free-flyer, (0, 0, 1, 0) for a planar base; the joints' entries are left as they are.
+void setNeutralBase(BaseKind kind, Eigen::Ref<Eigen::VectorXd> q);
 
 }  // namespace vereshchagin

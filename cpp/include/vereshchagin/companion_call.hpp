@@ -10,7 +10,9 @@
 ///     companionShape(dd.kinematics(), call, ndim, shape);  // (n_joints, n_joints)
 ///     callCompanion(model, dd, call, out);                 // out: shape[0] * shape[1] doubles
 ///
-/// Units, frames and signs: those of kinematics.hpp and dynamics.hpp (base axes, physical gravity,
+/// The dynamics and momentum companions take a floating base's whole state (q: nq, qd and qdd: nv
+/// entries), the kinematics companions the joints' (base_kind.hpp).
+/// Units, frames and signs: those of kinematics.hpp, dynamics.hpp and momentum.hpp (base axes, physical gravity,
 /// f_ext ON each segment BY the environment about its tip origin). Every failure is a Status whose
 /// message lives in the KinematicsData (dd.kinematics()); no allocation on success.
 #pragma once
@@ -26,15 +28,20 @@ namespace vereshchagin {
 
 /// The companions, named in messages by their Python names ("inverse_dynamics", ...).
 enum class Companion {
-  InverseDynamics,     ///< tau (n,) from q, qd, qdd, f_ext, gravity
-  MassMatrix,          ///< H (n, n) from q
-  GravityTorques,      ///< g(q) (n,) from q, gravity
-  CoriolisTorques,     ///< C(q, qd) qd (n,) from q, qd
-  Fk,                  ///< the frame's pose (4, 4), or (N, 4, 4) for N rows of q
-  FkAll,               ///< every segment's tip pose (n_segments, 4, 4) from q
-  Jacobian,            ///< the frame's Jacobian (6, n), written COLUMN-major, from q
-  Twist,               ///< the frame's twist (6,), or (N, 6) for N rows of q and qd
-  JacobianDotTimesQd,  ///< the frame's bias acceleration (6,) from q, qd
+  InverseDynamics,       ///< tau (n,) from q, qd, qdd, f_ext, gravity
+  MassMatrix,            ///< H (n, n) from q
+  GravityTorques,        ///< g(q) (n,) from q, gravity
+  CoriolisTorques,       ///< C(q, qd) qd (n,) from q, qd
+  Fk,                    ///< the frame's pose (4, 4), or (N, 4, 4) for N rows of q
+  FkAll,                 ///< every segment's tip pose (n_segments, 4, 4) from q
+  Jacobian,              ///< the frame's Jacobian (6, n), written COLUMN-major, from q
+  Twist,                 ///< the frame's twist (6,), or (N, 6) for N rows of q and qd
+  JacobianDotTimesQd,    ///< the frame's bias acceleration (6,) from q, qd
+  CenterOfMass,          ///< the centre of mass (3,) from q (momentum.hpp)
+  CenterOfMassJacobian,  ///< its Jacobian (3, nv), written COLUMN-major, from q
+  CenterOfMassVelocity,  ///< its velocity (3,) from q, qd
+  CentroidalMomentum,    ///< [linear; angular about the centre of mass] (6,) from q, qd
+  Integrate,             ///< q (+) qd (nq,): integrateConfiguration of base_kind.hpp with dt = 1
 };
 
 /// The arguments, in the order a companion reads and checks them (those it does not take are not

@@ -95,8 +95,9 @@ class Data {
   /// Kinematics at the last solve's state, base axes (allocation-free, O(depth) per call):
   /// the pose of a frame in the base frame, its twist [linear velocity of its origin; angular],
   /// and its Jacobian (6 x n_joints, columns in joint order; twist = J q_dot). On a floating base
-  /// the pose and twist are in the world frame (the base's motion included); the Jacobian has the
-  /// joints' columns only (world axes), the base's are not there yet.
+  /// the pose and twist are in the world frame (the base's motion included) and the Jacobian is
+  /// 6 x nv, world axes, the base's columns first (for its LOCAL velocity: twist = J q_dot, as
+  /// Pinocchio's getFrameJacobian in LOCAL_WORLD_ALIGNED).
   KDL::Frame framePose(const FrameRef& frame) const;
   KDL::Twist frameTwist(const FrameRef& frame) const;                                       ///< see framePose()
   Status frameJacobian(const FrameRef& frame, Eigen::Ref<Eigen::MatrixXd> jacobian) const;  ///< see framePose()
@@ -144,8 +145,11 @@ Status solve(const Model& model, Data& data, const SolveInput& input);
 /// (the conditions of friction, limits and contacts on the end velocities, see
 /// SolveInput::time_step), then qd_next = q_dot + dt qdd, exactly 0 for a joint friction holds
 /// (JointStatus::Stick), and q_next = q + dt qd_next (n_joints each; they may alias input.q and
-/// input.q_dot). Error::OutOfRange for dt <= 0, SizeMismatch for wrong sizes, InvalidOptions on a
-/// floating base (not supported yet), else solve()'s status. The results of the solve stay in data.
+/// input.q_dot). On a floating base (base_kind.hpp) q_next has nq entries and qd_next nv, and
+/// q_next = q (+) dt qd_next: the base moves on SE(3) (SE(2) for a planar base) by the exponential
+/// of its LOCAL twist, as Pinocchio's integrate (integrateConfiguration()); free motion and segment
+/// constraints there (friction and contacts are refused by solve()). Error::OutOfRange for
+/// dt <= 0, SizeMismatch for wrong sizes, else solve()'s status. The results of the solve stay in data.
 Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,
             Eigen::Ref<Eigen::VectorXd> qd_next);
 
@@ -162,8 +166,10 @@ Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<
 /// the feed-forward torques not included, as always). After 100 iterations without convergence
 /// (max |change of u+| <= 1e-12 max(1, |u+|)) the last iterate is taken: Error::Degraded. The
 /// first call on a Data allocates its workspace (O(n)); later ones allocate nothing. Outputs
-/// must not alias the inputs (fixed bases only, as step()). Errors: those of step(), SizeMismatch for a momentum of the
-/// wrong size, NonfiniteInput for one that is not finite.
+/// must not alias the inputs. On a floating base (as step()) momentum, qd_next and momentum_next
+/// have nv entries, the base's rows the momentum in base axes (LOCAL), dT/dq's base rows those of
+/// energy.hpp, and q_next = q (+) dt u+ (nq). Errors: those of step(), SizeMismatch for a momentum of
+/// the wrong size, NonfiniteInput for one that is not finite.
 Status stepSymplectic(const Model& model, Data& data, const SolveInput& input,
                       const Eigen::Ref<const Eigen::VectorXd>& momentum, Eigen::Ref<Eigen::VectorXd> q_next,
                       Eigen::Ref<Eigen::VectorXd> qd_next, Eigen::Ref<Eigen::VectorXd> momentum_next);

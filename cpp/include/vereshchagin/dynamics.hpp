@@ -23,6 +23,16 @@
 ///    segment i BY the environment, base-frame axes, the moment about segment i's TIP ORIGIN (as
 ///    SolveInput::f_ext); J_i is the Jacobian of segment i's tip origin (kinematics.hpp).
 ///
+/// On a floating base (Model::baseKind() FreeFlyer or Planar, base_kind.hpp) the same functions
+/// take and give the whole state: q has nq entries, q_dot, q_ddot and tau nv (H is nv x nv), the
+/// base's first in Pinocchio's layout: the base's velocity and acceleration in BASE axes (LOCAL),
+/// and on tau's base rows the wrench on the base body [force (N); moment about the base origin
+/// (N m)] in base axes (planar: f_x, f_y, n_z), as pin.rnea / pin.crba with a JointModelFreeFlyer
+/// or JointModelPlanar. There gravity and f_ext are in WORLD axes (as SolveInput's on a floating
+/// base; f_ext's moments still about each tip origin); the base body's inertia is
+/// ModelOptions::base_inertia (with a URDF's root link). The base's unit quaternion (or
+/// (cos, sin) pair) is checked as the solver checks it (NonfiniteInput beyond 1e-6 off unit).
+///
 /// After a call, dd.kinematics() holds the forward kinematics at q (and at q_dot for
 /// inverseDynamics and coriolisTorques): framePose() etc. of kinematics.hpp can be asked of it.
 /// Errors: NotUpToDate (dd built for another model), SizeMismatch (a vector, f_ext or the output
@@ -75,15 +85,16 @@ class DynamicsData {
 };
 
 /// tau = H q_ddot + C q_dot + g - sum_i J_i^T f_ext_i (recursive Newton-Euler). f_ext: 6 x n_segments
-/// or 6 x 0; tau: n_joints (written).
+/// or 6 x 0; tau: n_joints, nv on a floating base (written).
 Status inverseDynamics(const Model& model, DynamicsData& ddata, const JointPositions& q, const JointVelocities& q_dot,
                        const JointAccelerations& q_ddot, const Eigen::Ref<const Matrix6X>& f_ext,
                        const KDL::Vector& gravity, Eigen::Ref<Eigen::VectorXd> tau);
 
-/// H(q), n_joints x n_joints (written in full, both triangles).
+/// H(q), n_joints x n_joints, nv x nv on a floating base (written in full, both triangles).
 Status massMatrix(const Model& model, DynamicsData& ddata, const JointPositions& q, Eigen::Ref<Eigen::MatrixXd> H);
 
-/// g(q) for physical gravity `gravity` (base axes, m/s^2): tau = g(q) holds the robot still.
+/// g(q) for physical gravity `gravity` (base axes, m/s^2; world axes on a floating base): tau = g(q)
+/// holds the robot still (on a floating base with the base rows: the wrench that holds its weight).
 Status gravityTorques(const Model& model, DynamicsData& ddata, const JointPositions& q, const KDL::Vector& gravity,
                       Eigen::Ref<Eigen::VectorXd> tau);
 

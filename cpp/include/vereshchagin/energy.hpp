@@ -12,6 +12,16 @@
 ///    L = T - V the equation of motion reads d/dt (H q_dot) = dT/dq - dV/dq + tau (+ J^T f_ext),
 ///    and dT/dq = C(q, q_dot)^T q_dot for the Coriolis matrix C whose H_dot - 2 C is skew.
 ///
+/// On a floating base (base_kind.hpp; dynamics.hpp for q of nq and q_dot of nv entries, gravity in
+/// world axes): T includes the base body's and is 1/2 q_dot^T H q_dot still; V sums every mass's
+/// height in the WORLD frame (the base body's too: Pinocchio's computePotentialEnergy); dT/dq's
+/// base rows are -S_b^T (V_b x* h): V_b the base's spatial velocity and h the whole robot's
+/// momentum, both in base axes about the base origin, S_b the base's axes (identity, or the
+/// x, y, yaw columns of a planar base). With the base's LOCAL velocity these rows are not a
+/// partial derivative (T does not depend on the base's pose) but the body-frame term of
+/// d/dt (H q_dot) = C^T q_dot + tau - g, so that dT/dq = C(q, q_dot)^T q_dot holds on every row
+/// (Pinocchio's computeCoriolisMatrix).
+///
 /// Each call is O(n): one sweep out (poses, velocities, body momenta about the base origin) and,
 /// for the gradient, one sweep in (subtree momenta h_sub): dT/dq_j = (V_j x S_j) . h_sub(j), with
 /// V_j the spatial velocity of joint j's segment and S_j its axis (derivation: docs/time-step.md).

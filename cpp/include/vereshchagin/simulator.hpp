@@ -68,6 +68,10 @@ struct RolloutRecord {
   /// Sizes t, q, q_dot for `n_steps` steps of a model with `n_joints` joints, and tau_command,
   /// friction_torque (when asked) and contact_force (3 n_contacts rows; 0: not recorded).
   void resize(int n_joints, int n_steps, bool tau_command = false, bool friction_torque = false, int n_contacts = 0);
+  /// As resize() above for `model`'s sizes: on a floating base q has nq rows, q_dot and
+  /// tau_command nv (base_kind.hpp), friction_torque n_joints.
+  void resize(const Model& model, int n_steps, bool tau_command = false, bool friction_torque = false,
+              int n_contacts = 0);
 };
 
 /// Fills the input of the next step from the state: joint positions q (rad or m), velocities
@@ -82,7 +86,10 @@ class Simulator {
  public:
   /// For `model` (copied: a Model shares its immutable data) with the time step `dt` (s, > 0 and
   /// finite), the integrator and the solver options (Data's). The state starts at rest at q = 0,
-  /// t = 0. status() reports an invalid model, invalid options or a bad dt.
+  /// t = 0 (a floating base at the world origin, unrotated: setNeutralBase()). status() reports an
+  /// invalid model, invalid options or a bad dt. On a floating base (base_kind.hpp) the state has
+  /// nq positions and nv velocities, and both integrators move the base on SE(3) (SE(2) for a
+  /// planar base): step() and stepSymplectic() of data.hpp.
   Simulator(const Model& model, double dt, Integrator integrator = Integrator::SemiImplicitEuler,
             const SolverOptions& options = SolverOptions());
 
@@ -92,12 +99,12 @@ class Simulator {
   double timeStep() const noexcept { return dt_; }                ///< dt, s
   Integrator integrator() const noexcept { return integrator_; }  ///< the integrator
 
-  /// Sets the state: q (rad or m), q_dot (rad/s or m/s), n_joints each and finite, and the time t
+  /// Sets the state: q (rad or m), q_dot (rad/s or m/s), n_joints each (nq, nv) and finite, and the time t
   /// (s, finite). Error::SizeMismatch or NonfiniteInput (the state unchanged) otherwise.
   Status setState(const JointPositions& q, const JointVelocities& q_dot, double t = 0.0);
-  const Eigen::VectorXd& q() const noexcept { return q_; }      ///< joint positions, n_joints
-  const Eigen::VectorXd& qDot() const noexcept { return qd_; }  ///< joint velocities, n_joints
-  /// Integrator::Symplectic's carried momentum (N m s or N s, n_joints): H(q) q_dot after
+  const Eigen::VectorXd& q() const noexcept { return q_; }      ///< joint positions, n_joints (nq)
+  const Eigen::VectorXd& qDot() const noexcept { return qd_; }  ///< joint velocities, n_joints (nv)
+  /// Integrator::Symplectic's carried momentum (N m s or N s, n_joints or nv): H(q) q_dot after
   /// setState(), H(q_prev) u after a step. Zeros under SemiImplicitEuler (not used).
   const Eigen::VectorXd& momentum() const noexcept { return p_; }
   /// s: the t of setState() plus dt times the steps since (a product, not a running sum).
