@@ -18,7 +18,7 @@ void PySolver::solveArgs(PyObject* const* args, double* const* next, const doubl
     py::gil_scoped_release release;
     vereshchagin::BatchWorkspace& w = *workspaces_[0];
     args_.input.fillRow(0, w.input);
-    const auto P = [&](int k) { return Eigen::Map<Eigen::VectorXd>(next[k], nj); };
+    const auto P = [&](int k) { return Eigen::Map<Eigen::VectorXd>(next[k], k ? nj : nq); };  // q_next: nq
     st = !next ? vereshchagin::solve(cpp_model_, w.data, w.input)
          : p ? vereshchagin::stepSymplectic(cpp_model_, w.data, w.input, Eigen::Map<const Eigen::VectorXd>(p, nj), P(0),
                                             P(1), P(2))
@@ -34,7 +34,8 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out, int step) {
   Lock lk(*this);
   py::object next_arrays[3];  // the step's (no arrays made for a solve)
   double* next[3] = {};
-  for (int k = 0; k < (step == 2 ? 3 : step ? 2 : 0); ++k) next[k] = doubles(next_arrays[k] = newDoubles({nj}));
+  for (int k = 0; k < (step == 2 ? 3 : step ? 2 : 0); ++k)
+    next[k] = doubles(next_arrays[k] = newDoubles({k ? nj : nq}));
   const F64View p = step == 2 ? vectorView(out ? out : Py_None, "momentum (out=)", nj) : F64View();
   solveArgs(args, step ? next : nullptr, step == 2 ? p.data : nullptr);
   const bool fr = args_.any_friction;
