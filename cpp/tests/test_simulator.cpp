@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "holding_friction.hpp"
 #include "random_chain.hpp"
 #include "vereshchagin/dynamics.hpp"
 #include "vereshchagin/simulator.hpp"
@@ -15,20 +16,6 @@ using namespace vereshchagin;
 using testutil::RandomGen;
 
 namespace {
-
-// Breakaway friction 1.2 times the gravity torques at q plus 0.05 N m, kinetic 0.8 of it.
-FrictionModel holdingFriction(const Model& model, const Eigen::VectorXd& q) {
-  const int n = static_cast<int>(model.nrOfJoints());
-  DynamicsData dyn(model);
-  Eigen::VectorXd g(n);
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  REQUIRE(inverseDynamics(model, dyn, JointPositions(q), JointVelocities(zero), JointAccelerations(zero),
-                          Matrix6X::Zero(6, model.nrOfSegments()), KDL::Vector(0, 0, -9.81), g));
-  FrictionModel fm;
-  fm.static_friction = 1.2 * g.cwiseAbs() + Eigen::VectorXd::Constant(n, 0.05);
-  fm.kinetic_friction = 0.8 * fm.static_friction;
-  return fm;
-}
 
 bool same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() && (a.array() == b.array()).all();
@@ -43,7 +30,7 @@ TEST_CASE("an arm held by friction keeps q bitwise over 10^5 steps of the Simula
   REQUIRE(sim.status());
   const Eigen::VectorXd q0 = g.q(7).data;
   REQUIRE(sim.setState(JointPositions(q0), JointVelocities(Eigen::VectorXd::Zero(7)), 2.0));
-  const FrictionModel fm = holdingFriction(model, q0);
+  const FrictionModel fm = testutil::holdingFriction(model, q0, 1.2, 0.05);
   SolveInput in(model);
   in.friction = &fm;
   bool ok = true;
@@ -61,7 +48,7 @@ TEST_CASE("a Simulator step equals step() of data.hpp bitwise and ignores the in
   Simulator sim(model, 2e-3);
   const Eigen::VectorXd q0 = g.q(6).data, qd0 = g.qdot(6).data;
   REQUIRE(sim.setState(JointPositions(q0), JointVelocities(qd0)));
-  FrictionModel fm = holdingFriction(model, q0);
+  FrictionModel fm = testutil::holdingFriction(model, q0, 1.2, 0.05);
   SolveInput in(model), ref(model);
   in.friction = ref.friction = &fm;
   in.ff_torques = ref.ff_torques = g.torques(6).data;
@@ -88,7 +75,7 @@ TEST_CASE("rollout equals repeated step() bitwise and records what it is asked")
   RandomGen g(83);
   const Model model(g.chain(7));
   const Eigen::VectorXd q0 = g.q(7).data, qd0 = 0.2 * g.qdot(7).data;
-  const FrictionModel fm = holdingFriction(model, q0);
+  const FrictionModel fm = testutil::holdingFriction(model, q0, 1.2, 0.05);
   const int n_steps = 300;
   // The controller: a PD pull towards q0 plus a sine on joint 2, written into the input.
   const Controller pd = [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t, SolveInput& in) {
@@ -176,7 +163,7 @@ TEST_CASE("the symplectic Simulator: held bitwise, equal to stepSymplectic(), mo
   RandomGen g(84);
   const Model model(g.chain(7));
   const Eigen::VectorXd q0 = g.q(7).data, v0 = g.qdot(7).data;
-  const FrictionModel fm = holdingFriction(model, q0);
+  const FrictionModel fm = testutil::holdingFriction(model, q0, 1.2, 0.05);
   SolveInput in(model);
   Simulator held(model, 1e-3, Integrator::Symplectic);
   REQUIRE(held.status());

@@ -6,30 +6,13 @@
 
 #include <cmath>
 
+#include "holding_friction.hpp"
 #include "random_chain.hpp"
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/dynamics.hpp"
 
 using namespace vereshchagin;
 using testutil::RandomGen;
-
-namespace {
-
-// Breakaway friction `factor` times the gravity torques at q (plus `extra`), kinetic 0.8 of it.
-FrictionModel holdingFriction(const Model& model, const Eigen::VectorXd& q, double factor, double extra) {
-  const int n = static_cast<int>(model.nrOfJoints());
-  DynamicsData dyn(model);
-  Eigen::VectorXd g(n);
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  REQUIRE(inverseDynamics(model, dyn, JointPositions(q), JointVelocities(zero), JointAccelerations(zero),
-                          Matrix6X::Zero(6, model.nrOfSegments()), KDL::Vector(0, 0, -9.81), g));
-  FrictionModel fm;
-  fm.static_friction = factor * g.cwiseAbs() + Eigen::VectorXd::Constant(n, extra);
-  fm.kinetic_friction = 0.8 * fm.static_friction;
-  return fm;
-}
-
-}  // namespace
 
 TEST_CASE("a chain held by friction keeps q bitwise over a million steps") {
   RandomGen g(71);
@@ -38,7 +21,7 @@ TEST_CASE("a chain held by friction keeps q bitwise over a million steps") {
   SolveInput in(model);
   in.q = g.q(4).data;
   in.q_dot.setZero();
-  const FrictionModel fm = holdingFriction(model, in.q, 1.1, 0.01);
+  const FrictionModel fm = testutil::holdingFriction(model, in.q, 1.1, 0.01);
   in.friction = &fm;
   in.time_step = 1e-3;
   const Eigen::VectorXd q0 = in.q;
@@ -61,7 +44,7 @@ TEST_CASE("a moving chain friction can stop comes to exact rest and stays") {
   Data data(model);
   SolveInput in(model);
   in.q = g.q(5).data;
-  const FrictionModel fm = holdingFriction(model, in.q, 1.5, 1.0);
+  const FrictionModel fm = testutil::holdingFriction(model, in.q, 1.5, 1.0);
   in.q_dot = Eigen::VectorXd::Constant(5, 0.05);
   in.friction = &fm;
   in.time_step = 1e-3;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "holding_friction.hpp"
 #include "random_chain.hpp"
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/dynamics.hpp"
@@ -15,20 +16,6 @@ using namespace vereshchagin;
 using testutil::RandomGen;
 
 namespace {
-
-// Breakaway friction `factor` times the gravity torques at q plus `extra`, kinetic 0.8 of it.
-FrictionModel holdingFriction(const Model& model, const Eigen::VectorXd& q, double factor, double extra) {
-  const int n = static_cast<int>(model.nrOfJoints());
-  DynamicsData dyn(model);
-  Eigen::VectorXd g(n);
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  REQUIRE(inverseDynamics(model, dyn, JointPositions(q), JointVelocities(zero), JointAccelerations(zero),
-                          Matrix6X::Zero(6, model.nrOfSegments()), KDL::Vector(0, 0, -9.81), g));
-  FrictionModel fm;
-  fm.static_friction = factor * g.cwiseAbs() + Eigen::VectorXd::Constant(n, extra);
-  fm.kinetic_friction = 0.8 * fm.static_friction;
-  return fm;
-}
 
 // Two supports with friction on the last two segments and a force set-point (its normal held by
 // the motors: one motor column) on the one before, all on horizontal surfaces.
@@ -61,7 +48,7 @@ TEST_CASE("at rest the step's least-effort split is the instant's") {
     SolveInput in(model);
     in.q = g.q(7).data;
     in.q_dot.setZero();
-    const FrictionModel fm = holdingFriction(model, in.q, 0.7, 0.3);
+    const FrictionModel fm = testutil::holdingFriction(model, in.q, 0.7, 0.3);
     in.friction = &fm;
     in.contacts = sharedLoad(ns);
     REQUIRE(solve(model, data, in));
@@ -84,7 +71,7 @@ TEST_CASE("a chain held by supports, a set-point and friction keeps q bitwise ov
   SolveInput in(model);
   in.q = g.q(7).data;
   in.q_dot.setZero();
-  const FrictionModel fm = holdingFriction(model, in.q, 1.2, 0.5);
+  const FrictionModel fm = testutil::holdingFriction(model, in.q, 1.2, 0.5);
   in.friction = &fm;
   in.contacts = sharedLoad(ns);
   in.time_step = 1e-3;
