@@ -153,11 +153,7 @@ class Simulator:
         return self._advance(solve_args)
 
     def _advance(self, args):
-        if self._base != "fixed":  # C++ step(): the solve over the step, then q (+) dt qd_next
-            result = self._solver.solve(self._q, self._qd, time_step=self._dt, **args)
-            qd = self._qd + self._dt * result.qdd
-            self._q, self._qd = self._model.integrate(self._q, self._dt * qd), qd
-        elif self._p is None:
+        if self._p is None:  # C++ step(): q (+) dt qd_next on a floating base too
             self._q, self._qd, result = self._solver._step(self._q, self._qd, time_step=self._dt, **args)
         else:
             step = self._solver._step_symplectic
