@@ -54,8 +54,7 @@ class Simulator:
         (``Tree.from_urdf(..., base='free' | 'planar')``, docs/floating-base.md) q has ``nq``
         entries and qd ``nv``, the base's first (default: the base at the world origin,
         unrotated); each step moves the base on SE(3) (SE(2)) by its LOCAL twist,
-        ``q_next = model.integrate(q, dt * qd_next)``, as ``pin.integrate``; the symplectic
-        integrator there is C++ only for now.
+        ``q_next = model.integrate(q, dt * qd_next)``, as ``pin.integrate`` (both integrators).
     t : float
         The initial time, s (default 0).
     integrator : str
@@ -96,11 +95,6 @@ class Simulator:
         self._solver = Solver(model, gravity, rcond, damping, inertia_check, max_constraints)
         self._model = self._solver.model  # the momentum H(q) qd at reset (symplectic), integrate
         self._base = getattr(self._model, "base", "fixed")
-        if self._base != "fixed" and integrator == "symplectic":
-            raise _core.SolverError(
-                "Simulator: the symplectic integrator on a floating base is not available from Python yet "
-                "(C++: stepSymplectic(), Simulator with Integrator::Symplectic); use 'semi_implicit_euler'"
-            )
         nv = self._solver.n_joints  # nv: the base's entries first on a floating base
         nq = getattr(self._model, "nq", nv)
         if q is None:  # at rest, a floating base at the world origin, unrotated
