@@ -34,12 +34,14 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     out_dir : str or Path
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
-    case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "all"}
+    case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "all"}
         ``contact``: the three use cases of W. K. Lau (2023) in MuJoCo (:mod:`vereshchagin_experiments.contact.report`);
         ``dual-arm``: one hand of a dual-arm Gen3 resting on a table while the other slides, tree
         solver against separate chains (:mod:`vereshchagin_experiments.contact.dual_arm_report`);
         ``friction-energy``: the motor effort exact static friction saves on the Gen3
         (:mod:`vereshchagin_experiments.friction_energy_report`).
+        ``mobile``: a Gen3 on a holonomic base, base locked vs base helping
+        (:mod:`vereshchagin_experiments.floating.mobile_report`).
 
     Returns
     -------
@@ -119,6 +121,10 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
         from .contact.wiping_report import run as run_wiping
 
         ok &= _section("wiping case (discrete time)", run_wiping, out, quick, index)
+    if case in ("mobile", "all"):
+        from .floating.mobile_report import run as run_mobile
+
+        ok &= _section("mobile manipulation on a holonomic base (MuJoCo plant)", run_mobile, out, quick, index)
     index_path = out / "index.md"
     index_path.write_text("\n".join(index), encoding="utf-8")
     _say(f"[reproduce] wrote {index_path}")
@@ -150,7 +156,7 @@ def main(argv=None) -> int:
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
     rep.add_argument(
         "--case",
-        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "all"),
+        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "all"),
         default="all",
         help="which experiments to run (default: all)",
     )
