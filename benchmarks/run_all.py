@@ -187,6 +187,7 @@ class Bench:
     counted: bool = True  # its exit code counts in run_all's
 
     def command(self, build: Path) -> list:
+        """The command line that runs it with its report in ``build``."""
         if self.name.endswith(".py"):
             return [sys.executable, REPO / "benchmarks" / self.name, "--out", build / self.report]
         return [build / "benchmarks" / self.name, *self.args(), build / self.report]
