@@ -26,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 import bench_pinocchio as bp
+from bench_output import publish
 import vereshchagin as vs
 from vereshchagin.task import Task, beta_for
 
@@ -155,10 +156,7 @@ def main():
     for label, n, name, t_o, t_p, err in rows:
         out.append(f"| {label} | {n} | {name} | {t_o:.2f} | {t_p:.2f} | {t_o / t_p:.2f} | {err:.1e} |")
     text = "\n".join(out) + "\n"
-    print(text)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
+    publish(text, args.out)
     sys.exit(0 if ok else 2)
 
 

@@ -59,6 +59,7 @@ from vereshchagin.robots import gen3_urdf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_pinocchio import N_STATES, paired_ratio, per_state, time_group  # noqa: E402
+from bench_output import publish  # noqa: E402
 
 TOL = 1e-10
 RTOL_CHECK = 1e-6
@@ -284,9 +285,7 @@ def main():
         "difference there is a different admissible split, not an error). Differences over the converged solves."
     )
     text = "\n".join(out) + "\n"
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text)
+    publish(text, args.out)
     return 2 if worst > 0 else 0
 
 

@@ -41,6 +41,7 @@ from vereshchagin.robots import GEN3_START_POSE
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_hold_creep import G, Models  # noqa: E402
+from bench_output import publish  # noqa: E402
 
 V0 = 0.5  # rad/s at every joint
 
@@ -175,9 +176,7 @@ def main():
             print(f"{name} dt={dt}", file=sys.stderr, flush=True)
             results[(name, dt)] = measure(arm, run, dt, args.seconds)
     text = report(results, args.seconds)
-    print(text)
-    if args.out:
-        args.out.write_text(text)
+    publish(text, args.out)
     sym = results[('ours, symplectic (`Simulator`, `integrator="symplectic"`)', 1e-3)]
     semi = results[("ours, semi-implicit (`Solver.step`)", 1e-3)]
     return 0 if sym["rel"] < 0.10 and semi["gain"] > sym["gain"] else 2

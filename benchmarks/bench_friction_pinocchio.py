@@ -49,6 +49,7 @@ from vereshchagin.robots import gen3_urdf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_pinocchio import N_STATES, paired_ratio, per_state, time_group  # noqa: E402
+from bench_output import publish  # noqa: E402
 
 TOL_TIGHT = 1e-12
 RTOL_CHECK = 1e-6  # tight ADMM vs ours, relative to max(1, |qdd|)
@@ -223,9 +224,7 @@ def main():
             f"{RTOL_CHECK:.0e}.**"
         )
     text = "\n".join(out) + "\n"
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text)
+    publish(text, args.out)
     return 0 if ok else 2
 
 

@@ -49,13 +49,13 @@ import argparse
 import statistics
 import sys
 import time
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import pinocchio as pin
 
 import vereshchagin as vs
+from bench_output import publish
 from vereshchagin.robots import gen3_urdf
 
 Q0 = np.array([0.0, 0.6, 0.0, 2.1, 0.0, 0.45, 1.57])
@@ -396,9 +396,7 @@ def main():
     text = report(models, masses, dg, results, time.perf_counter() - t_start)
     if not ok:
         text += "\n**The models disagree or our step moved (see above).**\n"
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text)
+    publish(text, args.out)
     return 0 if ok else 2
 
 

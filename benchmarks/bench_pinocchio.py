@@ -37,6 +37,7 @@ import numpy as np
 import pinocchio as pin
 
 import vereshchagin as vs
+from bench_output import publish
 
 N_STATES = 64
 TASK_SIZES = (0, 1, 6)
@@ -363,10 +364,7 @@ def main():
     for label, segs, seed in cases:
         rows += bench_case(label, segs, seed, args.batches, args.batch_ms * 1e-3)
     text, ok = report(rows, args.batches, args.batch_ms * 1e-3, time.perf_counter() - t0)
-    print(text)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
+    publish(text, args.out)
     return 0 if ok else 2
 
 

@@ -54,6 +54,7 @@ from bench_pinocchio import (
     random_segments,
     time_group,
 )
+from bench_output import publish  # noqa: E402
 
 BATCH_ROWS = 8192
 
@@ -278,10 +279,7 @@ def main():
     rows += case_rows("7 (random)", random_segments(7, 0x5EED0000 + 7), 1007, args.batches, args.batch_ms * 1e-3)
     batch_passes(rows, max(9, args.batches // 2))
     text = report(rows, args.batches, args.batch_ms * 1e-3, time.perf_counter() - t0)
-    print(text)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
+    publish(text, args.out)
     return 0
 
 

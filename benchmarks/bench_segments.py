@@ -53,6 +53,7 @@ from vereshchagin.robots import example_robot_urdf, gen3, gen3_urdf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_pinocchio import N_STATES, RTOL, UP, paired_ratio, per_state, rel_diff, time_group  # noqa: E402
+from bench_output import publish  # noqa: E402
 
 LWA = pin.LOCAL_WORLD_ALIGNED
 G = np.array([0.0, 0.0, -9.81])
@@ -299,9 +300,7 @@ def main():
         rows += r
         kept.append(k)
     text, ok = report(rows, kept, args.batches, args.batch_ms * 1e-3, time.perf_counter() - t0)
-    print(text)
-    if args.out:
-        Path(args.out).write_text(text)
+    publish(text, args.out)
     return 0 if ok else 2
 
 

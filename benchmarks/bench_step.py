@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 import vereshchagin as vs
+from bench_output import publish
 
 POSE = np.array([0.0, 0.6, 0.0, 2.1, 0.0, 0.45, 1.57])
 DT = 1e-3
@@ -143,10 +144,7 @@ def main():
         st, ro = _simulator(chain, POSE, friction, args.batches)
         lines.append(f"| {label} | {st:.2f} | {1e6 / st:.0f} | {ro:.2f} | {1e6 / ro:.0f} |")
     md = "\n".join(lines) + "\n"
-    print(md)
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as f:
-            f.write(md)
+    publish(md, args.out)
 
 
 if __name__ == "__main__":

@@ -38,6 +38,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests"))
 from bench_pinocchio import LWA, N_STATES, UP, paired_ratio, rel_diff, time_group  # noqa: E402
+from bench_output import publish  # noqa: E402
 from support.trees import pin_q, pin_v_index, random_solvable_tree  # noqa: E402  (tests/support/trees.py)
 
 G = -UP[:3]
@@ -211,10 +212,7 @@ def main():
         robot, leaves = random_robot(n, 0x7EE0000 + n)
         rows.append(bench_case(robot, leaves, 400 + n, args.batches, batch_s, cols=3))
     text = report(rows, args.batches, batch_s, time.perf_counter() - t0)
-    print(text)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
+    publish(text, args.out)
     return 2 if any(r["err"] > RTOL for r in rows) else 0
 
 

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "holding_friction.hpp"
+#include "held_chain.hpp"
 #include "random_chain.hpp"
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/dynamics.hpp"
@@ -16,37 +16,17 @@ using testutil::RandomGen;
 
 TEST_CASE("a chain held by friction keeps q bitwise over a million steps") {
   RandomGen g(71);
-  const Model model(g.chain(4));
-  Data data(model);
-  SolveInput in(model);
-  in.q = g.q(4).data;
-  in.q_dot.setZero();
-  const FrictionModel fm = testutil::holdingFriction(model, in.q, 1.1, 0.01);
-  in.friction = &fm;
+  testutil::HeldChain held(g, 4, 1.1, 0.01);
+  auto& [model, data, in, fm] = held;
   in.time_step = 1e-3;
-  const Eigen::VectorXd q0 = in.q;
-  Eigen::VectorXd q_next(4), qd_next(4);
-  bool ok = true;
-  for (int k = 0; k < 1000000 && ok; ++k) {
-    ok = static_cast<bool>(step(model, data, in, q_next, qd_next));
-    in.q = q_next;
-    in.q_dot = qd_next;
-  }
-  REQUIRE(ok);
-  CHECK((in.q.array() == q0.array()).all());
-  CHECK((in.q_dot.array() == 0.0).all());
-  for (const JointStatus s : data.jointStatus()) CHECK(s == JointStatus::Stick);
+  testutil::checkHeldOverSteps(model, data, in, 1000000);
 }
 
 TEST_CASE("a moving chain friction can stop comes to exact rest and stays") {
   RandomGen g(72);
-  const Model model(g.chain(5));
-  Data data(model);
-  SolveInput in(model);
-  in.q = g.q(5).data;
-  const FrictionModel fm = testutil::holdingFriction(model, in.q, 1.5, 1.0);
+  testutil::HeldChain held(g, 5, 1.5, 1.0);  // friction that would hold it at rest at q
+  auto& [model, data, in, fm] = held;
   in.q_dot = Eigen::VectorXd::Constant(5, 0.05);
-  in.friction = &fm;
   in.time_step = 1e-3;
   Eigen::VectorXd q_next(5), qd_next(5), q_rest(5);
   int stopped = -1;

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "holding_friction.hpp"
+#include "held_chain.hpp"
 #include "random_chain.hpp"
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/dynamics.hpp"
@@ -42,15 +42,9 @@ TEST_CASE("at rest the step's least-effort split is the instant's") {
   for (const unsigned seed : {81u, 82u, 83u, 84u}) {
     CAPTURE(seed);
     RandomGen g(seed);
-    const Model model(g.chain(7));
-    const int ns = static_cast<int>(model.nrOfSegments());
-    Data data(model);
-    SolveInput in(model);
-    in.q = g.q(7).data;
-    in.q_dot.setZero();
-    const FrictionModel fm = testutil::holdingFriction(model, in.q, 0.7, 0.3);
-    in.friction = &fm;
-    in.contacts = sharedLoad(ns);
+    testutil::HeldChain held(g, 7, 0.7, 0.3);
+    auto& [model, data, in, fm] = held;
+    in.contacts = sharedLoad(static_cast<int>(model.nrOfSegments()));
     REQUIRE(solve(model, data, in));
     const Eigen::MatrixXd f_inst = data.contactForces();
     const Eigen::VectorXd cmd_inst = data.commandTorques(), fric_inst = data.frictionTorques();
@@ -65,28 +59,11 @@ TEST_CASE("at rest the step's least-effort split is the instant's") {
 
 TEST_CASE("a chain held by supports, a set-point and friction keeps q bitwise over many steps") {
   RandomGen g(85);
-  const Model model(g.chain(7));
-  const int ns = static_cast<int>(model.nrOfSegments());
-  Data data(model);
-  SolveInput in(model);
-  in.q = g.q(7).data;
-  in.q_dot.setZero();
-  const FrictionModel fm = testutil::holdingFriction(model, in.q, 1.2, 0.5);
-  in.friction = &fm;
-  in.contacts = sharedLoad(ns);
+  testutil::HeldChain held(g, 7, 1.2, 0.5);
+  auto& [model, data, in, fm] = held;
+  in.contacts = sharedLoad(static_cast<int>(model.nrOfSegments()));
   in.time_step = 1e-3;
-  const Eigen::VectorXd q0 = in.q;
-  Eigen::VectorXd q_next(7), qd_next(7);
-  bool ok = true;
-  for (int k = 0; k < 20000 && ok; ++k) {
-    ok = static_cast<bool>(step(model, data, in, q_next, qd_next));
-    in.q = q_next;
-    in.q_dot = qd_next;
-  }
-  REQUIRE(ok);
-  CHECK((in.q.array() == q0.array()).all());
-  CHECK((in.q_dot.array() == 0.0).all());
-  for (const JointStatus s : data.jointStatus()) CHECK(s == JointStatus::Stick);
+  testutil::checkHeldOverSteps(model, data, in, 20000);
   // The set-point's normal force is the input's, its reaction the motors' least effort.
   CHECK(data.contactForces()(2, 2) == doctest::Approx(3.0).epsilon(1e-12));
 }

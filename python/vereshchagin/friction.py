@@ -64,6 +64,11 @@ def _iteration_bound(value) -> int:
     )
 
 
+# The fields of Friction in declaration order: the order of its constructor's arguments and of
+# ``_fields_of``'s.
+_FIELD_NAMES = ("static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance", "max_iterations")
+
+
 def _fields_of(static, kinetic, velocity_tolerance, lower, upper, limit_tolerance, max_iterations=None) -> tuple:
     """What a solver reads of a friction model: ``(static, kinetic, velocity_tolerance, lower,
     upper, limit_tolerance, max_iterations)``, the arrays as given (the solver checks their shapes
@@ -99,8 +104,7 @@ def _friction_fields(obj) -> tuple:
         raise SolverError(
             "friction must be None, True or a vereshchagin.Friction(static=..., kinetic=..., velocity_tolerance=...)"
         ) from None
-    names = ("kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance", "max_iterations")
-    rest = [getattr(obj, name, None) for name in names]
+    rest = [getattr(obj, name, None) for name in _FIELD_NAMES[1:]]
     return _fields_of(static, *rest)
 
 
@@ -185,36 +189,21 @@ class Friction:
         object.__setattr__(self, "lower", _frozen_vector(self.lower, "lower", allow_inf=True))
         object.__setattr__(self, "upper", _frozen_vector(self.upper, "upper", allow_inf=True))
 
+    def _values(self) -> tuple:
+        """The field values in ``_FIELD_NAMES`` order (the constructor's argument order)."""
+        return tuple(getattr(self, name) for name in _FIELD_NAMES)
+
     @cached_property
     def _fields(self) -> tuple:
         """What solvers read (``_fields_of``), cached until a field is replaced."""
-        return _fields_of(
-            self.static,
-            self.kinetic,
-            self.velocity_tolerance,
-            self.lower,
-            self.upper,
-            self.limit_tolerance,
-            self.max_iterations,
-        )
+        return _fields_of(*self._values())
 
     def __reduce__(self):
         # Rebuilt through the constructor, so copies and unpickled objects stay read-only.
-        return (
-            Friction,
-            (
-                self.static,
-                self.kinetic,
-                self.velocity_tolerance,
-                self.lower,
-                self.upper,
-                self.limit_tolerance,
-                self.max_iterations,
-            ),
-        )
+        return (Friction, self._values())
 
 
 # The fields become _Field descriptors once the dataclass has made its methods (whose defaults stay
 # those above).
-for _name in ("static", "kinetic", "velocity_tolerance", "lower", "upper", "limit_tolerance", "max_iterations"):
+for _name in _FIELD_NAMES:
     setattr(Friction, _name, _Field(_name, Friction.__dict__.get(_name, _Field)))
