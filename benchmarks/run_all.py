@@ -216,7 +216,7 @@ BENCHES = (
     Bench("bench_friction_pinocchio.py", "bench_friction_pinocchio.md"),
     Bench("bench_segments.py", "bench_segments.md"),
     Bench("bench_python_face.py", "bench_python_face.md"),
-    Bench("bench_companions.py", "bench_companions.md", counted=False),
+    Bench("bench_companions.py", "bench_companions.md"),
     Bench("bench_tree.py", "bench_tree.md"),
     Bench("bench_tree_kkt", "bench_tree_kkt.md", args=_baxter_urdf, optional=True),
     Bench("bench_contacts", "bench_contacts.md"),
