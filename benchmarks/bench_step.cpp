@@ -5,7 +5,8 @@
 // (64 steps per call, a gravity-compensating controller). 64 seeded states near a pose; static
 // friction |gravity torque| x U(0.3, 1.5) + 0.2 N m per joint (kinetic 0.8 of it) so that some
 // joints stick and some slip, dt = 1 ms. Method: bench_common.hpp (interleaved batches, medians,
-// paired ratios). Prints a markdown report (stdout, or the file given as argv[1]).
+// paired ratios). Prints a markdown report (stdout, or the file given as argv[1]); `--dump file` writes
+// step()'s results for comparing two builds, `--profile step|solve` loops one of them for perf.
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -139,6 +140,12 @@ int main(int argc, char** argv) {
   const Model model(bench::makeGen3Chain());
   bench::Rng rng(20261127);
   const std::vector<State> rest = states(model, false, rng), moving = states(model, true, rng);
+  if (argc > 2 && std::string(argv[1]) == "--profile") {  // step() on the moving states, for perf
+    Runner r{model, std::string(argv[2]) == "solve" ? kSolve : kStep};
+    for (int rep = 0; rep < 20000; ++rep)
+      for (const State& st : moving) bench::g_sink += r(st);
+    return bench::g_sink == 0.123 ? 1 : 0;
+  }
   if (argc > 2 && std::string(argv[1]) == "--dump") {
     std::vector<State> slow = states(model, true, rng);
     for (State& st : slow) st.qd *= 0.1;
