@@ -5,12 +5,14 @@
 // (64 steps per call, a gravity-compensating controller). 64 seeded states near a pose; static
 // friction |gravity torque| x U(0.3, 1.5) + 0.2 N m per joint (kinetic 0.8 of it) so that some
 // joints stick and some slip, dt = 1 ms. Method: bench_common.hpp (interleaved batches, medians,
-// paired ratios). Prints a markdown report (stdout, or the file given as argv[1]).
+// paired ratios). Prints a markdown report (stdout, or the file given as argv[1]); `--dump file` writes
+// step()'s results for comparing two builds, `--profile step|solve` loops one of them for perf.
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <string>
 
 #include "bench_common.hpp"
 #include "vereshchagin/data.hpp"
@@ -93,12 +95,62 @@ struct Runner {
   }
 };
 
+// `bench_step --dump file`: the results of step() on the bench's states (at rest, moving, moving
+// slowly so that most joints stop within the step, with a support) and along 300-step runs from
+// each moving state, every number with 17 digits, to compare two builds (a change of the step's
+// method must agree to 1e-12 where the answer is unique).
+int dump(const Model& model, const std::vector<State>& rest, const std::vector<State>& moving,
+         const std::vector<State>& slow, const char* path) {
+  std::ofstream out(path);
+  Data data(model);
+  Eigen::VectorXd q_next(7), qd_next(7);
+  const auto write = [&](const char* tag, int s, int t) {
+    out << tag << ' ' << s << ' ' << t << ' ' << data.iterations();
+    const Eigen::VectorXd* rows[] = {&qd_next, &q_next, &data.frictionTorques(), &data.commandTorques()};
+    for (const Eigen::VectorXd* v : rows)
+      for (int j = 0; j < 7; ++j) out << ' ' << bench::fmt("%.17g", (*v)(j));
+    out << '\n';
+  };
+  const char* tags[] = {"rest", "moving", "slow", "support"};
+  const std::vector<State>* sets[] = {&rest, &moving, &slow, &rest};
+  for (int c = 0; c < 4; ++c) {
+    SolveInput in(model);
+    if (c == 3) addSupport(in);
+    in.time_step = kDt;
+    for (std::size_t s = 0; s < sets[c]->size(); ++s) {
+      const State& st = (*sets[c])[s];
+      in.friction = &st.friction;
+      in.q = st.q;
+      in.q_dot = st.qd;
+      for (int t = 0; t < (c == 1 || c == 2 ? 300 : 1); ++t) {
+        const Status status = step(model, data, in, q_next, qd_next);
+        if (!status) out << "error " << status.message() << '\n';
+        write(tags[c], static_cast<int>(s), t);
+        in.q = q_next;
+        in.q_dot = qd_next;
+      }
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const Model model(bench::makeGen3Chain());
   bench::Rng rng(20261127);
   const std::vector<State> rest = states(model, false, rng), moving = states(model, true, rng);
+  if (argc > 2 && std::string(argv[1]) == "--profile") {  // step() on the moving states, for perf
+    Runner r{model, std::string(argv[2]) == "solve" ? kSolve : kStep};
+    for (int rep = 0; rep < 20000; ++rep)
+      for (const State& st : moving) bench::g_sink += r(st);
+    return bench::g_sink == 0.123 ? 1 : 0;
+  }
+  if (argc > 2 && std::string(argv[1]) == "--dump") {
+    std::vector<State> slow = states(model, true, rng);
+    for (State& st : slow) st.qd *= 0.1;
+    return dump(model, rest, moving, slow, argv[2]);
+  }
   const char* kinds[] = {"friction-aware solve (instant)", "step() (data.hpp)", "Simulator::step"};
   const char* cases[] = {"at rest", "moving", "at rest + support (mu 0.6)"};
   std::vector<std::unique_ptr<Runner>> runners;

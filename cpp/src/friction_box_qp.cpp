@@ -174,6 +174,16 @@ long FrictionCore::iterationBound(int k) const {
   return std::min(cap, exhaustive);
 }
 
+// Where boxQp's iteration count (iterations_, counted on from earlier rounds) must stop: at the
+// instant iterationBound(k); over a step one budget for all rounds of the slide guess
+// (friction_step_guess.cpp), iterationBound of the full problem's step_k_ unknowns, and with the
+// exhaustive bound each round its own.
+long FrictionCore::iterationEnd(int k) const {
+  if (step_k_ < 0) return iterationBound(k);
+  if (max_iterations_ == 0) return iterations_ + exhaustiveIterationBound(k);
+  return iterationBound(step_k_);
+}
+
 int FrictionCore::boxQp(int k) {
   auto x = x_.head(k);
   x.setZero();               // feasible: every box contains 0
@@ -185,8 +195,10 @@ int FrictionCore::boxQp(int k) {
   // gradient look like round-off and stopped at x = 0 (no friction on a slipping joint). The
   // torques matter when a task fixes the resting joints and the bounds are zero or tiny: c is
   // then round-off.
-  const double cmax = std::max(c_.head(k).cwiseAbs().maxCoeff(), qdd0_.cwiseAbs().maxCoeff());
-  const double torque_scale = std::max(tau0_.cwiseAbs().maxCoeff(), tau_cmd0_.cwiseAbs().maxCoeff());
+  const double cmax = std::max({c_.head(k).cwiseAbs().maxCoeff(), qdd0_.cwiseAbs().maxCoeff(), row_scale_});
+  // (Over a step the feed-forward alone: tau0_ also holds the guessed slides' friction.)
+  const Eigen::VectorXd& tau_ff = dt_ > 0.0 ? ff_driver_ : tau0_;
+  const double torque_scale = std::max(tau_ff.cwiseAbs().maxCoeff(), tau_cmd0_.cwiseAbs().maxCoeff());
   // Iteration bound. Between two face-optimal points each iteration binds one more variable (a
   // blocked step) or ends on the face optimum (a full step): at most k + 1 iterations. The
   // objective never increases, and it strictly decreases from one face-optimal point to the next
@@ -206,13 +218,14 @@ int FrictionCore::boxQp(int k) {
   // rounds when the whole Q is singular (a task fixes accelerations): its nearly singular faces
   // have minimisers far outside the box, and the rounds then cost more than the primal steps.
   // (The free-set factor updates of factorDelete() change how a step is computed, not which.)
-  const long max_iterations = iterationBound(k);
+  const long max_iterations = iterationEnd(k), it0 = iterations_;
+  bound_ = max_iterations;
   int rounds_left = kPrimalDualRounds;
   bool face_optimal = false, bland = false;
   double last_face_value = kInf;
   free_full_rank_ = false;
   factor_valid_ = false;
-  for (long it = 0; it < max_iterations; ++it) {
+  for (long it = it0; it < max_iterations; ++it) {
     iterations_ = static_cast<int>(std::min<long>(it + 1, 2147483647L));
     gscale_ = std::max({cmax, qscale_ * x.cwiseAbs().maxCoeff(), qscale_ * torque_scale, 1e-300});
     const double tol_g = kGradientTolerance * gscale_;
@@ -224,7 +237,7 @@ int FrictionCore::boxQp(int k) {
       const bool zero_curvature = freeStep(nf);
       // A singular full problem (a task fixes some accelerations) leaves nearly singular faces
       // whose minimisers overshoot far: primal steps only then.
-      if (it == 0 && !free_full_rank_) rounds_left = 0;
+      if (it == it0 && !free_full_rank_) rounds_left = 0;
       if (!zero_curvature && free_full_rank_ && rounds_left > 0) {
         --rounds_left;
         if (primalDualRound(k, nf, tol_g)) return ChainHdSolver::E_NOERROR;  // KKT point

@@ -90,9 +90,19 @@ class FrictionCore {
   int restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                     const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction);
   int optimiseResting(int k);
+  int restingProblem(int k);  // optimiseResting's data: base, response columns, Q_, c_, qscale_
+  void applyResting(int k);   // optimiseResting's outputs at x_: qdd_, nu_, tau_cmd_
   void frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_dot, const FrictionModel& friction, int k);
+  // Over a step, the slide guess (friction_step_guess.cpp): from hd_'s solve with every guessed
+  // slide's kinetic friction in tau0_ and the k resting joints in rest_, the rounds of refuting
+  // guesses and solving the box QP on the rest; k becomes the final number of unknowns.
+  int optimiseStep(int& k);
+  int refuteSlides();                // clears slide_ (marks 2) of each guess its end velocity refutes; how many
+  int mergeRefuted(int k);           // the refuted guesses into rest_ (joint order kept); the new k
+  int stepFallback(int& k);          // boxQp's bound hit in a round: the fallback on the full problem (its k)
   int boxQp(int k);                  // stage 1 on Q_, c_, lo_, hi_ -> x_
   long iterationBound(int k) const;  // iterations a stage on k unknowns may spend (max_iterations_)
+  long iterationEnd(int k) const;    // where boxQp's count (iterations_ on entry) stops (iterationBound)
   void boxQpFallback(int k);         // stage 1's real-time fallback at its bound (sets x_)
   void leastCommand(int k);          // stage 2: tie-break on the optimal face
   // Stage 2's solvers on the sticking set (ns joints, Q_StSt = V_ V_^T of rank r < ns), from
@@ -134,6 +144,17 @@ class FrictionCore {
   // row qdd_j + qd_j / dt (shift_ = qd / dt: the QP's c is shifted by it).
   double dt_ = 0.0;
   Eigen::VectorXd shift_;
+  // The slide guess over a step (friction_step_guess.cpp): each moving joint with friction is
+  // first taken as sliding through the step with its kinetic friction, x = xg_ = F sign(qd) (its
+  // friction torque -xg_ in tau0_); slide_ 1 while the guess stands, 2 refuted and not yet in
+  // rest_, 0 otherwise. step_k_ is the full problem's number of unknowns (every joint with
+  // friction or on a limit; -1 at the instant), row_scale_ the guess solve's largest end-velocity
+  // row (a scale for boxQp, 0 at the instant), bound_ the iteration end boxQp last used.
+  Eigen::VectorXd xg_;
+  std::vector<char> slide_;
+  int step_k_ = -1;
+  double row_scale_ = 0.0;
+  long bound_ = 0;
   Eigen::VectorXd fbound_;  // each resting joint's friction bound of the last solve (gaussValue())
   // Optimisation workspace (k <= n resting joints).
   Eigen::VectorXi rest_;                    // joint index of each resting joint

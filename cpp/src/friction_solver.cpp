@@ -160,7 +160,8 @@ FrictionCore::FrictionCore(HdCore& hd) : hd_(&hd) {
   nj_ = hd.model.nj;
   const int n = static_cast<int>(nj_);
   qdd_ = tau_cmd_ = friction_ = limit_ = tau0_ = qdd0_ = tau_cmd0_ = ff_driver_ = Eigen::VectorXd::Zero(n);
-  fbound_ = shift_ = Eigen::VectorXd::Zero(n);
+  fbound_ = shift_ = xg_ = Eigen::VectorXd::Zero(n);
+  slide_.assign(static_cast<std::size_t>(n), 0);
   status_.assign(n, Moving);
   rest_ = state_ = free_idx_ = rows_ = Eigen::VectorXi::Zero(n);
   Gc_ = Q_ = work_ = L_ = Eigen::MatrixXd::Zero(n, n);
@@ -261,22 +262,33 @@ int FrictionCore::checkFriction(const FrictionModel& friction) {
 // with friction or on a limit into rest_, with the bounds of their mu (friction torque -mu):
 // [-f, f], opened to -inf at a lower limit (the reaction pushes up) and to +inf at an upper one.
 // Over a time step every joint with friction goes into rest_ (f: kinetic while moving) and its
-// row is shifted by qd / dt (shift_). Returns their number k.
+// row is shifted by qd / dt (shift_); of those, the moving ones are first guessed sliding (slide_,
+// their kinetic friction in tau0_, not in rest_: friction_step_guess.cpp). Returns k.
 int FrictionCore::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
                                 const Eigen::Ref<const Eigen::VectorXd>& q_dot,
                                 const Eigen::Ref<const Eigen::VectorXd>& ff_torques, const FrictionModel& friction) {
   int k = 0;
+  step_k_ = dt_ > 0.0 ? 0 : -1;
+  row_scale_ = 0.0;
   for (long j = 0; j < static_cast<long>(nj_); ++j) {
     tau0_(j) = ff_driver_(j) = ff_torques.size() ? ff_torques(j) : 0.0;
     shift_(j) = dt_ > 0.0 ? q_dot(j) / dt_ : 0.0;
-    fbound_(j) = 0.0;
+    fbound_(j) = xg_(j) = 0.0;
+    slide_[static_cast<std::size_t>(j)] = 0;
     const JointFriction jf = jointFriction(friction, j, q(j), q_dot(j));
     if (jf.moving && dt_ == 0.0) {
       tau0_(j) -= jf.f * (q_dot(j) > 0.0 ? 1.0 : -1.0);
       continue;
     }
     // At rest, or over a time step (friction against the end velocity, kinetic while moving).
-    if (jf.unknown(dt_)) {
+    if (jf.unknown(dt_) && jf.moving) {  // (over a step only): the slide guess
+      ++step_k_;
+      fbound_(j) = jf.f;
+      xg_(j) = jf.f * (q_dot(j) > 0.0 ? 1.0 : -1.0);
+      tau0_(j) -= xg_(j);
+      slide_[static_cast<std::size_t>(j)] = 1;
+    } else if (jf.unknown(dt_)) {
+      step_k_ += dt_ > 0.0 ? 1 : 0;
       lo_(k) = jf.at_lower ? -kInf : -jf.f;
       hi_(k) = jf.at_upper ? kInf : jf.f;
       fbound_(j) = jf.f;
@@ -290,14 +302,35 @@ int FrictionCore::restingJoints(const Eigen::Ref<const Eigen::VectorXd>& q,
 // the box QP on Q = W G W^T, the least-command tie-break, and the outputs updated from the
 // response columns (they are affine in the friction torques: no new solve).
 int FrictionCore::optimiseResting(int k) {
+  int rc = restingProblem(k);
+  if (rc != ChainHdSolver::E_NOERROR) return rc;
+  rc = boxQp(k);
+  if (rc != ChainHdSolver::E_NOERROR) return rc;
+  tau_cmd_known_ = false;
+  if (degraded_ == 0) leastCommand(k);  // (the tie-break is for the optimal face only)
+  applyResting(k);
+  return ChainHdSolver::E_NOERROR;
+}
+
+// The box QP's data for the k joints in rest_: the base qdd0_ / nu0_ / tau_cmd0_ without their
+// friction (hd_'s solve, plus back the friction of guessed slides now in rest_), the response
+// columns Gc_ / dnu_, Q_, c_ and qscale_.
+int FrictionCore::restingProblem(int k) {
   qdd0_ = hd_->res.qdd;
   tau_cmd0_ = hd_->res.tau_cmd;
-  nu0_.head(hd_->res.m) = hd_->nu();
+  const int m = hd_->res.m;
+  nu0_.head(m) = hd_->nu();
   // d qdd and d nu per resting joint; tau_cmd follows from nu (commandTorquesOf), so its columns
   // are not formed.
   Eigen::Ref<Eigen::MatrixXd> dnu = dnu_.leftCols(k);
   int rc = hd_->responseColumns(rest_.head(k), Gc_.leftCols(k), Tc_.leftCols(0), &dnu);
   if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
+  if (dt_ > 0.0)  // (over a step) a refuted slide's guessed friction -xg_ was in hd_'s solve
+    for (int a = 0; a < k; ++a)
+      if (const double xg = xg_(rest_(a)); xg != 0.0) {
+        qdd0_ += xg * Gc_.col(a);
+        nu0_.head(m) += xg * dnu.col(a).head(m);
+      }
   for (int a = 0; a < k; ++a) {
     c_(a) = qdd0_(rest_(a)) + shift_(rest_(a));  // (over a time step: the end velocity over dt)
     for (int b = 0; b < k; ++b) Q_(a, b) = 0.5 * (Gc_(rest_(a), b) + Gc_(rest_(b), a));
@@ -308,17 +341,20 @@ int FrictionCore::optimiseResting(int k) {
   qscale_ = 0.0;
   for (int a = 0; a < k; ++a)
     qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_->ws.seg[hd_->model.joint_segment[rest_(a)]].D});
-  rc = boxQp(k);
-  if (rc != ChainHdSolver::E_NOERROR) return rc;
-  tau_cmd_known_ = false;
-  if (degraded_ == 0) leastCommand(k);  // (the tie-break is for the optimal face only)
+  for (unsigned int j = 0; j < nj_; ++j)  // (over a step) the standing guesses are unknowns too
+    if (slide_[j] == 1) qscale_ = std::max(qscale_, 1.0 / hd_->ws.seg[hd_->model.joint_segment[j]].D);
+  return ChainHdSolver::E_NOERROR;
+}
+
+// The outputs at the friction x_ of the k joints in rest_: qdd_, nu_ and (unless leastCommand
+// left it) tau_cmd_, affine from the base and the response columns.
+void FrictionCore::applyResting(int k) {
   qdd_ = qdd0_;
   qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
   const int m = hd_->res.m;
   nu_.head(m) = nu0_.head(m);
   nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);
   if (!tau_cmd_known_) (void)hd_->commandTorquesOf(nu_.head(m), tau_cmd_);  // (else kept by leastCommand)
-  return ChainHdSolver::E_NOERROR;
 }
 
 // Stage 3: friction and limit torques and the status of every joint at the optimum (k resting
@@ -341,9 +377,10 @@ void FrictionCore::frictionOutputs(const Eigen::Ref<const Eigen::VectorXd>& q_do
     }
     friction_(j) = 0.0;
     limit_(j) = 0.0;
-    if (a < k && rest_(a) == j) {
+    const bool unknown = a < k && rest_(a) == j;
+    if (unknown || slide_[static_cast<std::size_t>(j)] == 1) {  // (a standing slide guess: -xg_)
       // Friction holds what it can (up to its bound); a limit reaction takes the rest.
-      const double total = -x_(a++), f = moving ? fkj : fsj;
+      const double total = unknown ? -x_(a++) : -xg_(j), f = moving ? fkj : fsj;
       friction_(j) = std::min(f, std::max(-f, total));
       limit_(j) = total - friction_(j);
     }
@@ -370,13 +407,16 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
     rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, ff_torques);
     return failFromHd(rc);
   }
-  const int k = restingJoints(q, q_dot, ff_torques, friction);
+  int k = restingJoints(q, q_dot, ff_torques, friction);
   rc = hdSolve(q, q_dot, alfa, beta, segments, f_ext, tau0_);
   if (rc != ChainHdSolver::E_NOERROR) return failFromHd(rc);
   iterations_ = 0;
   max_iterations_ = friction.max_iterations;
   degraded_ = 0;
-  if (k > 0) {
+  if (dt_ > 0.0) {
+    rc = optimiseStep(k);
+    if (rc != ChainHdSolver::E_NOERROR) return rc;
+  } else if (k > 0) {
     rc = optimiseResting(k);
     if (rc != ChainHdSolver::E_NOERROR) return rc;
   } else {
@@ -400,7 +440,7 @@ int FrictionCore::solveImpl(const Eigen::Ref<const Eigen::VectorXd>& q, const Ei
     std::snprintf(message_.data(), message_.size(),
                   "friction: the real-time bound of %ld active-set iterations (friction.max_iterations) was hit: the "
                   "fallback friction is taken (the last iterate, scaled so that friction does no positive work)",
-                  iterationBound(k));
+                  bound_);
   else
     std::snprintf(message_.data(), message_.size(),
                   "friction: the real-time iteration bound (friction.max_iterations) was hit in the least-command "
