@@ -70,7 +70,8 @@ void WholeBodySolver::Impl::rows(const SolveInput& in) {
     JR.leftCols(p).noalias() = J6 * R.leftCols(p);
     const long cols = alfa.cols();
     E.block(row, 0, cols, p).noalias() = alfa.transpose() * JR.leftCols(p);
-    e.segment(row, cols) = beta - alfa.transpose() * x0;
+    e.segment(row, cols) = beta;
+    e.segment(row, cols).noalias() -= alfa.transpose() * x0;  // no temporary
     row += static_cast<int>(cols);
   };
   for (const ConstraintBlock& b : in.constraints) {
@@ -79,7 +80,7 @@ void WholeBodySolver::Impl::rows(const SolveInput& in) {
     const auto alfa = b.alfa.leftCols(b.columns);
     Vector6 beta = b.beta;
     if (b.classical)
-      beta.head(b.columns) =
+      beta.head(b.columns).noalias() =
           alfa.transpose() * spatialFromClassical(b.classical_acceleration, twistOf(data, f), in.gravity);
     frameRows(f, alfa, beta.head(b.columns));
   }

@@ -89,7 +89,7 @@ TEST_CASE("a free-flyer holds its base still through its joints alone") {
   checkReplay(m, in, r);
 }
 
-TEST_CASE("unactuated joints get no torque; supports and a task on a fixed tree replay") {
+TEST_CASE("unactuated joints get no torque, supports and a task on a fixed tree replay") {
   const vereshchagin::Model m = model(BaseKind::Fixed, 8);
   REQUIRE(m.status());
   vereshchagin::SolveInput in(m);
