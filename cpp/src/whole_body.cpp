@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdarg>
 
+#include "vereshchagin/momentum.hpp"
 #include "whole_body_impl.hpp"
 
 namespace vereshchagin {
@@ -37,6 +38,14 @@ WholeBodySolver::Impl::Impl(const Model& mdl, const WholeBodyOptions& opt)
   g.resize(9 * kmax);
   lqp_p = pmax, lqp_k = 9 * kmax;
   lqp.reserve(lqp_p, lqp_k);
+  if (mdl.baseKind() == BaseKind::FreeFlyer && mdl.status()) {  // M from p = M c_dot for a unit base velocity
+    DynamicsData dd(mdl);
+    Eigen::VectorXd q0 = Eigen::VectorXd::Zero(mdl.nq()), v0 = Eigen::VectorXd::Zero(nv);
+    q0(6) = 1.0;
+    v0(0) = 1.0;
+    Vector6 h;
+    if (centroidalMomentum(mdl, dd, JointPositions(q0), JointVelocities(v0), h)) mass = h(0);
+  }
 }
 
 Status WholeBodySolver::Impl::fail(Error code, const char* format, ...) {
@@ -72,7 +81,10 @@ Status checkInput(WholeBodySolver::Impl& s, const SolveInput& in, const Eigen::R
   const int ns = static_cast<int>(s.model->nrOfSegments());
   int rows = 0;
   for (const ConstraintBlock& b : in.constraints) {
-    if (b.segment < -1 || b.segment >= ns || b.columns < 0 || b.columns > 6)
+    if (b.segment == kCenterOfMass && !(s.mass > 0.0 && b.alfa.bottomRows<3>().leftCols(b.columns).isZero(0.0)))
+      return s.fail(Error::OutOfRange,
+                    "a centre-of-mass task needs a free-flyer base with mass and alfa's moment rows zero");
+    if (b.segment < kCenterOfMass || b.segment >= ns || b.columns < 0 || b.columns > 6)
       return s.fail(Error::OutOfRange, "a task block's segment %d (or its %d columns) is out of range", b.segment,
                     b.columns);
     rows += b.columns;

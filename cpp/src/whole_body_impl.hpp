@@ -21,6 +21,7 @@ struct WholeBodySolver::Impl {
   // whole_body_rows.cpp: R (nv x p) from the free solve, then E (m x p) and e (m).
   Status columns(const SolveInput& input);
   void rows(const SolveInput& input);
+  void comRows(const SolveInput& input, const ConstraintBlock& block, int& row);
   // whole_body_qp.cpp: x (p) from E x = e, the cones and the objective; false with message_ set.
   bool eliminate();
   bool program(const SolveInput& input);
@@ -32,6 +33,7 @@ struct WholeBodySolver::Impl {
   Data data;
   SolveInput free;  // the input without task and supports: qdd0 and the response columns
   int nv = 0, nj = 0, nb = 0;
+  double mass = 0.0;  // the robot's total mass (a free-flyer's: centre-of-mass tasks), kg
   int na = 0, k = 0, mt = 0, p = 0, m = 0, rank = 0, cone_rows = 0;
   Eigen::VectorXi joints;   // the actuated joints (na)
   Eigen::MatrixXd R, dtau;  // nv x p: qdd per unknown; scratch for responseColumns

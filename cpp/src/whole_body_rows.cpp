@@ -76,6 +76,10 @@ void WholeBodySolver::Impl::rows(const SolveInput& in) {
   };
   for (const ConstraintBlock& b : in.constraints) {
     if (b.columns == 0) continue;
+    if (b.segment == kCenterOfMass) {
+      comRows(in, b, row);
+      continue;
+    }
     const FrameRef f{b.segment, KDL::Frame(KDL::Vector(b.point(0), b.point(1), b.point(2)))};
     const auto alfa = b.alfa.leftCols(b.columns);
     Vector6 beta = b.beta;
@@ -91,6 +95,29 @@ void WholeBodySolver::Impl::rows(const SolveInput& in) {
     const Vector3 beta = spatialFromClassical(Vector6::Zero(), twistOf(data, f), in.gravity).head<3>();
     frameRows(f, lin, beta);
   }
+}
+
+// A centre-of-mass block on a free-flyer: alfa_f^T (c_ddot - gravity) = beta with
+// M (c_ddot - gravity) = F (the external forces, world axes) + sum_c lambda_c.
+void WholeBodySolver::Impl::comRows(const SolveInput& in, const ConstraintBlock& b, int& row) {
+  Vector3 force = in.f_ext.topRows<3>().rowwise().sum();
+  for (const FrameWrench& w : in.wrenches) force += w.wrench.head<3>();
+  const KDL::Rotation Rb = data.framePose(FrameRef{-1, KDL::Frame::Identity()}).M;
+  const KDL::Vector fb = Rb * KDL::Vector(in.ff_torques(0), in.ff_torques(1), in.ff_torques(2));
+  force += toVector3(fb);
+  const auto alfa = b.alfa.topRows<3>().leftCols(b.columns);
+  const int cols = b.columns;
+  for (int c = 0; c < cols; ++c) {
+    double beta = b.beta(c);
+    if (b.classical) {
+      const Vector3 g = toVector3(in.gravity);
+      beta = alfa.col(c).dot(b.classical_acceleration.head<3>() - g);
+    }
+    E.row(row + c).head(p).setZero();
+    for (int k3 = 0; k3 < k; ++k3) E.block(row + c, na + 3 * k3, 1, 3) = alfa.col(c).transpose() / mass;
+    e(row + c) = beta - alfa.col(c).dot(force) / mass;
+  }
+  row += cols;
 }
 
 }  // namespace vereshchagin

@@ -47,12 +47,20 @@ class WholeBodyResult:
     residual: float
 
 
+COM = "<centre of mass>"
+"""The key of a centre-of-mass task in ``task`` (a free-flyer only): ``alpha`` (6, m) with zero
+moment rows, against ``[c_ddot - gravity; 0]`` (world axes), so ``beta = alpha[:3].T @ (c_ddot -
+gravity)`` for a desired centre-of-mass acceleration ``c_ddot``."""
+
+
 def _frame(model: Any, key: Any, point: Any) -> tuple[int, np.ndarray]:
     """(segment index, the point in that segment's tip frame) for a segment or merged link name
     or index (None: the base, its own frame)."""
     point = np.zeros(3) if point is None else np.asarray(point, dtype=float).reshape(3)
     if key is None:
         return -1, point
+    if isinstance(key, str) and key == COM:
+        return -2, point
     try:
         index = int(model.segment_index(key))
         if isinstance(key, str):  # a merged link: its pose in the tip frame (constant)
@@ -110,7 +118,8 @@ def least_effort(
         ``{segment: (alpha, beta)}`` or ``{segment: (alpha, beta, point)}``: ``alpha`` (6, m) unit
         constraint wrenches (base axes, moment about ``point``, a point in the named segment's or
         link's frame, default its origin), ``beta`` (m,) as in :meth:`Solver.solve` (spatial
-        acceleration, ``-gravity`` included). ``None`` as the segment: the base body.
+        acceleration, ``-gravity`` included). ``None`` as the segment: the base body;
+        :data:`COM`: the centre of mass (a free-flyer only).
     supports : sequence of vereshchagin.Contact
         Points that stick (zero classical acceleration), their forces in the friction cones.
         Segments by name (a merged link's frame too) or index (the segment's tip frame).

@@ -128,9 +128,11 @@ class Standing:
         return M, h, np.vstack(J), np.concatenate(drift)
 
 
-def oracle(M, h, J, drift, D, n_base=6):
-    """min |tau|^2, then min |lambda|^2, over (qdd, tau, lambda): SLSQP, then the exact KKT polish."""
+def oracle(M, h, J, drift, D, n_base=6, task=None):
+    """min |tau|^2, then min |lambda|^2, over (qdd, tau, lambda): SLSQP, then the exact KKT polish.
+    task: rows (T, t) with T qdd = t (default: the base still, qdd_base = 0)."""
     nv, k3 = M.shape[0], J.shape[0]
+    T, t = task if task is not None else (np.eye(n_base, nv), np.zeros(n_base))
     na = nv - n_base
     S = np.vstack([np.zeros((n_base, na)), np.eye(na)])
     # Equalities A z = b, z = (qdd, tau, lambda).
@@ -138,10 +140,10 @@ def oracle(M, h, J, drift, D, n_base=6):
         [
             [M, -S, -J.T],
             [J, np.zeros((k3, na)), np.zeros((k3, k3))],
-            [np.eye(n_base, nv), np.zeros((n_base, na + k3))],
+            [T, np.zeros((T.shape[0], na + k3))],
         ]
     )
-    b = np.r_[-h, -drift, np.zeros(n_base)]
+    b = np.r_[-h, -drift, t]
     G = np.hstack([np.zeros((D.shape[0], nv + na)), D])
     sl_t, sl_l = slice(nv, nv + na), slice(nv + na, None)
     z0 = np.linalg.lstsq(A, b, rcond=None)[0]
@@ -255,6 +257,26 @@ def test_talos_standing_and_hand_load(facets):
     st, q = talos_standing()
     check_against_oracle(st, q, 0.7, facets)
     check_against_oracle(st, q, 0.7, facets, wrenches={"arm_left_7_joint": np.array([0.0, 0.0, -30.0, 0.0, 0.0, 0.0])})
+
+
+def test_solo12_centre_of_mass_task():
+    """The centre of mass accelerated (0.3, -0.2, 0.1) m/s^2 with the base's orientation still."""
+    st, q = solo_standing()
+    c_ddot = np.array([0.3, -0.2, 0.1])
+    task = {vs.whole_body.COM: (np.eye(6, 3), c_ddot - GRAVITY), None: (np.eye(6)[:, 3:], np.zeros(3))}
+    supports = st.supports(0.7, 8)
+    ours = vs.whole_body.least_effort(st.solver, q, np.zeros(st.tree.nv), task=task, supports=supports)
+    _, pin_fext = st.fext(q, {})
+    M, h, J, drift = st.pieces(q, np.zeros(6), pin_fext)
+    Jcom = pin.jacobianCenterOfMass(st.model, st.data, st.pin_q(q))
+    T = np.vstack([Jcom, np.eye(6, st.model.nv, 3)[:3]])
+    D = np.kron(np.eye(len(st.points)), cone_rows([0, 0, 1], 0.7, 8))
+    qdd, tau, lam = oracle(M, h, J, drift, D, task=(T, np.r_[c_ddot, np.zeros(3)]))
+    assert_rel(st.pin_v(ours.tau), np.r_[np.zeros(6), tau], "tau")
+    assert_rel(ours.contact_force, lam, "contact forces")
+    assert_rel(st.pin_v(ours.qdd), qdd, "qdd")
+    pin.centerOfMass(st.model, st.data, st.pin_q(q), np.zeros(st.model.nv), st.pin_v(ours.qdd))
+    assert_rel(st.data.acom[0], c_ddot, "centre-of-mass acceleration")
 
 
 def test_not_realizable_solo12_on_one_foot():

@@ -16,7 +16,12 @@
 ///   - every task row holds: alfa^T Xdd = beta for each column of each SolveInput::constraints block
 ///     (the same meaning as in solve(), hd_solver.hpp; `classical` blocks too), and a block on
 ///     segment -1 constrains the base body itself (a floating base's frame, `point` in base axes):
-///     "base still" is alfa = I (6 x 6) on segment -1 with beta = [-gravity; 0] at rest;
+///     "base still" is alfa = I (6 x 6) on segment -1 with beta = [-gravity; 0] at rest; a block on
+///     segment kCenterOfMass (free-flyer only) constrains the centre of mass: alfa's force rows
+///     (its moment rows must be zero) against [c_ddot - gravity; 0] (world axes, `point` unused;
+///     `classical`: classical_acceleration's first 3 entries are c_ddot). On a free-flyer
+///     M c_ddot = M gravity + the external forces (f_ext, wrenches, the base rows of ff_torques,
+///     the supports): the joints' torques do not move it;
 ///   - each force lies in its contact's friction cone: n.f >= 0 and the polygon of `facets`
 ///     vertices of docs/contacts.md, written as its facets: mu cos(pi/k) n.f - m_j.f >= 0, m_j the
 ///     unit outward normal of facet j (at angle (2 j + 1) pi / k from t1).
@@ -46,6 +51,9 @@
 #include "vereshchagin/status.hpp"
 
 namespace vereshchagin {
+
+/// ConstraintBlock::segment of a centre-of-mass task row block (see the top of this file).
+constexpr int kCenterOfMass = -2;
 
 /// Capacities and tolerance of a WholeBodySolver.
 struct WholeBodyOptions {
@@ -96,7 +104,8 @@ class WholeBodySolver {
 /// as n x 1): q (nq), qd (nv), f_ext (6 x n_segments, as SolveInput::f_ext), ff_torques (nv),
 /// gravity (3), actuated (n_joints, non-zero: a motor; or 0 entries: every joint), supports
 /// (k x 9 rows: segment, point (3, tip frame, m), normal (3, base axes), mu, facets), task blocks
-/// (b x 4 rows: segment (-1: the base), point (3, tip frame)), then per block its alfa (6 x m) and
+/// (b x 4 rows: segment (-1: the base, -2: the centre of mass), point (3, tip frame)), then per
+/// block its alfa (6 x m) and
 /// beta (m). Returns (status code, message, tau (nv), forces (3 x k), qdd (nv), effort, residual);
 /// the arrays are empty unless the code is Error::None. Builds a WholeBodySolver per call.
 std::tuple<int, std::string, Eigen::VectorXd, Eigen::MatrixXd, Eigen::VectorXd, double, double> wholeBodyArrays(
