@@ -11,7 +11,9 @@ classical accelerations of the contact points):
 
 solved by scipy's SLSQP (min |tau|^2, then min |lambda|^2 with that tau), then polished exactly:
 its active cone rows and the equalities as a KKT system (numpy least squares; the multipliers of
-the active rows checked non-negative). Also: our answer's dynamics residual in Pinocchio, a task
+the active rows checked non-negative). Also: a centre-of-mass acceleration task (through
+``pin.jacobianCenterOfMass``), solo12 with its hip abduction joints unactuated (the mask), our
+answer's dynamics residual in Pinocchio, a task
 that no support forces realize (solo12 on one foot, every other foot and the base held still), a
 cone too narrow, and a fixed-base Gen3 whose 7 task rows determine qdd: tau equals the plain
 solve's tau_command.
@@ -128,13 +130,15 @@ class Standing:
         return M, h, np.vstack(J), np.concatenate(drift)
 
 
-def oracle(M, h, J, drift, D, n_base=6, task=None):
+def oracle(M, h, J, drift, D, n_base=6, task=None, actuated=None):
     """min |tau|^2, then min |lambda|^2, over (qdd, tau, lambda): SLSQP, then the exact KKT polish.
-    task: rows (T, t) with T qdd = t (default: the base still, qdd_base = 0)."""
+    task: rows (T, t) with T qdd = t (default: the base still, qdd_base = 0); actuated: the
+    velocity indices with a motor (default: every joint)."""
     nv, k3 = M.shape[0], J.shape[0]
     T, t = task if task is not None else (np.eye(n_base, nv), np.zeros(n_base))
-    na = nv - n_base
-    S = np.vstack([np.zeros((n_base, na)), np.eye(na)])
+    actuated = np.arange(n_base, nv) if actuated is None else np.asarray(actuated)
+    na = actuated.size
+    S = np.eye(nv)[:, actuated]
     # Equalities A z = b, z = (qdd, tau, lambda).
     A = np.block(
         [
@@ -277,6 +281,26 @@ def test_solo12_centre_of_mass_task():
     assert_rel(st.pin_v(ours.qdd), qdd, "qdd")
     pin.centerOfMass(st.model, st.data, st.pin_q(q), np.zeros(st.model.nv), st.pin_v(ours.qdd))
     assert_rel(st.data.acom[0], c_ddot, "centre-of-mass acceleration")
+
+
+def test_solo12_with_unactuated_hips():
+    """The four HAA joints without motors (the mask): their torque is zero, the rest as the QP."""
+    st, q = solo_standing()
+    actuated = np.array(["HAA" not in n for n in st.tree.joint_names])
+    ours = vs.whole_body.least_effort(
+        st.solver, q, np.zeros(st.tree.nv), task={None: BASE_STILL}, supports=st.supports(), actuated=actuated
+    )
+    _, pin_fext = st.fext(q, {})
+    M, h, J, drift = st.pieces(q, np.zeros(6), pin_fext)
+    D = np.kron(np.eye(len(st.points)), cone_rows([0, 0, 1], 0.7, 4))
+    motors = st.v_index[6:][actuated]  # Pinocchio's velocity indices of the actuated joints
+    qdd, tau, lam = oracle(M, h, J, drift, D, actuated=np.sort(motors))
+    expected = np.zeros(st.model.nv)
+    expected[np.sort(motors)] = tau
+    assert np.all(ours.tau[6:][~actuated] == 0.0)
+    assert_rel(st.pin_v(ours.tau), expected, "tau")
+    assert_rel(ours.contact_force, lam, "contact forces")
+    assert_rel(st.pin_v(ours.qdd), qdd, "qdd")
 
 
 def test_not_realizable_solo12_on_one_foot():
