@@ -5,11 +5,11 @@
 #pragma once
 
 #include <atomic>
-#include <memory>
 #include <mutex>
 #include <thread>
 
 #include "vereshchagin/batch_args.hpp"  // also <string>, <vector>
+#include "vereshchagin/whole_body.hpp"  // also <memory>
 
 #include "common.hpp"
 #include "model_class.hpp"

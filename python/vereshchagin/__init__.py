@@ -8,7 +8,7 @@ feed-forward torques. Conventions (frames, signs, units) are those of Orocos KDL
 """
 
 from ._core import Chain, Joint, SolveResult, SolverError, Tree
-from . import _models, _results, robots, task  # noqa: F401 (_models, _results: members in Python)
+from . import _models, _results, robots, task, whole_body  # noqa: F401 (_models, _results: members in Python)
 from ._version import __version__ as __version__  # written once: CMakeLists.txt
 from .contacts import Contact, ContactOutcome, ContactStatus
 from .friction import Friction

@@ -283,6 +283,9 @@ class Solver:
     def response_columns(
         self, joints: Sequence[int], hold_sticking: bool = True
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+    def _whole_body(
+        self, arg0: Sequence[ArrayLike]
+    ) -> tuple[int, str, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float, float]: ...
     @property
     def model(self) -> Union[Chain, Tree]: ...
     @property
