@@ -34,14 +34,15 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
     out_dir : str or Path
     quick : bool
         Coarser sampling of the friction figures (the optimum is exact either way).
-    case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "all"}
+    case : {"friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "quadruped", "all"}
         ``contact``: the three use cases of W. K. Lau (2023) in MuJoCo (:mod:`vereshchagin_experiments.contact.report`);
         ``dual-arm``: one hand of a dual-arm Gen3 resting on a table while the other slides, tree
         solver against separate chains (:mod:`vereshchagin_experiments.contact.dual_arm_report`);
         ``friction-energy``: the motor effort exact static friction saves on the Gen3
         (:mod:`vereshchagin_experiments.friction_energy_report`).
         ``mobile``: a Gen3 on a holonomic base, base locked vs base helping
-        (:mod:`vereshchagin_experiments.floating.mobile_report`).
+        (:mod:`vereshchagin_experiments.floating.mobile_report`); ``quadruped``: Solo 12 shifting
+        its weight under whole-body least effort (:mod:`vereshchagin_experiments.floating.quadruped_report`).
 
     Returns
     -------
@@ -125,6 +126,10 @@ def reproduce(out_dir, quick: bool = False, case: str = "all") -> int:
         from .floating.mobile_report import run as run_mobile
 
         ok &= _section("mobile manipulation on a holonomic base (MuJoCo plant)", run_mobile, out, quick, index)
+    if case in ("quadruped", "all"):
+        from .floating.quadruped_report import run as run_quadruped
+
+        ok &= _section("standing quadruped shifting its weight (MuJoCo plant)", run_quadruped, out, quick, index)
     index_path = out / "index.md"
     index_path.write_text("\n".join(index), encoding="utf-8")
     _say(f"[reproduce] wrote {index_path}")
@@ -156,7 +161,7 @@ def main(argv=None) -> int:
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
     rep.add_argument(
         "--case",
-        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "all"),
+        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "quadruped", "all"),
         default="all",
         help="which experiments to run (default: all)",
     )
