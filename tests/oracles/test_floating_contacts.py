@@ -372,3 +372,26 @@ def test_step_joint_friction_and_feet_against_the_enumeration(seed):
     best = min(found, key=lambda sol: _rel(r.qdd, c.ours(sol.qdd)))
     assert _rel(qd + dt * r.qdd, qd + dt * c.ours(best.qdd)) <= RTOL
     assert _rel(r.friction_torque, c.ours(best.joint_torques)) <= RTOL
+
+
+def test_response_columns_hold_the_sticking_joints_on_a_floating_base():
+    """After a solve with joint friction alone, response_columns holds the sticking joints: the
+    inverse of Pinocchio's mass matrix with those joints locked (Schur form), the base free."""
+    rng = np.random.default_rng(21)
+    c = case("solo12")
+    n = c.tree.n_joints
+    q, qd = c.random_state(rng)
+    qd[6:] = 0.0
+    fs = np.full(n, 50.0)  # every joint sticks
+    r = c.solver.solve(q, qd, friction=vs.Friction(static=fs))
+    stick = np.flatnonzero(r.status[6:] == 1)
+    assert len(stick) == n
+    held, _ = c.solver.response_columns(range(n))
+    free, _ = c.solver.response_columns(range(n), hold_sticking=False)
+    H = pin.crba(c.model, c.data, c.pin_q(q))
+    H = np.triu(H) + np.triu(H, 1).T
+    Minv = np.linalg.inv(H)[np.ix_(c.v_index, c.v_index)]  # our order
+    E = np.eye(c.tree.nv)[6 + stick]
+    expected = Minv - Minv @ E.T @ np.linalg.solve(E @ Minv @ E.T, E @ Minv)
+    assert _rel(held, expected[:, 6:]) <= 1e-8 * max(1.0, np.abs(Minv).max())
+    assert _rel(free, Minv[:, 6:]) <= 1e-8 * max(1.0, np.abs(Minv).max())
