@@ -395,3 +395,24 @@ def test_response_columns_hold_the_sticking_joints_on_a_floating_base():
     expected = Minv - Minv @ E.T @ np.linalg.solve(E @ Minv @ E.T, E @ Minv)
     assert _rel(held, expected[:, 6:]) <= 1e-8 * max(1.0, np.abs(Minv).max())
     assert _rel(free, Minv[:, 6:]) <= 1e-8 * max(1.0, np.abs(Minv).max())
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_gen3_on_a_planar_base_sticking_tip_is_constraint_dynamics(seed):
+    """A planar base (x, y, yaw): the tool tip held at rest (normal along Pinocchio's force)."""
+    rng = np.random.default_rng(900 + seed)
+    c = case("gen3_planar")
+    tip = c.tree.segment_names[-1]
+    specs = [(tip, np.array([0.0, 0.0, 0.05]))]
+    q, _ = c.random_state(rng)
+    pq = c.pin_q(q)
+    qd = _held_velocity(c, pq, specs, rng)
+    tau = np.r_[np.zeros(3), rng.normal(size=c.tree.n_joints)]
+    qdd_pin, f_pin = _pin_rigid(c, pq, c.pin_v(qd), c.pin_v(tau), specs)
+    contact = vs.Contact(
+        c.tree.segment_names.index(tip), point=specs[0][1], normal=f_pin[0] / np.linalg.norm(f_pin[0]), mu=0.5
+    )
+    r = c.solver.solve(q, qd, tau_ff=tau, contacts=[contact])
+    assert _rel(r.qdd, c.ours(qdd_pin)) <= RTOL
+    assert _rel(r.contact_force, f_pin) <= RTOL
+    assert r.contact_status[0] == vs.ContactStatus.STICKING
