@@ -93,9 +93,14 @@ bool BatchOutput::write(std::ptrdiff_t b, const Data& d, int columns, bool with_
     iterations[b] = -1;
     return true;
   }
-  std::copy_n(d.frictionTorques().data(), n, friction_torque + b * n);
-  std::copy_n(d.limitTorques().data(), n, limit_torque + b * n);
-  for (std::ptrdiff_t j = 0; j < n; ++j) status[b * n + j] = static_cast<int>(d.jointStatus()[j]);
+  // A floating base's rows first (nv rows, the joints' n after them): no friction, no limit there.
+  const std::ptrdiff_t nb = n - static_cast<std::ptrdiff_t>(d.jointStatus().size());
+  std::fill_n(friction_torque + b * n, nb, 0.0);
+  std::fill_n(limit_torque + b * n, nb, 0.0);
+  std::fill_n(status + b * n, nb, static_cast<int>(JointStatus::Moving));
+  std::copy_n(d.frictionTorques().data(), n - nb, friction_torque + b * n + nb);
+  std::copy_n(d.limitTorques().data(), n - nb, limit_torque + b * n + nb);
+  for (std::ptrdiff_t j = nb; j < n; ++j) status[b * n + j] = static_cast<int>(d.jointStatus()[j - nb]);
   gauss_value[b] = d.gaussValue();
   iterations[b] = d.iterations();
   return std::isfinite(gauss_value[b]);

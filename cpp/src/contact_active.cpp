@@ -31,7 +31,7 @@ namespace detail {
 // separating), then a resting point's two tangents (with friction); their unit forces, wrenches
 // about the segment's tip origin, acceleration rows J^T e and a0 (base solve's accelerations).
 int ContactStage::heldDirections(DataImpl& d, const SolveInput& in) {
-  const int n = static_cast<int>(model_.nrOfJoints());
+  const int n = nv_;
   int h = 0;
   for (std::size_t k = 0; k < points_.size(); ++k) {
     const Point& p = points_[k];
@@ -60,7 +60,7 @@ int ContactStage::heldDirections(DataImpl& d, const SolveInput& in) {
 // The directions' response (dqdd, dnu, the motors' torques per unit force) and Delassus matrix.
 int ContactStage::heldResponse(DataImpl& d, int h) {
   HdCore& c = d.core;
-  const int n = static_cast<int>(model_.nrOfJoints()), m = c.res.m;
+  const int n = nv_, m = c.res.m;
   auto dqdd = act_dqdd_.topLeftCorner(n, h);
   auto T = act_cmd_.topLeftCorner(n, h);
   if (m > 0) {
@@ -271,7 +271,7 @@ int ContactStage::activeRows(const SolveInput& in, int k, int dn) {
 // rule): min 1/2 ||tau0 + C y||^2 with tau0 the motors' torques at x and C = T N, then
 // min 1/2 ||x + N y||^2 among its minimisers (LexicographicQp).
 int ContactStage::redundantGuess(DataImpl& d, const SolveInput& in, int k, int dn) {
-  const int n = static_cast<int>(model_.nrOfJoints());
+  const int n = nv_;
   const auto N = act_null_.topLeftCorner(k, dn);
   auto x = act_x_.head(k);
   auto tau0 = act_tau_.head(n);
@@ -300,7 +300,7 @@ int ContactStage::redundantGuess(DataImpl& d, const SolveInput& in, int k, int d
 }
 
 void ContactStage::reserveActive(int directions, int rows) {
-  const int n = static_cast<int>(model_.nrOfJoints()), h = std::max(directions, 1);
+  const int n = nv_, h = std::max(directions, 1);
   if (act_del_.rows() < h) {
     act_seg_.resize(h), act_idx_.resize(h), act_piv_.resize(h);
     act_dirs_.resize(3, h), act_wrench_.resize(6, h);

@@ -90,11 +90,11 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
   eff_contacts_ = p;
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     const JointUnknown& u = joints_[i];
-    if (std::abs(qdd(u.joint) + u.row_bias) > a_tol) continue;
+    if (std::abs(qdd(nbv_ + u.joint) + u.row_bias) > a_tol) continue;
     eff_dir_.col(p).setZero();
     eff_contact_(p) = -1 - static_cast<int>(i);
     eff_joint_(p - eff_contacts_) = u.joint;
-    eff_x_(p) = joint_tau_(u.joint);
+    eff_x_(p) = joint_tau_(nbv_ + u.joint);
     const int x = p++;
     if (std::isfinite(u.lo)) eff_rows_(addRow(u.lo), x) = 1.0;    // tau >= lo
     if (std::isfinite(u.hi)) eff_rows_(addRow(-u.hi), x) = -1.0;  // tau <= hi
@@ -105,7 +105,7 @@ int ContactStage::effortCoordinates(const SolveInput& in, const Eigen::VectorXd&
 
 int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   HdCore& c = d.core;
-  const int n = static_cast<int>(model_.nrOfJoints()), m = c.res.m;
+  const int n = nv_, m = c.res.m;
   const int nj = static_cast<int>(joints_.size());
   int k_max = 2 * nj;
   for (const PointContact& pc : in.contacts) k_max += 1 + pc.facets;
@@ -166,7 +166,7 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
     const double fn = points_[ci].n.dot(forces.col(ci));
     if (in.contacts[ci].isSupport() && fn < 0.0) forces.col(ci) -= fn * points_[ci].n;
   }
-  for (int i = pc; i < p; ++i) joint_tau_(eff_joint_(i - pc)) = eff_x_(i);
+  for (int i = pc; i < p; ++i) joint_tau_(nbv_ + eff_joint_(i - pc)) = eff_x_(i);
   if (const int rc = solveWithForces(d, in)) return rc;
   for (int i = 0; i < pc; ++i) {  // the supports' statuses with their new forces
     const int ci = eff_contact_(i);
@@ -180,7 +180,7 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
 }
 
 void ContactStage::reserveEffort(int p, int k, int m) {
-  const int n = static_cast<int>(model_.nrOfJoints());
+  const int n = nv_;
   if (eff_dir_.cols() < p) {
     eff_dir_.resize(3, p);
     eff_contact_.resize(p), eff_x_.resize(p), eff_seg_.resize(p), eff_c_.resize(p), eff_dx_.resize(p);

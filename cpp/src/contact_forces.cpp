@@ -32,7 +32,7 @@ constexpr int E_NO_SOLUTION = static_cast<int>(Error::NoContactSolution);
 
 // The unknowns' force directions as wrench columns, their response, and the acceleration rows.
 void ContactStage::prepareColumns(DataImpl& d, const SolveInput& in) {
-  const int n = static_cast<int>(model_.nrOfJoints());
+  const int n = nv_;
   for (std::size_t k = 0; k < points_.size(); ++k) {
     const Point& p = points_[k];
     const PointContact& pc = in.contacts[k];

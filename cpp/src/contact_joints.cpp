@@ -37,12 +37,17 @@ int ContactStage::checkJointFriction(DataImpl& d, const SolveInput& in) {
 void ContactStage::classifyJoints(const SolveInput& in) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   joints_.clear();
+  for (int v = 0; v < nbv_; ++v) {  // a floating base: no friction, no limit, no motor
+    ff_user_(v) = in.ff_torques.size() ? in.ff_torques(v) : 0.0;
+    joint_tau_(v) = 0.0;
+  }
   for (int j = 0; j < static_cast<int>(model_.nrOfJoints()); ++j) {
-    ff_user_(j) = in.ff_torques.size() ? in.ff_torques(j) : 0.0;
-    joint_tau_(j) = 0.0;
-    const JointFriction jf = jointFriction(*in.friction, j, in.q(j), in.q_dot(j));
+    const int v = nbv_ + j;  // joint j's entry of q_dot, qdd and the torques
+    ff_user_(v) = in.ff_torques.size() ? in.ff_torques(v) : 0.0;
+    joint_tau_(v) = 0.0;
+    const JointFriction jf = jointFriction(*in.friction, j, in.q(nbq_ + j), in.q_dot(v));
     if (jf.moving && dt_ == 0.0) {  // at the instant: kinetic friction against the velocity
-      joint_tau_(j) = -jf.f * (in.q_dot(j) > 0.0 ? 1.0 : -1.0);
+      joint_tau_(v) = -jf.f * (in.q_dot(v) > 0.0 ? 1.0 : -1.0);
       continue;
     }
     // At rest, or over a time step (friction against the end velocity, kinetic while moving).
@@ -52,7 +57,7 @@ void ContactStage::classifyJoints(const SolveInput& in) {
     u.f = jf.f;
     u.lo = jf.at_upper ? -inf : -jf.f;
     u.hi = jf.at_lower ? inf : jf.f;
-    u.row_bias = dt_ > 0.0 ? in.q_dot(j) / dt_ : 0.0;
+    u.row_bias = dt_ > 0.0 ? in.q_dot(v) / dt_ : 0.0;
     joints_.push_back(u);  // within the capacity reserved for every joint
   }
 }
@@ -66,7 +71,7 @@ void ContactStage::layoutJoints() {
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     JointUnknown& u = joints_[i];
     u.nvar = std::isfinite(u.lo) == std::isfinite(u.hi) ? 2 : 1;
-    joint_tau_(u.joint) = offset(u);  // the problem's base solve: z = 0
+    joint_tau_(nbv_ + u.joint) = offset(u);  // the problem's base solve: z = 0
     u.var = nz_, u.col = ncol_, u.row = nrow_;
     joint_index_(static_cast<Eigen::Index>(i)) = u.joint;
     nz_ += u.nvar, ++ncol_, ++nrow_;
@@ -81,7 +86,7 @@ void ContactStage::prepareJointColumns(DataImpl& d) {
                                nullptr);
   for (const JointUnknown& u : joints_) {
     rows_jac_.col(u.row).setZero();
-    rows_jac_(u.joint, u.row) = 1.0;
+    rows_jac_(nbv_ + u.joint, u.row) = 1.0;
     rows_bias_(u.row) = u.row_bias;
   }
 }
@@ -119,8 +124,9 @@ void ContactStage::assembleJointLcp() {
 void ContactStage::applyJointTorques() {
   const auto z = z_.head(nz_);
   for (const JointUnknown& u : joints_) {
-    joint_tau_(u.joint) = offset(u) + coef_.row(u.col).head(nz_).dot(z);
-    work_.ff_torques(u.joint) = ff_user_(u.joint) + joint_tau_(u.joint);
+    const int v = nbv_ + u.joint;
+    joint_tau_(v) = offset(u) + coef_.row(u.col).head(nz_).dot(z);
+    work_.ff_torques(v) = ff_user_(v) + joint_tau_(v);
   }
 }
 
@@ -132,7 +138,8 @@ int ContactStage::runWork(DataImpl& d) {
 }
 
 void ContactStage::jointOutputs(DataImpl& d, const SolveInput& in) {
-  joint_friction = joint_tau_;  // kinetic friction of the moving joints (at the instant), else 0
+  joint_friction = joint_tau_.tail(joint_friction.size());  // kinetic friction of the moving joints (at the
+                                                            // instant), else 0
   joint_limit.setZero();
   std::fill(d.status_per_joint.begin(), d.status_per_joint.end(), JointStatus::Moving);
   q_dot_ = in.q_dot;
@@ -145,12 +152,12 @@ void ContactStage::jointOutputs(DataImpl& d, const SolveInput& in) {
   // Round-off of the rows (qdd_j, or v+_j / dt): the complementarity problem's scale.
   const double a_tol = 1e-9 * (nz_ > 0 ? lcp_scale_ : std::max(1.0, qdd.cwiseAbs().maxCoeff()));
   for (const JointUnknown& u : joints_) {
-    const int j = u.joint;
-    const double f = u.f, t = joint_tau_(j);
+    const int j = u.joint, v = nbv_ + j;
+    const double f = u.f, t = joint_tau_(v);
     joint_friction(j) = std::clamp(t, -f, f);  // beyond the friction bound: the limit's reaction
     joint_limit(j) = t - joint_friction(j);
-    const double row = qdd(j) + u.row_bias;  // the acceleration, or the end velocity over dt
-    const bool moving = std::abs(in.q_dot(j)) > fm.velocity_tolerance;
+    const double row = qdd(v) + u.row_bias;  // the acceleration, or the end velocity over dt
+    const bool moving = std::abs(in.q_dot(v)) > fm.velocity_tolerance;
     d.status_per_joint[j] = std::abs(row) <= a_tol ? JointStatus::Stick
                             : moving               ? JointStatus::Moving
                             : row > 0              ? JointStatus::SlipPositive
@@ -166,11 +173,13 @@ double ContactStage::gaussValue(DataImpl& d) {
   gauss_tau_ = c.res.tau_cmd;
   double dissipation = 0.0;
   for (const JointUnknown& u : joints_) {
-    gauss_tau_(u.joint) += joint_tau_(u.joint);
+    const int v = nbv_ + u.joint;  // (a floating base's rows first)
+    gauss_tau_(v) += joint_tau_(v);
     if (d.status_per_joint[u.joint] == JointStatus::Stick) continue;  // (round-off times a huge f)
     const double f = u.f;
-    dissipation += f * std::abs(c.res.qdd(u.joint) + u.row_bias);
+    dissipation += f * std::abs(c.res.qdd(v) + u.row_bias);
   }
+  if (nbv_ > 0) return 0.5 * floatingInverseInertiaDot(gauss_tau_) + dissipation;
   c.inverseInertia(gauss_tau_, gauss_out_);
   return 0.5 * gauss_tau_.dot(gauss_out_) + dissipation;
 }

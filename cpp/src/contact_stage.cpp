@@ -71,6 +71,7 @@ bool ContactStage::convexProblem(const SolveInput& in) const {
 }
 
 void ContactStage::pointKinematics(const PointContact& pc, Vector6& bias) {
+  if (nbv_ > 0) return floatingPointKinematics(pc, bias);
   const FrameRef at{pc.segment, KDL::Frame(KDL::Vector(pc.point(0), pc.point(1), pc.point(2)))};
   (void)frameJacobian(model_, kin_, at, jac_);
   (void)frameBiasAcceleration(model_, kin_, at, bias);
@@ -96,13 +97,25 @@ int ContactStage::solveWithForces(DataImpl& d, const SolveInput& in) {
 
 ContactStage::ContactStage(const Model& model) : model_(model), kin_(model), work_(model) {
   const int n = static_cast<int>(model.nrOfJoints());
+  nv_ = static_cast<int>(model.nv());  // n on a fixed base
+  nbq_ = baseConfigurationSize(model.baseKind());
+  nbv_ = baseVelocitySize(model.baseKind());
   joint_friction.setZero(n), joint_limit.setZero(n);
-  q_dot_.setZero(n), gauss_tau_.setZero(n), gauss_out_.setZero(n);
-  jac_.resize(6, n);
+  q_dot_.setZero(nv_), gauss_tau_.setZero(nv_), gauss_out_.setZero(nv_);
+  jac_.resize(6, nv_);
   joints_.reserve(n);
-  joint_tau_.setZero(n), ff_user_.setZero(n);
+  joint_tau_.setZero(nv_), ff_user_.setZero(nv_);
   joint_index_.setZero(n);
-  joint_dtau_.resize(n, n);
+  joint_dtau_.resize(nv_, n);
+  if (nbv_ > 0) {  // the base's axes (base_kind.hpp): a free-flyer's all six, a planar base's x, y, yaw
+    base_S_.setZero(6, nbv_);
+    if (nbv_ == 6)
+      base_S_.setIdentity();
+    else
+      base_S_(0, 0) = base_S_(1, 1) = base_S_(5, 2) = 1.0;
+    jac_b_.resize(6, n);
+    floating_gauss_ = makeFloatingGauss(model);
+  }
 }
 
 int ContactStage::check(HdCore& c, const SolveInput& in) const {
@@ -142,21 +155,27 @@ int ContactStage::check(HdCore& c, const SolveInput& in) const {
 
 // Step 1: each contact's state at (q, qd) and the sizes of its unknowns, columns and rows.
 int ContactStage::classify(HdCore& c, const SolveInput& in) {
-  if (!forwardKinematics(model_, kin_, JointPositions(in.q), JointVelocities(in.q_dot)))
+  const int nj = static_cast<int>(model_.nrOfJoints());  // (a floating base's entries first)
+  if (!forwardKinematics(model_, kin_, JointPositions(in.q.tail(nj)), JointVelocities(in.q_dot.tail(nj))))
     return c.fail(E_CONTACT, "contacts: the forward kinematics of the state failed");
+  if (nbv_ > 0) floatingBase(in);
   const double tol = in.contact_velocity_tolerance;
   points_.resize(in.contacts.size());
   user_columns = in.columns();
   for (std::size_t k = 0; k < in.contacts.size(); ++k) {
     const PointContact& pc = in.contacts[k];
     Point& p = points_[k];
-    KDL::Frame tip;
-    Vector6 twist;
-    (void)framePose(model_, kin_, FrameRef{pc.segment, KDL::Frame::Identity()}, tip);
-    const KDL::Vector point(pc.point(0), pc.point(1), pc.point(2)), r = tip.M * point;
-    (void)frameTwist(model_, kin_, FrameRef{pc.segment, KDL::Frame(point)}, twist);
-    p.r = Vector3(r.x(), r.y(), r.z());
-    p.v = twist.head<3>();
+    if (nbv_ > 0) {  // world axes
+      floatingPointState(pc, p);
+    } else {
+      KDL::Frame tip;
+      Vector6 twist;
+      (void)framePose(model_, kin_, FrameRef{pc.segment, KDL::Frame::Identity()}, tip);
+      const KDL::Vector point(pc.point(0), pc.point(1), pc.point(2)), r = tip.M * point;
+      (void)frameTwist(model_, kin_, FrameRef{pc.segment, KDL::Frame(point)}, twist);
+      p.r = Vector3(r.x(), r.y(), r.z());
+      p.v = twist.head<3>();
+    }
     p.n = pc.normal.normalized();
     tangents(p.n, p.t1, p.t2);
     const double vn = p.n.dot(p.v);
@@ -209,7 +228,7 @@ void ContactStage::layout(const SolveInput& in, bool stick) {
 }
 
 void ContactStage::reserve(int contacts, int unknowns, int columns, int rows) {
-  const int n = static_cast<int>(model_.nrOfJoints());
+  const int n = nv_;
   status.resize(contacts);  // within its capacity after the first solve of this size
   if (forces.cols() < contacts) forces.resize(3, contacts);
   count = contacts;

@@ -20,8 +20,12 @@
 // in the same complementarity problem; the all-active guess is skipped. Step 4 then runs the
 // friction stage with the contact forces as wrenches: its max-min has the same unique qdd, and it
 // picks the joints' friction torques by its least-command rule.
+// On a floating base (floating_contact_points.cpp) the points' kinematics are in world axes with
+// the base's columns first (nv columns, the joints' rows of q_dot, qdd and the torques after the
+// base's nbv_), and joint friction without contacts runs here too (solve.cpp).
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,6 +41,13 @@ namespace detail {
 
 struct DataImpl;
 class HdCore;
+
+// step() on a floating base (floating_contact_points.cpp): qd_next = q_dot + dt qdd, exactly zero
+// for a joint friction holds (JointStatus::Stick) and, with every joint held, for the base too
+// when the sticking contacts fix it (ContactStage::baseHeld).
+void floatingEndVelocity(DataImpl& d, const SolveInput& in, Eigen::Ref<Eigen::VectorXd> qd_next);
+// The workspace of floatingInverseInertiaDot for `model` (floating_contact_points.cpp).
+std::shared_ptr<struct FloatingGauss> makeFloatingGauss(const Model& model);
 
 class ContactStage {
  public:
@@ -59,6 +70,11 @@ class ContactStage {
   // articulated pass.
   Eigen::VectorXd joint_friction, joint_limit;
   double gaussValue(DataImpl& d);
+  // A floating base (floating_contact_points.cpp): the last solve's sticking points fix the base
+  // (their base columns have full rank), so with every joint held the robot ends a step at rest.
+  bool baseHeld(const SolveInput& in);
+  // gaussValue's 1/2 tau^T H^-1 tau on a floating base: H from the companions (dynamics.hpp).
+  double floatingInverseInertiaDot(const Eigen::VectorXd& tau);
 
  private:
   // The contact's state at (q, qd); a frictionless point at rest counts as sliding (kSliding).
@@ -102,6 +118,11 @@ class ContactStage {
   // The contact point's acceleration (base axes) at joint accelerations qdd; `bias`: its part at
   // qdd = 0 (pointKinematics; jac_ holds the point's Jacobian afterwards).
   Vector3 pointAcceleration(const PointContact& pc, const Eigen::VectorXd& qdd, Vector3& bias);
+  // A floating base (floating_contact_points.cpp): its pose and LOCAL twist from in.q, in.q_dot
+  // (classify); a point's r and v (world axes) and its Jacobian (jac_, 6 x nv) and bias.
+  void floatingBase(const SolveInput& in);
+  void floatingPointState(const PointContact& pc, Point& p);
+  void floatingPointKinematics(const PointContact& pc, Vector6& bias);
   // A force on the contact point as one more wrench of work_.
   void addForce(const PointContact& pc, const Vector3& f);
   // The final sweep: the input with every contact force (`forces`) as a wrench.
@@ -170,16 +191,26 @@ class ContactStage {
   void reserve(int contacts, int unknowns, int columns, int rows);
 
   Model model_;
+  // nv (q_dot's size) and a floating base's entries of q and q_dot (0 on a fixed base): the
+  // joints' rows of q_dot, qdd and the torques start at nbv_.
+  int nv_ = 0, nbq_ = 0, nbv_ = 0;
   KinematicsData kin_;
+  // A floating base at the solve's state: its orientation and origin in the world, its LOCAL
+  // twist S qd_b (base axes), its axes S (6 x nbv_); jac_b_: a point's joint columns (base frame).
+  Matrix3 base_R_ = Matrix3::Identity();
+  Vector3 base_p_ = Vector3::Zero();
+  Vector6 base_v_ = Vector6::Zero();
+  Eigen::MatrixXd base_S_, jac_b_;
+  std::shared_ptr<struct FloatingGauss> floating_gauss_;  // (floatingInverseInertiaDot)
   SolveInput work_;  // the input with the set-point columns and the contact wrenches
   Lemke lemke_;
   std::vector<Point> points_;
-  Eigen::MatrixXd jac_;                 // 6 x n_joints: one contact point's Jacobian
-  Eigen::MatrixXd rows_jac_;            // n_joints x rows: each acceleration row per joint acceleration
+  Eigen::MatrixXd jac_;                 // 6 x nv: one contact point's Jacobian
+  Eigen::MatrixXd rows_jac_;            // nv x rows: each acceleration row per joint acceleration
   Eigen::VectorXd rows_bias_;           // rows: their value at qdd = 0
   Eigen::VectorXi col_segment_;         // columns: the segment of each force direction
   Matrix6X col_wrench_;                 // columns: unit force direction as a wrench about the tip origin
-  Eigen::MatrixXd dqdd_;                // n_joints x columns: wrench response
+  Eigen::MatrixXd dqdd_;                // nv x columns: wrench response
   Eigen::MatrixXd acc_per_col_;         // rows x columns: acceleration rows per unit column force
   Eigen::MatrixXd coef_;                // columns x unknowns: column force per unit unknown
   Eigen::MatrixXd lcp_m_, rows_per_z_;  // N x N; rows x N

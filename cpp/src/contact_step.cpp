@@ -68,8 +68,8 @@ Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<
   if (!s) return s;
   const double dt = input.time_step;
   const Eigen::VectorXd& qdd = data.qdd();
-  if (model.baseKind() != BaseKind::Fixed) {  // no friction there: q (+) dt qd_next on SE(3) / SE(2)
-    qd_next = input.q_dot + dt * qdd;
+  if (model.baseKind() != BaseKind::Fixed) {  // q (+) dt qd_next on SE(3) / SE(2)
+    detail::floatingEndVelocity(data.impl(), input, qd_next);
     integrateConfiguration(model.baseKind(), input.q, qd_next, dt, q_next);
     return s;
   }

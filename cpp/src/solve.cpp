@@ -70,10 +70,10 @@ int checkInput(HdCore& c, const SolveInput& in) {
   }
   if (!(std::isfinite(in.time_step) && in.time_step >= 0.0))
     return c.fail(E_RANGE, "time_step must be finite and >= 0 (s; 0: the instant), got %g", in.time_step);
-  if (c.model.floating && (moving_base || in.friction != nullptr || !in.contacts.empty()))
+  if (c.model.floating && moving_base)
     return c.fail(E_RANGE,
-                  "on a floating base, base_acceleration must be zero and joint friction and contacts are not "
-                  "supported yet (docs/floating-base.md)");
+                  "on a floating base, base_acceleration must be zero: a moving world is not supported yet "
+                  "(docs/floating-base.md)");
   if (classical && moving_base)
     return c.fail(E_RANGE,
                   "a classical set-point (ConstraintBlock::classical) needs a base at rest: base_acceleration "
@@ -166,7 +166,9 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
   // The contact stage with contacts (joint friction, at the instant or over a time step, alone:
   // the friction stage).
   const bool with_friction = input.friction != nullptr;
-  const bool with_contacts = !input.contacts.empty();
+  // (On a floating base the contact stage also takes joint friction alone: the friction stage has
+  // no base step.)
+  const bool with_contacts = !input.contacts.empty() || (c.model.floating && with_friction);
   if (with_contacts) rc = d.contacts().check(c, input);
   if (rc == 0) rc = with_contacts ? d.contacts().solve(d, input) : detail::runInput(d, input);
   d.contacts_last = with_contacts && rc == 0;

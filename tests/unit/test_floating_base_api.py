@@ -62,8 +62,11 @@ def test_solve_sizes(urdf):
     np.testing.assert_allclose(r.qdd[:3], [0.0, 0.0, -9.81], atol=1e-12)  # free fall
     with pytest.raises(vs.SolverError, match="qd"):
         solver.solve(q, np.zeros(tree.n_joints))
-    with pytest.raises(vs.SolverError, match="not supported yet"):
-        solver.solve(q, np.zeros(tree.nv), friction=vs.Friction(static=np.ones(tree.n_joints)))
+    with pytest.raises(vs.SolverError, match="not supported on a floating base yet"):  # (friction is)
+        held = {tree.segment_names[-1]: (np.eye(6)[:, :1], [0.0])}
+        solver.solve(q, np.zeros(tree.nv), constraints=held, f_ext_pass_through=[0.5])
+    r = solver.solve(q, np.zeros(tree.nv), friction=vs.Friction(static=np.ones(tree.n_joints)))
+    assert r.qdd.shape == (tree.nv,) and r.friction_torque.shape == (tree.nv,)  # the base rows 0
 
 
 def test_fixed_base_unchanged(urdf):
