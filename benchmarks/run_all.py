@@ -22,7 +22,10 @@
    TreeHdSolver vs a dense KKT solve from Pinocchio's C++ pieces, about 20 s) and
    DIR/benchmarks/bench_pv (Gen3, tip held: ours vs Pinocchio's pv and constrainedABA, about 5 s)
    and DIR/benchmarks/bench_contacts_pinocchio (the contacts of bench_contacts vs Pinocchio's ADMM
-   and PGS at 1e-10, about 70 s); then benchmarks/bench_contacts_pinocchio.py (the same from
+   and PGS at 1e-10, about 70 s) and DIR/benchmarks/bench_floating_pinocchio (Talos, solo12, ANYmal on
+   a free-flyer, free and with their feet held: ours vs aba, constraintDynamics, pv and
+   constrainedABA, about 40 s); then benchmarks/bench_floating.py (the same against pin.aba and
+   pin.constraintDynamics from Python, about 30 s), benchmarks/bench_contacts_pinocchio.py (the same from
    Python, about 3 min) and benchmarks/bench_hold_creep.py (a friction-held Gen3's creep: ours
    against MuJoCo and Pinocchio's ADMM, about 5 s), benchmarks/bench_energy.py (passive energy of a
    swinging Gen3: our integrators against MuJoCo's, about 5 s) and DIR/benchmarks/bench_realtime (the friction
@@ -258,6 +261,26 @@ def main():
     pv_file, pv_exe = build / "bench_pv.md", build / "benchmarks" / "bench_pv"
     pv_file.unlink(missing_ok=True)
     pv_rc = run([pv_exe, pv_file], stdout=subprocess.DEVNULL).returncode if pv_exe.exists() else 0
+    fl_file, fl_exe = build / "bench_floating_pinocchio.md", build / "benchmarks" / "bench_floating_pinocchio"
+    flpy_file = build / "bench_floating.md"
+    fl_file.unlink(missing_ok=True)
+    flpy_file.unlink(missing_ok=True)
+    fl_rc = 0
+    if fl_exe.exists():
+        from vereshchagin.robots import example_robot_urdf
+
+        fl_urdfs = [
+            example_robot_urdf(u)
+            for u in (
+                "talos_data/robots/talos_reduced.urdf",
+                "solo_description/robots/solo12.urdf",
+                "anymal_b_simple_description/robots/anymal.urdf",
+            )
+        ]
+        fl_rc = run([fl_exe, *fl_urdfs, fl_file], stdout=subprocess.DEVNULL).returncode
+    flpy_rc = run(
+        [sys.executable, REPO / "benchmarks" / "bench_floating.py", "--out", flpy_file], stdout=subprocess.DEVNULL
+    ).returncode
     cpin_file, cpin_exe = build / "bench_contacts_pinocchio.md", build / "benchmarks" / "bench_contacts_pinocchio"
     cpin_file.unlink(missing_ok=True)
     cpin_rc = run([cpin_exe, cpin_file], stdout=subprocess.DEVNULL).returncode if cpin_exe.exists() else 0
@@ -383,6 +406,17 @@ def main():
         if pv_file.exists()
         else f"**bench_pv was not built (Pinocchio's C++ headers not found) or wrote no report (exit code {pv_rc}).**",
         "",
+        "## Floating bases",
+        "",
+        fl_file.read_text().rstrip()
+        if fl_file.exists()
+        else "**bench_floating_pinocchio was not built (Pinocchio's C++ headers not found) or wrote no report "
+        f"(exit code {fl_rc}).**",
+        "",
+        flpy_file.read_text().rstrip()
+        if flpy_file.exists()
+        else f"**bench_floating.py exited with code {flpy_rc} and wrote no report.**",
+        "",
         hold_file.read_text().rstrip()
         if hold_file.exists()
         else f"**bench_hold_creep.py exited with code {hold_rc} and wrote no report.**",
@@ -398,7 +432,22 @@ def main():
     ]
     args.out.write_text("\n".join(md))
     print(f"wrote {args.out} (target {'met' if met else 'NOT met'})", file=sys.stderr)
-    codes = (cpp_rc, py_rc, fr_rc, frpy_rc, seg_rc, face_rc, tree_rc, kkt_rc, pv_rc, ct_rc, cpin_rc, pypin_rc)
+    codes = (
+        cpp_rc,
+        py_rc,
+        fr_rc,
+        frpy_rc,
+        seg_rc,
+        face_rc,
+        tree_rc,
+        kkt_rc,
+        pv_rc,
+        ct_rc,
+        cpin_rc,
+        pypin_rc,
+        fl_rc,
+        flpy_rc,
+    )
     return 0 if all(rc == 0 for rc in (*codes, hold_rc, energy_rc, rt_rc, step_rc, steppy_rc)) else 1
 
 
