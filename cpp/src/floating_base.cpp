@@ -134,10 +134,10 @@ int HdCore::closeAtBase(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
     return fail(HdSolver::E_DEGENERATE_INERTIA,
                 "the floating base's articulated inertia is not positive definite: the base and the robot on it have "
                 "no mass or inertia along some base direction (ModelOptions::base_inertia, the URDF root link)");
+  if (m == 0) return 0;  // free is only needed for the constraint columns' U
   BaseVector rhs = ff ? BaseVector(-b.pA) : BaseVector(-(S.transpose() * b.pA));
   if (ff_torques.size() != 0) rhs += ff_torques.head(k);
   b.free = b.llt.solve(rhs);
-  if (m == 0) return 0;
   auto A = g.acur.leftCols(m);  // every column, carried to the base (base axes)
   auto e = b.e.leftCols(m);
   if (ff) {
