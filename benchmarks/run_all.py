@@ -208,6 +208,17 @@ def _baxter_urdf() -> list:
     return [example_robot_urdf("baxter")]
 
 
+def _floating_urdfs() -> list:
+    from vereshchagin.robots import example_robot_urdf
+
+    names = (
+        "talos_data/robots/talos_reduced.urdf",
+        "solo_description/robots/solo12.urdf",
+        "anymal_b_simple_description/robots/anymal.urdf",
+    )
+    return [example_robot_urdf(u) for u in names]
+
+
 # The two benchmarks without whose reports there is no BENCHMARKS.md.
 SOLVER, PINOCCHIO = Bench("bench_solver", "bench_cpp.md"), Bench("bench_pinocchio.py", "bench_pinocchio.md")
 # The others, in the order they run.
@@ -228,6 +239,8 @@ BENCHES = (
     Bench("bench_energy.py", "bench_energy.md"),
     Bench("bench_hold_creep.py", "bench_hold_creep.md"),
     Bench("bench_realtime", "bench_realtime.md", args=lambda: ["1000000", "600", "5000"]),
+    Bench("bench_floating_pinocchio", "bench_floating_pinocchio.md", args=_floating_urdfs, optional=True),
+    Bench("bench_floating.py", "bench_floating.md"),
 )
 # The reports after the segments section, in their order in BENCHMARKS.md; "#" starts a heading.
 REPORT_ORDER = (
@@ -245,6 +258,9 @@ REPORT_ORDER = (
     "bench_hold_creep.py",
     "bench_energy.py",
     "bench_realtime",
+    "## Floating bases",
+    "bench_floating_pinocchio",
+    "bench_floating.py",
 )
 
 

@@ -13,6 +13,12 @@
 //    drawn) through TreeHdSolver (both solve overloads, up to 13 columns on drawn segments,
 //    responseColumns) and FrictionSolver on the tree. Each call returns 0 with finite outputs, or
 //    an error code < 0 with a non-empty message.
+//  * checkFloating (fuzz_floating_checks.cpp): the bytes describe a tree of 0..8 segments on a
+//    free-flyer or planar base (base inertia mostly valid), a base configuration whose quaternion /
+//    (cos, sin) is unit, slightly off or anything, and inputs with 0..3 constraint blocks; solve,
+//    step, stepSymplectic, integrateConfiguration and the dynamics and momentum companions each
+//    succeed with finite outputs or fail with a message, and a finite base configuration off the
+//    unit norm by more than 1e-5 is refused (saying "unit" when nothing else is wrong).
 // Both return "" when the properties hold, else a description of the violation.
 #pragma once
 
@@ -24,5 +30,6 @@ namespace fuzzutil {
 
 std::string checkUrdf(const std::uint8_t* data, std::size_t size);
 std::string checkSolver(const std::uint8_t* data, std::size_t size);
+std::string checkFloating(const std::uint8_t* data, std::size_t size);
 
 }  // namespace fuzzutil

@@ -121,21 +121,31 @@ int HdCore::closeAtBase(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   CouplingGeneral& g = ws.general;
   const BaseAxes& S = model.S_base;
   const int k = model.nbv, m = res.m;
-  b.U.noalias() = b.IA * S;
-  b.D.noalias() = S.transpose() * b.U;
+  const bool ff = model.base == BaseKind::FreeFlyer;  // S = identity: its products are copies
+  if (ff) {
+    b.U = b.IA;
+    b.D = b.IA;
+  } else {
+    b.U.noalias() = b.IA * S;
+    b.D.noalias() = S.transpose() * b.U;
+  }
   b.llt.compute(b.D);
   if (b.llt.info() != Eigen::Success || !(b.D.diagonal().minCoeff() > 0.0))
     return fail(HdSolver::E_DEGENERATE_INERTIA,
                 "the floating base's articulated inertia is not positive definite: the base and the robot on it have "
                 "no mass or inertia along some base direction (ModelOptions::base_inertia, the URDF root link)");
-  BaseVector rhs = -(S.transpose() * b.pA);
+  if (m == 0) return 0;  // free is only needed for the constraint columns' U
+  BaseVector rhs = ff ? BaseVector(-b.pA) : BaseVector(-(S.transpose() * b.pA));
   if (ff_torques.size() != 0) rhs += ff_torques.head(k);
   b.free = b.llt.solve(rhs);
-  if (m == 0) return 0;
   auto A = g.acur.leftCols(m);  // every column, carried to the base (base axes)
   auto e = b.e.leftCols(m);
-  e.noalias() = S.transpose() * A;
-  const Vector6 bias = S * b.free;
+  if (ff) {
+    e = A;
+  } else {
+    e.noalias() = S.transpose() * A;
+  }
+  const Vector6 bias = ff ? Vector6(b.free) : Vector6(S * b.free);
   g.ug.head(m).noalias() += A.transpose().lazyProduct(bias);
   auto De = b.De.leftCols(m);  // D^-1 e
   De = e;
@@ -155,12 +165,14 @@ void HdCore::finalBaseStep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) 
   BaseState& b = ws.base;
   const BaseAxes& S = model.S_base;
   const int k = model.nbv, m = res.m;
-  BaseVector rhs = -(S.transpose() * (b.pA + b.IA * b.a_world));
+  const bool ff = model.base == BaseKind::FreeFlyer;  // S = identity (see closeAtBase)
+  const Vector6 p = b.pA + b.IA * b.a_world;
+  BaseVector rhs = ff ? BaseVector(-p) : BaseVector(-(S.transpose() * p));
   if (ff_torques.size() != 0) rhs += ff_torques.head(k);
   if (m > 0) rhs.noalias() -= b.e.leftCols(m).lazyProduct(ws.general.nug.head(m));
   const BaseVector qdd = b.llt.solve(rhs);
   res.qdd.head(k) = qdd;
-  b.xdd = b.a_world + S * qdd;
+  b.xdd = ff ? Vector6(b.a_world + qdd) : Vector6(b.a_world + S * qdd);
 }
 
 // Response columns (response_columns.cpp) at the base. Inward: each column's apparent force

@@ -9,7 +9,7 @@
 #include <cmath>
 
 #include "alloc_counter.hpp"
-#include "random_tree.hpp"
+#include "floating_fixture.hpp"
 #include "vereshchagin/data.hpp"
 #include "vereshchagin/simulator.hpp"
 
@@ -18,26 +18,11 @@ namespace {
 using namespace vereshchagin;
 
 Model floatingModel(BaseKind kind, unsigned seed) {
-  testutil::RandomGen g(seed);
-  testutil::TreeSpec spec;
-  spec.n_joints = 7;
-  spec.rotor_inertia = false;  // a rotor's inertia is not the body's: free fall would feel it
-  ModelOptions options;
-  options.base = kind;
-  options.base_inertia = KDL::RigidBodyInertia(3.0, KDL::Vector(0.05, -0.02, 0.01),
-                                               KDL::RotationalInertia(0.2, 0.3, 0.25, 0.01, 0.0, -0.02));
-  return Model(testutil::randomTree(g, spec), "", options);
+  return testutil::floatingTreeModel(kind, seed, 7);
 }
 
 Eigen::VectorXd startQ(const Model& model) {
-  Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(model.nq(), -0.7, 0.8);
-  if (model.baseKind() == BaseKind::FreeFlyer) {
-    q.segment<4>(3) << 0.3, -0.5, 0.2, 0.8;
-    q.segment<4>(3).normalize();
-  } else {
-    q.segment<2>(2) << std::cos(0.7), std::sin(0.7);
-  }
-  return q;
+  return testutil::floatingConfiguration(model, -0.7, 0.8);
 }
 
 }  // namespace

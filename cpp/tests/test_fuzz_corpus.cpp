@@ -1,7 +1,8 @@
 // Replays the fuzzers' committed inputs (seed corpora and regressions of past findings) through the
 // same property checks as the libFuzzer targets, with any compiler: cpp/fuzz/corpus/urdf/* and
 // cpp/fuzz/regressions/urdf-* through checkUrdf, cpp/fuzz/corpus/solver/* and
-// cpp/fuzz/regressions/solver-* through checkSolver. Arguments: the cpp/fuzz directory and
+// cpp/fuzz/regressions/solver-* through checkSolver, cpp/fuzz/corpus/floating/* and
+// cpp/fuzz/regressions/floating-* through checkFloating. Arguments: the cpp/fuzz directory and
 // doctest's options (this file has its own main(), to take the directory).
 #define DOCTEST_CONFIG_IMPLEMENT
 #include <dirent.h>
@@ -61,6 +62,10 @@ TEST_CASE("URDF corpus and regressions replay through checkUrdf") {
 
 TEST_CASE("solver corpus and regressions replay through checkSolver") {
   replay("solver", fuzzutil::checkSolver);
+}
+
+TEST_CASE("floating corpus and regressions replay through checkFloating") {
+  replay("floating", fuzzutil::checkFloating);
 }
 
 // The first argument that is not an option is the cpp/fuzz directory (ctest passes it after

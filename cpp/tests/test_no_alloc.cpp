@@ -8,14 +8,17 @@
 #include <limits>
 
 #include "alloc_counter.hpp"
+#include "floating_fixture.hpp"
 #include "random_chain.hpp"
 #include "random_tree.hpp"
 #include "test_common.hpp"
 #include "vereshchagin/chain_hd_solver.hpp"
 #include "vereshchagin/data.hpp"
+#include "vereshchagin/dynamics.hpp"
 #include "vereshchagin/friction_solver.hpp"
 #include "vereshchagin/kdl_compat.hpp"
 #include "vereshchagin/kinematics.hpp"
+#include "vereshchagin/momentum.hpp"
 #include "vereshchagin/simulator.hpp"
 #include "vereshchagin/tree_hd_solver.hpp"
 
@@ -37,6 +40,20 @@ vereshchagin::SolverOptions dampedLeastSquares() {
   vereshchagin::SolverOptions dls;
   dls.policy = vereshchagin::SingularityPolicy::DampedLeastSquares;
   return dls;
+}
+
+// Four supports with friction (mu 0.9) on the last two segments and on segments 3 and 2, their
+// points and normals a little apart, for the redundant-contact tests.
+void addFourSupports(vereshchagin::SolveInput& in, unsigned int ns) {
+  const int segments[4] = {static_cast<int>(ns) - 1, static_cast<int>(ns) - 2, 3, 2};
+  for (int k = 0; k < 4; ++k) {
+    vereshchagin::PointContact pc;
+    pc.segment = segments[k];
+    pc.point = vereshchagin::Vector3(0.03 * (k % 2 ? 1 : -1), 0.02, -0.05);
+    pc.normal = vereshchagin::Vector3(0.1 * k, -0.1, 1.0).normalized();
+    pc.mu = 0.9;
+    in.contacts.push_back(pc);
+  }
 }
 
 // A random 7-joint chain, its solvers (truncated and damped policies) and every input and output
@@ -456,15 +473,7 @@ TEST_CASE_FIXTURE(Fixture, "redundant resting contacts (the least-effort guess) 
   vereshchagin::Data data(model);
   vereshchagin::SolveInput in(model);
   in.constraints.reserve(2);
-  const int segments[4] = {static_cast<int>(ns) - 1, static_cast<int>(ns) - 2, 3, 2};
-  for (int k = 0; k < 4; ++k) {
-    vereshchagin::PointContact pc;
-    pc.segment = segments[k];
-    pc.point = vereshchagin::Vector3(0.03 * (k % 2 ? 1 : -1), 0.02, -0.05);
-    pc.normal = vereshchagin::Vector3(0.1 * k, -0.1, 1.0).normalized();
-    pc.mu = 0.9;
-    in.contacts.push_back(pc);
-  }
+  addFourSupports(in, ns);
   const Eigen::VectorXd rest = Eigen::VectorXd::Zero(n);
   double csum = 0.0;
   int cfail = 0;
@@ -497,15 +506,7 @@ TEST_CASE_FIXTURE(Fixture, "redundant supports over a time step (the least-effor
   vereshchagin::Data data(model);
   vereshchagin::SolveInput in(model);
   in.constraints.reserve(2);
-  const int segments[4] = {static_cast<int>(ns) - 1, static_cast<int>(ns) - 2, 3, 2};
-  for (int k = 0; k < 4; ++k) {
-    vereshchagin::PointContact pc;
-    pc.segment = segments[k];
-    pc.point = vereshchagin::Vector3(0.03 * (k % 2 ? 1 : -1), 0.02, -0.05);
-    pc.normal = vereshchagin::Vector3(0.1 * k, -0.1, 1.0).normalized();
-    pc.mu = 0.9;
-    in.contacts.push_back(pc);
-  }
+  addFourSupports(in, ns);
   vereshchagin::FrictionModel fm;
   fm.static_friction = Eigen::VectorXd::LinSpaced(n, 3.0, 0.5);
   fm.kinetic_friction = 0.7 * fm.static_friction;
@@ -589,6 +590,82 @@ TEST_CASE_FIXTURE(Fixture, "Simulator steps and rollouts with friction and conta
     CHECK_MESSAGE(sfail == 0, "Simulator steps failed: " << str(sfail) << " (" << last_error << ")");
     CHECK_MESSAGE(std::isfinite(ssum), "non-finite Simulator results");
     CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "Simulator steps allocated: operator new "
+                                                                        << str(c1.news - c0.news) << ", malloc "
+                                                                        << str(c1.mallocs - c0.mallocs));
+  }
+}
+
+TEST_CASE("floating bases: solves, response columns, companions, steps and Simulator rollouts do not allocate") {
+  // A free-flyer and a planar base under a random tree: solve with f_ext, a wrench on the base
+  // (its rows of ff_torques) and constraints on two segments, response columns, the dynamics and
+  // momentum companions, step(), stepSymplectic() and both integrators' Simulator steps and
+  // rollouts with a controller; every state a little different from the last.
+  for (const vereshchagin::BaseKind kind : {vereshchagin::BaseKind::FreeFlyer, vereshchagin::BaseKind::Planar}) {
+    CAPTURE(static_cast<int>(kind));
+    const vereshchagin::Model model = testutil::floatingTreeModel(kind, 31, 8);
+    REQUIRE(model.status());
+    const long nq = static_cast<long>(model.nq()), nv = static_cast<long>(model.nv());
+    const int last = static_cast<int>(model.nrOfSegments()) - 1;
+    vereshchagin::Data data(model);
+    vereshchagin::DynamicsData dd(model);
+    vereshchagin::SolveInput in(model, 2, 0);
+    in.q = testutil::floatingConfiguration(model, -0.6, 0.7);
+    in.q_dot = Eigen::VectorXd::LinSpaced(nv, 0.4, -0.3);
+    in.ff_torques = Eigen::VectorXd::LinSpaced(nv, -1.0, 2.0);
+    in.f_ext.setConstant(0.3);
+    const Eigen::VectorXd beta = Eigen::VectorXd::LinSpaced(6, -1.0, 1.0);
+    REQUIRE(in.addConstraint(last, Eigen::MatrixXd::Identity(6, 6), beta));
+    REQUIRE(in.addConstraint(2, Eigen::MatrixXd::Identity(6, 3), beta.head(3)));
+    const Eigen::VectorXi joints = Eigen::VectorXi::LinSpaced(3, 0, 2);
+    Eigen::MatrixXd dqdd(nv, 3), dtau(nv, 3), H(nv, nv), Jc(3, nv);
+    Eigen::VectorXd tau(nv), q_next(nq), qd_next(nv), p(nv), p_next(nv);
+    Eigen::Vector3d com, com_vel;
+    vereshchagin::Vector6 h;
+    vereshchagin::Simulator euler(model, 1e-3, vereshchagin::Integrator::SemiImplicitEuler);
+    vereshchagin::Simulator symplectic(model, 1e-3, vereshchagin::Integrator::Symplectic);
+    vereshchagin::RolloutRecord rec;
+    rec.resize(model, 10, true);
+    const vereshchagin::Controller controller = [&](const Eigen::VectorXd&, const Eigen::VectorXd& qds, double,
+                                                    vereshchagin::SolveInput& input) {
+      input.ff_torques.tail(model.nrOfJoints()) = -0.1 * qds.tail(model.nrOfJoints());
+    };
+    int failed = 0;
+    double sum = 0.0;
+    const auto run = [&](int it) {
+      in.q_dot(0) = 0.01 * it;
+      in.time_step = 0.0;
+      const vereshchagin::JointPositions q(in.q);
+      const vereshchagin::JointVelocities qd(in.q_dot);
+      failed += !vereshchagin::solve(model, data, in);
+      failed += !data.responseColumns(joints, dqdd, dtau);
+      sum += data.qdd()(0) + dqdd(0, 0);
+      failed += !vereshchagin::massMatrix(model, dd, q, H);
+      failed += !vereshchagin::inverseDynamics(model, dd, q, qd, vereshchagin::JointAccelerations(data.qdd()), in.f_ext,
+                                               in.gravity, tau);
+      failed += !vereshchagin::centerOfMass(model, dd, q, com);
+      failed += !vereshchagin::centerOfMassJacobian(model, dd, q, Jc);
+      failed += !vereshchagin::centerOfMassVelocity(model, dd, q, qd, com_vel);
+      failed += !vereshchagin::centroidalMomentum(model, dd, q, qd, h);
+      sum += H(0, 0) + tau(0) + com(0) + Jc(0, 0) + com_vel(0) + h(0);
+      in.time_step = 1e-3;
+      p.noalias() = H * in.q_dot;
+      failed += !vereshchagin::step(model, data, in, q_next, qd_next);
+      failed += !vereshchagin::stepSymplectic(model, data, in, p, q_next, qd_next, p_next);
+      sum += q_next(0) + p_next(0);
+      for (vereshchagin::Simulator* sim : {&euler, &symplectic}) {
+        failed += !sim->setState(q, qd);
+        failed += !sim->step(in);
+        failed += !sim->rollout(10, controller, in, rec);
+        sum += sim->q()(0);
+      }
+    };
+    run(0);  // warm: the first symplectic step sizes its workspace
+    const Counts c0 = now();
+    for (int it = 1; it <= 20; ++it) run(it);
+    const Counts c1 = now();
+    CHECK_MESSAGE(failed == 0, "floating-base calls failed: " << str(failed));
+    CHECK_MESSAGE(std::isfinite(sum), "non-finite floating-base results");
+    CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "floating-base calls allocated: operator new "
                                                                         << str(c1.news - c0.news) << ", malloc "
                                                                         << str(c1.mallocs - c0.mallocs));
   }
