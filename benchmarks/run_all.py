@@ -255,12 +255,12 @@ REPORT_ORDER = (
     "bench_step",
     "bench_step.py",
     "bench_pv",
-    "bench_hold_creep.py",
-    "bench_energy.py",
-    "bench_realtime",
     "## Floating bases",
     "bench_floating_pinocchio",
     "bench_floating.py",
+    "bench_hold_creep.py",
+    "bench_energy.py",
+    "bench_realtime",
 )
 
 
