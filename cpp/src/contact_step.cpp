@@ -54,7 +54,18 @@ int ContactStage::generalForces(DataImpl& d, const SolveInput& in) {
   return forcesOfLcp(d, in, convex);
 }
 
+Status finiteStep(const Eigen::Ref<const Eigen::VectorXd>& q_next, const Eigen::Ref<const Eigen::VectorXd>& qd_next,
+                  const Status& s, const char* message) {
+  return q_next.allFinite() && qd_next.allFinite() ? s : Status(Error::NonfiniteResult, message);
+}
+
 }  // namespace detail
+
+namespace {
+const char* const kStepOverflow =
+    "step(): the state after the step overflows (finite inputs, q_next or qd_next not finite): the velocities "
+    "or the time step are too large";
+}  // namespace
 
 Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<Eigen::VectorXd> q_next,
             Eigen::Ref<Eigen::VectorXd> qd_next) {
@@ -71,14 +82,14 @@ Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<
   if (model.baseKind() != BaseKind::Fixed) {  // q (+) dt qd_next on SE(3) / SE(2)
     detail::floatingEndVelocity(data.impl(), input, qd_next);
     integrateConfiguration(model.baseKind(), input.q, qd_next, dt, q_next);
-    return s;
+    return detail::finiteStep(q_next, qd_next, s, kStepOverflow);
   }
   const std::vector<JointStatus>& status = data.jointStatus();
   for (long j = 0; j < n; ++j) {  // a joint held by friction ends the step exactly at rest
     qd_next(j) = status[j] == JointStatus::Stick ? 0.0 : input.q_dot(j) + dt * qdd(j);
     q_next(j) = input.q(j) + dt * qd_next(j);
   }
-  return s;
+  return detail::finiteStep(q_next, qd_next, s, kStepOverflow);
 }
 
 }  // namespace vereshchagin

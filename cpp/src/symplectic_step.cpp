@@ -10,6 +10,7 @@
 
 #include "symplectic_step.hpp"
 
+#include "contact_stage.hpp"
 #include "data_impl.hpp"
 #include "vereshchagin/energy.hpp"
 
@@ -28,6 +29,9 @@ namespace {
 
 const Eigen::Map<const Matrix6X> kNoWrenches(nullptr, 6, 0);
 const KDL::Vector kNoGravity(0.0, 0.0, 0.0);
+const char* const kSymplecticOverflow =
+    "the symplectic step: the state after the step overflows (finite inputs, q_next or u_next not finite): the "
+    "velocities or the time step are too large";
 
 // ws.fixed = c(q, u) - H u / dt + p / dt: one Newton-Euler pass at (q, u, -u / dt) without gravity.
 Status fixedForce(const Model& model, SymplecticWorkspace& ws, const SolveInput& in,
@@ -96,6 +100,8 @@ Status symplecticStep(const Model& model, Data& data, SymplecticWorkspace& ws, c
   } else {
     for (Eigen::Index j = 0; j < n; ++j) q_next(j) = input.q(j) + dt * u_next(j);
   }
+  const Status finite = detail::finiteStep(q_next, u_next, Status(), kSymplecticOverflow);
+  if (!finite) return finite;
   if (!converged)
     return Status(Error::Degraded,
                   "the symplectic step did not converge within its iteration bound: the last "

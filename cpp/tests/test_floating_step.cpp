@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <string>
 
 #include "alloc_counter.hpp"
 #include "floating_fixture.hpp"
@@ -100,4 +101,25 @@ TEST_CASE("floating-base steps do not allocate") {
     CHECK(g_new_calls.load() + g_malloc_calls.load() == before);
     CHECK(step(model, data, in, qd_next, qd_next).code() == Error::SizeMismatch);  // q_next needs nq
   }
+}
+
+TEST_CASE("a step whose position update overflows is refused with NonfiniteResult, never NaN") {
+  // Finite but enormous base wrenches (the fuzz target's finding): the solve's accelerations stay
+  // below its overflow check, the SE(3) update of dt qd_next does not.
+  const Model model = floatingModel(BaseKind::FreeFlyer, 5);
+  REQUIRE(model.status());
+  Data data(model);
+  SolveInput in(model);
+  in.q = startQ(model);
+  in.q_dot = Eigen::VectorXd::Zero(model.nv());
+  in.time_step = 1e-3;
+  in.ff_torques = Eigen::VectorXd::Zero(model.nv());
+  in.ff_torques.head<6>().setConstant(5.4e137);
+  Eigen::VectorXd q_next(model.nq()), qd_next(model.nv()), p_next(model.nv());
+  const Status s = step(model, data, in, q_next, qd_next);
+  CHECK(s.code() == Error::NonfiniteResult);
+  CHECK(std::string(s.message()).find("overflows") != std::string::npos);
+  const Eigen::VectorXd p = Eigen::VectorXd::Zero(model.nv());
+  const Status t = stepSymplectic(model, data, in, p, q_next, qd_next, p_next);
+  CHECK(t.code() == Error::NonfiniteResult);
 }
