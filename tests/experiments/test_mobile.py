@@ -3,7 +3,8 @@
 What is checked: the plant (MuJoCo, planar joints under the base) and the controller's model
 (``Tree.from_urdf(..., base="planar")``) agree on the forward dynamics (a random state and random
 motor commands, the base's force rotated into world axes); short runs: the tool follows its path
-in both variants, the base moves and the arm's effort is lower when the base helps; the report is
+in both variants, the base moves and the arm's effort is lower when the base helps, the plant's
+table force averages the press set-point; the report is
 written.
 """
 
@@ -17,7 +18,7 @@ import vereshchagin as vs
 from vereshchagin_experiments.floating import mobile as mb
 from vereshchagin_experiments.floating import mobile_report
 
-STEPS = 1500  # 1.5 s of the reach
+STEPS = 2600  # the reach (2 s) and 0.6 s of pressing and sliding on the table
 
 
 def test_plant_and_model_agree_on_the_dynamics():
@@ -54,6 +55,10 @@ def test_both_track_and_the_base_takes_arm_effort(runs):
     assert base["tau2"] < 0.95 * arm["tau2"]
     assert base["base_travel"] > 0.05 and arm["base_travel"] == 0.0
     assert np.all(runs["arm"].base_force == 0.0)
+    for r in runs.values():  # the set-point contact: the plant's table force averages it
+        m = mb.metrics(r)
+        assert abs(m["plant_normal"] - mb.PRESS) < 0.05 * mb.PRESS and m["normal_deviation"] < 0.2 * mb.PRESS
+        assert np.all(r.model_normal[r.t < mb.TIMES[0]] == 0.0)
 
 
 def test_bad_arguments_raise():

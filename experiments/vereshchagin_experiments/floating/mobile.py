@@ -14,28 +14,34 @@ origin of a box-shaped mobile base (:data:`BASE_MASS`, :data:`BASE_BOX`), one UR
 - ``arm`` variant (before): the base locked (``Tree.from_urdf(urdf)``: the base welded to the
   world, its mass then irrelevant), the arm alone realizes the same task.
 
-Task (both): the tool's (``end_effector_link``) full pose, world axes, on a minimum-jerk path from
-its start pose (:data:`vereshchagin.robots.GEN3_START_POSE`, base at the origin) ahead over the
-table, then a slide along y and back at :data:`TABLE_CLEARANCE` above the table top, orientation
-held (:data:`PATHS`: ``near`` within the locked arm's reach, ``far`` beyond it). The motors
-saturate at their limits (the Gen3's effort limits, :data:`BASE_LIMITS`). Computed-torque PD on the path
+Task (both): on a minimum-jerk path from the tool's (``end_effector_link``) start pose
+(:data:`vereshchagin.robots.GEN3_START_POSE`, base at the origin), the tool's full pose (world
+axes) until its ball (:data:`TOOL_RADIUS`) touches the table ahead; then the tool presses on the
+table with :data:`PRESS` N and slides along y and back, orientation held: a force set-point
+contact (``vs.Contact(..., mu=MU, force=PRESS)``: the table pushes with exactly that force, its
+friction opposes the sliding) and five task rows (x, y and the orientation; z is the contact's).
+:data:`PATHS`: ``near`` within the locked arm's reach, ``far`` beyond it. The motors saturate at
+their limits (the Gen3's effort limits, :data:`BASE_LIMITS`). Computed-torque PD on the path
 through the solve (``a = a_ref + KP e + KD (v_ref - v)``, ``beta_for``), a posture term on the
 arm (spring to the start pose, damping) and damping on the base's velocity as feed-forward
-torques (the redundant directions). 1 kHz, MuJoCo ``implicitfast``, no joint friction. The tool slides just above the table, not on it:
-contacts on a floating base are the next step.
+torques (the redundant directions). 1 kHz, MuJoCo ``implicitfast``, no joint friction; in the
+plant only the tool's ball touches the table (friction :data:`MU`).
 
-Measured: the tool's tracking error, each motor's RMS torque, the arm's ∫τ² and the base's travel.
+Measured: the tool's tracking error (x, y and z while it reaches, x and y while it slides), each
+motor's RMS torque, the arm's ∫τ², the base's travel, the table's normal force in the plant
+against the set-point.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Optional
 
 import mujoco
 import numpy as np
 
-from vereshchagin import Solver, Tree, robots
-from vereshchagin.task import beta_for, pose_error
+from vereshchagin import Contact, Solver, Tree, robots
+from vereshchagin.task import beta_for, directions, pose_error
 
 __all__ = ["BASE_MASS", "PATHS", "VARIANTS", "MobileRun", "metrics", "mobile_urdf", "run_variant"]
 
@@ -49,8 +55,16 @@ MOUNT = 0.30
 TIP = "end_effector_link"
 TABLE_TOP = 0.25
 """m: the table's top surface above the floor (the base origin's height)."""
-TABLE_CLEARANCE = 0.08
-"""m: the tool's height above the table while it slides."""
+TOOL_RADIUS = 0.02
+"""m: the ball at the tool (the end-effector origin at its centre) that touches the table."""
+PRESS = 10.0
+"""N: the normal force the tool presses on the table with while it slides."""
+MU = 0.3
+"""Tool-table friction coefficient (model and plant)."""
+PRESS_RAMP = 0.3
+"""s: the set-point rises from 1 N to :data:`PRESS` over this time after touch-down."""
+CONTACT_TOLERANCE = 1e-2
+"""m/s: the solves' ``contact_velocity_tolerance`` (the plant's soft contact moves the ball a little)."""
 PATHS = {"near": (0.30, 0.20), "far": (0.50, 0.30)}
 """``(reach, slide)`` in m: how far ahead (+x) of its start position the tool reaches, then how far
 it slides along +y and back. ``near`` is within the locked arm's reach, ``far`` is not."""
@@ -111,11 +125,15 @@ def _plant(mobile: bool, model) -> mujoco.MjModel:
     spec.option.timestep = DT
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.gravity = list(GRAVITY)
-    for g in spec.geoms:
-        g.contype, g.conaffinity = 1, 0
+    for g in spec.geoms:  # the arm touches nothing but with its tool's ball
+        g.contype, g.conaffinity = 0, 0
+    spec.body(TIP).add_geom(
+        name="tool", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[TOOL_RADIUS, 0, 0], mass=0.0,
+        contype=1, conaffinity=0, friction=[MU, 0.005, 1e-4],
+    )  # fmt: skip
     spec.worldbody.add_geom(
         name="table", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.3, 0.6, TABLE_TOP / 2],
-        pos=[1.05, 0.0, TABLE_TOP / 2], contype=0, conaffinity=1,
+        pos=[1.05, 0.0, TABLE_TOP / 2], contype=0, conaffinity=1, friction=[MU, 0.005, 1e-4],
     )  # fmt: skip
     for j in spec.joints:
         spec.add_actuator(name=f"motor_{j.name}", target=j.name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
@@ -146,6 +164,8 @@ class MobileRun:
         Base x, y (m) and yaw (rad).
     tool : ndarray, shape (k, 3)
         Tool position, world (m).
+    model_normal, plant_normal : ndarray, shape (k,)
+        The table's normal force on the tool (N): the model's (the set-point) and the plant's.
     """
 
     variant: str
@@ -155,6 +175,8 @@ class MobileRun:
     base_force: np.ndarray
     base_pose: np.ndarray
     tool: np.ndarray
+    model_normal: np.ndarray
+    plant_normal: np.ndarray
     info: dict = field(default_factory=dict)
 
 
@@ -167,7 +189,7 @@ def reference(t: float, p0: np.ndarray, path: str = "near") -> tuple[np.ndarray,
     """The tool's reference position, velocity and acceleration at time ``t`` on ``path`` (a key of
     :data:`PATHS`) from ``p0`` (world, m, m/s, m/s^2)."""
     reach, slide = PATHS[path]
-    goal = np.array([p0[0] + reach, p0[1], TABLE_TOP + TABLE_CLEARANCE])
+    goal = np.array([p0[0] + reach, p0[1], TABLE_TOP + TOOL_RADIUS])  # the ball on the table
     legs = [(p0, goal), (goal, goal + [0.0, slide, 0.0]), (goal + [0.0, slide, 0.0], goal)]
     start = 0.0
     for (a, b), T in zip(legs, TIMES):
@@ -206,9 +228,16 @@ def _base_state(variant: str, data) -> np.ndarray:
     return np.array([x, y, yaw, v[0], v[1], data.qvel[2]])
 
 
-def _command(variant, path, model, solver, data, t, p0, R0) -> tuple[np.ndarray, float]:
-    """The plant's motor commands of one period (arm torques N m; base forces world N and N m)
-    and the tool's position error (m)."""
+def _press(t: float) -> Optional[float]:
+    """The set-point at ``t`` (N), None before touch-down (the reach: no contact)."""
+    if t < TIMES[0]:
+        return None
+    return 1.0 + (PRESS - 1.0) * min(1.0, (t - TIMES[0]) / PRESS_RAMP)
+
+
+def _command(variant, path, model, solver, data, t, p0, R0):
+    """The plant's motor commands of one period (arm torques N m; base forces world N and N m),
+    the tool's position error (m; x and y only in contact) and the model's table normal force (N)."""
     nb = 0 if variant == "arm" else 3
     qa, qda = data.qpos[nb:], data.qvel[nb:]
     base = _base_state(variant, data)
@@ -218,18 +247,44 @@ def _command(variant, path, model, solver, data, t, p0, R0) -> tuple[np.ndarray,
     goal[:3, :3], goal[:3, 3] = R0, p
     e = pose_error(T, goal)
     a_des = np.r_[a, 0.0, 0.0, 0.0] + GAINS[0] * e + GAINS[1] * (np.r_[v, 0.0, 0.0, 0.0] - tw)
-    alpha = np.eye(6)
+    press = _press(t)
+    args = {}
+    if press is None:
+        alpha, err = np.eye(6), float(np.linalg.norm(e[:3]))
+    else:  # z is the contact's: the ball stays on the table, pushed with the set-point
+        alpha, err = directions(("x", "y", "rx", "ry", "rz")), float(np.linalg.norm(e[:2]))
+        point = -TOOL_RADIUS * R0.T @ np.array([0.0, 0.0, 1.0])  # the ball's lowest point, tip frame
+        args = {
+            "contacts": [Contact(TIP, point=point, normal=(0.0, 0.0, 1.0), mu=MU, force=press)],
+            "contact_velocity_tolerance": CONTACT_TOLERANCE,
+        }
     beta = beta_for(alpha, a_des, tw, GRAVITY)
     ff = POSTURE[0] * (np.asarray(robots.GEN3_START_POSE) - qa) - POSTURE[1] * qda
     if variant == "arm":
-        r = solver.solve(qa, qda, tau_ff=ff, constraints={TIP: (alpha, beta)})
-        return ff + r.tau_command, float(np.linalg.norm(e[:3]))
+        r = solver.solve(qa, qda, tau_ff=ff, constraints={TIP: (alpha, beta)}, **args)
+        return ff + r.tau_command, err, _normal(r, press)
     q = np.r_[base[:2], np.cos(base[2]), np.sin(base[2]), qa]
     qd = np.r_[base[3:], qda]
     ff = np.r_[-np.asarray(BASE_DAMPING) * base[3:], ff]
-    u = ff + solver.solve(q, qd, tau_ff=ff, constraints={TIP: (alpha, beta)}).tau_command
+    r = solver.solve(q, qd, tau_ff=ff, constraints={TIP: (alpha, beta)}, **args)
+    u = ff + r.tau_command
     world = _rz(base[2])[:2, :2] @ u[:2]  # the base's force from base axes into the world's
-    return np.r_[world, u[2:]], float(np.linalg.norm(e[:3]))
+    return np.r_[world, u[2:]], err, _normal(r, press)
+
+
+def _normal(result, press) -> float:
+    return 0.0 if press is None else float(np.asarray(result.contact_force)[0, 2])
+
+
+def _plant_normal(plant, data) -> float:
+    """The table's normal force on the tool's ball in the plant (N)."""
+    f6, total = np.zeros(6), 0.0
+    tool = plant.geom("tool").id
+    for i in range(data.ncon):
+        if tool in (data.contact[i].geom1, data.contact[i].geom2):
+            mujoco.mj_contactForce(plant, data, i, f6)
+            total += f6[0]
+    return total
 
 
 def run_variant(variant: str, path: str = "near", steps: int | None = None) -> MobileRun:
@@ -250,24 +305,31 @@ def run_variant(variant: str, path: str = "near", steps: int | None = None) -> M
     mujoco.mj_forward(plant, data)
     T0, _ = _tool_world(model, _base_state(variant, data), data.qpos[nb:], data.qvel[nb:])
     steps = int(round(sum(TIMES) / DT)) if steps is None else steps
-    rows = {k: [] for k in ("t", "error", "torque", "base_force", "base_pose", "tool")}
+    keys = ("t", "error", "torque", "base_force", "base_pose", "tool", "model_normal", "plant_normal")
+    rows = {k: [] for k in keys}
     for k in range(steps):
-        u, err = _command(variant, path, model, solver, data, k * DT, T0[:3, 3], T0[:3, :3])
+        u, err, normal = _command(variant, path, model, solver, data, k * DT, T0[:3, 3], T0[:3, :3])
         u = np.clip(u, -limits, limits)  # what the motors can give
         data.ctrl[:] = u
         base = _base_state(variant, data)
         T, _ = _tool_world(model, base, data.qpos[nb:], data.qvel[nb:])
-        for key, val in zip(rows, (k * DT, err, u[nb:], u[:nb] if mobile else np.zeros(3), base[:3], T[:3, 3])):
+        vals = (k * DT, err, u[nb:], u[:nb] if mobile else np.zeros(3), base[:3], T[:3, 3], normal)
+        for key, val in zip(keys, (*vals, _plant_normal(plant, data))):
             rows[key].append(val)
         mujoco.mj_step(plant, data)
-    run = MobileRun(variant, *(np.asarray(rows[k], float) for k in rows))
+    run = MobileRun(variant, *(np.asarray(rows[k], float) for k in keys))
     run.info.update(path=path, saturated=float(np.mean(np.any(np.abs(run.torque) >= model.effort_limit, axis=1))))
     return run
 
 
 def metrics(run: MobileRun) -> dict:
     """Tracking and effort numbers of one run: RMS / max position error (m), each arm motor's RMS
-    torque (N m), the arm's ∫τ² (N² m² s), the base's RMS force (N) and travel (m)."""
+    torque (N m), the arm's ∫τ² (N² m² s), the base's RMS force (N) and travel (m), and while the
+    tool presses with the full set-point: the plant's mean normal force (N), the RMS deviation of
+    its 10 ms means from the model's (N), the fraction of periods the plant's ball is off the table."""
+    full = run.t >= TIMES[0] + PRESS_RAMP + 0.1
+    window = np.ones(10) / 10.0
+    dev = np.convolve(run.plant_normal - run.model_normal, window, "valid")[full[9:]] if full.any() else np.zeros(0)
     return {
         "rms_error": float(np.sqrt(np.mean(run.error**2))),
         "max_error": float(run.error.max()),
@@ -275,4 +337,7 @@ def metrics(run: MobileRun) -> dict:
         "tau2": float(np.sum(run.torque**2) * DT),
         "base_rms_force": float(np.sqrt(np.mean(np.sum(run.base_force[:, :2] ** 2, axis=1)))),
         "base_travel": float(np.sum(np.linalg.norm(np.diff(run.base_pose[:, :2], axis=0), axis=1))),
+        "plant_normal": float(run.plant_normal[full].mean()) if full.any() else float("nan"),
+        "normal_deviation": float(np.sqrt(np.mean(dev**2))) if dev.size else float("nan"),
+        "contact_lost": float(np.mean(run.plant_normal[full] == 0.0)) if full.any() else float("nan"),
     }
