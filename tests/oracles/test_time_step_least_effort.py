@@ -57,7 +57,9 @@ def _generators(c, row, scale):
     if np.linalg.norm(wt) <= tol:
         return np.array([c.normal + c.mu * d for d in D]).T
     score = D @ wt
-    best = np.flatnonzero(score <= score.min() + 1e-9 * np.linalg.norm(wt))
+    # Ties to the rows' round-off (not to |wt|'s): a point sliding exactly along an edge's outward
+    # normal, as the polygon makes it whenever its force lies inside that edge, has two tied vertices.
+    best = np.flatnonzero(score <= score.min() + tol)
     return np.array([c.normal + c.mu * D[j] for j in best]).T
 
 
@@ -427,6 +429,59 @@ def test_baxter_steps_that_found_no_impulses(seed):
     f = r.contact_force.copy()  # a leaving support's force is zero to round-off of the largest
     f[np.linalg.norm(f, axis=1) <= 1e-9 * np.abs(f).max()] = 0.0
     _admissible(prob, qdd, f, joint)
+
+
+def _sliding_chain(seed, k=5, mu=0.6, dt=2e-3):
+    """A random 6-joint chain moving at about 1 rad/s, no joint friction, k supports with friction
+    on its segments whose normals oppose the points' motion (the randomized search's chains)."""
+    rng = np.random.default_rng([2026, seed])
+    rc = random_chain(rng, 6, prismatic=False)
+    q, qd = random_state(rng, rc, qd_scale=1.0)
+    tau = rng.normal(size=6) * 3
+    model, data = rc.model, rc.model.createData()
+    pq = pin_configuration(model, q)
+    a = np.linalg.solve(pin.crba(model, data, pq), tau - pin.rnea(model, data, pq, qd, np.zeros(6)))
+    pin.computeJointJacobians(model, data, pq)
+    pin.forwardKinematics(model, data, pq, qd, np.zeros(6))
+    contacts = []
+    for s in rng.choice(rc.n_segments, size=k, replace=False):
+        point = rng.normal(size=3) * 0.1
+        J, bias, v = point_jacobian(model, data, rc.tip_frames[s], point)
+        normal = -(J @ a * dt + v) / np.linalg.norm(J @ a * dt + v) + 0.2 * rng.normal(size=3)
+        contacts.append(vs.Contact(int(s), point=point, normal=normal / np.linalg.norm(normal), mu=mu))
+    return rc, q, qd, tau, contacts
+
+
+def test_chain_seed_2070_slides_along_an_edge_normal():
+    """Chain seed 2070 of the randomized search (5 supports, mu 0.6, about 1 rad/s, dt 2 ms): its
+    impulses failed the admissibility check, support 2's force (771, -358, -1219) N lying inside
+    the polygon edge between vertices 0 and 1 while the check wanted vertex 1 alone. The answer was
+    right: that support slides (end velocity 7.6e-7 m/s) exactly along the edge's outward normal,
+    where maximum dissipation allows any force on the edge, and the polygon's complementarity
+    makes it so (two positive edge weights: d_0 . v+ = d_1 . v+); the two scores differ by 2e-14
+    of the rows' scale, round-off, but the check took ties relative to the sliding speed itself
+    (1e-9 |v_t+|), far below round-off of rows near 1e3. Ties are now the rows' round-off."""
+    dt = 2e-3
+    rc, q, qd, tau, contacts = _sliding_chain(2070)
+    r = rc.solver().solve(q, qd, tau_ff=tau, contacts=contacts, time_step=dt)
+    model = rc.model
+    pq = pin_configuration(model, q)
+    specs = [dict(frame=rc.tip_frames[c.segment], point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
+    prob = contact_problem(model, model.createData(), pq, qd, tau, specs, time_step=dt)
+    gen = sum((c.J.T @ f for c, f in zip(prob.contacts, r.contact_force)), np.zeros(6))
+    assert _rel(prob.H @ r.qdd - prob.h, gen) <= RTOL  # no motors, no joint friction
+    _admissible(prob, r.qdd, r.contact_force, np.zeros(6))
+    c, f = prob.contacts[2], r.contact_force[2]
+    row = c.J @ r.qdd + c.bias
+    wt = row - (c.normal @ row) * c.normal
+    D = facet_directions(c.normal, c.facets)
+    weights = nnls(np.array([c.normal + c.mu * d for d in D]).T, f)[0]
+    assert np.count_nonzero(weights > 1e-6 * weights.max()) == 2  # inside an edge
+    tied = np.flatnonzero(weights > 1e-6 * weights.max())
+    scale = max(np.abs(c.J @ r.qdd).max(), np.abs(c.bias).max())  # the terms of the row (v / dt in bias)
+    assert np.linalg.norm(wt) > 1e-7 * scale  # it slides
+    assert abs((D[tied[0]] - D[tied[1]]) @ wt) <= 1e-12 * scale  # exactly along the edge's normal
+    assert (D[tied[0]] @ wt) <= (D @ wt).min() + 1e-12 * scale  # the edge most opposed
 
 
 @pytest.mark.parametrize("seed", range(6))
