@@ -27,30 +27,31 @@ int Lemke::ratioTest(int entering, int n, double tol) const {
   const double col_max = T.col(entering).cwiseAbs().maxCoeff();
   const double piv_tol = std::max(tol, 1e-11 * col_max);
   int best = -1;
+  double rb = 0.0;  // the best row's ratio (the same quotient as recomputing it)
   for (int i = 0; i < n; ++i) {
     const double a = T(i, entering);
     if (a <= piv_tol) continue;
+    const double ri = T(i, 2 * n + 1) / a;
     if (best < 0) {
-      best = i;
+      best = i, rb = ri;
       continue;
     }
     const double b = T(best, entering);
-    const double ri = T(i, 2 * n + 1) / a, rb = T(best, 2 * n + 1) / b;
     const double eps = 1e-12 * std::max({1.0, std::abs(ri), std::abs(rb)});
     if (ri < rb - eps) {
-      best = i;
+      best = i, rb = ri;
       continue;
     }
     if (ri > rb + eps) continue;
     if (basis_(i) == 2 * n) {  // z0 ties: let it leave
-      best = i;
+      best = i, rb = ri;
       continue;
     }
     if (basis_(best) == 2 * n) continue;
     for (int k = 0; k < n; ++k) {  // lexicographic on B^-1
       const double xi = T(i, k) / a, xb = T(best, k) / b;
       if (xi < xb - 1e-12 * std::max({1.0, std::abs(xi), std::abs(xb)})) {
-        best = i;
+        best = i, rb = ri;
         break;
       }
       if (xi > xb + 1e-12 * std::max({1.0, std::abs(xi), std::abs(xb)})) break;
