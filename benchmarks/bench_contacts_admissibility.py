@@ -39,10 +39,12 @@ import pinocchio as pin
 from scipy.optimize import nnls
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests" / "oracles"))
 
 import vereshchagin as vs  # noqa: E402
 from support.chains import G_EARTH, pin_configuration, random_chain, random_state  # noqa: E402
 from support.contact_oracle import contact_problem, facet_directions, point_jacobian  # noqa: E402
+from test_time_step_least_effort import _free_motion, _sliding_chain  # noqa: E402
 
 TOL = 1e-9
 SPEED_TIES = "--speed-ties" in sys.argv  # ties relative to the sliding speed: the old rule
@@ -117,12 +119,7 @@ def chain_case(rng):
     qd *= rng.random() < 0.5
     tau = rng.normal(size=n) * 3
     model, data = rc.model, rc.model.createData()
-    pq = pin_configuration(model, q)
-    h = tau - pin.rnea(model, data, pq, qd, np.zeros(n))
-    fs = np.abs(h) * rng.uniform(0.5, 1.5, size=n) + 0.05
-    minv_h = np.linalg.solve(pin.crba(model, data, pq), h)
-    pin.computeJointJacobians(model, data, pq)
-    pin.forwardKinematics(model, data, pq, qd, np.zeros(n))
+    pq, fs, minv_h = _free_motion(rng, rc, q, qd, tau, data)
 
     def frames(rng, k):
         return [(rc.tip_frames[s], int(s)) for s in rng.choice(np.arange(rc.n_segments), size=k)]
@@ -169,23 +166,12 @@ def tree_case(rng, cases):
 
 
 def sliding_case(seed):
-    """The sliding chains of the least-effort tests: 6 joints at about 1 rad/s, five supports with
-    mu 0.6 against the points' motion over dt 2 ms, no joint friction, no task."""
-    rng = np.random.default_rng([2026, seed])
-    rc = random_chain(rng, 6, prismatic=False)
-    q, qd = random_state(rng, rc, qd_scale=1.0)
-    tau = rng.normal(size=6) * 3
-    model, data = rc.model, rc.model.createData()
-    pq = pin_configuration(model, q)
-    a = np.linalg.solve(pin.crba(model, data, pq), tau - pin.rnea(model, data, pq, qd, np.zeros(6)))
-    pin.computeJointJacobians(model, data, pq)
-    pin.forwardKinematics(model, data, pq, qd, np.zeros(6))
-
-    def frames(rng, k):
-        return [(rc.tip_frames[s], int(s)) for s in rng.choice(rc.n_segments, size=k, replace=False)]
-
-    sup = _supports(rng, model, data, frames, a, 2e-3, 5, 0.6, 0.1)
-    return rc.solver(), model, (q, qd, tau, None), (pq, qd, tau, None), sup, {}, lambda x: x
+    """The sliding chains of the least-effort tests (their ``_sliding_chain``): 6 joints at about
+    1 rad/s, five supports with mu 0.6 against the points' motion over dt 2 ms, no joint friction."""
+    rc, q, qd, tau, contacts = _sliding_chain(seed)
+    sup = [(rc.tip_frames[c.segment], c) for c in contacts]
+    pq = pin_configuration(rc.model, q)
+    return rc.solver(), rc.model, (q, qd, tau, None), (pq, qd, tau, None), sup, {}, lambda x: x
 
 
 def run(kind, seed, cases):

@@ -21,6 +21,17 @@ using testutil::RandomGen;
 
 namespace {
 
+// Static friction 0.1-0.6 times each joint's gravity torque at q plus 0.01 N m, kinetic 0.8 of it.
+void frictionNearGravity(const Model& model, const Eigen::VectorXd& q, RandomGen& g, FrictionModel& fm) {
+  const long n = q.size();
+  DynamicsData dyn(model);
+  Eigen::VectorXd load(n);
+  REQUIRE(gravityTorques(model, dyn, JointPositions(q), KDL::Vector(0, 0, -9.81), load));
+  fm.static_friction = load.cwiseAbs();
+  for (long j = 0; j < n; ++j) fm.static_friction(j) = g.uniform(0.1, 0.6) * fm.static_friction(j) + 0.01;
+  fm.kinetic_friction = 0.8 * fm.static_friction;
+}
+
 // A random chain at rest (or creeping) with k supports with friction (mu 0.6) whose normals oppose
 // their points' free acceleration (so they carry), and joint friction near each joint's gravity load.
 struct Case {
@@ -31,12 +42,7 @@ struct Case {
     in.q = g.q(n).data;
     for (int j = 0; j < n; ++j) in.q_dot(j) = speed * g.uniform(-1.0, 1.0);
     in.ff_torques = g.torques(n).data;
-    DynamicsData dyn(model);
-    Eigen::VectorXd grav(n);
-    REQUIRE(gravityTorques(model, dyn, JointPositions(in.q), KDL::Vector(0, 0, -9.81), grav));
-    fm.static_friction.resize(n);
-    for (int j = 0; j < n; ++j) fm.static_friction(j) = g.uniform(0.1, 0.6) * std::abs(grav(j)) + 0.01;
-    fm.kinetic_friction = 0.8 * fm.static_friction;
+    frictionNearGravity(model, in.q, g, fm);
     Data free(model);
     REQUIRE(solve(model, free, in).code() == Error::None);
     KinematicsData kin(model);

@@ -255,6 +255,19 @@ def test_gen3_pressed_on_a_table_by_two_supports_with_joints_holding(qd_scale, d
     _check(r, prob, A, f"dt {dt}, qd {qd_scale}")
 
 
+def _free_motion(rng, rc, q, qd, tau, data):
+    """(Pinocchio's q, joint friction 0.5 to 1.5 times each joint's load, the free motion M^-1 h) of
+    a random chain's state, ``data`` left with its Jacobians and kinematics at (q, qd)."""
+    n = rc.n_joints
+    pq = pin_configuration(rc.model, q)
+    h = tau - pin.rnea(rc.model, data, pq, qd, np.zeros(n))
+    fs = np.abs(h) * rng.uniform(0.5, 1.5, size=n) + 0.05
+    minv_h = np.linalg.solve(pin.crba(rc.model, data, pq), h)
+    pin.computeJointJacobians(rc.model, data, pq)
+    pin.forwardKinematics(rc.model, data, pq, qd, np.zeros(n))
+    return pq, fs, minv_h
+
+
 def _chain_case(rng, k, mu, moving):
     """A random 7-joint chain at rest or creeping (joints at 1e-3 rad/s: friction can stop them
     within the step), friction on every joint 0.5 to 1.5 times its load (the gravity and
@@ -268,12 +281,7 @@ def _chain_case(rng, k, mu, moving):
     tau = rng.normal(size=n) * 3
     model = rc.model
     data = model.createData()
-    pq = pin_configuration(model, q)
-    h = tau - pin.rnea(model, data, pq, qd, np.zeros(n))
-    fs = np.abs(h) * rng.uniform(0.5, 1.5, size=n) + 0.05
-    minv_h = np.linalg.solve(pin.crba(model, data, pq), h)
-    pin.computeJointJacobians(model, data, pq)
-    pin.forwardKinematics(model, data, pq, qd, np.zeros(n))
+    pq, fs, minv_h = _free_motion(rng, rc, q, qd, tau, data)
     contacts = []
     for s in rng.choice(np.arange(n - 3, rc.n_segments), size=k, replace=False):
         point = rng.normal(size=3) * 0.1
