@@ -120,11 +120,13 @@ int ContactStage::solveLcp(HdCore& c, bool convex) {
   const auto q = lcp_q_.head(nz_);
   auto z = z_.head(nz_), w = w_.head(nz_);
   int pivots = 0;
-  const int limit = 50 + 20 * nz_;
+  const int limit = max_pivots_ > 0 ? max_pivots_ : 50 + 20 * nz_;
   Lemke::Result r = lemke_.solve(M, q, z, w, limit, pivots);
   if (r == Lemke::kRay) r = perturbedLcp(limit);
-  if (r == Lemke::kPivotLimit)
+  if (r == Lemke::kPivotLimit) {
+    capped_ = limit;  // (the general problem then takes the fallback: contact_fallback.cpp)
     return c.fail(E_NO_SOLUTION, "contacts: the complementarity problem did not finish within %d pivots", limit);
+  }
   if (r == Lemke::kRay)
     return c.fail(E_NO_SOLUTION,
                   convex ? "contacts: no contact forces meet the contact conditions (the constraints and the "
@@ -230,6 +232,7 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
   dt_ = in.time_step;
   joints_.clear();
   step_without_bias_ = false;
+  max_pivots_ = in.contact_max_pivots;
   if (dt_ > 0.0) stepKinds(in);
   if (joint_friction_) {
     if (int rc = checkJointFriction(d, in)) return rc;
@@ -248,7 +251,8 @@ int ContactStage::solve(DataImpl& d, const SolveInput& in) {
       return finish(d, in);
     }
   }
-  if (int rc = generalForces(d, in)) return rc;
+  capped_ = 0;  // (a bound hit by the sticking trial is not the general problem's)
+  if (int rc = generalForces(d, in)) return capped_ > 0 && rc == E_NO_SOLUTION ? degradedForces(d, in) : rc;
   if (nz_ > 0)
     if (int rc = runWork(d)) return rc;
   reportStatus(in, false);

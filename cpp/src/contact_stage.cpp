@@ -144,6 +144,8 @@ int ContactStage::check(HdCore& c, const SolveInput& in) const {
                   "%d constraint columns and %d more for the contacts (one per contact, two more per point with "
                   "friction): at most %d in all (SolverOptions::max_constraints)",
                   in.columns(), extra, c.mcap);
+  if (in.contact_max_pivots == 0 || in.contact_max_pivots < -1)
+    return c.fail(E_CONTACT, "contact_max_pivots must be -1 (the default bound) or > 0, got %d", in.contact_max_pivots);
   if (!(std::isfinite(in.contact_velocity_tolerance) && in.contact_velocity_tolerance >= 0.0))
     return c.fail(E_CONTACT, "contact_velocity_tolerance must be finite and >= 0, got %g",
                   in.contact_velocity_tolerance);
@@ -225,12 +227,15 @@ void ContactStage::layout(const SolveInput& in, bool stick) {
   }
   layoutJoints();
   reserve(static_cast<int>(in.contacts.size()), nz_, ncol_, nrow_);
+  // work_'s blocks: the input's, one per set-point, two per resting point with friction (the
+  // sticking trial) or one per support (the fallback's held normals): no allocation after the first.
+  work_.constraints.reserve(in.constraints.size() + 3 * in.contacts.size());
 }
 
 void ContactStage::reserve(int contacts, int unknowns, int columns, int rows) {
   const int n = nv_;
   status.resize(contacts);  // within its capacity after the first solve of this size
-  if (forces.cols() < contacts) forces.resize(3, contacts);
+  if (forces.cols() < contacts) forces.resize(3, contacts), saved_forces_.resize(3, contacts);
   count = contacts;
   if (rows_jac_.cols() < rows) rows_jac_.resize(n, rows), rows_bias_.resize(rows), rows0_.resize(rows);
   if (col_wrench_.cols() < columns) {
@@ -248,6 +253,18 @@ void ContactStage::reserve(int contacts, int unknowns, int columns, int rows) {
   lemke_.reserve(unknowns);
 }
 
+void ContactStage::addColumn(int segment, const Point& p, const Vector3& point, const Vector3& e) {
+  ConstraintBlock b;
+  b.segment = segment;
+  b.columns = 1;
+  b.alfa.col(0) << e, Vector3::Zero();  // the point's acceleration along e ...
+  b.point = point;
+  b.classical = true;  // ... held at zero (classical: the physical acceleration), over a time step
+  if (dt_ > 0.0)       // at the value that ends the step at rest along e: v+ = v + dt a = 0
+    b.classical_acceleration.head<3>() = -e.dot(p.v) / dt_ * e;
+  work_.constraints.push_back(b);
+}
+
 // The input with a constraint column and a known wrench per force set-point and, for the sticking
 // trial, two tangential columns per resting point with friction (after all the set-points').
 void ContactStage::buildWorkInput(const SolveInput& in, bool stick) {
@@ -258,15 +275,7 @@ void ContactStage::buildWorkInput(const SolveInput& in, bool stick) {
     work_.ff_torques = ff_user_ + joint_tau_;
   }
   const auto column = [this](int segment, const Point& p, const Vector3& point, const Vector3& e) {
-    ConstraintBlock b;
-    b.segment = segment;
-    b.columns = 1;
-    b.alfa.col(0) << e, Vector3::Zero();  // the point's acceleration along e ...
-    b.point = point;
-    b.classical = true;  // ... held at zero (classical: the physical acceleration), over a time step
-    if (dt_ > 0.0)       // at the value that ends the step at rest along e: v+ = v + dt a = 0
-      b.classical_acceleration.head<3>() = -e.dot(p.v) / dt_ * e;
-    work_.constraints.push_back(b);
+    addColumn(segment, p, point, e);
   };
   for (std::size_t k = 0; k < in.contacts.size(); ++k) {
     const Point& p = points_[k];

@@ -168,10 +168,17 @@ class ContactStage {
   // tangentially by two constraint columns) or the full polygonal problem.
   void layout(const SolveInput& in, bool stick);
   void buildWorkInput(const SolveInput& in, bool stick);
+  // One constraint column on work_: the point's acceleration along e (base axes) held at zero, over
+  // a time step at the value that ends the step at rest along e.
+  void addColumn(int segment, const Point& p, const Vector3& point, const Vector3& e);
   void prepareColumns(DataImpl& d, const SolveInput& in);
   void assembleLcp(const SolveInput& in);
   int solveLcp(HdCore& c, bool convex);
   Lemke::Result perturbedLcp(int limit);  // solveLcp's second try after a ray (contact_forces.cpp)
+  // The real-time fallback when the general problem's pivoting reached its bound
+  // (contact_fallback.cpp): Error::Degraded with its result, or an error code.
+  int degradedForces(DataImpl& d, const SolveInput& in);
+  int heldNormalsRound(DataImpl& d, const SolveInput& in, int& worst, double& penetration);
   int forcesOfLcp(DataImpl& d, const SolveInput& in, bool convex);
   // The general problem (not the sticking trial) and, over a time step when it has no answer, the
   // velocity-level retry (step_without_bias_): 0 or an error code.
@@ -250,6 +257,9 @@ class ContactStage {
   // Stewart-Trinkle and Anitescu-Potra, which always has one (contact_step.cpp). Reset per solve.
   bool step_without_bias_ = false;
   double lcp_scale_ = 1.0;  // the last complementarity problem's scale (accelerations)
+  int max_pivots_ = -1;     // SolveInput::contact_max_pivots of this solve
+  int capped_ = 0;          // the general problem reached this pivot bound (0: not); reset per solve
+  Matrix3X saved_forces_;   // the fallback's last accepted forces
   Eigen::VectorXd q_dot_;   // the input's q_dot (jointOutputs); gaussValue's buffers
   Eigen::VectorXd gauss_tau_, gauss_out_;
   // speed: the all-active guess on one base solve and the held directions' response

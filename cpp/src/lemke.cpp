@@ -27,30 +27,31 @@ int Lemke::ratioTest(int entering, int n, double tol) const {
   const double col_max = T.col(entering).cwiseAbs().maxCoeff();
   const double piv_tol = std::max(tol, 1e-11 * col_max);
   int best = -1;
+  double rb = 0.0;  // the best row's ratio (the same quotient as recomputing it)
   for (int i = 0; i < n; ++i) {
     const double a = T(i, entering);
     if (a <= piv_tol) continue;
+    const double ri = T(i, 2 * n + 1) / a;
     if (best < 0) {
-      best = i;
+      best = i, rb = ri;
       continue;
     }
     const double b = T(best, entering);
-    const double ri = T(i, 2 * n + 1) / a, rb = T(best, 2 * n + 1) / b;
     const double eps = 1e-12 * std::max({1.0, std::abs(ri), std::abs(rb)});
     if (ri < rb - eps) {
-      best = i;
+      best = i, rb = ri;
       continue;
     }
     if (ri > rb + eps) continue;
     if (basis_(i) == 2 * n) {  // z0 ties: let it leave
-      best = i;
+      best = i, rb = ri;
       continue;
     }
     if (basis_(best) == 2 * n) continue;
     for (int k = 0; k < n; ++k) {  // lexicographic on B^-1
       const double xi = T(i, k) / a, xb = T(best, k) / b;
       if (xi < xb - 1e-12 * std::max({1.0, std::abs(xi), std::abs(xb)})) {
-        best = i;
+        best = i, rb = ri;
         break;
       }
       if (xi > xb + 1e-12 * std::max({1.0, std::abs(xi), std::abs(xb)})) break;
@@ -203,6 +204,24 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
     return res;
   const int d = nullBasis(Q);
   if (d == 0) return Lemke::kSolved;
+  if (!secondOnNull(P, pv, R, r, x, d)) {
+    if (eq > 0) (void)secondOnEqualities(P, pv, R, r, x, eq);  // else keep x1
+    return Lemke::kSolved;
+  }
+  x.noalias() += z_.topLeftCorner(p, d) * w_.head(d);
+  return Lemke::kSolved;
+}
+
+// The second programme in the coordinates w of x = x1 + Z w (Z: z_'s first d columns, x = x1):
+// min 1/2 w^T (Z^T P Z) w + (Z^T (P x1 + pv))^T w subject to (Rs Z) w >= rs - Rs x1, its dual
+// first (strictSecond), else the doubled primal. The answer w into w_'s head; false when neither
+// finishes.
+bool LexicographicQp::secondOnNull(const Eigen::Ref<const Eigen::MatrixXd>& P,
+                                   const Eigen::Ref<const Eigen::VectorXd>& pv,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& Rs,
+                                   const Eigen::Ref<const Eigen::VectorXd>& rs,
+                                   const Eigen::Ref<const Eigen::VectorXd>& x, int d) {
+  const int p = static_cast<int>(x.size()), k = static_cast<int>(rs.size());
   const auto Z = z_.topLeftCorner(p, d);
   auto PZ = v_.topLeftCorner(p, d);  // V is no longer needed
   PZ.noalias() = P * Z;
@@ -214,17 +233,12 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
   auto c2 = c2_.head(d);
   c2.noalias() = Z.transpose() * grad;
   auto RZ = rz_.topLeftCorner(k, d);
-  RZ.noalias() = R * Z;
+  RZ.noalias() = Rs * Z;
   auto r2 = r2_.head(k);
-  r2 = r;
-  r2.noalias() -= R * x;
+  r2 = rs;
+  r2.noalias() -= Rs * x;
   auto w = w_.head(d);
-  if (!strictSecond(Q2, c2, RZ, r2, w) && qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved) {
-    if (eq > 0) (void)secondOnEqualities(P, pv, R, r, x, eq);  // else keep x1
-    return Lemke::kSolved;
-  }
-  x.noalias() += Z * w;
-  return Lemke::kSolved;
+  return strictSecond(Q2, c2, RZ, r2, w) || qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) == Lemke::kSolved;
 }
 
 // The second programme on the null space of [C; E] (E = R's first eq rows): x = x1 + Z w keeps
@@ -248,27 +262,9 @@ bool LexicographicQp::secondOnEqualities(const Eigen::Ref<const Eigen::MatrixXd>
   Qe += Q / qs;
   const int d = nullBasis(Qe);
   if (d == 0) return false;
-  const auto Z = z_.topLeftCorner(p, d);
-  const auto Ri = R.bottomRows(k);
-  auto PZ = v_.topLeftCorner(p, d);
-  PZ.noalias() = P * Z;
-  auto Q2 = q2_.topLeftCorner(d, d);
-  Q2.noalias() = Z.transpose() * PZ;
-  auto grad = w_.head(p);
-  grad.noalias() = P * x;
-  grad += pv;
-  auto c2 = c2_.head(d);
-  c2.noalias() = Z.transpose() * grad;
-  auto RZ = rz_.topLeftCorner(k, d);
-  RZ.noalias() = Ri * Z;
-  auto r2 = r2_.head(k);
-  r2 = r.tail(k);
-  r2.noalias() -= Ri * x;
-  auto w = w_.head(d);
-  if (!strictSecond(Q2, c2, RZ, r2, w) && qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) != Lemke::kSolved)
-    return false;
+  if (!secondOnNull(P, pv, R.bottomRows(k), r.tail(k), x, d)) return false;
   auto u = c_.head(p);  // the step Z w, checked before it is taken
-  u.noalias() = Z * w;
+  u.noalias() = z_.topLeftCorner(p, d) * w_.head(d);
   auto Qu = diag_.head(p);
   Qu.noalias() = Q * u;
   const double size = std::max(1.0, (x + u).cwiseAbs().maxCoeff());

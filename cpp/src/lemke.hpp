@@ -83,6 +83,9 @@ class LexicographicQp {
   bool secondOnEqualities(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
                           const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
                           Eigen::Ref<Eigen::VectorXd> x, int eq);
+  bool secondOnNull(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
+                    const Eigen::Ref<const Eigen::MatrixXd>& Rs, const Eigen::Ref<const Eigen::VectorXd>& rs,
+                    const Eigen::Ref<const Eigen::VectorXd>& x, int d);
   bool strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2, const Eigen::Ref<const Eigen::VectorXd>& c2,
                     const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
                     Eigen::Ref<Eigen::VectorXd> w);

@@ -171,8 +171,8 @@ Status solve(const Model& model, Data& data, const SolveInput& input) {
   const bool with_contacts = !input.contacts.empty() || (c.model.floating && with_friction);
   if (with_contacts) rc = d.contacts().check(c, input);
   if (rc == 0) rc = with_contacts ? d.contacts().solve(d, input) : detail::runInput(d, input);
-  d.contacts_last = with_contacts && rc == 0;
-  const bool stage_joints = with_contacts && rc == 0 && (with_friction || input.time_step > 0.0);
+  d.contacts_last = with_contacts && rc >= 0;  // (rc 1: Degraded, a result)
+  const bool stage_joints = with_contacts && rc >= 0 && (with_friction || input.time_step > 0.0);
   if (!stage_joints) recordStatus(d, with_friction && rc >= 0);  // (else written by the stage)
   d.stage_joints = stage_joints;
   d.friction_last = with_friction && rc >= 0 && !stage_joints;  // (rc 1: Degraded, a result)

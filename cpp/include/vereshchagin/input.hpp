@@ -97,6 +97,11 @@ struct SolveInput {
   std::vector<PointContact> contacts;
   /// Below this speed (m/s) a contact point is at rest along the normal, resp. not sliding.
   double contact_velocity_tolerance = 1e-6;
+  /// Real-time bound of the contacts' complementarity problem: Lemke pivots per run, -1 (default)
+  /// 50 + 20 n_z for its n_z unknowns, n > 0: n. When the general problem reaches it, the solve
+  /// returns Error::Degraded with a safe fallback (touching supports held along their normals,
+  /// without friction at the contacts and resting joints: docs/friction.md, "Real-time bound").
+  int contact_max_pivots = -1;
   /// Time step dt (s) of a velocity-level solve; 0 (default): the instant. With dt > 0 the
   /// conditions of joint friction, joint limits and contacts hold at the end of the step, for the
   /// velocities qd+ = q_dot + dt qdd (the result's qdd is the step's mean acceleration): a joint or
