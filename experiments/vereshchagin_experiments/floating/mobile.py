@@ -43,6 +43,8 @@ import numpy as np
 from vereshchagin import Contact, Solver, Tree, robots
 from vereshchagin.task import beta_for, directions, pose_error
 
+from ._common import min_jerk
+
 __all__ = ["BASE_MASS", "PATHS", "VARIANTS", "MobileRun", "metrics", "mobile_urdf", "run_variant"]
 
 VARIANTS = ("arm", "base")
@@ -180,11 +182,6 @@ class MobileRun:
     info: dict = field(default_factory=dict)
 
 
-def _min_jerk(s: float) -> tuple[float, float, float]:
-    s = min(max(s, 0.0), 1.0)
-    return 10 * s**3 - 15 * s**4 + 6 * s**5, 30 * s**2 - 60 * s**3 + 30 * s**4, 60 * s - 180 * s**2 + 120 * s**3
-
-
 def reference(t: float, p0: np.ndarray, path: str = "near") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The tool's reference position, velocity and acceleration at time ``t`` on ``path`` (a key of
     :data:`PATHS`) from ``p0`` (world, m, m/s, m/s^2)."""
@@ -194,7 +191,7 @@ def reference(t: float, p0: np.ndarray, path: str = "near") -> tuple[np.ndarray,
     start = 0.0
     for (a, b), T in zip(legs, TIMES):
         if t < start + T:
-            s, ds, dds = _min_jerk((t - start) / T)
+            s, ds, dds = min_jerk((t - start) / T)
             return a + s * (b - a), ds / T * (b - a), dds / T**2 * (b - a)
         start += T
     return goal.copy(), np.zeros(3), np.zeros(3)

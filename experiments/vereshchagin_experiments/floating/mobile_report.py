@@ -14,6 +14,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from ..contact.report import md_table, write_csv
+from ._common import save
 from .mobile import BASE_MASS, MU, PATHS, PRESS, TABLE_TOP, VARIANTS, metrics, run_variant
 
 __all__ = ["run"]
@@ -79,9 +80,7 @@ def _plot(path: Path, runs: dict, nums: dict) -> None:
     ax.set_ylabel("tool position error [mm]")
     ax.set_title("tracking")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path)
 
 
 def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None) -> dict:

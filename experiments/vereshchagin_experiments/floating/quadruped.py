@@ -30,6 +30,7 @@ from vereshchagin.whole_body import least_effort
 from vereshchagin.task import beta_for, pose_error
 
 from . import solo_plant as sp
+from ._common import min_jerk
 
 __all__ = ["SHIFT", "STAND", "TIMES", "StandRun", "metrics", "run"]
 
@@ -81,11 +82,6 @@ class StandRun:
     info: dict = field(default_factory=dict)
 
 
-def _min_jerk(s: float) -> tuple[float, float, float]:
-    s = min(max(s, 0.0), 1.0)
-    return 10 * s**3 - 15 * s**4 + 6 * s**5, 30 * s**2 - 60 * s**3 + 30 * s**4, 60 * s - 180 * s**2 + 120 * s**3
-
-
 def reference(t: float, p0: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Base position, velocity, acceleration at ``t`` (world; m, m/s, m/s^2)."""
     settle, shift, hold, back, _ = TIMES
@@ -93,11 +89,11 @@ def reference(t: float, p0: np.ndarray, target: np.ndarray) -> tuple[np.ndarray,
     if t < settle:
         return p0.copy(), np.zeros(3), np.zeros(3)
     if t < settle + shift:
-        s, ds, dds = _min_jerk((t - settle) / shift)
+        s, ds, dds = min_jerk((t - settle) / shift)
         return p0 + s * d, ds / shift * d, dds / shift**2 * d
     if t < settle + shift + hold:
         return target.copy(), np.zeros(3), np.zeros(3)
-    s, ds, dds = _min_jerk((t - settle - shift - hold) / back)
+    s, ds, dds = min_jerk((t - settle - shift - hold) / back)
     return target - s * d, -ds / back * d, -dds / back**2 * d
 
 

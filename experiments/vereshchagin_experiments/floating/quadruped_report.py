@@ -14,6 +14,7 @@ import numpy as np
 
 
 from ..contact.report import md_table, write_csv
+from ._common import save
 from . import solo_plant as sp
 from .quadruped import MU_MODEL, SHIFT, TIMES, metrics, run as run_stand
 
@@ -79,28 +80,13 @@ def _plot(path: Path, r) -> None:
     ax.set_ylabel("motor torque [N m] (HAA -, HFE --, KFE :)")
     ax.set_title("motor torques")
     ax.legend(fontsize=7, loc="center right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path)
 
 
 def run(out_dir, quick: bool = False, progress: Optional[Callable[[str], None]] = None) -> dict:
-    """Run the weight shift and write ``quadruped/quadruped.md``, ``.csv`` and ``.png``.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        The results directory (the files go to its ``quadruped/``).
-    quick : bool
-        Unused (the run is short); for the common signature.
-    progress : callable, optional
-        Called with one line when the run starts.
-
-    Returns
-    -------
-    dict
-        ``index`` (Markdown lines for results/index.md), ``ok`` (all checks passed), ``checks``
-        (name -> bool), ``seconds``.
+    """Run the weight shift and write ``quadruped/quadruped.md``, ``.csv`` and ``.png`` into
+    ``out_dir``; the arguments and the returned dict as :func:`.mobile_report.run`'s (``quick``
+    unused, ``progress`` called once).
     """
     t0 = time.perf_counter()
     out = Path(out_dir) / "quadruped"
