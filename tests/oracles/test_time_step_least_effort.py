@@ -327,6 +327,26 @@ def test_some_random_chain_cases_are_redundant():
     assert count >= 4, count
 
 
+def _tree_supports(case, rng, q, qd, tau, k, mu):
+    """Pinocchio's (q, qd, tau) of a tree case and k supports on random segments whose normals
+    oppose their points' free motion (the free acceleration, plus qd / dt's part v), a little
+    tilted."""
+    model, names, n = case.model, list(case.tree.segment_names), case.n
+    pq, pqd, ptau = case.pin_q(q), case.pin_v(qd), case.pin_v(tau)
+    data = model.createData()
+    minv_h = np.linalg.solve(pin.crba(model, data, pq), ptau - pin.rnea(model, data, pq, pqd, np.zeros(n)))
+    pin.computeJointJacobians(model, data, pq)
+    pin.forwardKinematics(model, data, pq, pqd, np.zeros(n))
+    contacts = []
+    for s in rng.choice(len(names), size=k, replace=False):
+        point = rng.normal(size=3) * 0.05
+        J, bias, v = point_jacobian(model, data, model.getFrameId(names[s]), point)
+        d = J @ minv_h + bias + v
+        normal = -d / max(np.linalg.norm(d), 1e-9) + 0.2 * rng.normal(size=3)
+        contacts.append(vs.Contact(names[s], point=point, normal=normal / np.linalg.norm(normal), mu=mu))
+    return pq, pqd, ptau, contacts
+
+
 @pytest.mark.parametrize("name", ["baxter", "random_8"])
 def test_redundant_supports_on_trees(name):
     """Three to five supports (frictionless and with friction) on a tree, friction on every
@@ -343,18 +363,7 @@ def test_redundant_supports_on_trees(name):
         qd *= qd_scale > 0.0
         tau = rng.normal(size=n) * 2
         fs = rng.uniform(0.2, 2.0, size=n)
-        pq, pqd, ptau = case.pin_q(q), case.pin_v(qd), case.pin_v(tau)
-        data = model.createData()
-        minv_h = np.linalg.solve(pin.crba(model, data, pq), ptau - pin.rnea(model, data, pq, pqd, np.zeros(n)))
-        pin.computeJointJacobians(model, data, pq)
-        pin.forwardKinematics(model, data, pq, pqd, np.zeros(n))
-        contacts = []
-        for s in rng.choice(len(names), size=k, replace=False):
-            point = rng.normal(size=3) * 0.05
-            J, bias, v = point_jacobian(model, data, model.getFrameId(names[s]), point)
-            d = J @ minv_h + bias + v
-            normal = -d / max(np.linalg.norm(d), 1e-9) + 0.2 * rng.normal(size=3)
-            contacts.append(vs.Contact(names[s], point=point, normal=normal / np.linalg.norm(normal), mu=mu))
+        pq, pqd, ptau, contacts = _tree_supports(case, rng, q, qd, tau, k, mu)
         seg = names[int(rng.integers(len(names)))]
         alpha = np.zeros((6, 3))
         alpha[3:, :] = np.eye(3)
@@ -408,23 +417,12 @@ def test_baxter_steps_that_found_no_impulses(seed):
     from support.trees import robot
 
     case = robot("baxter")
-    model, names, n, dt = case.model, list(case.tree.segment_names), case.n, 1e-3
+    model, n, dt = case.model, case.n, 1e-3
     rng = np.random.default_rng([555, seed])
     q, qd = case.random_state(rng, qd_scale=0.2)
     tau = rng.normal(size=n) * 2
     fs = rng.uniform(0.2, 2.0, size=n)
-    pq, pqd, ptau = case.pin_q(q), case.pin_v(qd), case.pin_v(tau)
-    data = model.createData()
-    minv_h = np.linalg.solve(pin.crba(model, data, pq), ptau - pin.rnea(model, data, pq, pqd, np.zeros(n)))
-    pin.computeJointJacobians(model, data, pq)
-    pin.forwardKinematics(model, data, pq, pqd, np.zeros(n))
-    contacts = []
-    for s in rng.choice(len(names), size=3, replace=False):  # normals against the free motion
-        point = rng.normal(size=3) * 0.05
-        J, bias, v = point_jacobian(model, data, model.getFrameId(names[s]), point)
-        d = J @ minv_h + bias + v
-        normal = -d / max(np.linalg.norm(d), 1e-9) + 0.2 * rng.normal(size=3)
-        contacts.append(vs.Contact(names[s], point=point, normal=normal / np.linalg.norm(normal), mu=0.6))
+    pq, pqd, ptau, contacts = _tree_supports(case, rng, q, qd, tau, 3, 0.6)
     fr = vs.Friction(static=fs, kinetic=0.7 * fs)
     r = case.solver().solve(q, qd, tau_ff=tau, friction=fr, contacts=contacts, time_step=dt)
     specs = [dict(frame=model.getFrameId(c.segment), point=c.point, normal=c.normal, mu=c.mu) for c in contacts]
