@@ -46,10 +46,6 @@ class HdCore;
 // for a joint friction holds (JointStatus::Stick) and, with every joint held, for the base too
 // when the sticking contacts fix it (ContactStage::baseHeld).
 void floatingEndVelocity(DataImpl& d, const SolveInput& in, Eigen::Ref<Eigen::VectorXd> qd_next);
-/// `s` if q_next and qd_next are finite, else Error::NonfiniteResult with `message` (a literal):
-/// a step whose position update overflows (step(), stepSymplectic()).
-Status finiteStep(const Eigen::Ref<const Eigen::VectorXd>& q_next, const Eigen::Ref<const Eigen::VectorXd>& qd_next,
-                  const Status& s, const char* message);
 // The workspace of floatingInverseInertiaDot for `model` (floating_contact_points.cpp).
 std::shared_ptr<struct FloatingGauss> makeFloatingGauss(const Model& model);
 

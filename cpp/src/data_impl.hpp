@@ -51,5 +51,10 @@ struct DataImpl {
 // has friction), without its contacts; 0 or an error code with the core's message (solve.cpp).
 int runInput(DataImpl& d, const SolveInput& in);
 
+/// `s` if q_next and qd_next are finite, else Error::NonfiniteResult with `message` (a literal):
+/// a step whose position update overflows (step() in contact_step.cpp, stepSymplectic()).
+Status finiteStep(const Eigen::Ref<const Eigen::VectorXd>& q_next, const Eigen::Ref<const Eigen::VectorXd>& qd_next,
+                  const Status& s, const char* message);
+
 }  // namespace detail
 }  // namespace vereshchagin

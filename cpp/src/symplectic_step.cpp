@@ -10,7 +10,6 @@
 
 #include "symplectic_step.hpp"
 
-#include "contact_stage.hpp"
 #include "data_impl.hpp"
 #include "vereshchagin/energy.hpp"
 
