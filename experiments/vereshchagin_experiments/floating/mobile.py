@@ -234,7 +234,8 @@ def _press(t: float) -> Optional[float]:
 
 def _command(variant, path, model, solver, data, t, p0, R0):
     """The plant's motor commands of one period (arm torques N m; base forces world N and N m),
-    the tool's position error (m; x and y only in contact) and the model's table normal force (N)."""
+    the tool's position error (m; x and y only in contact), the model's table normal force (N), the
+    base's state (:func:`_base_state`) and the tool's world pose (4 x 4) at the period's start."""
     nb = 0 if variant == "arm" else 3
     qa, qda = data.qpos[nb:], data.qvel[nb:]
     base = _base_state(variant, data)
@@ -259,14 +260,14 @@ def _command(variant, path, model, solver, data, t, p0, R0):
     ff = POSTURE[0] * (np.asarray(robots.GEN3_START_POSE) - qa) - POSTURE[1] * qda
     if variant == "arm":
         r = solver.solve(qa, qda, tau_ff=ff, constraints={TIP: (alpha, beta)}, **args)
-        return ff + r.tau_command, err, _normal(r, press)
+        return ff + r.tau_command, err, _normal(r, press), base, T
     q = np.r_[base[:2], np.cos(base[2]), np.sin(base[2]), qa]
     qd = np.r_[base[3:], qda]
     ff = np.r_[-np.asarray(BASE_DAMPING) * base[3:], ff]
     r = solver.solve(q, qd, tau_ff=ff, constraints={TIP: (alpha, beta)}, **args)
     u = ff + r.tau_command
     world = _rz(base[2])[:2, :2] @ u[:2]  # the base's force from base axes into the world's
-    return np.r_[world, u[2:]], err, _normal(r, press)
+    return np.r_[world, u[2:]], err, _normal(r, press), base, T
 
 
 def _normal(result, press) -> float:
@@ -305,11 +306,9 @@ def run_variant(variant: str, path: str = "near", steps: int | None = None) -> M
     keys = ("t", "error", "torque", "base_force", "base_pose", "tool", "model_normal", "plant_normal")
     rows = {k: [] for k in keys}
     for k in range(steps):
-        u, err, normal = _command(variant, path, model, solver, data, k * DT, T0[:3, 3], T0[:3, :3])
+        u, err, normal, base, T = _command(variant, path, model, solver, data, k * DT, T0[:3, 3], T0[:3, :3])
         u = np.clip(u, -limits, limits)  # what the motors can give
         data.ctrl[:] = u
-        base = _base_state(variant, data)
-        T, _ = _tool_world(model, base, data.qpos[nb:], data.qvel[nb:])
         vals = (k * DT, err, u[nb:], u[:nb] if mobile else np.zeros(3), base[:3], T[:3, 3], normal)
         for key, val in zip(keys, (*vals, _plant_normal(plant, data))):
             rows[key].append(val)

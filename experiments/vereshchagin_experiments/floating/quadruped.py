@@ -97,17 +97,6 @@ def reference(t: float, p0: np.ndarray, target: np.ndarray) -> tuple[np.ndarray,
     return target - s * d, -ds / back * d, -dds / back**2 * d
 
 
-def _rotation(q: np.ndarray) -> np.ndarray:
-    x, y, z, w = q[3:7]
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def standing_state(tree: Tree) -> np.ndarray:
     """q (nq) of the robot standing at :data:`STAND`, base level at the origin's x, y, feet on the floor."""
     low = min(np.asarray(tree.fk(STAND, f))[2, 3] for f in sp.FEET)
@@ -115,24 +104,26 @@ def standing_state(tree: Tree) -> np.ndarray:
 
 
 def _feet_world(tree: Tree, q: np.ndarray) -> np.ndarray:
-    R = _rotation(q)
+    R = sp.base_rotation(q)
     return np.array([R @ np.asarray(tree.fk(q[7:], f))[:3, 3] + q[:3] for f in sp.FEET])
 
 
 def _command(tree, solver, supports, q, qd, ref, R0):
-    """Least-effort torques (12) and foot forces (4 x 3) for the base reference ``ref`` (p, v, a)."""
-    R = _rotation(q)
+    """Least-effort torques (12), foot forces (4 x 3) and the base's pose error (6: position,
+    rotation vector) for the base reference ``ref`` (p, v, a) and orientation ``R0``."""
+    R = sp.base_rotation(q)
     T = np.eye(4)
     T[:3, :3], T[:3, 3] = R, q[:3]
     goal = np.eye(4)
     goal[:3, :3], goal[:3, 3] = R0, ref[0]
     twist = np.r_[R @ qd[:3], R @ qd[3:6]]  # world axes, at the base origin
-    a = np.r_[ref[2], 0.0, 0.0, 0.0] + GAINS[0] * pose_error(T, goal) + GAINS[1] * (np.r_[ref[1], 0, 0, 0] - twist)
+    e = pose_error(T, goal)
+    a = np.r_[ref[2], 0.0, 0.0, 0.0] + GAINS[0] * e + GAINS[1] * (np.r_[ref[1], 0, 0, 0] - twist)
     alpha = np.eye(6)
     beta = beta_for(alpha, a, twist, GRAVITY)
     ff = np.r_[np.zeros(6), -JOINT_DAMPING * qd[6:]]
     r = least_effort(solver, q, qd, task={None: (alpha, beta)}, supports=supports, tau_ff=ff)
-    return r.tau[6:] + ff[6:], r.contact_force
+    return r.tau[6:] + ff[6:], r.contact_force, e
 
 
 def _plant_feet(plant, data) -> tuple[np.ndarray, np.ndarray]:
@@ -171,11 +162,10 @@ def run(steps: int | None = None) -> StandRun:
     for k in range(steps):
         q, qd = sp.to_model(data)
         ref = reference(k * sp.DT, p0, target)
-        tau, forces = _command(tree, solver, supports, q, qd, ref, np.eye(3))
+        tau, forces, e = _command(tree, solver, supports, q, qd, ref, np.eye(3))
         data.ctrl[:] = tau
-        e = pose_error(np.block([[_rotation(q), q[:3, None]], [np.zeros((1, 3)), 1.0]]), np.eye(4))
         normal, speed = _plant_feet(plant, data)
-        err = np.r_[np.linalg.norm(ref[0] - q[:3]), np.linalg.norm(e[3:])]
+        err = np.r_[np.linalg.norm(e[:3]), np.linalg.norm(e[3:])]
         for key, val in zip(rows, (k * sp.DT, err, data.ctrl.copy(), forces, normal, speed, q[:3])):
             rows[key].append(val)
         mujoco.mj_step(plant, data)

@@ -18,7 +18,17 @@ import numpy as np
 
 from vereshchagin import Tree, robots
 
-__all__ = ["FEET", "FOOT_RADIUS", "MU", "TORQUE_LIMIT", "build", "model_acceleration", "solo12_urdf", "to_model"]
+__all__ = [
+    "FEET",
+    "FOOT_RADIUS",
+    "MU",
+    "TORQUE_LIMIT",
+    "base_rotation",
+    "build",
+    "model_acceleration",
+    "solo12_urdf",
+    "to_model",
+]
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 FOOT_RADIUS = 0.016
@@ -71,6 +81,14 @@ def build(model: Tree, gravity=(0.0, 0.0, -9.81)) -> mujoco.MjModel:
     if names != list(model.joint_names):
         raise ValueError(f"the plant's joints {names} are not the model's {list(model.joint_names)}")
     return plant
+
+
+def base_rotation(q: np.ndarray) -> np.ndarray:
+    """The base's rotation (base axes to world axes) of the library's free-flyer q (quaternion
+    (x, y, z, w) at q[3:7])."""
+    R = np.zeros(9)
+    mujoco.mju_quat2Mat(R, np.r_[q[6], q[3:6]])
+    return R.reshape(3, 3)
 
 
 def _rotation(data) -> np.ndarray:
