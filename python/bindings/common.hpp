@@ -13,6 +13,7 @@
 
 #include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/kinematics.hpp"  // poseFromArray
+#include "vereshchagin/status.hpp"
 
 namespace vsbind {
 
@@ -36,6 +37,17 @@ inline const char* doc(const std::string& key) {
 
 [[noreturn]] inline void raise(const std::string& msg) {
   throw SolverError(msg);
+}
+// Raises the message of a library check ("" or a Status that is ok(): nothing to raise).
+inline void check(const std::string& why) {
+  if (!why.empty()) raise(why);
+}
+inline void check(const vereshchagin::Status& s) {
+  if (!s) raise(s.message());
+}
+// An optional argument that was passed (not missing, not None).
+inline bool given(PyObject* obj) {
+  return obj != nullptr && obj != Py_None;
 }
 
 // The value of an integer argument (an int or anything with __index__; each caller refuses bool

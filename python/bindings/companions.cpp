@@ -13,10 +13,6 @@ using K = vs::Companion;
 
 namespace {
 
-void check(const vs::Status& s) {
-  if (!s) raise(s.message());
-}
-
 // gravity as a list or tuple of three Python floats, read into g (storage) and viewed by `arg`
 // without numpy (false: anything else, converted by asF64). Values are checked with the others'.
 bool floatTriple(PyObject* obj, double g[3], vs::ArrayArg& arg) {

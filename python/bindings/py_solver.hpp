@@ -20,11 +20,10 @@ namespace vsbind {
 inline constexpr int kOutArg = 10, kADesiredArg = 11, kContactsArg = 12, kTimeStepArg = 13, kVelocityTolArg = 14,
                      kNumSolveArgs = 15;
 
-// The arguments of one solve (1 row, no batch axis) or of a batch (B rows, each argument shared or with a leading
-// batch axis) as a BatchInput, shapes checked by BatchArgs with messages naming the argument (values: by solve(), per
-// row). friction=: None/False, True (the model's values), a vereshchagin.Friction or any object with its attributes,
-// read as the tuple of vereshchagin/friction.py's _fields_of; a Friction caches it until an attribute is replaced and
-// its arrays cannot be written, so solve()'s SolveArgs reuses its parse while the tuple is the same.
+// The arguments of one solve (1 row) or of a batch (B rows, each argument shared or with a leading batch axis) as a
+// BatchInput, shapes checked by BatchArgs with messages naming the argument (values: by solve(), per row). friction=:
+// read as the tuple of vereshchagin/friction.py's _fields_of; a Friction caches it (its arrays are read-only) until an
+// attribute is replaced, so solve()'s SolveArgs reuses its parse while the tuple is the same.
 class SolveArgs : public vereshchagin::BatchArgs {
  public:
   // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
@@ -117,6 +116,14 @@ class PySolver {
   // successful solve_batch(): response_columns() linearises around it.
   bool last_state_ = false;
 };
+
+// vereshchagin.SolveResult (result_type.cpp: every output of a solve in storage allocated with the object, fields are
+// views). newResult: a new one for `layout`, or `out` checked to have that layout (a new reference); resultOutput:
+// where solve() writes into it (the friction outputs nullptr without friction); setSegmentLayout: segment_nu's (key,
+// start, count) tuples.
+py::object newResult(const vereshchagin::PackedRow& layout, PyObject* out);
+vereshchagin::BatchOutput resultOutput(PyObject* result);
+void setSegmentLayout(PyObject* result, py::tuple layout);
 
 // "physical" or "joint_space" (vereshchagin::parseInertiaCheck; raises otherwise, naming `where`).
 vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where);

@@ -6,18 +6,6 @@
 
 namespace vsbind {
 
-namespace {
-
-bool given(PyObject* obj) {
-  return obj != nullptr && obj != Py_None;
-}
-
-void check(const std::string& why) {
-  if (!why.empty()) raise(why);
-}
-
-}  // namespace
-
 F64View SolveArgs::view(PyObject* obj, const char* name) {
   F64View v = asF64(obj, name);
   if (v.keep) keep_.push_back(std::move(v.keep));  // v.data stays valid: keep_ holds the copy

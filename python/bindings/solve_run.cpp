@@ -4,7 +4,6 @@
 #include <algorithm>
 
 #include "py_solver.hpp"
-#include "result_type.hpp"
 
 namespace vsbind {
 

@@ -68,11 +68,8 @@ PyObject* guarded(Body&& body) {
 enum Entry { kSolve, kTimeCpp, kSolveBatch, kStep, kStepSymplectic };
 constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "solve_batch", "_step", "_step_symplectic"};
 
-// The METH_FASTCALL methods: solve(q, qd, ...); _time_cpp(reps, q, qd, ...): seconds per C++
-// solve (outputs read as solve() reads them), for benchmarks that compare the Python call with
-// the C++ work in the same process; solve_batch(q, qd, ..., threads, a_desired, contacts): a dict of the batch's arrays
-// (solver.py wraps it); _step(q, qd, ..., time_step=dt): vereshchagin::step(), (q_next, qd_next, SolveResult);
-// _step_symplectic(..., out=momentum): stepSymplectic(), (q_next, qd_next, momentum_next, SolveResult).
+// The METH_FASTCALL methods (what each returns: vereshchagin/_docstrings.py): solve, _time_cpp(reps, ...), solve_batch
+// (`out` is its `threads`; a dict that solver.py wraps), _step, _step_symplectic (`out` is its momentum).
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
