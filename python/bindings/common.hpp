@@ -88,7 +88,7 @@ struct F64View : vereshchagin::ArrayArg {
 // `obj` as numpy float64 with at most 3 dimensions. Native C-contiguous aligned float64 arrays are
 // viewed in place; integer and floating arrays (and nested sequences of numbers) are converted;
 // None, bool, complex, string, object and other dtypes raise naming `name` (a failed conversion
-// with its Python error). Values are not checked here (see requireFiniteView).
+// with its Python error). Values are not checked here.
 inline F64View asF64(PyObject* obj, const char* name) {
   namespace d = py::detail;
   const auto& api = d::npy_api::get();
@@ -120,10 +120,6 @@ inline F64View asF64(PyObject* obj, const char* name) {
   v.ndim = arr->nd;
   for (int k = 0; k < v.ndim; ++k) v.shape[k] = arr->dimensions[k];
   return v;
-}
-
-inline void requireFiniteView(const F64View& v, const char* name) {
-  if (const std::string why = vereshchagin::nonfiniteMessage(v, name); !why.empty()) raise(why);
 }
 
 // A checked (n,) vector argument (a scalar is accepted for n == 1 when scalar_ok).

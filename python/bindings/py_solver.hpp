@@ -18,7 +18,7 @@ namespace vsbind {
 
 // Positions in the argument array of SolveArgs::parse (solve()'s parameter order).
 inline constexpr int kOutArg = 10, kADesiredArg = 11, kContactsArg = 12, kTimeStepArg = 13, kVelocityTolArg = 14,
-                     kNumSolveArgs = 15;
+                     kMaxPivotsArg = 15, kNumSolveArgs = 16;
 
 // The arguments of one solve (1 row) or of a batch (B rows, each argument shared or with a leading batch axis) as a
 // BatchInput, shapes checked by BatchArgs with messages naming the argument (values: by solve(), per row). friction=:
@@ -26,9 +26,7 @@ inline constexpr int kOutArg = 10, kADesiredArg = 11, kContactsArg = 12, kTimeSt
 // attribute is replaced, so solve()'s SolveArgs reuses its parse while the tuple is the same.
 class SolveArgs : public vereshchagin::BatchArgs {
  public:
-  // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
-  // tau_ff_pass_through, (out: not read), a_desired, contacts, time_step, contact_velocity_tolerance
-  // (nullptr or None: not given).
+  // args: solve()'s parameters in kSolveParams order (solver_bindings.cpp; out: not read); nullptr or None: not given.
   void parse(class PySolver& s, PyObject* const* args, bool batch);
 
   bool any_friction = false;
@@ -94,7 +92,7 @@ class PySolver {
   };
 
   unsigned int nj = 0, ns = 0, nq = 0;  // nj: the model's nv, nq: its nq (base_kind.hpp)
-  const Addressable* addressing = nullptr;
+  const CompanionModel* addressing = nullptr;  // what the argument parser reads of the model
   vereshchagin::FrictionModel model_friction;  // friction=True's
 
  private:

@@ -2,6 +2,8 @@
 // float64 arrays are handed to vereshchagin::BatchArgs, which checks their shapes into rows with a stride of a
 // BatchInput (0: shared by every row; solve() is the one-row case without a batch axis); keys are resolved here.
 // friction=: its _fields tuple's arrays checked by vereshchagin::frictionFromArrays, values by vereshchagin::solve.
+#include <climits>
+
 #include "py_solver.hpp"
 
 namespace vsbind {
@@ -181,6 +183,12 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   input.time_step = given(a[kTimeStepArg]) ? scalarArg(a[kTimeStepArg], "time_step") : 0.0;  // (range: by solve)
   const bool v_tol = given(a[kVelocityTolArg]);
   input.contact_velocity_tolerance = v_tol ? scalarArg(a[kVelocityTolArg], "contact_velocity_tolerance") : 1e-6;
+  PyObject* p = given(a[kMaxPivotsArg]) ? a[kMaxPivotsArg] : nullptr;  // an int, not a bool (its value: solve()'s)
+  const bool is_int = p && !PyBool_Check(p) && PyIndex_Check(p);
+  const std::optional<long long> bound = !p ? -1 : is_int ? intWithin(p, INT_MIN, INT_MAX) : std::nullopt;
+  if (!bound)
+    raise("contact_max_pivots must be an int, -1 (the default bound) or > 0, got " + std::string(py::repr(p)));
+  input.contact_max_pivots = static_cast<int>(*bound);
   // Pass-through weights: one per constraint column (their range: checked by vereshchagin::solve).
   if (given(a[8])) input.f_ext_pass_through = vector(a[8], "f_ext_pass_through", columns, /*scalar_ok=*/true);
   if (given(a[9])) input.ff_pass_through = vector(a[9], "tau_ff_pass_through", columns, /*scalar_ok=*/true);

@@ -13,7 +13,7 @@ namespace {
 // clang-format off
 constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
                                         "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired", "contacts",
-                                        "time_step", "contact_velocity_tolerance"};
+                                        "time_step", "contact_velocity_tolerance", "contact_max_pivots"};
 // clang-format on
 static_assert(sizeof(kSolveParams) == kNumSolveArgs * sizeof(char*), "one name per SolveArgs::parse argument");
 PyObject* g_names[2][kNumSolveArgs];  // interned: solve()'s, solve_batch()'s

@@ -256,6 +256,7 @@ class Solver:
         contacts: Optional[Sequence[Contact]] = None,
         time_step: Optional[float] = None,
         contact_velocity_tolerance: Optional[float] = None,
+        contact_max_pivots: Optional[int] = None,
     ) -> SolveResult: ...
     def _time_cpp(self, reps: int, /, *args: object, **kwargs: object) -> float: ...
     def _step(self, /, *args: object, **kwargs: object) -> tuple[np.ndarray, np.ndarray, SolveResult]: ...
@@ -279,6 +280,7 @@ class Solver:
         contacts: Optional[Sequence[Contact]] = None,
         time_step: Optional[float] = None,
         contact_velocity_tolerance: Optional[float] = None,
+        contact_max_pivots: Optional[int] = None,
     ) -> dict: ...
     def response_columns(
         self, joints: Sequence[int], hold_sticking: bool = True
