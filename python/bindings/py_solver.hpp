@@ -8,8 +8,8 @@
 #include <mutex>
 #include <thread>
 
-#include "vereshchagin/batch_args.hpp"  // also <string>, <vector>
-#include "vereshchagin/whole_body.hpp"  // also <memory>
+#include "vereshchagin/batch_args.hpp"       // also <string>, <vector>
+#include "vereshchagin/whole_body_call.hpp"  // also <memory>
 
 #include "common.hpp"
 #include "model_class.hpp"
@@ -28,6 +28,8 @@ class SolveArgs : public vereshchagin::BatchArgs {
  public:
   // args: solve()'s parameters in kSolveParams order (solver_bindings.cpp; out: not read); nullptr or None: not given.
   void parse(class PySolver& s, PyObject* const* args, bool batch);
+  // contacts: a list or tuple of vereshchagin.Contact (`name` in messages), every row's, into input.contacts.
+  void parseContacts(PyObject* obj, const char* name);
 
   bool any_friction = false;
   py::list layout;  // segment_nu's: a (key, first column in nu, columns) tuple per constraints= key
@@ -39,7 +41,6 @@ class SolveArgs : public vereshchagin::BatchArgs {
   void parseFExt(PyObject* obj);
   void parseConstraints(PyObject* obj);
   void parseFriction(PyObject* obj);
-  void parseContacts(PyObject* obj);
   // The parsed friction (nullptr: none): the model's values, the cache or `scratch`.
   const vereshchagin::FrictionModel* friction(PyObject* obj, vereshchagin::FrictionModel& scratch);
 
@@ -65,6 +66,10 @@ class PySolver {
   double timeCpp(PyObject* const* args, long reps);
   // solve_batch(): args as solve()'s (`out` not read); threads: None (1) or an int, 0: one per core.
   py::dict solveBatch(PyObject* const* args, PyObject* threads);
+  // whole_body.least_effort (q, qd, f_ext, tau_ff, supports: as solve()'s; task: (label, segment -1 or -2, None, or 0,
+  // key as solve()'s constraints keys, point, alpha, beta) tuples; actuated: None or (n_joints,)): tau, forces, ...
+  using WholeBodyOut = std::tuple<Eigen::VectorXd, Eigen::MatrixXd, Eigen::VectorXd, double, double>;
+  WholeBodyOut wholeBody(O q, O qd, O f_ext, O tau_ff, O actuated, O supports, O task);
   // joints: joint indices in range (solver.py resolves names and negative indices).
   std::pair<Eigen::MatrixXd, Eigen::MatrixXd> responseColumns(const Eigen::VectorXi& joints, bool hold_sticking);
 
@@ -91,7 +96,7 @@ class PySolver {
     PySolver& s_;
   };
 
-  unsigned int nj = 0, ns = 0, nq = 0;  // nj: the model's nv, nq: its nq (base_kind.hpp)
+  unsigned int nj = 0, ns = 0, nq = 0;         // nj: the model's nv, nq: its nq (base_kind.hpp)
   const CompanionModel* addressing = nullptr;  // what the argument parser reads of the model
   vereshchagin::FrictionModel model_friction;  // friction=True's
 
@@ -107,7 +112,8 @@ class PySolver {
   KDL::Vector gravity_;
   vereshchagin::SolverOptions options_;
   std::vector<std::unique_ptr<vereshchagin::BatchWorkspace>> workspaces_;
-  SolveArgs args_;  // solve()'s, reused under the lock
+  SolveArgs args_;                          // solve()'s (and least_effort's), reused under the lock
+  vereshchagin::WholeBodyCall whole_body_;  // least_effort's (its solver built at its first call)
   std::mutex mutex_;
   std::atomic<std::thread::id> holder_{};  // the thread inside a call, or none
   // Workspace 0 holds the state of the last successful solve() or of the last row of the last

@@ -126,18 +126,17 @@ void SolveArgs::parseFriction(PyObject* obj) {  // input.friction: cleared by st
   }
 }
 
-// contacts: a list or tuple of vereshchagin.Contact, every row's. Each holds its segment key and its
-// checked values as a read-only float64 array (vereshchagin/contacts.py): point (3, in the segment's
-// or link's frame), normal (3), mu, facets, force (NaN: a support).
-void SolveArgs::parseContacts(PyObject* obj) {
+// Each Contact holds its segment key and its checked values as a read-only float64 array (vereshchagin/contacts.py):
+// point (3, in the segment's or link's frame), normal (3), mu, facets, force (NaN: a support).
+void SolveArgs::parseContacts(PyObject* obj, const char* name) {
   static PyObject* const type =
       py::object(py::module_::import("vereshchagin.contacts").attr("Contact")).release().ptr();
   static PyObject* const segment_name = PyUnicode_InternFromString("_segment");
   static PyObject* const values_name = PyUnicode_InternFromString("_values");
-  if (!PyList_Check(obj) && !PyTuple_Check(obj)) raise("contacts must be a list of vereshchagin.Contact");
+  if (!PyList_Check(obj) && !PyTuple_Check(obj)) raise(std::string(name) + " must be a list of vereshchagin.Contact");
   for (Py_ssize_t k = 0; k < PySequence_Fast_GET_SIZE(obj); ++k) {
     PyObject* c = PySequence_Fast_GET_ITEM(obj, k);
-    const std::string label = "contacts[" + std::to_string(k) + "]";
+    const std::string label = name + ("[" + std::to_string(k) + "]");
     if (!PyObject_TypeCheck(c, reinterpret_cast<PyTypeObject*>(type)))
       raise(label + " must be a vereshchagin.Contact, got " + Py_TYPE(c)->tp_name);
     const auto attr = [c](PyObject* name) {
@@ -179,7 +178,7 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   if (given(a[7])) parseConstraints(a[7]);
   parseFriction(a[6]);
   input.contacts.clear();
-  if (given(a[kContactsArg])) parseContacts(a[kContactsArg]);
+  if (given(a[kContactsArg])) parseContacts(a[kContactsArg], "contacts");
   input.time_step = given(a[kTimeStepArg]) ? scalarArg(a[kTimeStepArg], "time_step") : 0.0;  // (range: by solve)
   const bool v_tol = given(a[kVelocityTolArg]);
   input.contact_velocity_tolerance = v_tol ? scalarArg(a[kVelocityTolArg], "contact_velocity_tolerance") : 1e-6;

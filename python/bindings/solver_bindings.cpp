@@ -109,7 +109,7 @@ void bindSolver(py::module_& mod) {
           py::arg("max_constraints") = py::none())
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            doc("_core.Solver.response_columns"))
-      .def("_whole_body", &vereshchagin::wholeBodyArraysOf<PySolver>, doc("_core.Solver._whole_body"))
+      .def("_whole_body", &PySolver::wholeBody, doc("_core.Solver._whole_body"))
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, doc("_core.Solver.gravity"))
       .def_readonly("n_joints", &PySolver::nj, doc("_core.Solver.n_joints"))
       .def_readonly("n_segments", &PySolver::ns, doc("_core.Solver.n_segments"))

@@ -286,8 +286,16 @@ class Solver:
         self, joints: Sequence[int], hold_sticking: bool = True
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
     def _whole_body(
-        self, arg0: Sequence[ArrayLike]
-    ) -> tuple[int, str, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float, float]: ...
+        self,
+        arg0: ArrayLike,
+        arg1: ArrayLike,
+        arg2: object,
+        arg3: object,
+        arg4: object,
+        arg5: object,
+        arg6: object,
+        /,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float, float]: ...
     @property
     def model(self) -> Union[Chain, Tree]: ...
     @property

@@ -704,7 +704,7 @@ DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None,
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 """
 
-DOCS["_core.Solver._whole_body"] = r"""Whole-body least effort from a list of arrays (internal; see vereshchagin.whole_body.least_effort)."""
+DOCS["_core.Solver._whole_body"] = r"""_whole_body(q, qd, f_ext, tau_ff, actuated, supports, task) -> (tau, forces (3, k), qdd, effort, residual): whole-body least effort on the solver's kept C++ WholeBodySolver (internal; see vereshchagin.whole_body.least_effort, which resolves the task's keys into (label, segment, point, alpha, beta) tuples)."""
 DOCS["_core.Solver.response_columns"] = r"""Affine response of the last solve to unit feed-forward torques (see the wrapper in vereshchagin.Solver)."""
 
 DOCS["_core.Solver.gravity"] = r"""Physical gravity in the base frame, shape (3,), m/s^2 (settable; see :class:`Solver`)."""
