@@ -26,7 +26,7 @@ import pinocchio as pin
 import pytest
 
 import vereshchagin as vs
-from support.trees import pin_q, pin_v_index
+from support.trees import pin_q_free, pin_v_index, pin_v_scatter
 from vereshchagin.robots import example_robot_urdf
 
 UP = np.array([0.0, 0.0, 1.0])
@@ -53,14 +53,10 @@ class Solo:
         return np.r_[0.0, 0.0, 0.25, 0.0, 0.0, 0.0, 1.0, [joints[n] for n in self.tree.joint_names]]
 
     def pin_q(self, q):
-        out = pin_q(self.model, self.tree.joint_names, q[7:])
-        out[:7] = q[:7]
-        return out
+        return pin_q_free(self.model, self.tree.joint_names, q)
 
     def pin_v(self, v):
-        out = np.zeros(self.model.nv)
-        out[self.v_index] = v
-        return out
+        return pin_v_scatter(self.model, self.v_index, v)
 
     def feet_rows(self, q, qd, qdd):
         """Per foot (Pinocchio's numbers): Jacobian (3, nv), velocity (3,), classical acceleration (3,)."""
