@@ -76,10 +76,12 @@ int HdCore::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eig
   if (want_tau) commandPerNu();
   const long k = joints.size(), width = ws.response.width;
   // A few columns on a fixed-base chain: in the segments' own frames (response_local.cpp).
-  const bool local = model.is_chain && !model.floating && !res.general && k <= std::min<long>(width, kLocalColumns);
+  // (Not every joint in order: that request's response is the symmetric one, mirrored exactly.)
+  const JointTorqueSources src{joints, model};
+  const bool local = model.is_chain && !model.floating && !res.general && k <= std::min<long>(width, kLocalColumns) &&
+                     !src.identity(0, k);
   if (!local) baseAxes();
   // All columns, in chunks of at most the workspace width (n_joints, at most kResponseWidth).
-  const JointTorqueSources src{joints, model};
   for (long c0 = 0; c0 < k; c0 += width) {
     const long kc = std::min<long>(width, k - c0);
     if (local) {  // (then one chunk)
