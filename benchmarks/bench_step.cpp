@@ -6,8 +6,10 @@
 // friction |gravity torque| x U(0.3, 1.5) + 0.2 N m per joint (kinetic 0.8 of it) so that some
 // joints stick and some slip, dt = 1 ms. Method: bench_common.hpp (interleaved batches, medians,
 // paired ratios). Prints a markdown report (stdout, or the file given as argv[1]); `--dump file` writes
-// step()'s results for comparing two builds, `--profile step|solve` loops one of them for perf.
+// step()'s results for comparing two builds, `--profile step|solve|simulator [reps]` loops one of them
+// for perf or callgrind.
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -141,8 +143,10 @@ int main(int argc, char** argv) {
   bench::Rng rng(20261127);
   const std::vector<State> rest = states(model, false, rng), moving = states(model, true, rng);
   if (argc > 2 && std::string(argv[1]) == "--profile") {  // step() on the moving states, for perf
-    Runner r{model, std::string(argv[2]) == "solve" ? kSolve : kStep};
-    for (int rep = 0; rep < 20000; ++rep)
+    const std::string what = argv[2];
+    Runner r{model, what == "solve" ? kSolve : what == "simulator" ? kSimulator : kStep};
+    const int reps = argc > 3 ? std::atoi(argv[3]) : 20000;
+    for (int rep = 0; rep < reps; ++rep)
       for (const State& st : moving) bench::g_sink += r(st);
     return bench::g_sink == 0.123 ? 1 : 0;
   }

@@ -4,8 +4,9 @@
 #  * test_unpatched_kdl: Debian's unpatched KDL, to show the defects are really there.
 #
 # Usage: extern_patches/run_patch_tests.sh [OUT_DIR [VERESHCHAGIN_PREFIX]]   (default: build/patched_kdl)
-# VERESHCHAGIN_PREFIX: an installed copy of our library (built against Debian's KDL) that
-# test_unpatched_kdl links instead of compiling our sources once more.
+# VERESHCHAGIN_PREFIX: an installed copy of our library (built against Debian's KDL) that both
+# tests link instead of compiling our sources twice more (tests/CMakeLists.txt says why the
+# patched test may: the patches touch only KDL's Vereshchagin solver, which our library does not use).
 set -euo pipefail
 
 HERE="$(cd "$(dirname "$0")" && pwd)"
