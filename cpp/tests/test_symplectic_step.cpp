@@ -1,6 +1,6 @@
 // The symplectic step (src/symplectic_step.hpp, the Simulator's Integrator::Symplectic): without
 // friction it equals a dense symplectic Euler in momentum form built from massMatrix,
-// gravityTorques and kineticEnergyGradient (checked against Pinocchio in test_energy_pinocchio);
+// gravityTorques and kineticEnergyGradient (checked against Pinocchio in test_pinocchio_oracle);
 // a passive chain's energy stays bounded where semi-implicit Euler (step()) gains; a chain held by
 // friction keeps q bitwise with one solve per step; the iteration bound's fallback is Degraded.
 #include <doctest/doctest.h>
