@@ -53,6 +53,64 @@ double inverseFrobeniusSquared(const ML& L, VX& x) {
   return frob2;
 }
 
+// The coupling matrices' variants (hd_core.cpp, segment_constraints.cpp) of the three routines
+// above and below: the factor also writes inv(j) = 1 / L(j, j), and the substitutions multiply by
+// it (one division per pivot instead of one per entry, none on the substitutions' dependency
+// chains) and run forward by columns, each solved entry updating the rows below it independently.
+template <typename MA, typename ML, typename VI>
+bool choleskyCertified(const MA& A, ML& L, VI& inv, double min_pivot) {
+  const int k = static_cast<int>(A.rows());
+  for (int j = 0; j < k; ++j) {
+    double d = A(j, j);
+    for (int p = 0; p < j; ++p) d -= L(j, p) * L(j, p);
+    if (!(d > min_pivot)) return false;
+    L(j, j) = std::sqrt(d);
+    inv(j) = 1.0 / L(j, j);
+    for (int i = j + 1; i < k; ++i) {
+      double v = A(i, j);
+      for (int p = 0; p < j; ++p) v -= L(i, p) * L(j, p);
+      L(i, j) = v * inv(j);
+    }
+  }
+  return true;
+}
+
+// ||L^-1||_F^2 given inv = 1 / diag(L); X: scratch of at least k x k. L^-1 (lower triangular)
+// goes into X row by row: row i is (e_i - L(i, 0..i-1) X(0..i-1, :)) / L(i, i), its entries
+// independent of each other, so that only the rows form a dependency chain.
+template <typename ML, typename VI, typename MX>
+double inverseFrobeniusSquared(const ML& L, const VI& inv, MX& X) {
+  const int k = static_cast<int>(L.rows());
+  double frob2 = 0.0;
+  for (int i = 0; i < k; ++i) {
+    for (int c = 0; c <= i; ++c) {
+      double v = i == c ? 1.0 : 0.0;
+      for (int p = c; p < i; ++p) v -= L(i, p) * X(p, c);
+      X(i, c) = v * inv(i);
+    }
+    double row2 = 0.0;
+    for (int c = 0; c <= i; ++c) row2 += X(i, c) * X(i, c);
+    frob2 += row2;
+  }
+  return frob2;
+}
+
+// Solve L L^T x = b in place given inv = 1 / diag(L).
+template <typename ML, typename VI, typename VB>
+void choleskySolve(const ML& L, const VI& inv, VB& b) {
+  const int k = static_cast<int>(L.rows());
+  for (int p = 0; p < k; ++p) {
+    const double xp = b(p) * inv(p);
+    b(p) = xp;
+    for (int i = p + 1; i < k; ++i) b(i) -= L(i, p) * xp;
+  }
+  for (int i = k - 1; i >= 0; --i) {
+    double v = b(i);
+    for (int p = i + 1; p < k; ++p) v -= L(p, i) * b(p);
+    b(i) = v * inv(i);
+  }
+}
+
 // Per-eigenvalue multipliers of a symmetric positive semi-definite matrix's (pseudo-)inverse
 // under a singularity policy: truncated (1 / lambda for lambda > cut, else 0) or damped least
 // squares (lambda / (lambda^2 + damping^2)). Negative round-off eigenvalues count as 0. Returns

@@ -77,6 +77,19 @@ struct SegmentModel {
   double v2 = 0.0, w2 = 0.0;  // |linear part of S|^2, |angular part of S|^2
   double d_tolerance = 0.0;   // articulated inertias of this joint at or below this are degenerate
   int joint = -1;             // joint index or -1 for a fixed joint
+  int axis = -1;              // S has one nonzero entry (a coordinate axis): its index, else -1
+  // S^T x, on a coordinate axis the one product (the others are exact zeros: the same value).
+  template <typename V>
+  double dotS(const V& x) const {
+    return axis >= 0 ? S(axis) * x(axis) : S.dot(x);
+  }
+  // The screw motion of screwPose() with X0 folded in (model_build.cpp), for S = [v; w], unit
+  // axis k = w / |w|, K = [k]x: X(q).R = X0.R + sin(|w| q) RK + (1 - cos(|w| q)) RKK and
+  // X(q).p = X0.p - sin(|w| q) pK - (1 - cos(|w| q)) pKK + q pq, with RK = X0.R K,
+  // RKK = X0.R K K, pK = RK (k x v) / |w|, pKK = RKK (k x v) / |w|, pq = X0.R k (k . v) (zero
+  // but pq = X0.R v for a prismatic joint, |w| = 0).
+  Matrix3 RK = Matrix3::Zero(), RKK = Matrix3::Zero();
+  Vector3 pK = Vector3::Zero(), pKK = Vector3::Zero(), pq = Vector3::Zero();
 };
 
 // The robot: constant per robot, validated when built.
@@ -122,6 +135,7 @@ struct CouplingFast {
   VectorC U0;
   MatrixC L0, K;  // L0 = -K accumulated by the inward sweep
   MatrixC chol;   // lower Cholesky factor of K on the certified path
+  VectorC chol_inv;  // 1 / its diagonal
   Eigen::SelfAdjointEigenSolver<MatrixC> eig;
   VectorC inv_eigen;  // per-eigenvalue multiplier of the policy
 };
@@ -137,8 +151,11 @@ struct CouplingGeneral {
   Eigen::VectorXd ug, nug, rhs;
   mutable Eigen::VectorXd tmp;
   Eigen::MatrixXd kg, cholg, vg;           // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
+  Eigen::VectorXd cholg_inv;               // 1 / the Cholesky factor's diagonal
   Eigen::VectorXd invg;                    // policy multiplier per eigenvalue
-  mutable Eigen::MatrixXd work_g, work_v;  // smallest eigenvalue (both paths): matrix (mcap x mcap), scratch (mcap x 4)
+  // Smallest eigenvalue (both paths): matrix (mcap x mcap; also the Jacobi path's matrix and the
+  // certificate's L^-1), scratch (mcap x 4).
+  mutable Eigen::MatrixXd work_g, work_v;
   mutable Matrix6X seg_force;              // per-segment wrench accumulators
   int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
   {
@@ -185,6 +202,25 @@ struct PassThroughState {
   const Eigen::VectorXd* driver = nullptr;      // ff driver if not ff_torques (FrictionSolver)
 };
 
+// Cholesky factor D = L L^T of the floating base's k x k articulated inertia (k = nbv <= 6), with
+// the reciprocals of its diagonal, and its solves (floating_base.cpp). Fixed storage and plain
+// loops: at this size a general factorisation's blocking and dispatch cost more than its flops.
+struct BaseFactor {
+  Matrix6 L = Matrix6::Zero();  // lower triangle (k x k) used
+  Vector6 inv = Vector6::Zero();  // 1 / L(j, j)
+  int k = 0;
+  bool compute(const Matrix6& D, int size);  // false: D is not positive definite (or not finite)
+  template <typename V>
+  void forward(V&& x) const;  // x <- L^-1 x (k entries)
+  template <typename V>
+  void backward(V&& x) const;  // x <- L^-T x
+  template <typename V>
+  void solve(V&& x) const {  // x <- D^-1 x
+    forward(x);
+    backward(x);
+  }
+};
+
 // Per-solve state of the floating base body (floating_base.cpp), base axes.
 struct BaseState {
   Pose X;                             // pose of the base frame in the world frame at q
@@ -194,10 +230,10 @@ struct BaseState {
   Matrix6 IA = Matrix6::Zero();       // articulated inertia, closed over every root segment
   Vector6 pA = Vector6::Zero();       // articulated bias force
   BaseAxes U;                         // IA S
-  BaseSquare D;                       // S^T IA S
-  Eigen::LLT<BaseSquare> llt;         // of D
+  Matrix6 D = Matrix6::Zero();        // S^T IA S (top-left k x k)
+  BaseFactor factor;                  // of D
   BaseVector free;                    // D^-1 (tau - S^T pA): the base's acceleration, world at rest
-  Eigen::MatrixXd e, De;              // S^T A_base and D^-1 S^T A_base (k x mcap)
+  Eigen::MatrixXd e, De;              // S^T A_base and L^-1 S^T A_base, then D^-1 S^T A_base (k x mcap)
 };
 
 struct HdWorkspace {

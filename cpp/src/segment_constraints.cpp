@@ -189,7 +189,7 @@ void HdCore::projectColumns(int i, int lo, int w, double free) {
   double kappa = 0.0;
   for (int k = 0; k < w; ++k) {
     Eigen::Map<Vector6> a(g.acur.col(lo + k).data());
-    const double ek = sm.S.dot(a);
+    const double ek = sm.dotS(a);
     e[k] = ek;
     u[k] += a.dot(bias);
     // The fast path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
@@ -270,9 +270,10 @@ bool HdCore::choleskyBlocks() {
     withBlockSize(w, [&](auto size) {
       constexpr int S = decltype(size)::value;
       auto L = g.cholg.block<S, S>(lo, lo, w, w);
-      ok = detail::choleskyCertified(g.kg.block<S, S>(lo, lo, w, w), L, 0.0);
-      auto x = g.tmp.head<S>(w);
-      if (ok) frob2 += detail::inverseFrobeniusSquared(L, x);
+      auto inv = g.cholg_inv.segment<S>(lo, w);
+      ok = detail::choleskyCertified(g.kg.block<S, S>(lo, lo, w, w), L, inv, 0.0);
+      auto X = g.work_g.block<S, S>(0, 0, w, w);
+      if (ok) frob2 += detail::inverseFrobeniusSquared(L, inv, X);
     });
   });
   const double lower = 1.0 / frob2;
@@ -308,7 +309,7 @@ void HdCore::couplingSolve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::
       withBlockSize(w, [&](auto size) {
         constexpr int S = decltype(size)::value;
         auto x = out.template segment<S>(lo, w);
-        detail::choleskySolve(g.cholg.block<S, S>(lo, lo, w, w), x);
+        detail::choleskySolve(g.cholg.block<S, S>(lo, lo, w, w), g.cholg_inv.segment<S>(lo, w), x);
       });
     });
     return;
