@@ -133,8 +133,8 @@ struct SegmentState {
 // Coupling matrix of the fast path (m <= 6 columns on the last segment of a chain).
 struct CouplingFast {
   VectorC U0;
-  MatrixC L0, K;  // L0 = -K accumulated by the inward sweep
-  MatrixC chol;   // lower Cholesky factor of K on the certified path
+  MatrixC L0, K;     // L0 = -K accumulated by the inward sweep
+  MatrixC chol;      // lower Cholesky factor of K on the certified path
   VectorC chol_inv;  // 1 / its diagonal
   Eigen::SelfAdjointEigenSolver<MatrixC> eig;
   VectorC inv_eigen;  // per-eigenvalue multiplier of the policy
@@ -150,13 +150,13 @@ struct CouplingGeneral {
   Eigen::MatrixXd eg;         // mcap x n_segments: column i = (S_i^T A_i)^T on i's felt range (only)
   Eigen::VectorXd ug, nug, rhs;
   mutable Eigen::VectorXd tmp;
-  Eigen::MatrixXd kg, cholg, vg;           // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
-  Eigen::VectorXd cholg_inv;               // 1 / the Cholesky factor's diagonal
-  Eigen::VectorXd invg;                    // policy multiplier per eigenvalue
+  Eigen::MatrixXd kg, cholg, vg;  // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
+  Eigen::VectorXd cholg_inv;      // 1 / the Cholesky factor's diagonal
+  Eigen::VectorXd invg;           // policy multiplier per eigenvalue
   // Smallest eigenvalue (both paths): matrix (mcap x mcap; also the Jacobi path's matrix and the
   // certificate's L^-1), scratch (mcap x 4).
   mutable Eigen::MatrixXd work_g, work_v;
-  mutable Matrix6X seg_force;              // per-segment wrench accumulators
+  mutable Matrix6X seg_force;                // per-segment wrench accumulators
   int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
   {
     return active[model.subtree_end[i]];
@@ -206,7 +206,7 @@ struct PassThroughState {
 // the reciprocals of its diagonal, and its solves (floating_base.cpp). Fixed storage and plain
 // loops: at this size a general factorisation's blocking and dispatch cost more than its flops.
 struct BaseFactor {
-  Matrix6 L = Matrix6::Zero();  // lower triangle (k x k) used
+  Matrix6 L = Matrix6::Zero();    // lower triangle (k x k) used
   Vector6 inv = Vector6::Zero();  // 1 / L(j, j)
   int k = 0;
   bool compute(const Matrix6& D, int size);  // false: D is not positive definite (or not finite)
