@@ -7,10 +7,17 @@ friction cones (mu 0.7, square pyramids). Among all torques that do it, the solv
 of least motor effort ``sum(tau^2)`` and the feet's forces with them, exactly. The script prints
 the vertical foot forces and the effort standing symmetrically, then with the base moved 4 cm
 forward and 3 cm to the left and the legs re-posed (the weight shifts between the feet), and
-what the solver says when the base is pushed sideways harder than the cones allow.
+what the solver says when the base is pushed sideways harder than the cones allow. A load on a leg
+is given as ``Solver.solve`` takes it (``f_ext={segment or link: wrench}``). Last, the forward
+dynamics of the same stance pushed sideways (``Solver.solve`` with the feet as contacts, mu 0.3):
+the feet slide, and with the contact stage's real-time bound forced to one pivot
+(``contact_max_pivots=1``) the solve returns its safe fallback (the feet held along their normals,
+no friction) with a ``RuntimeWarning``.
 
 Run: ``python examples/floating_standing_quadruped.py [out_dir]`` (prints only; under 1 s).
 """
+
+import warnings
 
 import numpy as np
 
@@ -29,12 +36,12 @@ def feet(q):
     return [vs.Contact(foot, normal=[0, 0, 1], mu=0.7, facets=4) for foot in FEET]
 
 
-def stand(q, push=None):
+def stand(q, push=None, f_ext=None):
     push = np.zeros(6) if push is None else push
     base_still = (np.eye(6), np.r_[-GRAVITY, 0.0, 0.0, 0.0])  # at rest: beta = [-gravity; 0]
     tau_ff = np.r_[push, np.zeros(tree.n_joints)]  # a wrench on the base (base axes)
     return vs.whole_body.least_effort(
-        solver, q, np.zeros(tree.nv), task={None: base_still}, supports=feet(q), tau_ff=tau_ff
+        solver, q, np.zeros(tree.nv), task={None: base_still}, supports=feet(q), tau_ff=tau_ff, f_ext=f_ext
     )
 
 
@@ -58,3 +65,19 @@ try:
     stand(q, push=np.array([60.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
 except vs.SolverError as exc:
     print("pushed sideways with 60 N:", exc)
+
+# A 15 N load pressing down on the front-left upper leg (base axes, about that link's origin).
+r3 = stand(q, f_ext={"FL_UPPER_LEG": [0.0, 0.0, -15.0, 0.0, 0.0, 0.0]})
+print("15 N on the front-left upper leg: vertical forces (N)", np.round(r3.contact_force[:, 2], 3))
+
+# Forward dynamics, no task: the same stance, the legs' motors at their standing torques, pushed
+# sideways on the base (20 N), the feet as contacts on slippery ground.
+slippery = [vs.Contact(foot, normal=[0, 0, 1], mu=0.3) for foot in FEET]
+push = np.r_[20.0, 0.0, 0.0, 0.0, 0.0, 0.0, r.tau[6:]]
+exact = solver.solve(q, np.zeros(tree.nv), tau_ff=push, contacts=slippery)
+print("pushed on slippery ground: contact status", exact.contact_status, "(2: sliding)")
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    held = solver.solve(q, np.zeros(tree.nv), tau_ff=push, contacts=slippery, contact_max_pivots=1)
+print("with contact_max_pivots=1:", caught[0].message if caught else "no warning")
+print("  fallback forces along the normals (N)", np.round(held.contact_force[:, 2], 3))

@@ -43,6 +43,7 @@ void BatchInput::fillRow(std::ptrdiff_t b, SolveInput& in) const {
   in.contacts = contacts;  // within in.contacts' capacity after the first row
   in.contact_velocity_tolerance = contact_velocity_tolerance;
   in.time_step = time_step;
+  in.contact_max_pivots = contact_max_pivots;
   const double* f_pass = f_ext_pass_through.data ? f_ext_pass_through.row(b) : nullptr;
   const double* t_pass = ff_pass_through.data ? ff_pass_through.row(b) : nullptr;
   int col = 0;

@@ -220,6 +220,9 @@ int FrictionCore::boxQp(int k) {
   // (The free-set factor updates of factorDelete() change how a step is computed, not which.)
   const long max_iterations = iterationEnd(k), it0 = iterations_;
   bound_ = max_iterations;
+  qp_unique_ = (k == 1 && boxQpOne(cmax, torque_scale, max_iterations)) ||
+               (k == 2 && boxQpTwo(cmax, torque_scale, max_iterations));
+  if (qp_unique_) return ChainHdSolver::E_NOERROR;
   int rounds_left = kPrimalDualRounds;
   bool face_optimal = false, bland = false;
   double last_face_value = kInf;
@@ -261,6 +264,62 @@ int FrictionCore::boxQp(int k) {
   degraded_ = 1;  // the bound is hit: the fallback (boxQpFallback) on the feasible iterate x
   boxQpFallback(k);
   return ChainHdSolver::E_NOERROR;
+}
+
+// k = 1 (over a time step usually the one joint whose slide guess was refuted): with curvature
+// Q_00 above the zero-curvature tolerance the iterations below take the Newton step x = c / Q_00
+// (as freeStep computes it, c times the pivot's reciprocal) in their first primal-dual round, and
+// when it leaves the box clamp it to the bound and confirm the bound's multiplier in a second
+// iteration. The same here, with the same iteration count and scales; a multiplier of the wrong
+// sign at the bound (round-off can only make it tiny) leaves the case to the iterations.
+bool FrictionCore::boxQpOne(double cmax, double torque_scale, long max_iterations) {
+  const double q = Q_(0, 0), c = c_(0);
+  if (!(q > kZeroCurvature * qscale_) || max_iterations - iterations_ < 2) return false;
+  const double inv = 1.0 / q;
+  double x = c * inv;
+  int state = 0;
+  if (x > hi_(0)) {
+    x = hi_(0), state = 1;
+  } else if (x < lo_(0)) {
+    x = lo_(0), state = -1;
+  }
+  // (the scale of the iteration that ends: with x = 0 for the first, at the bound for the second)
+  gscale_ = std::max({cmax, qscale_ * (state == 0 ? 0.0 : std::abs(x)), qscale_ * torque_scale, 1e-300});
+  if (state != 0) {
+    const double grad = -c + q * x;
+    if ((state < 0 ? -grad : grad) > kGradientTolerance * gscale_) return false;
+  }
+  x_(0) = x;
+  state_(0) = state;
+  free_full_rank_ = true;
+  factor_valid_ = false;
+  iterations_ = static_cast<int>(std::min<long>(iterations_ + (state == 0 ? 1 : 2), 2147483647L));
+  return true;
+}
+
+// k = 2 (two refuted slide guesses, both usually ending the step stuck): the first iteration's
+// Newton step from x = 0 exactly as freeStep computes it (the unpivoted L D L^T of Q with
+// reciprocal pivots, both pivots above the curvature tolerance); when it lands inside the box the
+// primal-dual round finds no violation and no bound multiplier: a KKT point after one iteration.
+// Anything else is left to the iterations (nothing of the workspace is touched before).
+bool FrictionCore::boxQpTwo(double cmax, double torque_scale, long max_iterations) {
+  const double tol = kZeroCurvature * qscale_;
+  const double w00 = Q_(0, 0), w10 = Q_(1, 0);
+  if (kPrimalDualRounds < 1 || max_iterations - iterations_ < 1 || !(w00 > tol)) return false;
+  const double inv0 = 1.0 / w00, l10 = w10 * inv0;
+  const double w11 = Q_(1, 1) - l10 * w10;
+  if (!(w11 > tol)) return false;
+  const double inv1 = 1.0 / w11;
+  const double y0 = -c_(0), y1 = -c_(1) - l10 * y0;  // L y = g, g = -c at x = 0
+  const double x1 = -y1 * inv1, x0 = -y0 * inv0 - l10 * x1;
+  if (x0 > hi_(0) || x0 < lo_(0) || x1 > hi_(1) || x1 < lo_(1)) return false;
+  gscale_ = std::max({cmax, 0.0, qscale_ * torque_scale, 1e-300});  // (the iteration's, at x = 0)
+  x_(0) = x0, x_(1) = x1;
+  state_(0) = state_(1) = 0;
+  free_full_rank_ = true;
+  factor_valid_ = false;
+  iterations_ = static_cast<int>(std::min<long>(iterations_ + 1L, 2147483647L));
+  return true;
 }
 
 // The real-time fallback when boxQp hits its bound: the last iterate x (inside the box: primal

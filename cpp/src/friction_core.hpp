@@ -117,6 +117,12 @@ class FrictionCore {
   // (returns true) when g_F has a component in null(Q_FF).
   bool freeStep(int nf);
   bool primalDualRound(int k, int nf, double tol_g);
+  // One unknown of positive curvature: boxQp's answer and counts without its machinery (false:
+  // not that case, boxQp iterates).
+  bool boxQpOne(double cmax, double torque_scale, long max_iterations);
+  // Two unknowns whose Newton step from 0 stays in the box: boxQp's first round, inline.
+  bool boxQpTwo(double cmax, double torque_scale, long max_iterations);
+  bool qp_unique_ = false;  // boxQpOne / boxQpTwo answered: a strictly convex QP, no tie to break
   int primalStep(int nf, bool zero_curvature, bool& face_optimal);
   int wrongSignMultiplier(int k, double tol_g, bool bland) const;
   void gradient(int k);

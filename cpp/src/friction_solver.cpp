@@ -307,7 +307,8 @@ int FrictionCore::optimiseResting(int k) {
   rc = boxQp(k);
   if (rc != ChainHdSolver::E_NOERROR) return rc;
   tau_cmd_known_ = false;
-  if (degraded_ == 0) leastCommand(k);  // (the tie-break is for the optimal face only)
+  // (The tie-break is for the optimal face only; a strictly convex QP has one optimum.)
+  if (degraded_ == 0 && !qp_unique_) leastCommand(k);
   applyResting(k);
   return ChainHdSolver::E_NOERROR;
 }
@@ -340,9 +341,9 @@ int FrictionCore::restingProblem(int k) {
   // scale for themselves).
   qscale_ = 0.0;
   for (int a = 0; a < k; ++a)
-    qscale_ = std::max({qscale_, Q_(a, a), 1.0 / hd_->ws.seg[hd_->model.joint_segment[rest_(a)]].D});
+    qscale_ = std::max({qscale_, Q_(a, a), hd_->ws.seg[hd_->model.joint_segment[rest_(a)]].Dinv});  // (= 1 / D)
   for (unsigned int j = 0; j < nj_; ++j)  // (over a step) the standing guesses are unknowns too
-    if (slide_[j] == 1) qscale_ = std::max(qscale_, 1.0 / hd_->ws.seg[hd_->model.joint_segment[j]].D);
+    if (slide_[j] == 1) qscale_ = std::max(qscale_, hd_->ws.seg[hd_->model.joint_segment[j]].Dinv);
   return ChainHdSolver::E_NOERROR;
 }
 
@@ -350,7 +351,7 @@ int FrictionCore::restingProblem(int k) {
 // left it) tau_cmd_, affine from the base and the response columns.
 void FrictionCore::applyResting(int k) {
   qdd_ = qdd0_;
-  qdd_.noalias() -= Gc_.leftCols(k) * x_.head(k);
+  for (int a = 0; a < k; ++a) qdd_ -= x_(a) * Gc_.col(a);  // (k is small: no matrix-vector kernel)
   const int m = hd_->res.m;
   nu_.head(m) = nu0_.head(m);
   nu_.head(m).noalias() -= dnu_.topLeftCorner(m, k) * x_.head(k);

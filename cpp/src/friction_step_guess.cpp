@@ -23,13 +23,16 @@ namespace detail {
 
 int FrictionCore::refuteSlides() {
   const double acc_scale = std::max(1.0, nj_ ? qdd_.cwiseAbs().maxCoeff() : 0.0);  // as frictionOutputs'
+  const double band = 1e-9 * acc_scale;
   int refuted = 0;
   for (unsigned int j = 0; j < nj_; ++j) {
-    if (slide_[j] != 1) continue;
     // The end velocity over dt along qd: it must stay strictly outside the Stick band (a joint that
-    // ends the step at rest, or within round-off of it, is an unknown of the QP).
-    const double row = (qdd_(j) + shift_(j)) * (xg_(j) > 0.0 ? 1.0 : -1.0);
-    if (!(row > 1e-9 * acc_scale)) slide_[j] = 2, ++refuted;
+    // ends the step at rest, or within round-off of it, is an unknown of the QP). Without branches
+    // on the data (the signs are as good as random).
+    const double row = (qdd_(j) + shift_(j)) * std::copysign(1.0, xg_(j));  // (xg_ != 0 on a guess)
+    const int refute = (slide_[j] == 1) & !(row > band);
+    slide_[j] = static_cast<char>(slide_[j] + refute);
+    refuted += refute;
   }
   return refuted;
 }

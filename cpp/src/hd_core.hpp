@@ -454,6 +454,14 @@ class HdCore {
   void responseCoupling(long c0, long kc, Eigen::Ref<Eigen::MatrixXd>* dnu_out);
   template <typename Sources>
   void responseOutward(const Sources& src, long c0, long kc, Eigen::Ref<Eigen::MatrixXd> dqdd);
+  // At most kLocalColumns joint columns on a fixed-base chain on the fast path, both passes in
+  // the segments' own frames (response_local.cpp).
+  static constexpr int kLocalColumns = 4;
+  void localResponse(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                     Eigen::Ref<Eigen::MatrixXd>* dnu_out);
+  template <int K>
+  void localResponseT(const Eigen::Ref<const Eigen::VectorXi>& joints, Eigen::Ref<Eigen::MatrixXd> dqdd,
+                      Eigen::Ref<Eigen::MatrixXd>* dnu_out);
 };
 
 }  // namespace detail

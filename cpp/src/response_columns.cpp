@@ -74,15 +74,23 @@ int HdCore::responseColumns(const Eigen::Ref<const Eigen::VectorXi>& joints, Eig
   if (rc != 0) return rc;
   const int m = res.m;
   if (want_tau) commandPerNu();
-  baseAxes();
-  // All columns, in chunks of at most the workspace width (n_joints, at most kResponseWidth).
   const long k = joints.size(), width = ws.response.width;
+  // A few columns on a fixed-base chain: in the segments' own frames (response_local.cpp).
+  // (Not every joint in order: that request's response is the symmetric one, mirrored exactly.)
   const JointTorqueSources src{joints, model};
+  const bool local = model.is_chain && !model.floating && !res.general && k <= std::min<long>(width, kLocalColumns) &&
+                     !src.identity(0, k);
+  if (!local) baseAxes();
+  // All columns, in chunks of at most the workspace width (n_joints, at most kResponseWidth).
   for (long c0 = 0; c0 < k; c0 += width) {
     const long kc = std::min<long>(width, k - c0);
-    responseInward(src, c0, kc);
-    responseCoupling(c0, kc, dnu_out);
-    responseOutward(src, c0, kc, dqdd);
+    if (local) {  // (then one chunk)
+      localResponse(joints, dqdd, dnu_out);
+    } else {
+      responseInward(src, c0, kc);
+      responseCoupling(c0, kc, dnu_out);
+      responseOutward(src, c0, kc, dqdd);
+    }
     // tau_cmd is linear in nu: d tau_cmd = (d tau_cmd / d nu) d nu, the m columns built once.
     if (!want_tau) continue;
     if (m > 0) {
@@ -246,6 +254,7 @@ void HdCore::responseCoupling(long c0, long kc, Eigen::Ref<Eigen::MatrixXd>* dnu
   ResponseWorkspace& r = ws.response;
   const auto DU = r.energy.topLeftCorner(m, kc);
   auto DNU = r.dnu.topLeftCorner(m, kc);
+  if (m == 0) return;              // (no rows of dnu)
   if (ws.use_cholesky && m > 0) {  // all columns through one factor
     DNU = DU;
     couplingSolveColumns(DNU);

@@ -1,13 +1,16 @@
 // Real-time property: after construction, solve(), CartToJnt(), responseColumns() and Simulator steps allocate no
-// heap memory. Every allocation function is replaced by a counting version (alloc_counter.hpp:
-// operator new/delete and, on glibc, the malloc family, which Eigen uses). The test proves the
-// counters work by allocating on purpose in a counted region.
+// heap memory, also on the contact stage's real-time fallback (a pivot bound reached). Every allocation function is
+// replaced by a counting version (alloc_counter.hpp: operator new/delete and, on glibc, the malloc family, which Eigen
+// uses). The test proves the counters work by allocating on purpose in a counted region.
 #include <doctest/doctest.h>
 
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <limits>
+#include <memory>
+#include <vector>
 
 #include "alloc_counter.hpp"
+#include "contact_fallback_case.hpp"
 #include "floating_fixture.hpp"
 #include "random_chain.hpp"
 #include "random_tree.hpp"
@@ -669,4 +672,44 @@ TEST_CASE("floating bases: solves, response columns, companions, steps and Simul
                                                                         << str(c1.news - c0.news) << ", malloc "
                                                                         << str(c1.mallocs - c0.mallocs));
   }
+}
+
+TEST_CASE("the contact stage's real-time fallback (a pivot bound reached) does not allocate once warm") {
+  // Random chains with 2-5 supports that carry and joint friction near breakaway (the cases of
+  // test_contact_fallback.cpp), at the instant and over a step, with the pivot bound forced to 1 and
+  // 3: the general complementarity problem reaches it and the solve returns Error::Degraded from the
+  // held-normal fallback's sweeps. Each case is solved once before counting (its sizes), then again.
+  testutil::RandomGen g(2714);
+  std::vector<std::unique_ptr<testutil::Case>> cases;
+  for (int t = 0; t < 24; ++t)
+    cases.push_back(std::make_unique<testutil::Case>(g, g.integer(4, 8), g.integer(2, 5), t % 2 ? 0.0 : 0.01));
+  std::vector<std::unique_ptr<vereshchagin::Data>> data;
+  for (const auto& c : cases) data.push_back(std::make_unique<vereshchagin::Data>(c->model));
+  int degraded = 0, failed = 0;
+  double sum = 0.0;
+  const auto run = [&](std::size_t k, int bound, double dt) {
+    testutil::Case& c = *cases[k];
+    c.in.contact_max_pivots = bound;
+    c.in.time_step = dt;
+    const vereshchagin::Status s = vereshchagin::solve(c.model, *data[k], c.in);
+    degraded += s.code() == vereshchagin::Error::Degraded ? 1 : 0;
+    failed += s ? 0 : 1;
+    if (s) sum += data[k]->qdd()(0) + data[k]->contactForces()(2, 0);
+  };
+  const auto all = [&] {
+    for (std::size_t k = 0; k < cases.size(); ++k)
+      for (const double dt : {0.0, 1e-3})
+        for (const int bound : {1, 3}) run(k, bound, dt);
+  };
+  all();  // warm: every case's sizes once
+  degraded = failed = 0;
+  const Counts c0 = now();
+  all();
+  const Counts c1 = now();
+  CHECK_MESSAGE(degraded > 10, "too few fallbacks: " << str(degraded));
+  CHECK_MESSAGE(std::isfinite(sum), "non-finite fallback results");
+  CHECK_MESSAGE((c1.news == c0.news && c1.mallocs == c0.mallocs), "fallback solves allocated: operator new "
+                                                                      << str(c1.news - c0.news) << ", malloc "
+                                                                      << str(c1.mallocs - c0.mallocs));
+  INFO("failed solves (problems without an answer, not this test's): " << failed);
 }

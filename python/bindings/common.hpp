@@ -13,6 +13,7 @@
 
 #include "vereshchagin/array_arg.hpp"
 #include "vereshchagin/kinematics.hpp"  // poseFromArray
+#include "vereshchagin/status.hpp"
 
 namespace vsbind {
 
@@ -36,6 +37,17 @@ inline const char* doc(const std::string& key) {
 
 [[noreturn]] inline void raise(const std::string& msg) {
   throw SolverError(msg);
+}
+// Raises the message of a library check ("" or a Status that is ok(): nothing to raise).
+inline void check(const std::string& why) {
+  if (!why.empty()) raise(why);
+}
+inline void check(const vereshchagin::Status& s) {
+  if (!s) raise(s.message());
+}
+// An optional argument that was passed (not missing, not None).
+inline bool given(PyObject* obj) {
+  return obj != nullptr && obj != Py_None;
 }
 
 // The value of an integer argument (an int or anything with __index__; each caller refuses bool
@@ -76,7 +88,7 @@ struct F64View : vereshchagin::ArrayArg {
 // `obj` as numpy float64 with at most 3 dimensions. Native C-contiguous aligned float64 arrays are
 // viewed in place; integer and floating arrays (and nested sequences of numbers) are converted;
 // None, bool, complex, string, object and other dtypes raise naming `name` (a failed conversion
-// with its Python error). Values are not checked here (see requireFiniteView).
+// with its Python error). Values are not checked here.
 inline F64View asF64(PyObject* obj, const char* name) {
   namespace d = py::detail;
   const auto& api = d::npy_api::get();
@@ -108,10 +120,6 @@ inline F64View asF64(PyObject* obj, const char* name) {
   v.ndim = arr->nd;
   for (int k = 0; k < v.ndim; ++k) v.shape[k] = arr->dimensions[k];
   return v;
-}
-
-inline void requireFiniteView(const F64View& v, const char* name) {
-  if (const std::string why = vereshchagin::nonfiniteMessage(v, name); !why.empty()) raise(why);
 }
 
 // A checked (n,) vector argument (a scalar is accepted for n == 1 when scalar_ok).

@@ -13,10 +13,6 @@ using K = vs::Companion;
 
 namespace {
 
-void check(const vs::Status& s) {
-  if (!s) raise(s.message());
-}
-
 // gravity as a list or tuple of three Python floats, read into g (storage) and viewed by `arg`
 // without numpy (false: anything else, converted by asF64). Values are checked with the others'.
 bool floatTriple(PyObject* obj, double g[3], vs::ArrayArg& arg) {
@@ -116,8 +112,6 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
     return out;
   };
   const auto grav = [](const M& m, O q, O g) { return run(m, K::GravityTorques, {q, {}, {}, g}); };
-  const auto coriolis = [](const M& m, O q, O qd) { return run(m, K::CoriolisTorques, {q, qd}); };
-  const auto fk_all = [](const M& m, O q) { return run(m, K::FkAll, {q}); };
   const auto of_q = [](K kind) { return [kind](const M& m, O q) { return run(m, kind, {q}); }; };
   const auto of_state = [](K kind) { return [kind](const M& m, O q, O qd) { return run(m, kind, {q, qd}); }; };
   cls.def("fk", fk, py::arg("q"), segment, key("fk"))
@@ -127,9 +121,9 @@ void bindCompanions(py::class_<M>& cls, const std::string& name, const S& segmen
            key("inverse_dynamics"))
       .def("mass_matrix", mass, py::arg("q"), key("mass_matrix"))
       .def("gravity_torques", grav, py::arg("q"), gravity, key("gravity_torques"))
-      .def("coriolis_torques", coriolis, py::arg("q"), py::arg("qd"), key("coriolis_torques"))
+      .def("coriolis_torques", of_state(K::CoriolisTorques), py::arg("q"), py::arg("qd"), key("coriolis_torques"))
       .def("jacobian_dot_times_qd", jdot, py::arg("q"), py::arg("qd"), segment, key("jacobian_dot_times_qd"))
-      .def("fk_all", fk_all, py::arg("q"), key("fk_all"))
+      .def("fk_all", of_q(K::FkAll), py::arg("q"), key("fk_all"))
       .def("center_of_mass", of_q(K::CenterOfMass), py::arg("q"), key("center_of_mass"))
       .def("center_of_mass_jacobian", of_q(K::CenterOfMassJacobian), py::arg("q"), key("center_of_mass_jacobian"))
       .def("center_of_mass_velocity", of_state(K::CenterOfMassVelocity), py::arg("q"), py::arg("qd"),
@@ -145,8 +139,10 @@ void bindDynamics(py::module_& mod) {
   mod.def("_beta_for", &betaFor, py::arg("alpha"), py::arg("a_desired"), py::arg("twist"), py::arg("gravity"),
           doc("_core._beta_for"));
   auto chain = py::reinterpret_borrow<py::class_<PyChain>>(mod.attr("Chain"));
-  bindCompanions(chain, "Chain", py::arg("segment") = py::none(),
-                 [](const PyChain& c, O s) { return c.resolveOptional(s, "segment"); });
+  const auto chainFrame = [](const PyChain& c, O s) {  // None: the last segment (Chain.fk's default)
+    return s.is_none() ? FrameTarget{c.names().segmentCount() - 1} : c.resolveTarget(s.ptr(), "segment");
+  };
+  bindCompanions(chain, "Chain", py::arg("segment") = py::none(), chainFrame);
   auto tree = py::reinterpret_borrow<py::class_<PyTree>>(mod.attr("Tree"));
   bindCompanions(tree, "Tree", py::arg("segment"),
                  [](const PyTree& t, O s) { return t.resolveTarget(s.ptr(), "segment"); });

@@ -50,10 +50,6 @@ class CompanionModel {
       raise(label + ": '" + py::str(which).cast<std::string>() + "' is (part of) the fixed base, not a moving segment");
     return t;
   }
-  // resolveTarget, with None meaning the last segment (the default of Chain.fk, jacobian, ...).
-  FrameTarget resolveOptional(const py::object& which, const std::string& label) const {
-    return which.is_none() ? FrameTarget{names().segmentCount() - 1} : resolveTarget(which.ptr(), label);
-  }
   // Joint index from a joint name or an int index (negative from the end).
   int resolveJoint(PyObject* which, const std::string& label) const {
     if (!PyUnicode_Check(which)) return indexInRange(which, static_cast<int>(jointInfos().size()), label, "joint");
@@ -88,7 +84,6 @@ class CompanionModel {
   }
   mutable std::shared_ptr<vereshchagin::DynamicsData> cache_;  // its model(): the one built
 };
-using Addressable = CompanionModel;  // what the solver's argument parser reads of a model
 
 template <class Robot>
 struct PyModel : CompanionModel {

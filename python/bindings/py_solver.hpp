@@ -8,8 +8,8 @@
 #include <mutex>
 #include <thread>
 
-#include "vereshchagin/batch_args.hpp"  // also <string>, <vector>
-#include "vereshchagin/whole_body.hpp"  // also <memory>
+#include "vereshchagin/batch_args.hpp"       // also <string>, <vector>
+#include "vereshchagin/whole_body_call.hpp"  // also <memory>
 
 #include "common.hpp"
 #include "model_class.hpp"
@@ -18,19 +18,18 @@ namespace vsbind {
 
 // Positions in the argument array of SolveArgs::parse (solve()'s parameter order).
 inline constexpr int kOutArg = 10, kADesiredArg = 11, kContactsArg = 12, kTimeStepArg = 13, kVelocityTolArg = 14,
-                     kNumSolveArgs = 15;
+                     kMaxPivotsArg = 15, kNumSolveArgs = 16;
 
-// The arguments of one solve (1 row, no batch axis) or of a batch (B rows, each argument shared or with a leading
-// batch axis) as a BatchInput, shapes checked by BatchArgs with messages naming the argument (values: by solve(), per
-// row). friction=: None/False, True (the model's values), a vereshchagin.Friction or any object with its attributes,
-// read as the tuple of vereshchagin/friction.py's _fields_of; a Friction caches it until an attribute is replaced and
-// its arrays cannot be written, so solve()'s SolveArgs reuses its parse while the tuple is the same.
+// The arguments of one solve (1 row) or of a batch (B rows, each argument shared or with a leading batch axis) as a
+// BatchInput, shapes checked by BatchArgs with messages naming the argument (values: by solve(), per row). friction=:
+// read as the tuple of vereshchagin/friction.py's _fields_of; a Friction caches it (its arrays are read-only) until an
+// attribute is replaced, so solve()'s SolveArgs reuses its parse while the tuple is the same.
 class SolveArgs : public vereshchagin::BatchArgs {
  public:
-  // args: q, qd, alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through,
-  // tau_ff_pass_through, (out: not read), a_desired, contacts, time_step, contact_velocity_tolerance
-  // (nullptr or None: not given).
+  // args: solve()'s parameters in kSolveParams order (solver_bindings.cpp; out: not read); nullptr or None: not given.
   void parse(class PySolver& s, PyObject* const* args, bool batch);
+  // contacts: a list or tuple of vereshchagin.Contact (`name` in messages), every row's, into input.contacts.
+  void parseContacts(PyObject* obj, const char* name);
 
   bool any_friction = false;
   py::list layout;  // segment_nu's: a (key, first column in nu, columns) tuple per constraints= key
@@ -42,7 +41,6 @@ class SolveArgs : public vereshchagin::BatchArgs {
   void parseFExt(PyObject* obj);
   void parseConstraints(PyObject* obj);
   void parseFriction(PyObject* obj);
-  void parseContacts(PyObject* obj);
   // The parsed friction (nullptr: none): the model's values, the cache or `scratch`.
   const vereshchagin::FrictionModel* friction(PyObject* obj, vereshchagin::FrictionModel& scratch);
 
@@ -68,6 +66,10 @@ class PySolver {
   double timeCpp(PyObject* const* args, long reps);
   // solve_batch(): args as solve()'s (`out` not read); threads: None (1) or an int, 0: one per core.
   py::dict solveBatch(PyObject* const* args, PyObject* threads);
+  // whole_body.least_effort (q, qd, f_ext, tau_ff, supports: as solve()'s; task: (label, segment -1 or -2, None, or 0,
+  // key as solve()'s constraints keys, point, alpha, beta) tuples; actuated: None or (n_joints,)): tau, forces, ...
+  using WholeBodyOut = std::tuple<Eigen::VectorXd, Eigen::MatrixXd, Eigen::VectorXd, double, double>;
+  WholeBodyOut wholeBody(O q, O qd, O f_ext, O tau_ff, O actuated, O supports, O task);
   // joints: joint indices in range (solver.py resolves names and negative indices).
   std::pair<Eigen::MatrixXd, Eigen::MatrixXd> responseColumns(const Eigen::VectorXi& joints, bool hold_sticking);
 
@@ -94,8 +96,8 @@ class PySolver {
     PySolver& s_;
   };
 
-  unsigned int nj = 0, ns = 0, nq = 0;  // nj: the model's nv, nq: its nq (base_kind.hpp)
-  const Addressable* addressing = nullptr;
+  unsigned int nj = 0, ns = 0, nq = 0;         // nj: the model's nv, nq: its nq (base_kind.hpp)
+  const CompanionModel* addressing = nullptr;  // what the argument parser reads of the model
   vereshchagin::FrictionModel model_friction;  // friction=True's
 
  private:
@@ -110,13 +112,22 @@ class PySolver {
   KDL::Vector gravity_;
   vereshchagin::SolverOptions options_;
   std::vector<std::unique_ptr<vereshchagin::BatchWorkspace>> workspaces_;
-  SolveArgs args_;  // solve()'s, reused under the lock
+  SolveArgs args_;                          // solve()'s (and least_effort's), reused under the lock
+  vereshchagin::WholeBodyCall whole_body_;  // least_effort's (its solver built at its first call)
   std::mutex mutex_;
   std::atomic<std::thread::id> holder_{};  // the thread inside a call, or none
   // Workspace 0 holds the state of the last successful solve() or of the last row of the last
   // successful solve_batch(): response_columns() linearises around it.
   bool last_state_ = false;
 };
+
+// vereshchagin.SolveResult (result_type.cpp: every output of a solve in storage allocated with the object, fields are
+// views). newResult: a new one for `layout`, or `out` checked to have that layout (a new reference); resultOutput:
+// where solve() writes into it (the friction outputs nullptr without friction); setSegmentLayout: segment_nu's (key,
+// start, count) tuples.
+py::object newResult(const vereshchagin::PackedRow& layout, PyObject* out);
+vereshchagin::BatchOutput resultOutput(PyObject* result);
+void setSegmentLayout(PyObject* result, py::tuple layout);
 
 // "physical" or "joint_space" (vereshchagin::parseInertiaCheck; raises otherwise, naming `where`).
 vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::string& where);

@@ -1,13 +1,11 @@
-// vereshchagin.SolveResult: storage, views and the solve path's fast access (result_type.hpp).
+// vereshchagin.SolveResult: storage, views and the solve path's fast access (declared in py_solver.hpp).
 // Pickling, copies, segment_nu and repr are Python code over this storage (vereshchagin/_results.py).
-#include "result_type.hpp"
-
 #include <cstring>
 #include <string>
 #include <string_view>
 #include <tuple>
 
-#include "common.hpp"
+#include "py_solver.hpp"
 
 namespace vsbind {
 

@@ -2,21 +2,11 @@
 // float64 arrays are handed to vereshchagin::BatchArgs, which checks their shapes into rows with a stride of a
 // BatchInput (0: shared by every row; solve() is the one-row case without a batch axis); keys are resolved here.
 // friction=: its _fields tuple's arrays checked by vereshchagin::frictionFromArrays, values by vereshchagin::solve.
+#include <climits>
+
 #include "py_solver.hpp"
 
 namespace vsbind {
-
-namespace {
-
-bool given(PyObject* obj) {
-  return obj != nullptr && obj != Py_None;
-}
-
-void check(const std::string& why) {
-  if (!why.empty()) raise(why);
-}
-
-}  // namespace
 
 F64View SolveArgs::view(PyObject* obj, const char* name) {
   F64View v = asF64(obj, name);
@@ -136,18 +126,17 @@ void SolveArgs::parseFriction(PyObject* obj) {  // input.friction: cleared by st
   }
 }
 
-// contacts: a list or tuple of vereshchagin.Contact, every row's. Each holds its segment key and its
-// checked values as a read-only float64 array (vereshchagin/contacts.py): point (3, in the segment's
-// or link's frame), normal (3), mu, facets, force (NaN: a support).
-void SolveArgs::parseContacts(PyObject* obj) {
+// Each Contact holds its segment key and its checked values as a read-only float64 array (vereshchagin/contacts.py):
+// point (3, in the segment's or link's frame), normal (3), mu, facets, force (NaN: a support).
+void SolveArgs::parseContacts(PyObject* obj, const char* name) {
   static PyObject* const type =
       py::object(py::module_::import("vereshchagin.contacts").attr("Contact")).release().ptr();
   static PyObject* const segment_name = PyUnicode_InternFromString("_segment");
   static PyObject* const values_name = PyUnicode_InternFromString("_values");
-  if (!PyList_Check(obj) && !PyTuple_Check(obj)) raise("contacts must be a list of vereshchagin.Contact");
+  if (!PyList_Check(obj) && !PyTuple_Check(obj)) raise(std::string(name) + " must be a list of vereshchagin.Contact");
   for (Py_ssize_t k = 0; k < PySequence_Fast_GET_SIZE(obj); ++k) {
     PyObject* c = PySequence_Fast_GET_ITEM(obj, k);
-    const std::string label = "contacts[" + std::to_string(k) + "]";
+    const std::string label = name + ("[" + std::to_string(k) + "]");
     if (!PyObject_TypeCheck(c, reinterpret_cast<PyTypeObject*>(type)))
       raise(label + " must be a vereshchagin.Contact, got " + Py_TYPE(c)->tp_name);
     const auto attr = [c](PyObject* name) {
@@ -189,10 +178,16 @@ void SolveArgs::parse(PySolver& s, PyObject* const* a, bool batch) {
   if (given(a[7])) parseConstraints(a[7]);
   parseFriction(a[6]);
   input.contacts.clear();
-  if (given(a[kContactsArg])) parseContacts(a[kContactsArg]);
+  if (given(a[kContactsArg])) parseContacts(a[kContactsArg], "contacts");
   input.time_step = given(a[kTimeStepArg]) ? scalarArg(a[kTimeStepArg], "time_step") : 0.0;  // (range: by solve)
   const bool v_tol = given(a[kVelocityTolArg]);
   input.contact_velocity_tolerance = v_tol ? scalarArg(a[kVelocityTolArg], "contact_velocity_tolerance") : 1e-6;
+  PyObject* p = given(a[kMaxPivotsArg]) ? a[kMaxPivotsArg] : nullptr;  // an int, not a bool (its value: solve()'s)
+  const bool is_int = p && !PyBool_Check(p) && PyIndex_Check(p);
+  const std::optional<long long> bound = !p ? -1 : is_int ? intWithin(p, INT_MIN, INT_MAX) : std::nullopt;
+  if (!bound)
+    raise("contact_max_pivots must be an int, -1 (the default bound) or > 0, got " + std::string(py::repr(p)));
+  input.contact_max_pivots = static_cast<int>(*bound);
   // Pass-through weights: one per constraint column (their range: checked by vereshchagin::solve).
   if (given(a[8])) input.f_ext_pass_through = vector(a[8], "f_ext_pass_through", columns, /*scalar_ok=*/true);
   if (given(a[9])) input.ff_pass_through = vector(a[9], "tau_ff_pass_through", columns, /*scalar_ok=*/true);

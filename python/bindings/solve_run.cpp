@@ -1,10 +1,9 @@
-// Solver.solve (one row on workspace 0, its result new or written into `out`), _step and
-// _step_symplectic, the benchmark hook _time_cpp and Solver.solve_batch (vereshchagin::solveBatch
-// over one workspace per thread), each on the arguments SolveArgs parsed.
+// Solver.solve (one row on workspace 0, its result new or `out`), _step, _step_symplectic, _whole_body (WholeBodyCall),
+// the benchmark hook _time_cpp and solve_batch (solveBatch, one workspace per thread) on the arguments SolveArgs
+// parsed.
 #include <algorithm>
 
 #include "py_solver.hpp"
-#include "result_type.hpp"
 
 namespace vsbind {
 
@@ -46,6 +45,30 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out, int step) {
   if (!args_.layout.empty()) setSegmentLayout(r.ptr(), py::tuple(args_.layout));
   if (step == 2) return py::make_tuple(next_arrays[0], next_arrays[1], next_arrays[2], r);
   return step ? py::object(py::make_tuple(next_arrays[0], next_arrays[1], r)) : r;
+}
+
+PySolver::WholeBodyOut PySolver::wholeBody(O q, O qd, O f_ext, O tau_ff, O actuated, O supports, O task) {
+  Lock lk(*this);
+  PyObject* a[kNumSolveArgs] = {q.ptr(), qd.ptr(), nullptr, nullptr, f_ext.ptr(), tau_ff.ptr()};
+  args_.parse(*this, a, /*batch=*/false);  // solve()'s checks and messages
+  args_.parseContacts(supports.ptr(), "supports");
+  whole_body_.start(cpp_model_, args_.input, gravity_);
+  for (const py::handle item : task) {
+    const py::tuple t = py::reinterpret_borrow<py::tuple>(item);
+    const std::string label = py::str(t[0]);
+    const FrameTarget f = t[2].is_none() ? FrameTarget{t[1].cast<int>()} : addressing->resolveMoving(t[2].ptr(), label);
+    const auto view = [&](int k, const char* what) { return asF64(t[k].ptr(), (label + what).c_str()); };
+    check(whole_body_.addTask(f.segment, f.link_in_tip, view(3, " point"), view(4, " alpha"), view(5, " beta"), label));
+  }
+  const F64View mask = given(actuated.ptr()) ? asF64(actuated.ptr(), "actuated") : F64View();
+  vereshchagin::Status st;
+  {
+    py::gil_scoped_release release;
+    st = whole_body_.solve(given(actuated.ptr()) ? &mask : nullptr);
+  }
+  if (!st) raise("least_effort: " + std::string(st.message()));
+  const vereshchagin::WholeBodyResult& r = whole_body_.result();
+  return {r.tau, r.forces, r.qdd, r.effort, r.residual};
 }
 
 double PySolver::timeCpp(PyObject* const* args, long reps) {

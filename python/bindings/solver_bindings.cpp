@@ -13,7 +13,7 @@ namespace {
 // clang-format off
 constexpr const char* kSolveParams[] = {"q", "qd", "alpha", "beta", "f_ext", "tau_ff", "friction", "constraints",
                                         "f_ext_pass_through", "tau_ff_pass_through", "out", "a_desired", "contacts",
-                                        "time_step", "contact_velocity_tolerance"};
+                                        "time_step", "contact_velocity_tolerance", "contact_max_pivots"};
 // clang-format on
 static_assert(sizeof(kSolveParams) == kNumSolveArgs * sizeof(char*), "one name per SolveArgs::parse argument");
 PyObject* g_names[2][kNumSolveArgs];  // interned: solve()'s, solve_batch()'s
@@ -68,11 +68,8 @@ PyObject* guarded(Body&& body) {
 enum Entry { kSolve, kTimeCpp, kSolveBatch, kStep, kStepSymplectic };
 constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "solve_batch", "_step", "_step_symplectic"};
 
-// The METH_FASTCALL methods: solve(q, qd, ...); _time_cpp(reps, q, qd, ...): seconds per C++
-// solve (outputs read as solve() reads them), for benchmarks that compare the Python call with
-// the C++ work in the same process; solve_batch(q, qd, ..., threads, a_desired, contacts): a dict of the batch's arrays
-// (solver.py wraps it); _step(q, qd, ..., time_step=dt): vereshchagin::step(), (q_next, qd_next, SolveResult);
-// _step_symplectic(..., out=momentum): stepSymplectic(), (q_next, qd_next, momentum_next, SolveResult).
+// The METH_FASTCALL methods (what each returns: vereshchagin/_docstrings.py): solve, _time_cpp(reps, ...), solve_batch
+// (`out` is its `threads`; a dict that solver.py wraps), _step, _step_symplectic (`out` is its momentum).
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
@@ -112,7 +109,7 @@ void bindSolver(py::module_& mod) {
           py::arg("max_constraints") = py::none())
       .def("response_columns", &PySolver::responseColumns, py::arg("joints"), py::arg("hold_sticking") = true,
            doc("_core.Solver.response_columns"))
-      .def("_whole_body", &vereshchagin::wholeBodyArraysOf<PySolver>, doc("_core.Solver._whole_body"))
+      .def("_whole_body", &PySolver::wholeBody, doc("_core.Solver._whole_body"))
       .def_property("gravity", &PySolver::gravity, &PySolver::setGravity, doc("_core.Solver.gravity"))
       .def_readonly("n_joints", &PySolver::nj, doc("_core.Solver.n_joints"))
       .def_readonly("n_segments", &PySolver::ns, doc("_core.Solver.n_segments"))

@@ -13,13 +13,11 @@ vereshchagin::InertiaCheck inertiaCheckArg(const std::string& value, const std::
 
 PySolver::PySolver(const py::object& model, const py::object& gravity, const py::object& rcond,
                    const py::object& damping, const py::object& inertia_check, const py::object& max_constraints) {
-  if (py::isinstance<PyTree>(model)) {
+  if (py::isinstance<PyTree>(model))
     tree_ = std::make_unique<PyTree>(model.cast<const PyTree&>());
-    addressing = tree_.get();
-  } else {  // a Chain (solver.py refuses other types)
+  else  // a Chain (solver.py refuses other types)
     chain_ = std::make_unique<PyChain>(model.cast<const PyChain&>());
-    addressing = chain_.get();
-  }
+  addressing = tree_ ? static_cast<const CompanionModel*>(tree_.get()) : chain_.get();
   options_.rcond = scalarArg(rcond, "rcond");
   // solver.py passes the check the model was built with for None.
   options_.inertia_check = inertiaCheckArg(py::str(inertia_check).cast<std::string>(), "");

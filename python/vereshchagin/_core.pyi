@@ -256,6 +256,7 @@ class Solver:
         contacts: Optional[Sequence[Contact]] = None,
         time_step: Optional[float] = None,
         contact_velocity_tolerance: Optional[float] = None,
+        contact_max_pivots: Optional[int] = None,
     ) -> SolveResult: ...
     def _time_cpp(self, reps: int, /, *args: object, **kwargs: object) -> float: ...
     def _step(self, /, *args: object, **kwargs: object) -> tuple[np.ndarray, np.ndarray, SolveResult]: ...
@@ -279,13 +280,22 @@ class Solver:
         contacts: Optional[Sequence[Contact]] = None,
         time_step: Optional[float] = None,
         contact_velocity_tolerance: Optional[float] = None,
+        contact_max_pivots: Optional[int] = None,
     ) -> dict: ...
     def response_columns(
         self, joints: Sequence[int], hold_sticking: bool = True
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
     def _whole_body(
-        self, arg0: Sequence[ArrayLike]
-    ) -> tuple[int, str, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float, float]: ...
+        self,
+        arg0: ArrayLike,
+        arg1: ArrayLike,
+        arg2: object,
+        arg3: object,
+        arg4: object,
+        arg5: object,
+        arg6: object,
+        /,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float, float]: ...
     @property
     def model(self) -> Union[Chain, Tree]: ...
     @property

@@ -594,7 +594,7 @@ DOCS["Tree.fk_all"] = _fk_all(", in segment order")
 
 # ---- Solver (solver_bindings.cpp): the C++ core of vereshchagin.Solver (solver.py) ----
 
-DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None, time_step=None, contact_velocity_tolerance=None)
+DOCS["_core.Solver.solve"] = r"""solve($self, /, q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None, time_step=None, contact_velocity_tolerance=None, contact_max_pivots=None)
 --
 
 Constrained hybrid dynamics of one state: the motion that minimises Gauss' acceleration energy
@@ -668,6 +668,15 @@ contact_velocity_tolerance : float, optional
     Speed (m/s) at or below which a contact point is at rest along its normal, resp. not sliding
     (default 1e-6). A support approaching its surface faster is refused at the instant (an impact
     needs an impulse: solve over a ``time_step`` instead).
+contact_max_pivots : int, optional
+    The contact stage's real-time bound: Lemke pivots per run of its complementarity problem
+    (None or -1, the default: 50 + 20 per unknown, never reached in the measurements; n > 0: n).
+    A solve that reaches it returns the safe fallback of docs "Friction", "Real-time bound"
+    ("Contact fallback": every touching support held along its normal, no friction at the
+    contacts or the resting joints, no point moving into its surface) and warns with a
+    ``RuntimeWarning`` of the message ("contacts: the real-time bound of n pivots ... was hit"),
+    as the friction stage's bound (``Friction(max_iterations=...)``) does. 0, values below -1
+    and non-integers raise :class:`SolverError`.
 
 Returns
 -------
@@ -690,12 +699,12 @@ The GIL is released during the solve. One solver serialises concurrent calls; us
 per thread (or :meth:`solve_batch` with ``threads=``) for parallel work.
 """
 
-DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None, contacts=None, time_step=None, contact_velocity_tolerance=None)
+DOCS["_core.Solver.solve_batch"] = r"""solve_batch(q, qd, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, threads=1, a_desired=None, contacts=None, time_step=None, contact_velocity_tolerance=None, contact_max_pivots=None)
 
 Solve B states; see :meth:`vereshchagin.Solver.solve_batch` for the documented wrapper.
 """
 
-DOCS["_core.Solver._whole_body"] = r"""Whole-body least effort from a list of arrays (internal; see vereshchagin.whole_body.least_effort)."""
+DOCS["_core.Solver._whole_body"] = r"""_whole_body(q, qd, f_ext, tau_ff, actuated, supports, task) -> (tau, forces (3, k), qdd, effort, residual): whole-body least effort on the solver's kept C++ WholeBodySolver (internal; see vereshchagin.whole_body.least_effort, which resolves the task's keys into (label, segment, point, alpha, beta) tuples)."""
 DOCS["_core.Solver.response_columns"] = r"""Affine response of the last solve to unit feed-forward torques (see the wrapper in vereshchagin.Solver)."""
 
 DOCS["_core.Solver.gravity"] = r"""Physical gravity in the base frame, shape (3,), m/s^2 (settable; see :class:`Solver`)."""

@@ -127,7 +127,8 @@ class Simulator:
         **solve_args
             What :meth:`Solver.solve` takes besides the state and the time step: ``tau_ff``,
             ``friction``, ``contacts``, a task (``alpha``, ``beta``, ``a_desired``,
-            ``constraints``), ``f_ext``, pass-through weights, ``contact_velocity_tolerance``.
+            ``constraints``), ``f_ext``, pass-through weights, ``contact_velocity_tolerance``,
+            ``contact_max_pivots``.
 
         Returns
         -------

@@ -170,6 +170,7 @@ class Solver(_core.Solver):
         contacts=None,
         time_step=None,
         contact_velocity_tolerance=None,
+        contact_max_pivots=None,
     ) -> BatchResult:
         """Solve B states at once (each row exactly as :meth:`solve` would).
 
@@ -204,6 +205,9 @@ class Solver(_core.Solver):
             Every row over a time step (see :meth:`solve`).
         contact_velocity_tolerance : float, optional
             As in :meth:`solve`.
+        contact_max_pivots : int, optional
+            The contact stage's real-time bound, as in :meth:`solve` (a row that reaches it gets
+            the fallback; no warning is raised per row).
 
         Returns
         -------
@@ -233,6 +237,7 @@ class Solver(_core.Solver):
             contacts,
             time_step,
             contact_velocity_tolerance,
+            contact_max_pivots,
         )
         if not out.pop("any_friction"):
             for key in ("friction_torque", "limit_torque", "status", "gauss_value", "iterations"):

@@ -52,6 +52,7 @@ class Solver(_core.Solver):
         contacts: Optional[Sequence[Contact]] = None,
         time_step: Optional[float] = None,
         contact_velocity_tolerance: Optional[float] = None,
+        contact_max_pivots: Optional[int] = None,
     ) -> BatchResult: ...
     def step(
         self, q: ArrayLike, qd: ArrayLike, time_step: float, **solve_args: object

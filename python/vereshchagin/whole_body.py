@@ -53,47 +53,40 @@ moment rows, against ``[c_ddot - gravity; 0]`` (world axes), so ``beta = alpha[:
 gravity)`` for a desired centre-of-mass acceleration ``c_ddot``."""
 
 
-def _frame(model: Any, key: Any, point: Any) -> tuple[int, np.ndarray]:
-    """(segment index, the point in that segment's tip frame) for a segment or merged link name
-    or index (None: the base, its own frame)."""
-    point = np.zeros(3) if point is None else np.asarray(point, dtype=float).reshape(3)
-    if key is None:
-        return -1, point
-    if isinstance(key, str) and key == COM:
-        return -2, point
+def _task_blocks(task: Optional[Mapping[Any, Sequence[Any]]]) -> list[tuple]:
+    """The task as (label, segment, key, point, alpha, beta) tuples: segment -1 (the base) or -2
+    (:data:`COM`) with key None, else 0 and the key, resolved by the C++ call as
+    :meth:`Solver.solve` resolves ``constraints`` keys (a merged link's point moved into its
+    segment's tip frame); the arrays are checked there too."""
+    if task is None:
+        return []
+    if not isinstance(task, Mapping):
+        raise SolverError("task must be a dict {segment: (alpha, beta)} or {segment: (alpha, beta, point)}")
+    blocks = []
+    for key, spec in task.items():
+        label = f"task[{key!r}]"
+        if not isinstance(spec, (tuple, list)) or len(spec) not in (2, 3):
+            raise SolverError(f"{label} must be a pair (alpha (6, m), beta (m,)) or a triple (alpha, beta, point)")
+        point = spec[2] if len(spec) > 2 else _ORIGIN
+        special = key is None or (isinstance(key, str) and key == COM)
+        segment = (-1 if key is None else -2) if special else 0
+        blocks.append((label, segment, None if special else key, point, spec[0], spec[1]))
+    return blocks
+
+
+_ORIGIN = np.zeros(3)
+_ORIGIN.flags.writeable = False
+
+
+def _mask(actuated: Any) -> Any:
+    """``actuated`` as numbers (bool arrays as 0/1); shape and values are checked by the C++ call."""
+    if actuated is None:
+        return None
     try:
-        index = int(model.segment_index(key))
-        if isinstance(key, str):  # a merged link: its pose in the tip frame (constant)
-            q0 = np.zeros(model.n_joints)
-            offset = np.linalg.solve(model.fk(q0, index), model.fk(q0, key))
-            point = offset[:3, :3] @ point + offset[:3, 3]
-    except Exception as exc:  # an unknown name or index: say which
-        raise SolverError(
-            f"least_effort: unknown segment {key!r} (a segment or link name, an index, None: the base)"
-        ) from exc
-    return index, point
-
-
-def _task_arrays(model: Any, task: Optional[Mapping[Any, Sequence[Any]]]) -> tuple[np.ndarray, list[np.ndarray]]:
-    header, blocks = [], []
-    for key, spec in (task or {}).items():
-        alpha = np.asarray(spec[0], dtype=float)
-        alpha = alpha.reshape(6, 1) if alpha.ndim == 1 else alpha
-        beta = np.atleast_1d(np.asarray(spec[1], dtype=float)).reshape(-1, 1)
-        segment, point = _frame(model, key, spec[2] if len(spec) > 2 else None)
-        header.append([segment, *point])
-        blocks += [alpha, beta]
-    return np.asarray(header, dtype=float).reshape(-1, 4), blocks
-
-
-def _support_rows(model: Any, supports: Sequence[Contact]) -> np.ndarray:
-    rows = []
-    for c in supports:
-        if c.force is not None:
-            raise SolverError("least_effort: supports only (a Contact without a force set-point)")
-        segment, point = _frame(model, c.segment, c.point)
-        rows.append([segment, *point, *c.normal, c.mu, c.facets])
-    return np.asarray(rows, dtype=float).reshape(-1, 9)
+        mask = np.asarray(actuated)
+    except (TypeError, ValueError) as exc:
+        raise SolverError(f"actuated must be an array of bool, one per joint: {exc}") from None
+    return mask.astype(np.float64) if mask.dtype == bool else actuated
 
 
 def least_effort(
@@ -120,15 +113,19 @@ def least_effort(
         link's frame, default its origin), ``beta`` (m,) as in :meth:`Solver.solve` (spatial
         acceleration, ``-gravity`` included). ``None`` as the segment: the base body;
         :data:`COM`: the centre of mass (a free-flyer only).
-    supports : sequence of vereshchagin.Contact
-        Points that stick (zero classical acceleration), their forces in the friction cones.
-        Segments by name (a merged link's frame too) or index (the segment's tip frame).
+    supports : list or tuple of vereshchagin.Contact
+        Points that stick (zero classical acceleration), their forces in the friction cones; no
+        force set-points. Segments by name (a merged link's frame too) or index (the segment's tip
+        frame). Read as :meth:`Solver.solve` reads ``contacts`` (messages name ``supports[k]``).
     actuated : array_like of bool, shape (n_joints,), optional
         Which joints have a motor (default: every joint; a floating base never).
-    f_ext : array_like, shape (n_segments, 6), optional
-        Wrenches on the segments by the environment (as :meth:`Solver.solve`).
+    f_ext : array_like, shape (n_segments, 6), or dict, optional
+        Wrenches on the segments by the environment, exactly as :meth:`Solver.solve` takes them:
+        one row ``[force, moment]`` per segment (base axes, moment about the segment's tip
+        origin), or ``{segment or link name or index: wrench (6,)}`` (moment about that frame's
+        origin).
     tau_ff : array_like, shape (nv,), optional
-        Feed-forward torques (a floating base's rows: a wrench on the base).
+        Feed-forward torques (a floating base's rows: a wrench on the base), as :meth:`Solver.solve`.
 
     Returns
     -------
@@ -137,30 +134,17 @@ def least_effort(
     Raises
     ------
     SolverError
-        Wrong shapes or values, or the task is not realizable with these supports (the message
-        says whether the rows contradict each other or the cones are too narrow).
+        Wrong shapes or values (``q``, ``qd``, ``f_ext``, ``tau_ff`` and ``supports`` with the
+        messages of :meth:`Solver.solve`), or the task is not realizable with these supports (the
+        message says whether the rows contradict each other or the cones are too narrow).
+
+    Notes
+    -----
+    The C++ ``WholeBodySolver`` is kept with ``solver`` (built at the first call, rebuilt larger
+    for more supports or task rows than it has room for); nothing of one call influences the next.
+    Calls on one ``solver`` are serialized like its solves (the GIL is released while solving).
     """
-    model = solver.model
-    nv = len(np.atleast_1d(qd))
-    ns = solver.n_segments
-    fe = np.zeros((ns, 6)) if f_ext is None else np.asarray(f_ext, dtype=float).reshape(ns, 6)
-    ff = np.zeros(nv) if tau_ff is None else np.asarray(tau_ff, dtype=float).reshape(nv)
-    act = np.zeros((0, 1)) if actuated is None else np.asarray(actuated, dtype=float).reshape(-1, 1)
-    header, blocks = _task_arrays(model, task)
-    args = [
-        np.asarray(q, dtype=float).reshape(-1, 1),
-        np.asarray(qd, dtype=float).reshape(-1, 1),
-        np.ascontiguousarray(fe.T),
-        ff.reshape(-1, 1),
-        np.asarray(solver.gravity, dtype=float).reshape(3, 1),
-        act,
-        _support_rows(model, supports),
-        header,
-        *blocks,
-    ]
-    code, message, tau, forces, qdd, effort, residual = solver._whole_body(args)
-    if code != 0:
-        raise SolverError(f"least_effort: {message}")
-    return WholeBodyResult(
-        np.asarray(tau), np.asarray(forces).T.copy(), np.asarray(qdd), float(effort), float(residual)
+    tau, forces, qdd, effort, residual = solver._whole_body(
+        q, qd, f_ext, tau_ff, _mask(actuated), supports, _task_blocks(task)
     )
+    return WholeBodyResult(tau, forces.T.copy(), qdd, float(effort), float(residual))

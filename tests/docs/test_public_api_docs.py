@@ -142,6 +142,7 @@ def test_solve_has_a_full_docstring_and_signature():
         "contacts",
         "time_step",
         "contact_velocity_tolerance",
+        "contact_max_pivots",
     ):
         assert section in doc, section
     params = list(inspect.signature(vs.Solver.solve).parameters)
@@ -162,6 +163,7 @@ def test_solve_has_a_full_docstring_and_signature():
         "contacts",
         "time_step",
         "contact_velocity_tolerance",
+        "contact_max_pivots",
     ]
 
 

@@ -372,6 +372,12 @@ def test_response_columns_dense(seed, m):
     assert_close(dtau_cmd, dtau[:, joints], RTOL, "dtau_command vs -A^T K^+ A Minv")
     full, _ = solver.response_columns(list(range(n)))
     assert_close(full, full.T, 1e-10, "G symmetric")
+    # One to four columns (a chain's own-frame path, the friction step's usual request).
+    for k in range(1, 5):
+        few = rng.integers(0, n, size=k)
+        dqdd_few, dtau_few = solver.response_columns(few)
+        assert_close(dqdd_few, G[:, few], RTOL, f"dqdd vs dense G, {k} columns")
+        assert_close(dtau_few, dtau[:, few], RTOL, f"dtau_command vs dense, {k} columns")
 
     # Affine: a second solve with tau_ff + e_j differs by exactly the columns.
     for c, j in enumerate(joints[:3]):

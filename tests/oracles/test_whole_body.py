@@ -29,7 +29,7 @@ import pytest
 from scipy.optimize import minimize
 
 import vereshchagin as vs
-from support.trees import pin_q, pin_v_index
+from support.trees import pin_q_free, pin_v_index, pin_v_scatter
 from vereshchagin.robots import example_robot_urdf
 
 RTOL = 1e-9
@@ -76,14 +76,10 @@ class Standing:
         self.points = []  # (pin frame id, segment name, point in the segment's frame)
 
     def pin_q(self, q):
-        out = pin_q(self.model, self.tree.joint_names, q[7:])
-        out[:7] = q[:7]
-        return out
+        return pin_q_free(self.model, self.tree.joint_names, q)
 
     def pin_v(self, v):
-        out = np.zeros(self.model.nv)
-        out[self.v_index] = v
-        return out
+        return pin_v_scatter(self.model, self.v_index, v)
 
     def add_point(self, frame, offset=(0.0, 0.0, 0.0)):
         f = self.model.frames[self.model.getFrameId(frame)]

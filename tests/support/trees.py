@@ -239,6 +239,20 @@ def pin_q(model: pin.Model, joint_names: list[str], q: np.ndarray) -> np.ndarray
     return out
 
 
+def pin_q_free(model: pin.Model, joint_names: list[str], q: np.ndarray) -> np.ndarray:
+    """Pinocchio configuration of our free-flyer q (base position, quaternion x y z w, joints)."""
+    out = pin_q(model, joint_names, q[7:])
+    out[:7] = q[:7]
+    return out
+
+
+def pin_v_scatter(model: pin.Model, v_index: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Pinocchio's velocity vector from ours, entry k of v into column v_index[k]."""
+    out = np.zeros(model.nv)
+    out[v_index] = v
+    return out
+
+
 def pin_v_index(model: pin.Model, joint_names: list[str]) -> np.ndarray:
     """For each of our joints, its column in Pinocchio's velocity vector."""
     return np.array([model.joints[model.getJointId(name)].idx_v for name in joint_names])

@@ -95,3 +95,45 @@ def test_the_bound_survives_copies():
     assert pickle.loads(pickle.dumps(fr)).max_iterations == 5
     assert copy.deepcopy(fr).max_iterations == 5
     assert vs.Friction(static=np.ones(3)).max_iterations == -1
+
+
+def pushed_solo12():
+    """solo12 on its four feet (mu 0.3) pushed sideways on the base: the feet cannot all stick, so
+    the contact stage runs its complementarity problem (Lemke's pivoting)."""
+    from vereshchagin.robots import example_robot_urdf
+
+    tree = vs.Tree.from_urdf(example_robot_urdf("solo_description/robots/solo12.urdf"), base="free")
+    legs = {"FL": (0.1, 0.8, -1.6), "FR": (-0.1, 0.8, -1.6), "HL": (0.1, -0.8, 1.6), "HR": (-0.1, -0.8, 1.6)}
+    joints = {f"{leg}_{j}": v for leg, vals in legs.items() for j, v in zip(("HAA", "HFE", "KFE"), vals)}
+    q = np.r_[0.0, 0.0, 0.25, 0.0, 0.0, 0.0, 1.0, [joints[n] for n in tree.joint_names]]
+    feet = [vs.Contact(f, normal=[0, 0, 1], mu=0.3) for f in ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")]
+    args = dict(tau_ff=np.r_[25.0, 8.0, 0.0, 0.0, 0.0, 1.5, np.zeros(12)], contacts=feet)
+    return vs.Solver(tree), q, np.zeros(tree.nv), args
+
+
+def test_contact_pivot_bound_gives_the_fallback_with_a_warning():
+    """contact_max_pivots=1: the contact stage's fallback, reported as the friction stage's bound is
+    (a RuntimeWarning of the C++ Error::Degraded message, the result returned); the default bound
+    and an explicit -1 give the exact answer without a warning, also in solve_batch and step()."""
+    solver, q, qd, args = pushed_solo12()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        exact = solver.solve(q, qd, **args)
+        default = solver.solve(q, qd, contact_max_pivots=-1, **args)
+    assert np.array_equal(exact.qdd, default.qdd)
+    with pytest.warns(RuntimeWarning, match="contacts: the real-time bound of 1 pivots"):
+        res = solver.solve(q, qd, contact_max_pivots=1, **args)
+    forces = res.contact_force
+    assert np.all(forces[:, :2] == 0.0) and np.all(forces[:, 2] >= 0.0)  # along the normals, pushing
+    assert not np.allclose(res.qdd, exact.qdd)
+    with pytest.warns(RuntimeWarning, match="real-time bound of 2 pivots"):
+        solver.step(q, qd, 1e-3, contact_max_pivots=2, **args)
+    batch = solver.solve_batch(np.stack([q, q]), qd, contact_max_pivots=1, **args)  # rows: the fallback, no warning
+    assert np.array_equal(batch.qdd[1], res.qdd)
+
+
+@pytest.mark.parametrize("bad", [0, -2, 1.5, True, "3", 2**31, None.__class__])
+def test_invalid_contact_pivot_bounds_are_refused(bad):
+    solver, q, qd, args = pushed_solo12()
+    with pytest.raises(vs.SolverError, match="contact_max_pivots"):
+        solver.solve(q, qd, contact_max_pivots=bad, **args)

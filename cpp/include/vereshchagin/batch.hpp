@@ -65,6 +65,7 @@ struct BatchInput {
   std::vector<PointContact> contacts;
   double contact_velocity_tolerance = 1e-6;  ///< SolveInput::contact_velocity_tolerance (m/s)
   double time_step = 0.0;                    ///< SolveInput::time_step (s; 0: the instant)
+  int contact_max_pivots = -1;               ///< SolveInput::contact_max_pivots (-1: the default bound)
 
   /// Constraint columns of every row (the size of nu).
   int columns() const;

@@ -39,9 +39,6 @@
 #pragma once
 
 #include <memory>
-#include <string>
-#include <tuple>
-#include <vector>
 
 #include <Eigen/Core>
 
@@ -99,22 +96,5 @@ class WholeBodySolver {
  private:
   std::unique_ptr<Impl> impl_;
 };
-
-/// The Python face's call (python/vereshchagin/whole_body.py), one list of arrays (column vectors
-/// as n x 1): q (nq), qd (nv), f_ext (6 x n_segments, as SolveInput::f_ext), ff_torques (nv),
-/// gravity (3), actuated (n_joints, non-zero: a motor; or 0 entries: every joint), supports
-/// (k x 9 rows: segment, point (3, tip frame, m), normal (3, base axes), mu, facets), task blocks
-/// (b x 4 rows: segment (-1: the base, -2: the centre of mass), point (3, tip frame)), then per
-/// block its alfa (6 x m) and
-/// beta (m). Returns (status code, message, tau (nv), forces (3 x k), qdd (nv), effort, residual);
-/// the arrays are empty unless the code is Error::None. Builds a WholeBodySolver per call.
-std::tuple<int, std::string, Eigen::VectorXd, Eigen::MatrixXd, Eigen::VectorXd, double, double> wholeBodyArrays(
-    const Model& model, const std::vector<Eigen::MatrixXd>& args);
-
-/// wholeBodyArrays() on the model of a holder with a cppModel() (the Python face's Solver).
-template <typename Holder>
-auto wholeBodyArraysOf(const Holder& holder, const std::vector<Eigen::MatrixXd>& args) {
-  return wholeBodyArrays(holder.cppModel(), args);
-}
 
 }  // namespace vereshchagin
