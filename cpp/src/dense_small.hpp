@@ -16,22 +16,26 @@ namespace detail {
 using MatBlock = Eigen::Block<Eigen::MatrixXd>;
 using VecBlock = Eigen::VectorBlock<Eigen::VectorXd>;
 
-// A = L L^T into the lower triangle of L (k x k). Fails (false) when a pivot is not above
-// min_pivot, i.e. when A is not safely positive definite at the caller's scale.
+// A = L L^T into the lower triangle of L (k x k, column-major storage). Fails (false) when a
+// pivot is not above min_pivot, i.e. when A is not safely positive definite at the caller's scale.
+// Column j of L accumulates A(j.., j) - sum_p L(j.., p) L(j, p) in place with p in order (each
+// entry's sum in the same order as a dot product's: the same values), down contiguous columns.
 template <typename MA, typename ML>
 bool choleskyCertified(const MA& A, ML& L, double min_pivot) {
   const int k = static_cast<int>(A.rows());
   for (int j = 0; j < k; ++j) {
-    double d = A(j, j);
-    for (int p = 0; p < j; ++p) d -= L(j, p) * L(j, p);
+    double* lj = &L(0, j);
+    for (int i = j; i < k; ++i) lj[i] = A(i, j);
+    for (int p = 0; p < j; ++p) {
+      const double* lp = &L(0, p);
+      const double ljp = lp[j];
+      for (int i = j; i < k; ++i) lj[i] -= lp[i] * ljp;
+    }
+    const double d = lj[j];
     if (!(d > min_pivot)) return false;
     const double ljj = std::sqrt(d);
-    L(j, j) = ljj;
-    for (int i = j + 1; i < k; ++i) {
-      double v = A(i, j);
-      for (int p = 0; p < j; ++p) v -= L(i, p) * L(j, p);
-      L(i, j) = v / ljj;
-    }
+    lj[j] = ljj;
+    for (int i = j + 1; i < k; ++i) lj[i] /= ljj;
   }
   return true;
 }
@@ -53,62 +57,33 @@ double inverseFrobeniusSquared(const ML& L, VX& x) {
   return frob2;
 }
 
-// The coupling matrices' variants (hd_core.cpp, segment_constraints.cpp) of the three routines
-// above and below: the factor also writes inv(j) = 1 / L(j, j), and the substitutions multiply by
-// it (one division per pivot instead of one per entry, none on the substitutions' dependency
-// chains) and run forward by columns, each solved entry updating the rows below it independently.
-template <typename MA, typename ML, typename VI>
-bool choleskyCertified(const MA& A, ML& L, VI& inv, double min_pivot) {
-  const int k = static_cast<int>(A.rows());
-  for (int j = 0; j < k; ++j) {
-    double d = A(j, j);
-    for (int p = 0; p < j; ++p) d -= L(j, p) * L(j, p);
-    if (!(d > min_pivot)) return false;
-    L(j, j) = std::sqrt(d);
-    inv(j) = 1.0 / L(j, j);
-    for (int i = j + 1; i < k; ++i) {
-      double v = A(i, j);
-      for (int p = 0; p < j; ++p) v -= L(i, p) * L(j, p);
-      L(i, j) = v * inv(j);
-    }
-  }
-  return true;
-}
-
-// ||L^-1||_F^2 given inv = 1 / diag(L); X: scratch of at least k x k. L^-1 (lower triangular)
-// goes into X row by row: row i is (e_i - L(i, 0..i-1) X(0..i-1, :)) / L(i, i), its entries
-// independent of each other, so that only the rows form a dependency chain.
-template <typename ML, typename VI, typename MX>
-double inverseFrobeniusSquared(const ML& L, const VI& inv, MX& X) {
+// An upper bound of ||L^-1||_2^2 for a lower-triangular L with a positive diagonal, in k^2
+// operations where ||L^-1||_F^2 takes k^3 / 3: with M(L) the comparison matrix (|L(i, i)| on the
+// diagonal, -|L(i, j)| off it), |L^-1| <= M(L)^-1 entrywise and M(L)^-1 >= 0 (N. J. Higham,
+// Accuracy and Stability of Numerical Algorithms, 2nd ed., SIAM 2002, Theorem 8.12), so
+// ||L^-1||_inf <= max_i (M^-1 1)_i, ||L^-1||_1 <= max_i (M^-T 1)_i, and ||L^-1||_2^2 <=
+// ||L^-1||_1 ||L^-1||_inf. Both substitutions only add non-negative terms (relative round-off
+// below 2 k eps, covered by the factor 1 + 1e-10). It can exceed ||L^-1||_2^2 by a factor growing
+// with k (up to 2^k): callers fall back to inverseFrobeniusSquared() when it is not enough.
+// x: scratch of at least k entries.
+template <typename ML, typename VX>
+double inverseNormBound(const ML& L, VX& x) {
   const int k = static_cast<int>(L.rows());
-  double frob2 = 0.0;
-  for (int i = 0; i < k; ++i) {
-    for (int c = 0; c <= i; ++c) {
-      double v = i == c ? 1.0 : 0.0;
-      for (int p = c; p < i; ++p) v -= L(i, p) * X(p, c);
-      X(i, c) = v * inv(i);
-    }
-    double row2 = 0.0;
-    for (int c = 0; c <= i; ++c) row2 += X(i, c) * X(i, c);
-    frob2 += row2;
+  double row_max = 0.0, col_max = 0.0;
+  for (int i = 0; i < k; ++i) x(i) = 1.0;
+  for (int j = 0; j < k; ++j) {  // x = M^-1 1, by columns
+    const double xj = x(j) / L(j, j);
+    x(j) = xj;
+    row_max = std::max(row_max, xj);
+    for (int i = j + 1; i < k; ++i) x(i) += std::abs(L(i, j)) * xj;
   }
-  return frob2;
-}
-
-// Solve L L^T x = b in place given inv = 1 / diag(L).
-template <typename ML, typename VI, typename VB>
-void choleskySolve(const ML& L, const VI& inv, VB& b) {
-  const int k = static_cast<int>(L.rows());
-  for (int p = 0; p < k; ++p) {
-    const double xp = b(p) * inv(p);
-    b(p) = xp;
-    for (int i = p + 1; i < k; ++i) b(i) -= L(i, p) * xp;
+  for (int i = k - 1; i >= 0; --i) {  // x = M^-T 1
+    double v = 1.0;
+    for (int p = i + 1; p < k; ++p) v += std::abs(L(p, i)) * x(p);
+    x(i) = v / L(i, i);
+    col_max = std::max(col_max, x(i));
   }
-  for (int i = k - 1; i >= 0; --i) {
-    double v = b(i);
-    for (int p = i + 1; p < k; ++p) v -= L(p, i) * b(p);
-    b(i) = v * inv(i);
-  }
+  return row_max * col_max * (1.0 + 1e-10);
 }
 
 // Per-eigenvalue multipliers of a symmetric positive semi-definite matrix's (pseudo-)inverse

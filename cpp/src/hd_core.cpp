@@ -18,20 +18,35 @@ namespace detail {
 
 // Pose of the tip frame at joint position q: the tip moves by the screw motion exp(q S) of its
 // own joint axis (constant in the tip frame), so X(q) = X(0) * exp(q [S]) with, for S = [v; w]
-// and theta = |w| q, unit axis k = w / |w|, K = [k]x:  E.R = I + sin(theta) K + (1 - cos(theta)) K K
-// (Rodrigues), E.p = (I - E.R) (k x v) / |w| + k (k . v) q;  for |w| = 0 (prismatic) E = (I, v q).
-// X0 is folded into the constant factors at model build (SegmentModel::RK, ...), so a pose costs
-// one sincos and 27 multiply-adds.
+// and theta = |w| q, unit axis k = w / |w|:  E.R = Rodrigues(k, theta),
+// E.p = (I - E.R) (k x v) / |w| + k (k . v) q;  for |w| = 0 (prismatic) E = (I, v q).
 void HdCore::screwPose(const SegmentModel& sm, SegmentState& s, double q) const {
+  const Vector3 v = sm.S.head<3>();
   if (sm.w_norm == 0.0) {
     s.X.R = sm.X0.R;
-    s.X.p.noalias() = sm.X0.p + sm.pq * q;
+    s.X.p.noalias() = sm.X0.p + sm.X0.R * (v * q);
     return;
   }
+  const Vector3 k = sm.S.tail<3>() / sm.w_norm;
   const double theta = sm.w_norm * q;
   const double sn = std::sin(theta), c1 = 1.0 - std::cos(theta);
-  s.X.R = sm.X0.R + sn * sm.RK + c1 * sm.RKK;
-  s.X.p = sm.X0.p - sn * sm.pK - c1 * sm.pKK + q * sm.pq;
+  const Matrix3 K = skew(k);
+  // K K entry by entry: the nonzero products of the dense product (the others are exact zeros),
+  // so the same values at a third of the multiplications: k_i k_j off the diagonal and minus the
+  // other two squares on it.
+  Matrix3 KK;
+  KK << -(k.z() * k.z()) - k.y() * k.y(), k.y() * k.x(), k.z() * k.x(),  //
+      k.x() * k.y(), -(k.z() * k.z()) - k.x() * k.x(), k.z() * k.y(),    //
+      k.x() * k.z(), k.y() * k.z(), -(k.y() * k.y()) - k.x() * k.x();
+  Matrix3 R = Matrix3::Identity();
+  R.noalias() += sn * K + c1 * KK;
+  // (I - R) = -(sn K + c1 KK), applied to k x v / |w|.
+  const Vector3 kxv = k.cross(v) / sm.w_norm;
+  Vector3 p;
+  p.noalias() = -(sn * (K * kxv) + c1 * (KK * kxv));
+  p.noalias() += k * (k.dot(v) * q);
+  s.X.R.noalias() = sm.X0.R * R;
+  s.X.p.noalias() = sm.X0.p + sm.X0.R * p;
 }
 
 // Outward sweep: poses, velocities, velocity-product accelerations, rigid bias forces.
@@ -219,17 +234,19 @@ void HdCore::factorizeCoupling() {
 
 // Cholesky factor K = L L^T (into chol), and a proof that every eigenvalue of K is above the
 // truncation threshold rcond * max(lambda_max, kappa) = rcond * kappa: lambda_min(K) =
-// 1 / ||L^-1||_2^2 >= 1 / ||L^-1||_F^2 and lambda_max(K) <= trace(K) <= kappa. False if the
-// factorisation breaks down or the proof fails.
+// 1 / ||L^-1||_2^2, bounded below first by the k^2 bound of inverseNormBound(), then (when that
+// is not enough) by 1 / ||L^-1||_F^2; lambda_max(K) <= trace(K) <= kappa. False if the
+// factorisation breaks down or both proofs fail.
 bool HdCore::choleskyFullRank() {
   const int m = res.m;
   CouplingFast& f = ws.fast;
   f.chol.setZero(m, m);
-  f.chol_inv.resize(m);
-  if (!detail::choleskyCertified(f.K, f.chol, f.chol_inv, 0.0)) return false;
-  MatrixC X(m, m);
-  const double lower = 1.0 / detail::inverseFrobeniusSquared(f.chol, f.chol_inv, X);
-  return std::isfinite(lower) && lower > options.rcond * ws.kappa;
+  if (!detail::choleskyCertified(f.K, f.chol, 0.0)) return false;
+  const double threshold = options.rcond * ws.kappa;
+  VectorC x(m);
+  if (1.0 / detail::inverseNormBound(f.chol, x) > threshold) return true;
+  const double lower = 1.0 / detail::inverseFrobeniusSquared(f.chol, x);
+  return std::isfinite(lower) && lower > threshold;
 }
 
 double HdCore::smallestSingularValue() const {
@@ -260,7 +277,7 @@ void HdCore::applyCouplingInverse(const VectorC& rhs, VectorC& out) const {
   }
   if (ws.use_cholesky) {
     out = rhs;  // K out = rhs with K = L L^T
-    detail::choleskySolve(ws.fast.chol, ws.fast.chol_inv, out);
+    detail::choleskySolve(ws.fast.chol, out);
     return;
   }
   VectorC t;

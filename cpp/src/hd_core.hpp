@@ -83,13 +83,6 @@ struct SegmentModel {
   double dotS(const V& x) const {
     return axis >= 0 ? S(axis) * x(axis) : S.dot(x);
   }
-  // The screw motion of screwPose() with X0 folded in (model_build.cpp), for S = [v; w], unit
-  // axis k = w / |w|, K = [k]x: X(q).R = X0.R + sin(|w| q) RK + (1 - cos(|w| q)) RKK and
-  // X(q).p = X0.p - sin(|w| q) pK - (1 - cos(|w| q)) pKK + q pq, with RK = X0.R K,
-  // RKK = X0.R K K, pK = RK (k x v) / |w|, pKK = RKK (k x v) / |w|, pq = X0.R k (k . v) (zero
-  // but pq = X0.R v for a prismatic joint, |w| = 0).
-  Matrix3 RK = Matrix3::Zero(), RKK = Matrix3::Zero();
-  Vector3 pK = Vector3::Zero(), pKK = Vector3::Zero(), pq = Vector3::Zero();
 };
 
 // The robot: constant per robot, validated when built.
@@ -133,9 +126,8 @@ struct SegmentState {
 // Coupling matrix of the fast path (m <= 6 columns on the last segment of a chain).
 struct CouplingFast {
   VectorC U0;
-  MatrixC L0, K;     // L0 = -K accumulated by the inward sweep
-  MatrixC chol;      // lower Cholesky factor of K on the certified path
-  VectorC chol_inv;  // 1 / its diagonal
+  MatrixC L0, K;  // L0 = -K accumulated by the inward sweep
+  MatrixC chol;   // lower Cholesky factor of K on the certified path
   Eigen::SelfAdjointEigenSolver<MatrixC> eig;
   VectorC inv_eigen;  // per-eigenvalue multiplier of the policy
 };
@@ -150,13 +142,10 @@ struct CouplingGeneral {
   Eigen::MatrixXd eg;         // mcap x n_segments: column i = (S_i^T A_i)^T on i's felt range (only)
   Eigen::VectorXd ug, nug, rhs;
   mutable Eigen::VectorXd tmp;
-  Eigen::MatrixXd kg, cholg, vg;  // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
-  Eigen::VectorXd cholg_inv;      // 1 / the Cholesky factor's diagonal
-  Eigen::VectorXd invg;           // policy multiplier per eigenvalue
-  // Smallest eigenvalue (both paths): matrix (mcap x mcap; also the Jacobi path's matrix and the
-  // certificate's L^-1), scratch (mcap x 4).
-  mutable Eigen::MatrixXd work_g, work_v;
-  mutable Matrix6X seg_force;                // per-segment wrench accumulators
+  Eigen::MatrixXd kg, cholg, vg;           // coupling matrix (its diagonal blocks), Cholesky factor, eigenvectors
+  Eigen::VectorXd invg;                    // policy multiplier per eigenvalue
+  mutable Eigen::MatrixXd work_g, work_v;  // smallest eigenvalue (both paths): matrix (mcap x mcap), scratch (mcap x 4)
+  mutable Matrix6X seg_force;              // per-segment wrench accumulators
   int lo(const HdModel& model, int i) const  // first sorted column felt by segment i
   {
     return active[model.subtree_end[i]];

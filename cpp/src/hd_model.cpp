@@ -94,7 +94,7 @@ void HdCore::allocateWorkspace() {
   g.active.assign(ns + 1, 0);
   g.anew = g.acur = Matrix6X::Zero(6, mcap);
   g.eg = Eigen::MatrixXd::Zero(mcap, std::max<unsigned int>(ns, 1));
-  g.ug = g.nug = g.rhs = g.tmp = g.invg = g.cholg_inv = Eigen::VectorXd::Zero(mcap);
+  g.ug = g.nug = g.rhs = g.tmp = g.invg = Eigen::VectorXd::Zero(mcap);
   res.nu_user = Eigen::VectorXd::Zero(mcap);
   g.kg = g.cholg = g.vg = g.work_g = Eigen::MatrixXd::Zero(mcap, mcap);
   g.work_v = Eigen::MatrixXd::Zero(mcap, 4);  // smallestEigenvalue's scratch: 4 columns
