@@ -158,6 +158,7 @@ int ContactStage::leastEffort(DataImpl& d, const SolveInput& in) {
   }
   auto dx = eff_dx_.head(p);
   if (lqp_.solve(T, c.res.tau_cmd.head(tr), P, pv, R, r, dx, n) != Lemke::kSolved) return 0;  // keep the forces
+  if (dx.isZero(0.0)) return 0;  // the forces found are the programme's: the last sweep stands
   eff_x_.head(p) += dx;
   for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) = points_[eff_contact_(i)].fixed;  // known part
   for (int i = 0; i < pc; ++i) forces.col(eff_contact_(i)) += eff_x_(i) * eff_dir_.col(i);

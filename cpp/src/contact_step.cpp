@@ -71,7 +71,7 @@ Status step(const Model& model, Data& data, const SolveInput& input, Eigen::Ref<
             Eigen::Ref<Eigen::VectorXd> qd_next) {
   const long n = static_cast<long>(model.nrOfJoints());
   if (!(input.time_step > 0.0) || !std::isfinite(input.time_step))
-    return Status(Error::OutOfRange, "step() needs a finite SolveInput::time_step > 0 (s)");
+    return Status(Error::OutOfRange, "step(): time_step must be finite and > 0 (s)");
   if (q_next.size() != model.nq() || qd_next.size() != model.nv())
     return Status(Error::SizeMismatch,
                   "step(): q_next and qd_next must have one entry per joint (nq and nv entries on a floating base)");

@@ -198,9 +198,14 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
   auto c = c_.head(p);
   c.noalias() = C.transpose() * t;
   const int limit = 100 + 40 * (2 * p + k);
-  if (C.rows() == 0)  // no first objective: x1 = 0 (the caller's point, feasible), Z spans everything
+  if (C.rows() == 0) {  // no first objective: x1 = 0 (the caller's point, feasible), Z spans everything
     x.setZero();
-  else if (const Lemke::Result res = qp_.solve(Q, c, R, r, x, limit); res != Lemke::kSolved)
+    // With the equality E x = 0 the second programme lives on E's null space: there first, its
+    // dual of the other rows (P is positive definite there in the usual case), before the doubled
+    // primal over all p coordinates with E as two inequalities, whose answer it equals up to the
+    // pairs' round-off slack.
+    if (eq > 0 && secondOnEqualities(P, pv, R, r, x, eq)) return Lemke::kSolved;
+  } else if (const Lemke::Result res = qp_.solve(Q, c, R, r, x, limit); res != Lemke::kSolved)
     return res;
   const int d = nullBasis(Q);
   if (d == 0) return Lemke::kSolved;

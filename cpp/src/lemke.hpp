@@ -69,7 +69,9 @@ class ConvexQp {
 // equality E x = 0 written as two inequalities (E, then -E, each >= a round-off slack), and the
 // second programme does not finish (P only positive semi-definite on Z's span, and the doubled
 // primal's pivoting stalls on the degenerate pairs), it runs once more on the null space of
-// [C; E] with the other rows only (secondOnEqualities). Workspace by reserve(p, k) (p unknowns,
+// [C; E] with the other rows only (secondOnEqualities); when C has no rows that form runs first
+// (the doubled primal over all p unknowns only if it fails: the same minimiser in exact
+// arithmetic, E x = 0 kept exactly instead of within the pairs' slack). Workspace by reserve(p, k) (p unknowns,
 // k rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:

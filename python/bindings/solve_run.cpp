@@ -1,6 +1,5 @@
-// Solver.solve (one row on workspace 0, its result new or `out`), _step, _step_symplectic, _whole_body (WholeBodyCall),
-// the benchmark hook _time_cpp and solve_batch (solveBatch, one workspace per thread) on the arguments SolveArgs
-// parsed.
+// Solver.solve and step (a row on workspace 0, the result new or `out`), _step_symplectic, _whole_body, the benchmark
+// hook _time_cpp and solve_batch (one workspace per thread), on the arguments SolveArgs parsed.
 #include <algorithm>
 
 #include "py_solver.hpp"
@@ -37,10 +36,9 @@ py::object PySolver::solve(PyObject* const* args, PyObject* out, int step) {
     next[k] = doubles(next_arrays[k] = newDoubles({k ? nj : nq}));
   const F64View p = step == 2 ? vectorView(out ? out : Py_None, "momentum (out=)", nj) : F64View();
   solveArgs(args, step ? next : nullptr, step == 2 ? p.data : nullptr);
-  const bool fr = args_.any_friction;
-  const long k = static_cast<long>(args_.input.contacts.size());
-  py::object r = newResult(vereshchagin::PackedRow{nj, ns, args_.columns, fr, k}, step ? nullptr : out);
-  if (!resultOutput(r.ptr()).write(0, workspaces_[0]->data, args_.columns, fr))
+  const vereshchagin::PackedRow layout{nj, ns, args_.columns, args_.any_friction, long(args_.input.contacts.size())};
+  py::object r = newResult(layout, step == 2 ? nullptr : out);  // (step 2's `out`: the momentum)
+  if (!resultOutput(r.ptr()).write(0, workspaces_[0]->data, args_.columns, layout.friction))
     raise("the results overflow: gauss_value is beyond the double range");
   if (!args_.layout.empty()) setSegmentLayout(r.ptr(), py::tuple(args_.layout));
   if (step == 2) return py::make_tuple(next_arrays[0], next_arrays[1], next_arrays[2], r);

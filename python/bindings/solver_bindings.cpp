@@ -19,13 +19,13 @@ static_assert(sizeof(kSolveParams) == kNumSolveArgs * sizeof(char*), "one name p
 PyObject* g_names[2][kNumSolveArgs];  // interned: solve()'s, solve_batch()'s
 
 // Fills `slots` (solve()'s parameters) from positional and keyword arguments; raises TypeError
-// like Python functions. names: g_names[0] or g_names[1].
+// like Python functions. names: g_names[0] or g_names[1]. step: q, qd, time_step positional, the rest keywords.
 void bindArguments(const char* fname, PyObject* const* names, PyObject* const* args, Py_ssize_t nargs,
-                   PyObject* kwnames, PyObject** slots) {
-  if (nargs > kNumSolveArgs)
-    throw py::type_error(std::string(fname) + "() takes at most " + std::to_string(kNumSolveArgs) +
+                   PyObject* kwnames, PyObject** slots, bool step) {
+  if (nargs > (step ? 3 : kNumSolveArgs))
+    throw py::type_error(std::string(fname) + "() takes at most " + std::to_string(step ? 3 : kNumSolveArgs) +
                          " positional arguments (" + std::to_string(nargs) + " given)");
-  for (Py_ssize_t k = 0; k < nargs; ++k) slots[k] = args[k];
+  for (Py_ssize_t k = 0; k < nargs; ++k) slots[step && k == 2 ? kTimeStepArg : k] = args[k];
   for (Py_ssize_t k = 0; kwnames != nullptr && k < PyTuple_GET_SIZE(kwnames); ++k) {
     PyObject* name = PyTuple_GET_ITEM(kwnames, k);
     int slot = -1;
@@ -66,10 +66,10 @@ PyObject* guarded(Body&& body) {
 }
 
 enum Entry { kSolve, kTimeCpp, kSolveBatch, kStep, kStepSymplectic };
-constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "solve_batch", "_step", "_step_symplectic"};
+constexpr const char* kEntryNames[] = {"solve", "_time_cpp", "solve_batch", "step", "_step_symplectic"};
 
 // The METH_FASTCALL methods (what each returns: vereshchagin/_docstrings.py): solve, _time_cpp(reps, ...), solve_batch
-// (`out` is its `threads`; a dict that solver.py wraps), _step, _step_symplectic (`out` is its momentum).
+// (`out` is its `threads`; a dict that solver.py wraps), step, _step_symplectic (`out` is its momentum).
 template <Entry kind>
 PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
   return guarded([&]() -> py::object {
@@ -77,7 +77,10 @@ PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyO
     const long reps = kind == kTimeCpp ? py::handle(args[0]).cast<long>() : 0;
     const int first = kind == kTimeCpp ? 1 : 0;  // _time_cpp's solve arguments follow reps
     PyObject* a[kNumSolveArgs] = {};
-    bindArguments(kEntryNames[kind], g_names[kind == kSolveBatch], args + first, nargs - first, kwnames, a);
+    bindArguments(kEntryNames[kind], g_names[kind == kSolveBatch], args + first, nargs - first, kwnames, a,
+                  kind == kStep);
+    if (kind >= kStep && a[kTimeStepArg] == nullptr)  // (its value: vereshchagin::step()'s check)
+      throw py::type_error("step() missing required argument 'time_step' (pos 3)");
     if (kind == kTimeCpp) return py::float_(solverOf(self).timeCpp(a, reps));
     if (kind == kSolveBatch) return solverOf(self).solveBatch(a, a[kOutArg]);
     return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg],

@@ -259,7 +259,27 @@ class Solver:
         contact_max_pivots: Optional[int] = None,
     ) -> SolveResult: ...
     def _time_cpp(self, reps: int, /, *args: object, **kwargs: object) -> float: ...
-    def _step(self, /, *args: object, **kwargs: object) -> tuple[np.ndarray, np.ndarray, SolveResult]: ...
+    def step(
+        self,
+        /,
+        q: ArrayLike,
+        qd: ArrayLike,
+        time_step: float,
+        *,
+        alpha: Optional[ArrayLike] = None,
+        beta: Optional[ArrayLike] = None,
+        f_ext: Optional[Union[ArrayLike, Mapping[Union[str, int], ArrayLike]]] = None,
+        tau_ff: Optional[ArrayLike] = None,
+        friction: object = None,
+        constraints: Optional[Mapping[Union[str, int], tuple[ArrayLike, ArrayLike]]] = None,
+        f_ext_pass_through: Optional[ArrayLike] = None,
+        tau_ff_pass_through: Optional[ArrayLike] = None,
+        out: Optional[SolveResult] = None,
+        a_desired: Optional[ArrayLike] = None,
+        contacts: Optional[Sequence[Contact]] = None,
+        contact_velocity_tolerance: Optional[float] = None,
+        contact_max_pivots: Optional[int] = None,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], SolveResult]: ...
     def _step_symplectic(
         self, /, *args: object, **kwargs: object
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, SolveResult]: ...

@@ -722,7 +722,51 @@ DOCS["_core.Solver.inertia_check"] = r"""str: 'physical' or 'joint_space' (see S
 
 DOCS["_core.Solver._time_cpp"] = r"""_time_cpp(reps, q, qd, ...) -> float: seconds per C++ solve of these arguments (benchmarks)."""
 
-DOCS["_core.Solver._step"] = r"""_step(q, qd, ..., time_step=dt) -> (q_next, qd_next, SolveResult): the C++ step() (Solver.step, Simulator)."""
+DOCS["_core.Solver.step"] = r"""step($self, /, q, qd, time_step, *, alpha=None, beta=None, f_ext=None, tau_ff=None, friction=None, constraints=None, f_ext_pass_through=None, tau_ff_pass_through=None, out=None, a_desired=None, contacts=None, contact_velocity_tolerance=None, contact_max_pivots=None)
+--
+
+One step of semi-implicit Euler over ``time_step`` with friction and contacts solved exactly.
+
+The C++ ``step()`` (``data.hpp``), as :class:`Simulator` steps: :meth:`solve` with
+``time_step``: the conditions of joint friction, joint limits and contacts hold for the
+velocities at the end of the step, ``qd_next = qd + dt qdd``; then ``q_next = q + dt qd_next``.
+A joint that friction holds (status 1, sticking) ends the step exactly at rest, so a held arm
+keeps ``q`` bitwise (docs: "Friction in discrete time").
+
+Parameters
+----------
+q, qd : array_like, shape (n,)
+    Joint positions (rad or m) and velocities (rad/s or m/s) at the start of the step (on a
+    floating base ``tree.nq`` and ``tree.nv`` entries).
+time_step : float
+    dt > 0, s.
+alpha, beta, f_ext, tau_ff, friction, constraints, f_ext_pass_through, tau_ff_pass_through, a_desired, contacts, contact_velocity_tolerance, contact_max_pivots : optional
+    Keywords only, as in :meth:`solve` (the task, the drivers, friction and contacts over the step).
+out : SolveResult, optional
+    A result of an earlier step or solve of the same kind, overwritten in place and returned
+    as ``result`` (as in :meth:`solve`).
+
+Returns
+-------
+q_next, qd_next : ndarray, shape (n,)
+    The state at the end of the step (new arrays).
+result : SolveResult
+    The solve over the step: ``qdd`` is the step's mean acceleration, ``friction_torque``,
+    ``limit_torque``, ``contact_force`` the step's (impulses over dt).
+
+Raises
+------
+SolverError
+    A ``time_step`` that is not a finite number > 0, a state after the step that overflows, or
+    what :meth:`solve` raises.
+TypeError
+    A missing ``q``, ``qd`` or ``time_step``, more than three positional arguments, or an
+    unknown keyword.
+
+Notes
+-----
+A direct C++ entry (no Python wrapper); the GIL is released during the step.
+"""
 
 DOCS["_core.Solver._step_symplectic"] = r"""_step_symplectic(q, qd, ..., time_step=dt, out=p) -> (q_next, qd_next, p_next, SolveResult): the C++ stepSymplectic() from the momentum p (Simulator)."""
 

@@ -149,7 +149,7 @@ class Simulator:
 
     def _advance(self, args):
         if self._p is None:  # C++ step(): q (+) dt qd_next on a floating base too
-            self._q, self._qd, result = self._solver._step(self._q, self._qd, time_step=self._dt, **args)
+            self._q, self._qd, result = self._solver.step(self._q, self._qd, self._dt, **args)
         else:
             step = self._solver._step_symplectic
             self._q, self._qd, self._p, result = step(self._q, self._qd, time_step=self._dt, out=self._p, **args)

@@ -246,43 +246,6 @@ class Solver(_core.Solver):
         segment_nu = {key: out["nu"][:, start : start + count] for key, start, count in layout}
         return BatchResult(**out, segment_nu=segment_nu or None)
 
-    def step(self, q, qd, time_step, **solve_args):
-        """One step of semi-implicit Euler over ``time_step`` with friction and contacts solved exactly.
-
-        The C++ ``step()`` (``data.hpp``; GIL released), as :class:`Simulator` steps: :meth:`solve`
-        with ``time_step``: the conditions of joint friction, joint limits and
-        contacts hold for the velocities at the end of the step, ``qd_next = qd + dt qdd``; then
-        ``q_next = q + dt qd_next``. A joint that friction holds (status 1, sticking) ends the
-        step exactly at rest, so a held arm keeps ``q`` bitwise (docs: "Friction in discrete
-        time").
-
-        Parameters
-        ----------
-        q, qd : array_like, shape (n,)
-            Joint positions (rad or m) and velocities (rad/s or m/s) at the start of the step.
-        time_step : float
-            dt > 0, s.
-        **solve_args
-            Any other argument of :meth:`solve` (``tau_ff``, ``friction``, ``contacts``, a task, ...).
-
-        Returns
-        -------
-        q_next, qd_next : ndarray, shape (n,)
-            The state at the end of the step.
-        result : SolveResult
-            The solve over the step: ``qdd`` is the step's mean acceleration, ``friction_torque``,
-            ``limit_torque``, ``contact_force`` the step's (impulses over dt).
-
-        Raises
-        ------
-        SolverError
-            A ``time_step`` that is not a positive number, or what :meth:`solve` raises.
-        """
-        dt = time_step
-        if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating, np.integer)) or not dt > 0.0:
-            raise _core.SolverError(f"time_step must be a number > 0 (s), got {time_step!r}")
-        return self._step(q, qd, time_step=dt, **solve_args)  # the C++ step(), GIL released
-
     @property
     def chain(self) -> _core.Chain:
         """A copy of the solver's Chain.

@@ -54,9 +54,6 @@ class Solver(_core.Solver):
         contact_velocity_tolerance: Optional[float] = None,
         contact_max_pivots: Optional[int] = None,
     ) -> BatchResult: ...
-    def step(
-        self, q: ArrayLike, qd: ArrayLike, time_step: float, **solve_args: object
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], _core.SolveResult]: ...
     @property
     def chain(self) -> _core.Chain: ...
     @property

@@ -150,6 +150,22 @@ def test_the_step_converges_to_the_instant_as_dt_goes_to_zero(case):
     assert np.all(np.diff(errors) <= 1e-8 * scale), errors
 
 
+def test_step_call_takes_three_positionals_and_out():
+    solver = vs.Solver(vs.robots.gen3())
+    qd = np.full(7, 0.1)
+    q1, qd1, r1 = solver.step(GEN3_Q, qd, 1e-3, tau_ff=np.ones(7))
+    q2, qd2, r2 = solver.step(q=GEN3_Q, qd=qd, time_step=1e-3, tau_ff=np.ones(7), out=r1)
+    assert r2 is r1  # the result written in place, as solve(out=) does
+    assert np.array_equal(q1, q2) and np.array_equal(qd1, qd2)
+    assert np.array_equal(qd1, qd + 1e-3 * r2.qdd) and np.array_equal(q1, GEN3_Q + 1e-3 * qd1)
+    with pytest.raises(TypeError, match="time_step"):
+        solver.step(GEN3_Q, qd)
+    with pytest.raises(TypeError, match="at most 3 positional"):
+        solver.step(GEN3_Q, qd, 1e-3, None)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'dt'"):
+        solver.step(GEN3_Q, qd, dt=1e-3)
+
+
 @pytest.mark.parametrize("bad", [0.0, -1e-3, float("nan"), float("inf"), True, "1e-3", None])
 def test_a_bad_time_step_is_refused_with_a_message(bad):
     solver = vs.Solver(vs.robots.gen3())
