@@ -3,7 +3,9 @@
 #  * test_patched_kdl:   the patched ChainHdSolver_Vereshchagin against our solver (every patch);
 #  * test_unpatched_kdl: Debian's unpatched KDL, to show the defects are really there.
 #
-# Usage: extern_patches/run_patch_tests.sh [OUT_DIR]      (default: build/patched_kdl)
+# Usage: extern_patches/run_patch_tests.sh [OUT_DIR [VERESHCHAGIN_PREFIX]]   (default: build/patched_kdl)
+# VERESHCHAGIN_PREFIX: an installed copy of our library (built against Debian's KDL) that
+# test_unpatched_kdl links instead of compiling our sources once more.
 set -euo pipefail
 
 HERE="$(cd "$(dirname "$0")" && pwd)"
@@ -16,7 +18,8 @@ bash "$HERE/build_patched_kdl.sh" "$OUT"
 
 GEN=()
 if command -v ninja > /dev/null; then GEN=(-G Ninja); fi
-cmake -S "$HERE/tests" -B "$OUT/tests" "${GEN[@]}" -DCMAKE_BUILD_TYPE=Release -DPATCHED_KDL_PREFIX="$OUT/prefix" > /dev/null
+cmake -S "$HERE/tests" -B "$OUT/tests" "${GEN[@]}" -DCMAKE_BUILD_TYPE=Release -DPATCHED_KDL_PREFIX="$OUT/prefix" \
+  -DVERESHCHAGIN_PREFIX="${2:-}" > /dev/null
 cmake --build "$OUT/tests" -j "${KDL_BUILD_JOBS:-2}"
 
 # One KDL per process: the patched test must load the patched library, not Debian's.

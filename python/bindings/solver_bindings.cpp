@@ -80,7 +80,7 @@ PyObject* fastEntry(PyObject* self, PyObject* const* args, Py_ssize_t nargs, PyO
     bindArguments(kEntryNames[kind], g_names[kind == kSolveBatch], args + first, nargs - first, kwnames, a,
                   kind == kStep);
     if (kind >= kStep && a[kTimeStepArg] == nullptr)  // (its value: vereshchagin::step()'s check)
-      throw py::type_error("step() missing required argument 'time_step' (pos 3)");
+      throw py::type_error(std::string(kEntryNames[kind]) + "() missing required argument 'time_step' (pos 3)");
     if (kind == kTimeCpp) return py::float_(solverOf(self).timeCpp(a, reps));
     if (kind == kSolveBatch) return solverOf(self).solveBatch(a, a[kOutArg]);
     return solverOf(self).solve(a, a[kOutArg] == Py_None ? nullptr : a[kOutArg],
