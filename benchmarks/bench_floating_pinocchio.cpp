@@ -11,6 +11,8 @@
 // Every answer is compared (relative 1e-9) before timing.
 //
 //   bench_floating_pinocchio <talos_reduced.urdf> <solo12.urdf> <anymal.urdf> [output.md]
+//   bench_floating_pinocchio --profile <free|feet> <robot 0-2> <seconds> <the three URDFs>
+// The second form only loops over our solve of one case (for `perf record`), no Pinocchio call.
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/constrained-dynamics.hpp>
 #include <pinocchio/algorithm/proximal.hpp>
@@ -224,16 +226,51 @@ bool benchRobot(const Robot& robot, const std::string& path, std::vector<Row>& r
   return free_err <= 1e-9 && feet_err <= 1e-9;
 }
 
+// --profile: our solve of one robot's case in a loop for `seconds` (no timing, no comparison).
+int profile(const Robot& robot, const std::string& path, bool feet, double seconds) {
+  Loaded r(path, robot.joint_space);
+  const std::vector<State> states = makeStates(r.model, r.pin, !feet, 0xF10A7);
+  vereshchagin::SolveInput in(r.model, 4, 0);
+  in.gravity = kGravity;
+  const int k = robot.six_d ? 6 : 3;
+  Eigen::VectorXd beta = Eigen::VectorXd::Zero(k);
+  beta(2) = bench::kGravity;
+  for (const std::string& foot : robot.feet) {
+    vereshchagin::FrameRef f;
+    if (!feet) break;
+    if (!r.model.findFrame(foot, f) || !in.addConstraint(f, Eigen::MatrixXd::Identity(6, k), beta)) return 1;
+  }
+  const auto t0 = bench::Clock::now();
+  long calls = 0;
+  while (std::chrono::duration<double>(bench::Clock::now() - t0).count() < seconds) {
+    for (const State& s : states) {
+      in.q = s.q, in.q_dot = s.qd, in.ff_torques = s.tau;
+      if (!vereshchagin::solve(r.model, r.data, in)) return 2;
+      bench::g_sink += r.data.qdd()(0);
+    }
+    calls += static_cast<long>(states.size());
+  }
+  std::cerr << robot.label << (feet ? " feet" : " free") << ": " << calls << " solves, "
+            << 1e6 * seconds / static_cast<double>(calls) << " us each (sink " << bench::g_sink << ")\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 4) {
-    std::cerr << "usage: bench_floating_pinocchio <talos_reduced.urdf> <solo12.urdf> <anymal.urdf> [output.md]\n";
-    return 1;
-  }
   const Robot robots[3] = {{"Talos (reduced)", {"left_sole_link", "right_sole_link"}, true},
                            {"solo12", {"FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"}, false},
                            {"ANYmal", {"LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"}, false, true}};
+  if (argc == 8 && std::string(argv[1]) == "--profile") {
+    const int robot = std::stoi(argv[3]);
+    if (robot < 0 || robot > 2) return 1;
+    return profile(robots[robot], argv[5 + robot], std::string(argv[2]) == "feet", std::stod(argv[4]));
+  }
+  if (argc < 4) {
+    std::cerr << "usage: bench_floating_pinocchio <talos_reduced.urdf> <solo12.urdf> <anymal.urdf> [output.md]\n"
+                 "       bench_floating_pinocchio --profile <free|feet> <robot 0-2> <seconds> <the three URDFs>\n";
+    return 1;
+  }
   std::vector<Row> rows;
   bool ok = true;
   for (int r = 0; r < 3; ++r) ok = benchRobot(robots[r], argv[r + 1], rows, 0xF10A7 + 10 * r) && ok;

@@ -8,16 +8,21 @@ namespace vereshchagin {
 namespace detail {
 
 // u = IA S, D = rotor + S^T u; free = (tau - S^T (pA + IA c)) / D is the joint acceleration with
-// the parent at rest and no constraint; pa = pA + IA c + u free is the apparent bias force.
+// the parent at rest and no constraint; pa = pA + IA c + u free is the apparent bias force. On a
+// coordinate axis u is a column of IA times S's entry (the same values as the product).
 inline bool HdCore::articulate(int i, double tau, Vector6& pa, double& free) {
   const SegmentModel& sm = model.seg[i];
   SegmentState& s = ws.seg[i];
-  s.u.noalias() = s.IA * sm.S;
-  s.D = sm.rotor + sm.S.dot(s.u);
+  if (sm.axis >= 0) {
+    s.u = s.IA.col(sm.axis) * sm.S(sm.axis);
+  } else {
+    s.u.noalias() = s.IA * sm.S;
+  }
+  s.D = sm.rotor + sm.dotS(s.u);
   if (!(s.D > sm.d_tolerance)) return false;
   s.Dinv = 1.0 / s.D;
   const Vector6 IAc = s.IA * s.c;
-  free = s.Dinv * (tau - sm.S.dot(s.pA + IAc));
+  free = s.Dinv * (tau - sm.dotS(s.pA + IAc));
   pa = s.pA + IAc + s.u * free;
   return true;
 }
@@ -64,10 +69,14 @@ inline void HdCore::finalSweep(const Eigen::Ref<const Eigen::VectorXd>& ff_torqu
     Vector6 a = incomingAcceleration(i);
     if (sm.joint >= 0) {
       const double tau = has_tau ? ff_torques(sm.joint) : 0.0;
-      const double f = sm.S.dot(s.pA) + s.u.dot(a) + constraint_force(i);  // S^T IA a = u^T a
+      const double f = sm.dotS(s.pA) + s.u.dot(a) + constraint_force(i);  // S^T IA a = u^T a
       const double qdd = s.Dinv * (tau - f);
       qdd_joints[sm.joint] = qdd;
-      a += sm.S * qdd;
+      if (sm.axis >= 0) {
+        a(sm.axis) += sm.S(sm.axis) * qdd;
+      } else {
+        a += sm.S * qdd;
+      }
     }
     s.xdd = a;
   }

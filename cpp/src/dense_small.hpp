@@ -16,22 +16,26 @@ namespace detail {
 using MatBlock = Eigen::Block<Eigen::MatrixXd>;
 using VecBlock = Eigen::VectorBlock<Eigen::VectorXd>;
 
-// A = L L^T into the lower triangle of L (k x k). Fails (false) when a pivot is not above
-// min_pivot, i.e. when A is not safely positive definite at the caller's scale.
+// A = L L^T into the lower triangle of L (k x k, column-major storage). Fails (false) when a
+// pivot is not above min_pivot, i.e. when A is not safely positive definite at the caller's scale.
+// Column j of L accumulates A(j.., j) - sum_p L(j.., p) L(j, p) in place with p in order (each
+// entry's sum in the same order as a dot product's: the same values), down contiguous columns.
 template <typename MA, typename ML>
 bool choleskyCertified(const MA& A, ML& L, double min_pivot) {
   const int k = static_cast<int>(A.rows());
   for (int j = 0; j < k; ++j) {
-    double d = A(j, j);
-    for (int p = 0; p < j; ++p) d -= L(j, p) * L(j, p);
+    double* lj = &L(0, j);
+    for (int i = j; i < k; ++i) lj[i] = A(i, j);
+    for (int p = 0; p < j; ++p) {
+      const double* lp = &L(0, p);
+      const double ljp = lp[j];
+      for (int i = j; i < k; ++i) lj[i] -= lp[i] * ljp;
+    }
+    const double d = lj[j];
     if (!(d > min_pivot)) return false;
     const double ljj = std::sqrt(d);
-    L(j, j) = ljj;
-    for (int i = j + 1; i < k; ++i) {
-      double v = A(i, j);
-      for (int p = 0; p < j; ++p) v -= L(i, p) * L(j, p);
-      L(i, j) = v / ljj;
-    }
+    lj[j] = ljj;
+    for (int i = j + 1; i < k; ++i) lj[i] /= ljj;
   }
   return true;
 }
@@ -51,6 +55,35 @@ double inverseFrobeniusSquared(const ML& L, VX& x) {
     }
   }
   return frob2;
+}
+
+// An upper bound of ||L^-1||_2^2 for a lower-triangular L with a positive diagonal, in k^2
+// operations where ||L^-1||_F^2 takes k^3 / 3: with M(L) the comparison matrix (|L(i, i)| on the
+// diagonal, -|L(i, j)| off it), |L^-1| <= M(L)^-1 entrywise and M(L)^-1 >= 0 (N. J. Higham,
+// Accuracy and Stability of Numerical Algorithms, 2nd ed., SIAM 2002, Theorem 8.12), so
+// ||L^-1||_inf <= max_i (M^-1 1)_i, ||L^-1||_1 <= max_i (M^-T 1)_i, and ||L^-1||_2^2 <=
+// ||L^-1||_1 ||L^-1||_inf. Both substitutions only add non-negative terms (relative round-off
+// below 2 k eps, covered by the factor 1 + 1e-10). It can exceed ||L^-1||_2^2 by a factor growing
+// with k (up to 2^k): callers fall back to inverseFrobeniusSquared() when it is not enough.
+// x: scratch of at least k entries.
+template <typename ML, typename VX>
+double inverseNormBound(const ML& L, VX& x) {
+  const int k = static_cast<int>(L.rows());
+  double row_max = 0.0, col_max = 0.0;
+  for (int i = 0; i < k; ++i) x(i) = 1.0;
+  for (int j = 0; j < k; ++j) {  // x = M^-1 1, by columns
+    const double xj = x(j) / L(j, j);
+    x(j) = xj;
+    row_max = std::max(row_max, xj);
+    for (int i = j + 1; i < k; ++i) x(i) += std::abs(L(i, j)) * xj;
+  }
+  for (int i = k - 1; i >= 0; --i) {  // x = M^-T 1
+    double v = 1.0;
+    for (int p = i + 1; p < k; ++p) v += std::abs(L(p, i)) * x(p);
+    x(i) = v / L(i, i);
+    col_max = std::max(col_max, x(i));
+  }
+  return row_max * col_max * (1.0 + 1e-10);
 }
 
 // Per-eigenvalue multipliers of a symmetric positive semi-definite matrix's (pseudo-)inverse

@@ -23,7 +23,55 @@
 namespace vereshchagin {
 namespace detail {
 
+// Cholesky factor, left-looking, one division per pivot.
+bool BaseFactor::compute(const Matrix6& D, int size) {
+  k = size;
+  for (int j = 0; j < k; ++j) {
+    double d = D(j, j);
+    for (int p = 0; p < j; ++p) d -= L(j, p) * L(j, p);
+    if (!(d > 0.0)) return false;
+    L(j, j) = std::sqrt(d);
+    inv(j) = 1.0 / L(j, j);
+    for (int i = j + 1; i < k; ++i) {
+      double v = D(i, j);
+      for (int p = 0; p < j; ++p) v -= L(i, p) * L(j, p);
+      L(i, j) = v * inv(j);
+    }
+  }
+  return true;
+}
+
+// Forward substitution by columns: each solved entry updates the rows below it independently.
+template <typename V>
+void BaseFactor::forward(V&& x) const {
+  for (int j = 0; j < k; ++j) {
+    const double xj = x(j) * inv(j);
+    x(j) = xj;
+    for (int i = j + 1; i < k; ++i) x(i) -= L(i, j) * xj;
+  }
+}
+
+template <typename V>
+void BaseFactor::backward(V&& x) const {
+  for (int j = k - 1; j >= 0; --j) {
+    double v = x(j);
+    for (int i = j + 1; i < k; ++i) v -= L(i, j) * x(i);
+    x(j) = v * inv(j);
+  }
+}
+
 namespace {
+
+// K += Y^T Y for a symmetric K: the lower triangle's dot products, mirrored.
+template <typename MY, typename MK>
+void addGram(const MY& Y, MK& K) {
+  const Eigen::Index m = Y.cols();
+  for (Eigen::Index c = 0; c < m; ++c) {
+    for (Eigen::Index r = c; r < m; ++r) K(r, c) += Y.col(r).dot(Y.col(c));
+    for (Eigen::Index r = c + 1; r < m; ++r) K(c, r) = K(r, c);
+  }
+}
+
 constexpr double kUnitTolerance = 1e-6;  // |norm - 1| of the quaternion / (cos, sin) accepted
 constexpr int E_SIZE = KDL::SolverI::E_SIZE_MISMATCH, E_NF = HdSolver::E_NONFINITE_INPUT;
 }  // namespace
@@ -115,29 +163,26 @@ void HdCore::basePose(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::R
   b.pA = crossForce(b.v, model.I_base * b.v);
 }
 
-// The base step of the inward sweep (see the top of this file), after inwardSweepGeneral.
+// The base step of the inward sweep (see the top of this file), after inwardSweepGeneral. With
+// Y = L^-1 e (D = L L^T): K += Y^T Y, and kappa += |Y|_F^2 (the trace of that share).
 int HdCore::closeAtBase(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   BaseState& b = ws.base;
   CouplingGeneral& g = ws.general;
   const BaseAxes& S = model.S_base;
   const int k = model.nbv, m = res.m;
-  const bool ff = model.base == BaseKind::FreeFlyer;  // S = identity: its products are copies
-  if (ff) {
-    b.U = b.IA;
-    b.D = b.IA;
-  } else {
+  const bool ff = model.base == BaseKind::FreeFlyer;  // S = identity: U = D = IA, e = A
+  if (!ff) {
     b.U.noalias() = b.IA * S;
-    b.D.noalias() = S.transpose() * b.U;
+    b.D.topLeftCorner(k, k).noalias() = S.transpose() * b.U;
   }
-  b.llt.compute(b.D);
-  if (b.llt.info() != Eigen::Success || !(b.D.diagonal().minCoeff() > 0.0))
+  if (!b.factor.compute(ff ? b.IA : b.D, k))
     return fail(HdSolver::E_DEGENERATE_INERTIA,
                 "the floating base's articulated inertia is not positive definite: the base and the robot on it have "
                 "no mass or inertia along some base direction (ModelOptions::base_inertia, the URDF root link)");
   if (m == 0) return 0;  // free is only needed for the constraint columns' U
-  BaseVector rhs = ff ? BaseVector(-b.pA) : BaseVector(-(S.transpose() * b.pA));
-  if (ff_torques.size() != 0) rhs += ff_torques.head(k);
-  b.free = b.llt.solve(rhs);
+  b.free = ff ? BaseVector(-b.pA) : BaseVector(-(S.transpose() * b.pA));
+  if (ff_torques.size() != 0) b.free += ff_torques.head(k);
+  b.factor.solve(b.free);
   auto A = g.acur.leftCols(m);  // every column, carried to the base (base axes)
   auto e = b.e.leftCols(m);
   if (ff) {
@@ -147,14 +192,24 @@ int HdCore::closeAtBase(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) {
   }
   const Vector6 bias = ff ? Vector6(b.free) : Vector6(S * b.free);
   g.ug.head(m).noalias() += A.transpose().lazyProduct(bias);
-  auto De = b.De.leftCols(m);  // D^-1 e
-  De = e;
-  b.llt.solveInPlace(De);
-  auto K = g.kg.topLeftCorner(m, m);  // one block on a floating base (forEachCouplingBlock)
-  K.noalias() += e.transpose().lazyProduct(De);
-  ws.kappa += e.cwiseProduct(De).sum();     // trace of the base's share of K
-  if (model.base != BaseKind::FreeFlyer) {  // what the world feels: A - U D^-1 e (zero for a free-flyer)
-    A.noalias() -= b.U.lazyProduct(De);
+  auto Y = b.De.leftCols(m);
+  Y = e;
+  auto K = g.kg.topLeftCorner(m, m);  // one block on a floating base (forEachCouplingBlock); symmetric
+  if (ff) {
+    Eigen::Map<Matrix6X> Y6(Y.data(), 6, m);  // fixed rows: the loops below unroll
+    for (int j = 0; j < 6; ++j) {             // Y <- L^-1 Y, every column at once
+      Y6.row(j) *= b.factor.inv(j);
+      for (int i = j + 1; i < 6; ++i) Y6.row(i) -= b.factor.L(i, j) * Y6.row(j);
+    }
+    addGram(Y6, K);
+  } else {
+    for (int c = 0; c < m; ++c) b.factor.forward(Y.col(c));
+    addGram(Y, K);
+  }
+  ws.kappa += Y.squaredNorm();  // trace of the base's share of K
+  if (!ff) {                    // what the world feels: A - U D^-1 e (zero for a free-flyer)
+    for (int c = 0; c < m; ++c) b.factor.backward(Y.col(c));  // D^-1 e
+    A.noalias() -= b.U.lazyProduct(Y);
     g.ug.head(m).noalias() += A.transpose().lazyProduct(b.a_world);
   }
   return 0;
@@ -167,10 +222,10 @@ void HdCore::finalBaseStep(const Eigen::Ref<const Eigen::VectorXd>& ff_torques) 
   const int k = model.nbv, m = res.m;
   const bool ff = model.base == BaseKind::FreeFlyer;  // S = identity (see closeAtBase)
   const Vector6 p = b.pA + b.IA * b.a_world;
-  BaseVector rhs = ff ? BaseVector(-p) : BaseVector(-(S.transpose() * p));
-  if (ff_torques.size() != 0) rhs += ff_torques.head(k);
-  if (m > 0) rhs.noalias() -= b.e.leftCols(m).lazyProduct(ws.general.nug.head(m));
-  const BaseVector qdd = b.llt.solve(rhs);
+  BaseVector qdd = ff ? BaseVector(-p) : BaseVector(-(S.transpose() * p));
+  if (ff_torques.size() != 0) qdd += ff_torques.head(k);
+  if (m > 0) qdd.noalias() -= b.e.leftCols(m).lazyProduct(ws.general.nug.head(m));
+  b.factor.solve(qdd);
   res.qdd.head(k) = qdd;
   b.xdd = ff ? Vector6(b.a_world + qdd) : Vector6(b.a_world + S * qdd);
 }
@@ -192,7 +247,8 @@ void HdCore::responseBaseInward(long kc) {
     dp_base.tail<3>().noalias() = b.X.R.transpose() * n;
     r.base_sdp.col(c).noalias() = model.S_base.transpose() * dp_base;
     if (m == 0) continue;
-    const BaseVector dfree = b.llt.solve(-r.base_sdp.col(c));
+    BaseVector dfree = -r.base_sdp.col(c);
+    b.factor.solve(dfree);
     r.energy.col(c).head(m).noalias() += b.e.leftCols(m).transpose().lazyProduct(dfree);
   }
 }
@@ -207,9 +263,9 @@ void HdCore::responseBaseOutward(long c0, long kc, Eigen::Ref<Eigen::MatrixXd> d
   for (long c = 0; c < kc; ++c) {
     BaseVector rhs = -r.base_sdp.col(c);
     if (m > 0) rhs.noalias() -= b.e.leftCols(m).lazyProduct(r.dnu.col(c).head(m));
-    const BaseVector dq = b.llt.solve(rhs);
-    dqdd.col(c0 + c).head(k) = dq;
-    const Vector6 da = model.S_base * dq;
+    b.factor.solve(rhs);
+    dqdd.col(c0 + c).head(k) = rhs;
+    const Vector6 da = model.S_base * rhs;
     r.base_acc.col(c).head<3>().noalias() = b.X.R * da.head<3>();
     r.base_acc.col(c).tail<3>().noalias() = b.X.R * da.tail<3>();
   }

@@ -234,16 +234,19 @@ void HdCore::factorizeCoupling() {
 
 // Cholesky factor K = L L^T (into chol), and a proof that every eigenvalue of K is above the
 // truncation threshold rcond * max(lambda_max, kappa) = rcond * kappa: lambda_min(K) =
-// 1 / ||L^-1||_2^2 >= 1 / ||L^-1||_F^2 and lambda_max(K) <= trace(K) <= kappa. False if the
-// factorisation breaks down or the proof fails.
+// 1 / ||L^-1||_2^2, bounded below first by the k^2 bound of inverseNormBound(), then (when that
+// is not enough) by 1 / ||L^-1||_F^2; lambda_max(K) <= trace(K) <= kappa. False if the
+// factorisation breaks down or both proofs fail.
 bool HdCore::choleskyFullRank() {
   const int m = res.m;
   CouplingFast& f = ws.fast;
   f.chol.setZero(m, m);
   if (!detail::choleskyCertified(f.K, f.chol, 0.0)) return false;
+  const double threshold = options.rcond * ws.kappa;
   VectorC x(m);
+  if (1.0 / detail::inverseNormBound(f.chol, x) > threshold) return true;
   const double lower = 1.0 / detail::inverseFrobeniusSquared(f.chol, x);
-  return std::isfinite(lower) && lower > options.rcond * ws.kappa;
+  return std::isfinite(lower) && lower > threshold;
 }
 
 double HdCore::smallestSingularValue() const {

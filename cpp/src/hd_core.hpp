@@ -77,6 +77,12 @@ struct SegmentModel {
   double v2 = 0.0, w2 = 0.0;  // |linear part of S|^2, |angular part of S|^2
   double d_tolerance = 0.0;   // articulated inertias of this joint at or below this are degenerate
   int joint = -1;             // joint index or -1 for a fixed joint
+  int axis = -1;              // S has one nonzero entry (a coordinate axis): its index, else -1
+  // S^T x, on a coordinate axis the one product (the others are exact zeros: the same value).
+  template <typename V>
+  double dotS(const V& x) const {
+    return axis >= 0 ? S(axis) * x(axis) : S.dot(x);
+  }
 };
 
 // The robot: constant per robot, validated when built.
@@ -185,6 +191,25 @@ struct PassThroughState {
   const Eigen::VectorXd* driver = nullptr;      // ff driver if not ff_torques (FrictionSolver)
 };
 
+// Cholesky factor D = L L^T of the floating base's k x k articulated inertia (k = nbv <= 6), with
+// the reciprocals of its diagonal, and its solves (floating_base.cpp). Fixed storage and plain
+// loops: at this size a general factorisation's blocking and dispatch cost more than its flops.
+struct BaseFactor {
+  Matrix6 L = Matrix6::Zero();    // lower triangle (k x k) used
+  Vector6 inv = Vector6::Zero();  // 1 / L(j, j)
+  int k = 0;
+  bool compute(const Matrix6& D, int size);  // false: D is not positive definite (or not finite)
+  template <typename V>
+  void forward(V&& x) const;  // x <- L^-1 x (k entries)
+  template <typename V>
+  void backward(V&& x) const;  // x <- L^-T x
+  template <typename V>
+  void solve(V&& x) const {  // x <- D^-1 x
+    forward(x);
+    backward(x);
+  }
+};
+
 // Per-solve state of the floating base body (floating_base.cpp), base axes.
 struct BaseState {
   Pose X;                             // pose of the base frame in the world frame at q
@@ -194,10 +219,10 @@ struct BaseState {
   Matrix6 IA = Matrix6::Zero();       // articulated inertia, closed over every root segment
   Vector6 pA = Vector6::Zero();       // articulated bias force
   BaseAxes U;                         // IA S
-  BaseSquare D;                       // S^T IA S
-  Eigen::LLT<BaseSquare> llt;         // of D
+  Matrix6 D = Matrix6::Zero();        // S^T IA S (top-left k x k)
+  BaseFactor factor;                  // of D
   BaseVector free;                    // D^-1 (tau - S^T pA): the base's acceleration, world at rest
-  Eigen::MatrixXd e, De;              // S^T A_base and D^-1 S^T A_base (k x mcap)
+  Eigen::MatrixXd e, De;              // S^T A_base and L^-1 S^T A_base, then D^-1 S^T A_base (k x mcap)
 };
 
 struct HdWorkspace {

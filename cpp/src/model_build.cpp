@@ -115,6 +115,7 @@ int ModelBuilder::segment(int i) {
   if (!s.S.allFinite() || s.S.norm() == 0.0)
     return fail(HdSolver::E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite", s.joint,
                 joint.getName().c_str());
+  if ((s.S.array() != 0.0).count() == 1) s.S.cwiseAbs().maxCoeff(&s.axis);
   return 0;
 }
 

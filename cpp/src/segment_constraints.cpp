@@ -189,7 +189,7 @@ void HdCore::projectColumns(int i, int lo, int w, double free) {
   double kappa = 0.0;
   for (int k = 0; k < w; ++k) {
     Eigen::Map<Vector6> a(g.acur.col(lo + k).data());
-    const double ek = sm.S.dot(a);
+    const double ek = sm.dotS(a);
     e[k] = ek;
     u[k] += a.dot(bias);
     // The fast path's unit-consistent bound of |e_c|: |v||f_c| + |w||n_c|.
@@ -258,25 +258,38 @@ int HdCore::nullMultipliers(Eigen::Ref<Eigen::MatrixXd> out) const {
 }
 
 // Cholesky factor of K into cholg's diagonal blocks (their lower triangles; nothing reads the
-// rest) and the certificate that every eigenvalue is above the truncation threshold:
-// lambda_min(K) >= 1 / ||L^-1||_F^2 > rcond kappa (kappa >= lambda_max(K)). False if a block is
-// not positive definite or the proof fails.
+// rest) and the certificate that every eigenvalue is above the truncation threshold rcond kappa
+// (kappa >= lambda_max(K)): L^-1 is block-diagonal, so ||L^-1||_2^2 is the largest of the blocks'
+// (each bounded by inverseNormBound(), k^2 operations) and ||L^-1||_F^2 their sum (the exact
+// fallback, k^3 / 3, when the bound is not enough); lambda_min(K) >= 1 / either. False if a block
+// is not positive definite or both proofs fail.
 bool HdCore::choleskyBlocks() {
   CouplingGeneral& g = ws.general;
   bool ok = true;
-  double frob2 = 0.0;  // ||L^-1||_F^2
+  double bound2 = 0.0;  // >= ||L^-1||_2^2
   forEachCouplingBlock([&](int lo, int w) {
     if (!ok) return;
     withBlockSize(w, [&](auto size) {
       constexpr int S = decltype(size)::value;
       auto L = g.cholg.block<S, S>(lo, lo, w, w);
       ok = detail::choleskyCertified(g.kg.block<S, S>(lo, lo, w, w), L, 0.0);
-      auto x = g.tmp.head<S>(w);
-      if (ok) frob2 += detail::inverseFrobeniusSquared(L, x);
+      auto x = g.tmp.segment<S>(0, w);
+      if (ok) bound2 = std::max(bound2, detail::inverseNormBound(L, x));
+    });
+  });
+  if (!ok) return false;
+  const double threshold = options.rcond * ws.kappa;
+  if (1.0 / bound2 > threshold) return true;
+  double frob2 = 0.0;  // ||L^-1||_F^2
+  forEachCouplingBlock([&](int lo, int w) {
+    withBlockSize(w, [&](auto size) {
+      constexpr int S = decltype(size)::value;
+      auto x = g.tmp.segment<S>(0, w);
+      frob2 += detail::inverseFrobeniusSquared(g.cholg.block<S, S>(lo, lo, w, w), x);
     });
   });
   const double lower = 1.0 / frob2;
-  return ok && std::isfinite(lower) && lower > options.rcond * ws.kappa;
+  return std::isfinite(lower) && lower > threshold;
 }
 
 // Smallest eigenvalue of K: the smallest over its diagonal blocks.

@@ -64,9 +64,9 @@
 /// joint can affect, e.g. along a stretched arm, counts as rank 0 even when it is the only one);
 /// the rank reported counts the others. DampedLeastSquares uses lambda / (lambda^2 + damping^2)
 /// for every eigenvalue lambda. Both give finite outputs for any valid input. Fast path: when a
-/// Cholesky factor K = L L^T proves every eigenvalue above the threshold (lambda_min >= 1 /
-/// ||L^-1||_F^2 > rcond * kappa), K^+ = K^-1 is applied through L: the same solution at a fraction
-/// of the cost.
+/// Cholesky factor K = L L^T proves every eigenvalue above the threshold (lambda_min = 1 /
+/// ||L^-1||_2^2 > rcond * kappa, ||L^-1||_2^2 bounded through L's comparison matrix in O(M^2), else
+/// by ||L^-1||_F^2), K^+ = K^-1 is applied through L: the same solution at a fraction of the cost.
 ///
 /// Constraints on any segments (Shakhimardanov's extension of the recursion, KU Leuven 2015): at
 /// most 6 columns per segment, any number of segments (maxConstraints() in total: 6 x n_segments,
