@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "alloc_counter.hpp"
+#include "floating_fixture.hpp"
 #include "random_tree.hpp"
 #include "vereshchagin/data.hpp"
 
@@ -20,11 +21,7 @@ Model floatingModel(BaseKind kind, unsigned seed) {
   testutil::RandomGen g(seed);
   testutil::TreeSpec spec;
   spec.n_joints = 7;
-  ModelOptions options;
-  options.base = kind;
-  options.base_inertia = KDL::RigidBodyInertia(3.0, KDL::Vector(0.05, -0.02, 0.01),
-                                               KDL::RotationalInertia(0.2, 0.3, 0.25, 0.01, 0.0, -0.02));
-  return Model(testutil::randomTree(g, spec), "", options);
+  return testutil::floatingTreeModel(kind, g, spec, 3.0);
 }
 
 // A state with the base turned, three contacts (on the last segments, the ground's normal up),

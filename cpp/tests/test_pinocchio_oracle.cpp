@@ -26,6 +26,7 @@
 #include <cmath>
 
 #include "alloc_counter.hpp"
+#include "floating_fixture.hpp"
 #include "pinocchio_bridge.hpp"
 #include "random_tree.hpp"
 #include "test_common.hpp"
@@ -74,11 +75,7 @@ double relScalar(double a, double b) {
 Model floatingModel(BaseKind kind, testutil::RandomGen& g) {
   testutil::TreeSpec spec;
   spec.n_joints = 8;
-  ModelOptions options;
-  options.base = kind;
-  options.base_inertia = KDL::RigidBodyInertia(2.5, KDL::Vector(0.05, -0.02, 0.01),
-                                               KDL::RotationalInertia(0.2, 0.3, 0.25, 0.01, 0.0, -0.02));
-  return Model(testutil::randomTree(g, spec), "", options);
+  return testutil::floatingTreeModel(kind, g, spec, 2.5);
 }
 
 // q with a unit quaternion (free-flyer) or (cos, sin) (planar) in its base part.

@@ -43,10 +43,7 @@ TEST_CASE("at rest the step's least-effort split is the instant's") {
     CAPTURE(seed);
     RandomGen g(seed);
     testutil::HeldChain held(g, 7, 0.7, 0.3);
-    auto& model = held.model;
-    auto& data = held.data;
-    auto& in = held.in;
-    auto& fm = held.fm;
+    auto& [model, data, in, fm] = held;
     in.contacts = sharedLoad(static_cast<int>(model.nrOfSegments()));
     REQUIRE(solve(model, data, in));
     const Eigen::MatrixXd f_inst = data.contactForces();
@@ -63,10 +60,7 @@ TEST_CASE("at rest the step's least-effort split is the instant's") {
 TEST_CASE("a chain held by supports, a set-point and friction keeps q bitwise over many steps") {
   RandomGen g(85);
   testutil::HeldChain held(g, 7, 1.2, 0.5);
-  auto& model = held.model;
-  auto& data = held.data;
-  auto& in = held.in;
-  auto& fm = held.fm;
+  auto& [model, data, in, fm] = held;
   in.contacts = sharedLoad(static_cast<int>(model.nrOfSegments()));
   in.time_step = 1e-3;
   testutil::checkHeldOverSteps(model, data, in, 20000);
