@@ -18,35 +18,20 @@ namespace detail {
 
 // Pose of the tip frame at joint position q: the tip moves by the screw motion exp(q S) of its
 // own joint axis (constant in the tip frame), so X(q) = X(0) * exp(q [S]) with, for S = [v; w]
-// and theta = |w| q, unit axis k = w / |w|:  E.R = Rodrigues(k, theta),
-// E.p = (I - E.R) (k x v) / |w| + k (k . v) q;  for |w| = 0 (prismatic) E = (I, v q).
+// and theta = |w| q, unit axis k = w / |w|, K = [k]x:  E.R = I + sin(theta) K + (1 - cos(theta)) K K
+// (Rodrigues), E.p = (I - E.R) (k x v) / |w| + k (k . v) q;  for |w| = 0 (prismatic) E = (I, v q).
+// X0 is folded into the constant factors at model build (SegmentModel::RK, ...), so a pose costs
+// one sincos and 27 multiply-adds.
 void HdCore::screwPose(const SegmentModel& sm, SegmentState& s, double q) const {
-  const Vector3 v = sm.S.head<3>();
   if (sm.w_norm == 0.0) {
     s.X.R = sm.X0.R;
-    s.X.p.noalias() = sm.X0.p + sm.X0.R * (v * q);
+    s.X.p.noalias() = sm.X0.p + sm.pq * q;
     return;
   }
-  const Vector3 k = sm.S.tail<3>() / sm.w_norm;
   const double theta = sm.w_norm * q;
   const double sn = std::sin(theta), c1 = 1.0 - std::cos(theta);
-  const Matrix3 K = skew(k);
-  // K K entry by entry: the nonzero products of the dense product (the others are exact zeros),
-  // so the same values at a third of the multiplications: k_i k_j off the diagonal and minus the
-  // other two squares on it.
-  Matrix3 KK;
-  KK << -(k.z() * k.z()) - k.y() * k.y(), k.y() * k.x(), k.z() * k.x(),  //
-      k.x() * k.y(), -(k.z() * k.z()) - k.x() * k.x(), k.z() * k.y(),    //
-      k.x() * k.z(), k.y() * k.z(), -(k.y() * k.y()) - k.x() * k.x();
-  Matrix3 R = Matrix3::Identity();
-  R.noalias() += sn * K + c1 * KK;
-  // (I - R) = -(sn K + c1 KK), applied to k x v / |w|.
-  const Vector3 kxv = k.cross(v) / sm.w_norm;
-  Vector3 p;
-  p.noalias() = -(sn * (K * kxv) + c1 * (KK * kxv));
-  p.noalias() += k * (k.dot(v) * q);
-  s.X.R.noalias() = sm.X0.R * R;
-  s.X.p.noalias() = sm.X0.p + sm.X0.R * p;
+  s.X.R = sm.X0.R + sn * sm.RK + c1 * sm.RKK;
+  s.X.p = sm.X0.p - sn * sm.pK - c1 * sm.pKK + q * sm.pq;
 }
 
 // Outward sweep: poses, velocities, velocity-product accelerations, rigid bias forces.

@@ -83,6 +83,13 @@ struct SegmentModel {
   double dotS(const V& x) const {
     return axis >= 0 ? S(axis) * x(axis) : S.dot(x);
   }
+  // The screw motion of screwPose() with X0 folded in (model_build.cpp), for S = [v; w], unit
+  // axis k = w / |w|, K = [k]x: X(q).R = X0.R + sin(|w| q) RK + (1 - cos(|w| q)) RKK and
+  // X(q).p = X0.p - sin(|w| q) pK - (1 - cos(|w| q)) pKK + q pq, with RK = X0.R K,
+  // RKK = X0.R K K, pK = RK (k x v) / |w|, pKK = RKK (k x v) / |w|, pq = X0.R k (k . v) (zero
+  // but pq = X0.R v for a prismatic joint, |w| = 0).
+  Matrix3 RK = Matrix3::Zero(), RKK = Matrix3::Zero();
+  Vector3 pK = Vector3::Zero(), pKK = Vector3::Zero(), pq = Vector3::Zero();
 };
 
 // The robot: constant per robot, validated when built.

@@ -242,6 +242,10 @@ bool LexicographicQp::secondOnNull(const Eigen::Ref<const Eigen::MatrixXd>& P,
   auto r2 = r2_.head(k);
   r2 = rs;
   r2.noalias() -= Rs * x;
+  // x1 meets every row in exact arithmetic (the first programme's answer, or the caller's feasible
+  // point); a row it misses by round-off would make w = 0 infeasible and the pivoting end on a
+  // ray. Such a row asks only that w not make it worse.
+  r2 = r2.cwiseMin(0.0);
   auto w = w_.head(d);
   return strictSecond(Q2, c2, RZ, r2, w) || qp_.solve(Q2, c2, RZ, r2, w, 100 + 40 * (2 * d + k)) == Lemke::kSolved;
 }

@@ -28,6 +28,7 @@ class ModelBuilder {
   void topology();
   int segment(int i);
   void tolerances();  // SegmentModel::d_tolerance from the subtree sizes
+  static void screwConstants(SegmentModel& s);
   int fail(int code, const char* fmt, ...);
 
   HdModel& model;
@@ -115,8 +116,27 @@ int ModelBuilder::segment(int i) {
   if (!s.S.allFinite() || s.S.norm() == 0.0)
     return fail(HdSolver::E_INVALID_MODEL, "joint %d ('%s'): joint axis is zero or not finite", s.joint,
                 joint.getName().c_str());
+  screwConstants(s);
   if ((s.S.array() != 0.0).count() == 1) s.S.cwiseAbs().maxCoeff(&s.axis);
   return 0;
+}
+
+// The constant factors of the joint's screw motion with X0 folded in (SegmentModel::RK, ...;
+// the pose itself is HdCore::screwPose()).
+void ModelBuilder::screwConstants(SegmentModel& s) {
+  const Vector3 v = s.S.head<3>();
+  if (s.w_norm == 0.0) {  // prismatic: X(q) = (X0.R, X0.p + X0.R v q)
+    s.pq.noalias() = s.X0.R * v;
+    return;
+  }
+  const Vector3 k = s.S.tail<3>() / s.w_norm;
+  const Matrix3 K = skew(k);
+  s.RK.noalias() = s.X0.R * K;
+  s.RKK.noalias() = s.RK * K;
+  const Vector3 kxv = k.cross(v) / s.w_norm;
+  s.pK.noalias() = s.RK * kxv;
+  s.pKK.noalias() = s.RKK * kxv;
+  s.pq.noalias() = s.X0.R * (k * k.dot(v));
 }
 
 // The degeneracy tolerance of every joint, relative to what it moves (hd_solver.hpp, "Degenerate

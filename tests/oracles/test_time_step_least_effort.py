@@ -1,5 +1,5 @@
 """The least-effort rule over a time step (``solve(..., time_step=dt)``, docs/time-step.md) against
-an independent formulation with scipy, at 1e-9 relative.
+an independent formulation (Pinocchio, ProxQP), at 1e-9 relative.
 
 Where the step's impulses are not unique (redundant supports, supports and friction-held joints
 sharing a load, a redundant task with joint friction) the step's end velocities still are, and the
@@ -12,20 +12,24 @@ d_j``; sliding: the edges most opposed to its end sliding velocity; frictionless
 none) and the torques of the joints with friction (sticking: within their bounds; slipping: the
 bound against their end velocity), with the equation of motion ``H qdd - h = A^T nu + sum_c J_c^T
 f_c + tau_joints`` (Pinocchio's ``crba`` and ``rnea``). The two programmes, least effort and then
-least contact force with the effort kept, are solved from a feasible point (linear programming,
-scipy's HiGHS; the second from the first's answer) by a primal active-set method on the bounds and
-polished to the exact KKT solution of their active set (numpy), independently of the solver. (An
-SLSQP start polished the same way was used before: on the Baxter case with four supports it
-stopped at its iteration limit with the equalities unmet, and its polish put joint torques far
-outside their bounds, so that case was an expected failure of the oracle, not of the solver.)
+least contact force with the effort kept, are solved by ProxQP (the proxsuite package: a proximal
+augmented Lagrangian method, to 1e-12) and polished to the exact KKT solution on the bounds active
+there (numpy), checked to meet every bound and equality and to do no worse than ProxQP's answer,
+independently of the solver. (Before, a primal active-set method of our own from a linear
+programme's feasible point solved them: on degenerate cases, many force weights and joint torques
+at their bounds at once, it cycled to its iteration limit and its polish returned a feasible but
+larger least contact force than the solver's, so a round-off change in the solver looked like a
+failure. An SLSQP start was used before that: on the Baxter case with four supports it stopped at
+its iteration limit with the equalities unmet.)
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
+import proxsuite
 import pytest
-from scipy.optimize import linprog, nnls
+from scipy.optimize import nnls
 
 import vereshchagin as vs
 from support.chains import G_EARTH, pin_configuration, random_chain, random_state
@@ -63,56 +67,45 @@ def _generators(c, row, scale):
     return np.array([c.normal + c.mu * D[j] for j in best]).T
 
 
-def _qp(P, E, e, lo, hi, x0=None):
-    """min 1/2 x^T P x subject to E x = e and lo <= x <= hi (P positive semi-definite): from a
-    feasible point (``x0``, else one by linear programming, scipy's HiGHS), a primal active-set
-    method on the bounds (numpy), then the exact KKT solution of the equality-constrained programme
-    on the bounds it ends with active."""
+def _qp(P, E, e, lo, hi):
+    """min 1/2 x^T P x subject to E x = e and lo <= x <= hi (P positive semi-definite): ProxQP's
+    answer (the proxsuite package, a proximal augmented Lagrangian method, to 1e-12), then the
+    exact minimiser on the bounds active there (numpy), checked to meet every bound and the
+    equalities and to do no worse than ProxQP's answer."""
     N = P.shape[0]
     U, sv, _ = np.linalg.svd(E, full_matrices=False)  # independent equality rows
     rank = int(np.sum(sv > 1e-12 * max(1.0, sv.max())))
     E, e = U[:, :rank].T @ E, U[:, :rank].T @ e
-    if x0 is None:
-        x0 = linprog(np.zeros(N), A_eq=E, b_eq=e, bounds=list(zip(lo, hi)), method="highs").x
-    x = np.clip(x0, lo, hi)
-    scale = max(1.0, np.abs(x).max())
-    at_lo = x <= lo + 1e-9 * scale
-    at_hi = x >= hi - 1e-9 * scale
-    Pr = P + 1e-9 * max(1.0, np.abs(P).max()) * np.eye(N)  # strictly convex for the active-set steps
-    for _ in range(50 * N):
-        fixed = at_lo | at_hi
-        free = np.flatnonzero(~fixed)
-        g = Pr @ x
-        K = np.block([[Pr[np.ix_(free, free)], E[:, free].T], [E[:, free], np.zeros((rank, rank))]])
-        sol = np.linalg.lstsq(K, np.concatenate([-g[free], np.zeros(rank)]), rcond=None)[0]
-        p = np.zeros(N)
-        p[free] = sol[: free.size]
-        if np.abs(p).max() <= 1e-13 * max(1.0, np.abs(x).max()) or g @ p >= 0.0:
-            lam = sol[free.size :]  # the equalities' multipliers (K's)
-            mult = g + E.T @ lam + Pr @ p  # the bounds' multipliers: >= 0 at a lower bound, <= 0 at an upper
-            wrong = np.where(at_lo, -mult, 0.0) + np.where(at_hi, mult, 0.0)
-            worst = int(np.argmax(wrong))
-            if wrong[worst] <= 1e-10 * max(1.0, np.abs(g).max()):
-                break
-            at_lo[worst] = at_hi[worst] = False  # release the bound with the wrong sign
-            continue
-        step, block = 1.0, None
-        for i in free:  # the first bound in the way
-            if p[i] < 0.0 and np.isfinite(lo[i]) and (lo[i] - x[i]) / p[i] < step:
-                step, block = (lo[i] - x[i]) / p[i], (i, 0)
-            if p[i] > 0.0 and np.isfinite(hi[i]) and (hi[i] - x[i]) / p[i] < step:
-                step, block = (hi[i] - x[i]) / p[i], (i, 1)
-        x = x + max(step, 0.0) * p
-        if block is not None:
-            (at_lo if block[1] == 0 else at_hi)[block[0]] = True
-    fixed = np.flatnonzero(at_lo | at_hi)
-    B = np.zeros((len(fixed), N))
-    B[np.arange(len(fixed)), fixed] = 1.0
+    big = 1e20  # ProxQP's infinite bound
+    res = proxsuite.proxqp.dense.solve(
+        P,
+        np.zeros(N),
+        E,
+        e,
+        np.eye(N),
+        np.where(np.isfinite(lo), lo, -big),
+        np.where(np.isfinite(hi), hi, big),
+        eps_abs=1e-12,
+        eps_rel=0.0,
+        max_iter=100000,
+    )
+    assert res.info.status == proxsuite.proxqp.QPSolverOutput.PROXQP_SOLVED, res.info.status
+    x_p = res.x
+    tol = 1e-9 * max(1.0, np.abs(x_p).max())
+    active = [(i, 0) for i in range(N) if x_p[i] <= lo[i] + tol] + [(i, 1) for i in range(N) if x_p[i] >= hi[i] - tol]
+    B = np.zeros((len(active), N))
+    B[np.arange(len(active)), [i for i, _ in active]] = 1.0
     C = np.vstack([E, B])
-    d = np.concatenate([e, np.where(at_lo[fixed], lo[fixed], hi[fixed])])
+    d = np.concatenate([e, [lo[i] if side == 0 else hi[i] for i, side in active]])
     K = np.block([[P, C.T], [C, np.zeros((C.shape[0], C.shape[0]))]])
-    sol = np.linalg.lstsq(K, np.concatenate([np.zeros(N), d]), rcond=None)[0]
-    return sol[:N]
+    # The least change of ProxQP's answer (where P is singular the minimisers form a set: the one
+    # nearest it, which keeps the inactive bounds).
+    x = x_p + np.linalg.lstsq(K, np.concatenate([-P @ x_p, d - C @ x_p]), rcond=None)[0][:N]
+    scale = max(1.0, np.abs(x).max())
+    assert np.all(x >= lo - 1e-9 * scale) and np.all(x <= hi + 1e-9 * scale), "the oracle's polish left the bounds"
+    assert np.abs(E @ x - e).max() <= 1e-9 * max(1.0, np.abs(e).max()), "the oracle's polish left the equalities"
+    assert x @ P @ x <= x_p @ P @ x_p + 1e-9 * max(1.0, x_p @ P @ x_p), "the oracle's polish did worse than ProxQP"
+    return x
 
 
 def _oracle(prob, A, qdd):
@@ -145,7 +138,7 @@ def _oracle(prob, A, qdd):
     F = np.zeros((3 * len(gens), E.shape[1]))
     for i, G in enumerate(gens):
         F[3 * i : 3 * i + 3, sizes[i + 1] : sizes[i + 2]] = G
-    x2 = _qp(F.T @ F, np.vstack([E, T]), np.concatenate([e, tau_cmd]), lo, hi, x0=x1)  # x1 is feasible
+    x2 = _qp(F.T @ F, np.vstack([E, T]), np.concatenate([e, tau_cmd]), lo, hi)
     forces = (F @ x2).reshape(-1, 3)
     joint = rhs - A.T @ x2[:m] - sum((c.J.T @ f for c, f in zip(prob.contacts, forces)), np.zeros(n))
     return T @ x2, forces, joint
