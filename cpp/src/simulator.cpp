@@ -92,17 +92,38 @@ Status Simulator::step(const SolveInput& input) {
   work_.q = q_;
   work_.q_dot = qd_;
   work_.time_step = dt_;
-  if (integrator_ == Integrator::Symplectic) {
-    const Status s = stepSymplectic(model_, data_, work_, p_, q_next_, qd_next_, p_next_);
-    if (!s) return s;
-    q_.swap(q_next_), qd_.swap(qd_next_), p_.swap(p_next_);
-    ++steps_;
-    return s;
-  }
-  // Integrator::SemiImplicitEuler: step() writes q_, qd_ only on success.
-  const Status s = vereshchagin::step(model_, data_, work_, q_, qd_);
-  if (s) ++steps_;
+  const Status s = advance(work_);
+  if (s) adopt();
   return s;
+}
+
+Status Simulator::step(SolveInput& input) {
+  if (!status_) return status_;
+  // The state and dt lent to the caller's input for the step (the vectors' buffers swapped, no
+  // copy), the caller's own q, q_dot and time_step given back after it.
+  input.q.swap(q_);
+  input.q_dot.swap(qd_);
+  const double caller_time_step = input.time_step;
+  input.time_step = dt_;
+  const Status s = advance(input);
+  input.q.swap(q_);
+  input.q_dot.swap(qd_);
+  input.time_step = caller_time_step;
+  if (s) adopt();
+  return s;
+}
+
+Status Simulator::advance(const SolveInput& at_state) {
+  if (integrator_ == Integrator::Symplectic)
+    return stepSymplectic(model_, data_, at_state, p_, q_next_, qd_next_, p_next_);
+  return vereshchagin::step(model_, data_, at_state, q_next_, qd_next_);  // Integrator::SemiImplicitEuler
+}
+
+void Simulator::adopt() noexcept {
+  q_.swap(q_next_);
+  qd_.swap(qd_next_);
+  if (integrator_ == Integrator::Symplectic) p_.swap(p_next_);
+  ++steps_;
 }
 
 Status Simulator::checkRecord(int n_steps, const SolveInput& input, const RolloutRecord& r) const {

@@ -15,8 +15,9 @@
 namespace testutil {
 
 // g.chain(n) at q = g.q(n), q_dot zero, in.friction = &fm with fm = holdingFriction(model, q,
-// factor, extra). Neither copied nor moved (in points at fm); unpack it with
-// `auto& [model, data, in, fm] = held;`.
+// factor, extra). Neither copied nor moved (in points at fm). Name its members by references, not
+// by a structured binding: doctest's CHECK with DOCTEST_CONFIG_ASSERTS_RETURN_VALUES is a lambda,
+// and capturing a structured binding is C++20 (clang 14 refuses it in C++17).
 struct HeldChain {
   HeldChain(RandomGen& g, int n, double factor, double extra) : model(g.chain(n)), data(model), in(model) {
     in.q = g.q(n).data;

@@ -5,11 +5,22 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Core>
+#include <cstdlib>
 
 #include "vereshchagin/dynamics.hpp"
 #include "vereshchagin/friction_model.hpp"
 
 namespace testutil {
+
+// The number of steps of a long hold: `steps` in a plain build, a tenth of it where the tests run
+// under the sanitizers (cpp/tests/CMakeLists.txt sets VERESHCHAGIN_TEST_SANITIZED=1 there). The
+// sanitized library runs such a loop about 20 times slower; what the sanitizers look for (a bad
+// access, a leak, undefined behaviour) shows in the first steps as well, and the plain build keeps
+// the full count of the property.
+inline int longRunSteps(int steps) {
+  const char* sanitized = std::getenv("VERESHCHAGIN_TEST_SANITIZED");
+  return sanitized != nullptr && sanitized[0] == '1' ? steps / 10 : steps;
+}
 
 inline vereshchagin::FrictionModel holdingFriction(const vereshchagin::Model& model, const Eigen::VectorXd& q,
                                                    double factor, double extra) {

@@ -47,7 +47,14 @@ class RandomGen {
   int integer(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }  // inclusive
   bool coin(double p_true = 0.5) { return uniform(0.0, 1.0) < p_true; }
 
-  KDL::Vector vector(double lo, double hi) { return KDL::Vector(uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)); }
+  // Every draw is its own statement: the order of a call's arguments is unspecified in C++ (g++
+  // evaluates them last to first, clang++ first to last), so draws inside one argument list gave
+  // each compiler other samples. The statements keep the order g++ drew in before, so the tests'
+  // samples stayed what they were.
+  KDL::Vector vector(double lo, double hi) {
+    const double z = uniform(lo, hi), y = uniform(lo, hi), x = uniform(lo, hi);
+    return KDL::Vector(x, y, z);
+  }
 
   KDL::Vector unitVector() {
     for (;;) {
@@ -58,10 +65,22 @@ class RandomGen {
   }
 
   KDL::Rotation rotation() {
-    return KDL::Rotation::RPY(uniform(-M_PI, M_PI), uniform(-M_PI, M_PI), uniform(-M_PI, M_PI));
+    const double yaw = uniform(-M_PI, M_PI), pitch = uniform(-M_PI, M_PI), roll = uniform(-M_PI, M_PI);
+    return KDL::Rotation::RPY(roll, pitch, yaw);
   }
 
-  KDL::Frame frame(double half_width = 0.5) { return KDL::Frame(rotation(), vector(-half_width, half_width)); }
+  KDL::Frame frame(double half_width = 0.5) {
+    const KDL::Vector p = vector(-half_width, half_width);
+    const KDL::Rotation R = rotation();
+    return KDL::Frame(R, p);
+  }
+
+  // A segment's frame and inertia, drawn inertia first.
+  KDL::Segment segment(const std::string& name, const KDL::Joint& joint) {
+    const KDL::RigidBodyInertia I = inertia();
+    const KDL::Frame f = frame();
+    return KDL::Segment(name, joint, f, I);
+  }
 
   // Rotational inertia about the centre of mass: R diag(a, b, c) R^T, triangle inequality holds.
   KDL::RotationalInertia rotationalInertia() {
@@ -117,7 +136,7 @@ class RandomGen {
     }
   }
 
-  KDL::Segment fixedSegment() { return KDL::Segment(KDL::Joint(KDL::Joint::Fixed), frame(), inertia()); }
+  KDL::Segment fixedSegment() { return segment("NoName", KDL::Joint(KDL::Joint::Fixed)); }
 
   KDL::Chain chain(const ChainSpec& spec) {
     KDL::Chain ch;
@@ -126,7 +145,7 @@ class RandomGen {
       for (int f = 0; f < fixed_here; ++f) ch.addSegment(fixedSegment());
       if (k == spec.n_joints) break;
       const KDL::Joint j = movingJoint("j" + std::to_string(k), spec.allow_prismatic, spec.rotor_inertia);
-      ch.addSegment(KDL::Segment("s" + std::to_string(k), j, frame(), inertia()));
+      ch.addSegment(segment("s" + std::to_string(k), j));
     }
     return ch;
   }
@@ -150,7 +169,10 @@ class RandomGen {
 
   KDL::Wrenches fext(unsigned int n_segments, double scale = 2.0) {
     KDL::Wrenches w(n_segments);
-    for (auto& x : w) x = KDL::Wrench(vector(-scale, scale), vector(-scale, scale));
+    for (auto& x : w) {
+      const KDL::Vector torque = vector(-scale, scale), force = vector(-scale, scale);
+      x = KDL::Wrench(force, torque);
+    }
     return w;
   }
 

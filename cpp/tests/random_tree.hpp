@@ -34,7 +34,7 @@ inline KDL::Tree randomTree(RandomGen& g, const TreeSpec& spec) {
     const bool fixed = g.coin(spec.p_fixed);
     const KDL::Joint j =
         fixed ? KDL::Joint(joint, KDL::Joint::Fixed) : g.movingJoint(joint, spec.allow_prismatic, spec.rotor_inertia);
-    tree.addSegment(KDL::Segment(name, j, g.frame(), g.inertia()), parent);
+    tree.addSegment(g.segment(name, j), parent);
     names.push_back(name);
     moving += fixed ? 0 : 1;
   }

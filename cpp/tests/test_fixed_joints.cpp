@@ -147,9 +147,12 @@ void runSample(Stats& st, const KDL::Chain& orig, testutil::RandomGen& g, const 
   if (!CHECK_MESSAGE((m.chain.getNrOfJoints() == n && nsm == n), tag0 << ": merge bookkeeping")) return;
   const int nc = g.integer(0, std::min(6, static_cast<int>(n)));
   const int root_kind = g.integer(0, 2);  // 0: none, 1: gravity, 2: random spatial base acceleration
-  const KDL::Twist root_acc = root_kind == 0   ? KDL::Twist::Zero()
-                              : root_kind == 1 ? KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero())
-                                               : KDL::Twist(g.vector(-10, 10), g.vector(-3, 3));
+  KDL::Twist root_acc = KDL::Twist::Zero();
+  if (root_kind == 1) root_acc = KDL::Twist(KDL::Vector(0, 0, 9.81), KDL::Vector::Zero());
+  if (root_kind == 2) {  // (draws in their own statements: random_chain.hpp)
+    const KDL::Vector angular = g.vector(-3, 3), linear = g.vector(-10, 10);
+    root_acc = KDL::Twist(linear, angular);
+  }
   const KDL::JntArray q = g.q(n), qd = g.qdot(n), ff = g.torques(n);
   const KDL::Wrenches fext = g.fext(ns);
   const KDL::Jacobian alfa = g.alfa(nc);

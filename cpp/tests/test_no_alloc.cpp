@@ -681,8 +681,10 @@ TEST_CASE("the contact stage's real-time fallback (a pivot bound reached) does n
   // held-normal fallback's sweeps. Each case is solved once before counting (its sizes), then again.
   testutil::RandomGen g(2714);
   std::vector<std::unique_ptr<testutil::Case>> cases;
-  for (int t = 0; t < 24; ++t)
-    cases.push_back(std::make_unique<testutil::Case>(g, g.integer(4, 8), g.integer(2, 5), t % 2 ? 0.0 : 0.01));
+  for (int t = 0; t < 24; ++t) {
+    const int contacts = g.integer(2, 5), joints = g.integer(4, 8);  // (random_chain.hpp: draw order)
+    cases.push_back(std::make_unique<testutil::Case>(g, joints, contacts, t % 2 ? 0.0 : 0.01));
+  }
   std::vector<std::unique_ptr<vereshchagin::Data>> data;
   for (const auto& c : cases) data.push_back(std::make_unique<vereshchagin::Data>(c->model));
   int degraded = 0, failed = 0;

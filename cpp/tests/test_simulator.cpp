@@ -34,11 +34,12 @@ TEST_CASE("an arm held by friction keeps q bitwise over 10^5 steps of the Simula
   SolveInput in(model);
   in.friction = &fm;
   bool ok = true;
-  for (int k = 0; k < 100000 && ok; ++k) ok = static_cast<bool>(sim.step(in));
+  const int steps = testutil::longRunSteps(100000);
+  for (int k = 0; k < steps && ok; ++k) ok = static_cast<bool>(sim.step(in));
   REQUIRE(ok);
   CHECK(same(sim.q(), q0));
   CHECK((sim.qDot().array() == 0.0).all());
-  CHECK(sim.time() == 2.0 + 100000 * 1e-3);
+  CHECK(sim.time() == 2.0 + steps * 1e-3);
   for (const JointStatus s : sim.data().jointStatus()) CHECK(s == JointStatus::Stick);
 }
 
@@ -57,10 +58,15 @@ TEST_CASE("a Simulator step equals step() of data.hpp bitwise and ignores the in
   ref.q = q0;
   ref.q_dot = qd0;
   ref.time_step = 2e-3;
+  in.q_dot.setConstant(-3.0);  // ignored
+  const SolveInput& const_in = in;
+  Simulator copying(model, 2e-3);  // the const overload: steps a copy of the input
+  REQUIRE(copying.setState(JointPositions(q0), JointVelocities(qd0)));
   Data data(model);
   Eigen::VectorXd q(6), qd(6);
   for (int k = 0; k < 200; ++k) {
-    REQUIRE(sim.step(in));
+    REQUIRE(sim.step(in));  // the non-const overload: the state lent to `in` for the step
+    REQUIRE(copying.step(const_in));
     REQUIRE(step(model, data, ref, q, qd));
     ref.q = q;
     ref.q_dot = qd;
@@ -68,7 +74,19 @@ TEST_CASE("a Simulator step equals step() of data.hpp bitwise and ignores the in
   CHECK(same(sim.q(), q));
   CHECK(same(sim.qDot(), qd));
   CHECK(same(sim.data().frictionTorques(), data.frictionTorques()));
+  CHECK(same(copying.q(), q));
+  CHECK(same(copying.qDot(), qd));
   CHECK(std::abs(sim.time() - 0.4) < 1e-15);
+  // The caller's q, q_dot and time_step are back in the input, also after a failing step.
+  CHECK((in.q.array() == 7.0).all());
+  CHECK((in.q_dot.array() == -3.0).all());
+  CHECK(in.time_step == 0.5);
+  in.ff_torques(0) = std::numeric_limits<double>::quiet_NaN();
+  CHECK(sim.step(in).code() == Error::NonfiniteInput);
+  CHECK(same(sim.q(), q));
+  CHECK((in.q.array() == 7.0).all());
+  CHECK((in.q_dot.array() == -3.0).all());
+  CHECK(in.time_step == 0.5);
 }
 
 TEST_CASE("rollout equals repeated step() bitwise and records what it is asked") {
@@ -170,7 +188,8 @@ TEST_CASE("the symplectic Simulator: held bitwise, equal to stepSymplectic(), mo
   REQUIRE(held.setState(JointPositions(q0), JointVelocities(Eigen::VectorXd::Zero(7))));
   in.friction = &fm;
   bool ok = true;
-  for (int k = 0; k < 100000 && ok; ++k) ok = held.step(in).code() == Error::None;
+  for (int k = 0, steps = testutil::longRunSteps(100000); k < steps && ok; ++k)
+    ok = held.step(in).code() == Error::None;
   REQUIRE(ok);
   CHECK(same(held.q(), q0));
   CHECK((held.qDot().array() == 0.0).all());

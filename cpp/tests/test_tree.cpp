@@ -202,7 +202,11 @@ TEST_CASE("forward dynamics (no constraint) replayed through TreeIdSolver_RNE") 
   double worst = 0.0;
   for (int seed = 0; seed < 60; ++seed) {
     TreeCase c(500 + seed, 40);
-    auto& [g, tree, s, o, nj, ns] = c;
+    auto& g = c.g;
+    auto& s = c.s;
+    auto& o = c.o;
+    const int nj = c.nj;
+    const int ns = c.ns;
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, ff = g.torques(nj).data;
     const Matrix6X f_ext = testutil::toMatrix(g.fext(ns));
     const int rc = s.solve(q, qd, Matrix6X(6, 0), Eigen::VectorXd(0), f_ext, ff);
@@ -221,7 +225,11 @@ TEST_CASE("inverseInertiaTimes against H from TreeIdSolver_RNE") {
   double worst = 0.0;
   for (int seed = 0; seed < 30; ++seed) {
     TreeCase c(900 + seed, 30);
-    auto& [g, tree, s, o, nj, ns] = c;
+    auto& g = c.g;
+    auto& tree = c.tree;
+    auto& s = c.s;
+    auto& o = c.o;
+    const int nj = c.nj;
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, tau = g.torques(nj).data;
     Eigen::VectorXd out(nj);
     if (seed == 0) {
@@ -253,7 +261,12 @@ TEST_CASE("constraints on several branches against the KKT system") {
   int tested = 0;
   for (int seed = 0; seed < 120; ++seed) {
     TreeCase c(2000 + seed, 40);
-    auto& [g, tree, s, o, nj, ns] = c;
+    auto& g = c.g;
+    auto& tree = c.tree;
+    auto& s = c.s;
+    auto& o = c.o;
+    const int nj = c.nj;
+    const int ns = c.ns;
     const Task t = randomTask(g, s, tree, seed % 4);
     const Eigen::VectorXd q = g.q(nj).data, ff = g.torques(nj).data, zero = Eigen::VectorXd::Zero(nj);
     const Matrix6X f_ext = testutil::toMatrix(g.fext(ns));
@@ -303,7 +316,12 @@ TEST_CASE("link accelerations against finite differences of J(q) q_dot") {
   double worst = 0.0;
   for (int seed = 0; seed < 30; ++seed) {
     TreeCase c(7000 + seed, 25);
-    auto& [g, tree, s, o, nj, ns] = c;
+    auto& g = c.g;
+    auto& tree = c.tree;
+    auto& s = c.s;
+    auto& o = c.o;
+    const int nj = c.nj;
+    const int ns = c.ns;
     const Task t = randomTask(g, s, tree, seed % 4);
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, ff = g.torques(nj).data;
     if (s.solve(q, qd, t.alfa, t.beta, t.segments, Matrix6X(6, 0), ff) != 0) continue;
@@ -333,7 +351,10 @@ TEST_CASE("response columns against differences in ff_torques") {
   double worst = 0.0;
   for (int seed = 0; seed < 40; ++seed) {
     TreeCase c(9000 + seed, 30);
-    auto& [g, tree, s, o, nj, ns] = c;
+    auto& g = c.g;
+    auto& tree = c.tree;
+    auto& s = c.s;
+    const int nj = c.nj;
     const Task t = randomTask(g, s, tree, seed % 4);
     const int m = static_cast<int>(t.segments.size());
     const Eigen::VectorXd q = g.q(nj).data, qd = g.qdot(nj).data, ff = g.torques(nj).data;

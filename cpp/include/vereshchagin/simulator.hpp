@@ -120,6 +120,10 @@ class Simulator {
   /// contactForces() (impulses over dt, N), jointStatus() and contactStatus(). On failure the
   /// state is unchanged and the status says why (solve()'s messages).
   Status step(const SolveInput& input);
+  /// The same step without copying `input`: the simulator's state and dt take the place of
+  /// input.q, input.q_dot and input.time_step for the step (their vectors' buffers swapped) and
+  /// the caller's own values are back in them on return, whatever the status.
+  Status step(SolveInput& input);
 
   /// n_steps steps: before each, `controller` (may be empty: the input as given) fills `input`
   /// from the state; each step as step(input). Records into `record` (sized by
@@ -135,14 +139,18 @@ class Simulator {
   Data& data() noexcept { return data_; }
 
  private:
+  // One step from `at_state` (whose q, q_dot and time_step are the state and dt) into q_next_,
+  // qd_next_ (and p_next_); adopt() makes them the state.
+  Status advance(const SolveInput& at_state);
+  void adopt() noexcept;
   Status checkRecord(int n_steps, const SolveInput& input, const RolloutRecord& record) const;
   void recordStep(int k, RolloutRecord& record) const;
 
   Model model_;
   Data data_;
-  SolveInput work_;                            // the step's input: the caller's with the simulator's state and dt
+  SolveInput work_;                            // step(const SolveInput&): a copy of the caller's input
   Eigen::VectorXd q_, qd_, p_;                 // the state (p_: Integrator::Symplectic's momentum)
-  Eigen::VectorXd q_next_, qd_next_, p_next_;  // a symplectic step's results until it succeeds
+  Eigen::VectorXd q_next_, qd_next_, p_next_;  // a step's results until it succeeds
   DynamicsData dynamics_;                      // setState()'s momentum H(q) q_dot
   double dt_ = 0.0, t0_ = 0.0;                 // t0_: the time setState() gave
   long steps_ = 0;                             // steps since setState()
