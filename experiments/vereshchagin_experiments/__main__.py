@@ -7,6 +7,8 @@ import os
 import sys
 from pathlib import Path
 
+from ._optional import CASE_NEEDS, missing_message
+
 
 def _say(line: str) -> None:
     print(line, flush=True)
@@ -161,7 +163,7 @@ def main(argv=None) -> int:
     rep.add_argument("--quick", action="store_true", help="coarser sampling of the figures, shorter contact runs")
     rep.add_argument(
         "--case",
-        choices=("friction", "demo", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "quadruped", "all"),
+        choices=(*CASE_NEEDS, "all"),
         default="all",
         help="which experiments to run (default: all)",
     )
@@ -172,8 +174,6 @@ def main(argv=None) -> int:
         run()
         return 0
     if args.command == "reproduce":
-        from ._optional import CASE_NEEDS, missing_message
-
         cases = CASE_NEEDS if args.case == "all" else {args.case: CASE_NEEDS[args.case]}
         message = missing_message(sorted({m for needs in cases.values() for m in needs}))
         if message:

@@ -7,7 +7,7 @@ import importlib.util
 # module -> the PyPI package that provides it
 PACKAGES = {"matplotlib": "matplotlib", "mujoco": "mujoco"}
 
-# What each reproduce case imports beyond numpy.
+# What each reproduce case imports beyond numpy; its keys are the command line's --case choices.
 CASE_NEEDS = {
     "friction": ("matplotlib",),
     "demo": (),
@@ -15,6 +15,8 @@ CASE_NEEDS = {
     "dual-arm": ("mujoco", "matplotlib"),
     "friction-energy": ("mujoco", "matplotlib"),
     "wiping": ("matplotlib",),
+    "mobile": ("mujoco", "matplotlib"),
+    "quadruped": ("mujoco", "matplotlib"),
 }
 
 

@@ -235,6 +235,23 @@ def test_reproduce_command(tmp_path):
     assert "[reproduce] wrote" in proc.stdout
 
 
+@pytest.mark.parametrize(
+    "case", ["friction", "contact", "dual-arm", "friction-energy", "wiping", "mobile", "quadruped"]
+)
+def test_each_case_names_what_it_needs(case, monkeypatch, capsys, tmp_path):
+    # With its plotting package missing, every case the command line offers stops with an
+    # install hint before running anything (the mobile and quadruped cases once raised KeyError).
+    import importlib.util
+
+    from vereshchagin_experiments.__main__ import main
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else real(name, *a))
+    assert main(["reproduce", "--case", case, "--quick", "--out", str(tmp_path / "out")]) == 2
+    assert "pip install matplotlib" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
 def test_demo_command_still_works():
     proc = subprocess.run(
         [sys.executable, "-m", "vereshchagin_experiments", "demo"], capture_output=True, text=True, timeout=300
