@@ -153,36 +153,3 @@ def test_elbow_segment_constraint_rests_on_the_support_and_keeps_the_task(elbow_
     # the support lowers the shoulder torque and the copper-loss proxy of the whole arm
     assert ec["mean_abs_tau"][1] < 0.75 * ef["mean_abs_tau"][1]
     assert ec["energy_tau2"].sum() < 0.75 * ef["energy_tau2"].sum()
-
-
-def test_reproduce_contact_writes_index_tables_and_figures(tmp_path):
-    from vereshchagin_experiments.__main__ import main
-
-    assert main(["reproduce", "--out", str(tmp_path), "--quick", "--case", "contact"]) == 0
-    index = (tmp_path / "index.md").read_text(encoding="utf-8")
-    assert "Use case 1" in index and "Use case 2" in index and "Use case 3" in index
-    assert "report (Table 6.2)" in index and ("**agrees**" in index or "**disagrees**" in index)
-    # the audit's fixes: Table 6.2 quoted (not the report's swapped text), Table 6.1 printed and
-    # compared with signed torque, the differences stated, a model-error run, joints counted from 0
-    assert "Table 6.2's values average to contact 0.8256, contactless 1.9858 N m" in index
-    assert "Table 6.1" in index and "| report V·I contact [W] |" in index
-    assert "What differs from the report" in index and "Contact mode never ends" in index
-    assert "### Model error" in index and "seed 1:" in index
-    assert "Average displacement: the report's was 3.5× larger in contact" in index
-    assert "joint_" not in index.split("## Exploiting contact surfaces")[1]
-    assert "arm parts touching the table: gripper" in index
-    for name in (
-        "grasp_effort.csv",
-        "grasp_power_table_6_1.csv",
-        "writing_accuracy.csv",
-        "elbow_effort.csv",
-        "model_error.csv",
-        "grasp_torque_power.png",
-        "grasp_trajectories.png",
-        "writing_line.png",
-        "writing_torque_power.png",
-        "elbow_torque_power.png",
-    ):
-        path = tmp_path / "contact" / name
-        assert path.is_file() and path.stat().st_size > 0
-        assert f"contact/{name}" in index

@@ -233,6 +233,39 @@ def test_reproduce_command(tmp_path):
         assert (out / link).is_file(), link
     assert "hold pose (m=6)" in (out / "demo.txt").read_text(encoding="utf-8")
     assert "[reproduce] wrote" in proc.stdout
+    _check_contact_section(index, out)
+
+
+def _check_contact_section(index, out):
+    # The contact use cases' section of the main job (Lau 2023), checked in the all-case run
+    # above rather than in a run of its own (--case contact repeats 80 s of simulation).
+    assert "Use case 1" in index and "Use case 2" in index and "Use case 3" in index
+    assert "report (Table 6.2)" in index and ("**agrees**" in index or "**disagrees**" in index)
+    # the audit's fixes: Table 6.2 quoted (not the report's swapped text), Table 6.1 printed and
+    # compared with signed torque, the differences stated, a model-error run, joints counted from 0
+    assert "Table 6.2's values average to contact 0.8256, contactless 1.9858 N m" in index
+    assert "Table 6.1" in index and "| report V·I contact [W] |" in index
+    assert "What differs from the report" in index and "Contact mode never ends" in index
+    assert "### Model error" in index and "seed 1:" in index
+    assert "Average displacement: the report's was 3.5× larger in contact" in index
+    section = index.split("## Exploiting contact surfaces")[1].split("\n## ")[0]  # to the next case's heading
+    assert "joint_" not in section
+    assert "arm parts touching the table: gripper" in index
+    for name in (
+        "grasp_effort.csv",
+        "grasp_power_table_6_1.csv",
+        "writing_accuracy.csv",
+        "elbow_effort.csv",
+        "model_error.csv",
+        "grasp_torque_power.png",
+        "grasp_trajectories.png",
+        "writing_line.png",
+        "writing_torque_power.png",
+        "elbow_torque_power.png",
+    ):
+        path = out / "contact" / name
+        assert path.is_file() and path.stat().st_size > 0
+        assert f"contact/{name}" in index
 
 
 @pytest.mark.parametrize(
