@@ -85,21 +85,23 @@ Eigen::VectorXd kkt(const Dense& d, const Eigen::MatrixXd& C, const Eigen::Vecto
   return x.head(n);
 }
 
-// The replay identity's residual, relative.
-double replay(const Model& model, const SolveInput& in, const Data& data) {
-  const Dense d = dense(model, in);
+// The replay identity's residual, relative (d: dense(model, in)).
+double replay(const Dense& d, const SolveInput& in, const Data& data) {
   Eigen::VectorXd r = d.H * data.qdd() - d.h - data.commandTorques();
   for (std::size_t c = 0; c < in.contacts.size(); ++c) r -= d.J[c].transpose() * data.contactForces().col(c);
   return r.cwiseAbs().maxCoeff() / std::max(1.0, d.h.cwiseAbs().maxCoeff());
+}
+
+double replay(const Model& model, const SolveInput& in, const Data& data) {
+  return replay(dense(model, in), in, data);
 }
 
 // The worst violation of the support conditions at the instant, relative to the problem's scale
 // max(1, |h|) (forces) and max(1, |qdd|) (accelerations): per support, the normal force f_n >= 0,
 // the point's normal acceleration a_n >= 0, f_n a_n = 0, the tangential force within mu f_n (the
 // friction polygon lies inside that circle), a sticking point's acceleration zero and a separating
-// point's force zero.
-double supportViolation(const Model& model, const SolveInput& in, const Data& data) {
-  const Dense d = dense(model, in);
+// point's force zero (d: dense(model, in)).
+double supportViolation(const Dense& d, const SolveInput& in, const Data& data) {
   const double fs = std::max(1.0, d.h.cwiseAbs().maxCoeff()), as = std::max(1.0, data.qdd().cwiseAbs().maxCoeff());
   double worst = 0.0;
   for (std::size_t c = 0; c < in.contacts.size(); ++c) {
@@ -411,10 +413,11 @@ TEST_CASE("contacts with joint friction: the replay identity, friction bounds, a
     } else {
       // With friction at a touching support another consistent answer may exist (ContactOutcome::
       // Consistent): the two solves' methods may reach different ones, each of them valid.
-      CHECK(replay(model, in, plain) <= 1e-9);
-      CHECK(replay(model, in, data) <= 1e-9);
-      CHECK(supportViolation(model, in, plain) <= 1e-9);
-      CHECK(supportViolation(model, in, data) <= 1e-9);
+      const Dense d = dense(model, in);
+      CHECK(replay(d, in, plain) <= 1e-9);
+      CHECK(replay(d, in, data) <= 1e-9);
+      CHECK(supportViolation(d, in, plain) <= 1e-9);
+      CHECK(supportViolation(d, in, data) <= 1e-9);
     }
     for (int j = 0; j < n; ++j) fm.static_friction(j) = g.uniform(0.0, 2.0);
     in.q_dot(trial % n) = 0.5;  // one joint moving: its kinetic friction
