@@ -66,14 +66,25 @@ int ContactStage::heldResponse(DataImpl& d, int h) {
   if (m > 0) {
     Eigen::Ref<Eigen::MatrixXd> dnu(act_dnu_.topLeftCorner(m, h));
     if (c.wrenchResponse(act_seg_.head(h), act_wrench_.leftCols(h), dqdd, &dnu) != 0) return -1;
-    for (int i = 0; i < h; ++i)
-      if (c.commandTorquesOf(act_dnu_.col(i).head(m), T.col(i)) != 0) return -1;
+    if (h <= m) {
+      for (int i = 0; i < h; ++i)
+        if (c.commandTorquesOf(act_dnu_.col(i).head(m), T.col(i)) != 0) return -1;
+    } else {  // the torques are linear in nu: one pass per constraint column, then T = T_nu dnu
+      auto Tnu = act_tnu_.topLeftCorner(n, m);
+      auto e = act_enu_.head(m);
+      for (int i = 0; i < m; ++i) {
+        e.setZero();
+        e(i) = 1.0;
+        if (c.commandTorquesOf(e, Tnu.col(i)) != 0) return -1;
+      }
+      T.noalias() = Tnu.lazyProduct(act_dnu_.topLeftCorner(m, h));
+    }
   } else {
     if (c.wrenchResponse(act_seg_.head(h), act_wrench_.leftCols(h), dqdd, nullptr) != 0) return -1;
     T.setZero();
   }
   auto A = act_del_.topLeftCorner(h, h);
-  A.noalias() = act_rows_.topLeftCorner(n, h).transpose() * dqdd;
+  A.noalias() = act_rows_.topLeftCorner(n, h).transpose().lazyProduct(dqdd);
   for (int i = 0; i < h; ++i)  // symmetric to round-off: its mean
     for (int j = 0; j < i; ++j) A(i, j) = A(j, i) = 0.5 * (A(i, j) + A(j, i));
   act_tau0_.head(n) = c.res.tau_cmd;
@@ -280,9 +291,9 @@ int ContactStage::redundantGuess(DataImpl& d, const SolveInput& in, int k, int d
   for (int i = 0; i < k; ++i) Tk.col(i) = act_cmd_.col(act_idx_(i));
   tau0 = act_tau0_.head(n);
   tau0.noalias() += Tk * x;
-  C.noalias() = Tk * N;
+  C.noalias() = Tk.lazyProduct(N);
   auto P = act_q_.topLeftCorner(dn, dn);
-  P.noalias() = N.transpose() * N;
+  P.noalias() = N.transpose().lazyProduct(N);
   auto pv = act_lin_.head(dn);
   pv.noalias() = N.transpose() * x;
   const int rows = activeRows(in, k, dn);
@@ -311,6 +322,7 @@ void ContactStage::reserveActive(int directions, int rows) {
   }
   if (act_dnu_.cols() < act_del_.cols() || act_dnu_.rows() < work_.columns())
     act_dnu_.resize(std::max<Eigen::Index>(work_.columns(), act_dnu_.rows()), act_del_.cols());
+  if (act_tnu_.cols() < work_.columns()) act_tnu_.resize(n, work_.columns()), act_enu_.resize(work_.columns());
   if (act_normal_.size() < static_cast<Eigen::Index>(points_.size()))
     act_normal_.resize(points_.size()), act_tangent_.resize(points_.size());
   if (act_r_.rows() < rows || act_r_.cols() < act_del_.cols()) {

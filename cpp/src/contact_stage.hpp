@@ -277,6 +277,8 @@ class ContactStage {
   Matrix3X act_dirs_;
   Matrix6X act_wrench_;
   Eigen::MatrixXd act_rows_, act_dqdd_, act_dnu_, act_del_, act_v_, act_tk_, act_c_;
+  Eigen::MatrixXd act_tnu_;  // the motors' torques per unit constraint force nu_i (heldResponse)
+  Eigen::VectorXd act_enu_;
   Eigen::VectorXd act_a0_, act_x_, act_w_, act_diag_, act_tau0_;
   double act_scale_ = 0.0;     // A's scale without the constraints (rank decisions)
   double act_edge_tol_ = 0.0;  // activeForces: a sticking force may lie this far (x max(1, f_n)) outside

@@ -183,6 +183,7 @@ void LexicographicQp::reserve(int p, int k) {
     lemke2_.reserve(static_cast<int>(kk));
   }
   qp_.reserve(static_cast<int>(q_.cols()), static_cast<int>(rz_.rows()));
+  reserveActiveSet(static_cast<int>(q_.cols()), static_cast<int>(rz_.rows()));
 }
 
 Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
@@ -194,10 +195,15 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
                                      int eq) {
   const int p = static_cast<int>(C.cols()), k = static_cast<int>(r.size());
   auto Q = q_.topLeftCorner(p, p);
-  Q.noalias() = C.transpose() * C;
+  Q.noalias() = C.transpose().lazyProduct(C);
   auto c = c_.head(p);
   c.noalias() = C.transpose() * t;
   const int limit = 100 + 40 * (2 * p + k);
+  by_active_set_ = false;
+  if (C.rows() > 0) {
+    if ((by_active_set_ = activeSetSolve(P, pv, R, r, x, eq))) return Lemke::kSolved;
+    if (infeasible_ && eq == 0) return Lemke::kRay;  // (with E's pairs, their slack may matter)
+  }
   if (C.rows() == 0) {  // no first objective: x1 = 0 (the caller's point, feasible), Z spans everything
     x.setZero();
     // With the equality E x = 0 the second programme lives on E's null space: there first, its

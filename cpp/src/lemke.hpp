@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include "dual_qp.hpp"
+
 namespace vereshchagin {
 namespace detail {
 
@@ -71,8 +73,10 @@ class ConvexQp {
 // primal's pivoting stalls on the degenerate pairs), it runs once more on the null space of
 // [C; E] with the other rows only (secondOnEqualities); when C has no rows that form runs first
 // (the doubled primal over all p unknowns only if it fails: the same minimiser in exact
-// arithmetic, E x = 0 kept exactly instead of within the pairs' slack). Workspace by reserve(p, k) (p unknowns,
-// k rows); solve() allocates nothing within it.
+// arithmetic, E x = 0 kept exactly instead of within the pairs' slack). All of that is the fallback:
+// when C has rows, both programmes are first tried by the dual active-set method with a certificate
+// (lexicographic_active.cpp), which returns kRay itself when it proves the rows admit no point (without
+// E). Workspace by reserve(p, k) (p unknowns, k rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:
   void reserve(int p, int k);
@@ -80,6 +84,9 @@ class LexicographicQp {
                       const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
                       const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
                       Eigen::Ref<Eigen::VectorXd> x, int eq = 0);
+  // The last solve was answered by the dual active-set method (lexicographic_active.cpp), not the
+  // pivoting (tests, benchmarks).
+  bool byActiveSet() const { return by_active_set_; }
 
  private:
   bool secondOnEqualities(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
@@ -92,6 +99,20 @@ class LexicographicQp {
                     const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
                     Eigen::Ref<Eigen::VectorXd> w);
   int nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q);
+  // The first try by the dual active-set method, certified (lexicographic_active.cpp): true when x
+  // holds the answer; false leaves the pivoting to find it.
+  bool activeSetSolve(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
+                      const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
+                      Eigen::Ref<Eigen::VectorXd> x, int eq);
+  bool firstOnActive(int p);
+  bool certified(const Eigen::Ref<const Eigen::VectorXd>& x, int eq, int rows);
+  void reserveActiveSet(int p, int k);
+  DualActiveSetQp gi_, gi2_;  // the first programme's active rows; the second programme
+  bool infeasible_ = false;   // activeSetSolve: the rows admit no point
+  bool by_active_set_ = false;
+  Eigen::MatrixXd as_h_, as_pw_, as_s_, as_v_, as_rw_, as_gw_, as_lw_, as_a_;
+  Eigen::VectorXd as_g_, as_x_, as_y_, as_t_, as_diag_, as_l_, as_b_;
+  Eigen::VectorXi as_idx_, as_piv_;
   ConvexQp qp_;
   Lemke lemke2_;  // the second programme's dual
   Eigen::VectorXi idx_, piv_;
