@@ -60,6 +60,7 @@ bool LexicographicQp::firstOnActive(int p) {
     for (int j = 0; j < a; ++j) e(j) = as_b_(gi_.active(j)) - RW.row(j).dot(y);
     choleskySolve(LG, e);
     y.noalias() += RW.transpose() * e;
+    if (a >= p) return true;             // W's rows fix the point: y is the minimiser
     auto X = as_v_.topLeftCorner(a, p);  // (R_W R_W^T)^-1 R_W
     X = RW;
     choleskySolveColumns(LG, X);
@@ -78,9 +79,9 @@ bool LexicographicQp::firstOnActive(int p) {
   rhs.noalias() = -Pw * grad;
   for (int i = 0; i < p; ++i) as_idx_(i) = i;
   auto V = as_v_.topLeftCorner(p, p);
-  // (pivots relative to Q's scale: with W's rows spanning everything, S is round-off)
+  // (pivots relative to Q's scale: S may be round-off where W's rows span nearly everything)
   const double top = std::max(1e-300, Q.diagonal().maxCoeff());
-  const int r = a >= p ? 0 : pivotedCholeskyLeft(S, as_idx_, p, V, as_diag_, as_piv_, 1e-12 * top);
+  const int r = pivotedCholeskyLeft(S, as_idx_, p, V, as_diag_, as_piv_, 1e-12 * top);
   auto w = as_l_.head(std::max(r, 1));
   for (int i = 0; i < r; ++i) w(i) = rhs(as_piv_(i));
   for (int i = 0; i < r; ++i) {  // L1 L1^T w = rhs(piv), L1(i, j) = V(piv(i), j)
