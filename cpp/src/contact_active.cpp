@@ -207,26 +207,12 @@ bool ContactStage::heldPointsStill(const SolveInput& in, const Eigen::VectorXd& 
 int ContactStage::factorActive(int k, double rcond) {
   auto V = act_v_.topLeftCorner(k, k);
   const int r = k == 0 ? 0 : pivotedCholeskyLeft(act_del_, act_idx_, k, V, act_diag_, act_piv_, rcond * act_scale_);
-  const auto L = [&](int i, int j) { return V(act_piv_(i), j); };
-  // Forward and back substitution with L1 and L1^T, in act_w_.
-  const auto solveL1 = [&](auto&& w) {
-    for (int i = 0; i < r; ++i) {
-      for (int j = 0; j < i; ++j) w(i) -= L(i, j) * w(j);
-      w(i) /= L(i, i);
-    }
-  };
-  const auto solveL1t = [&](auto&& w) {
-    for (int i = r - 1; i >= 0; --i) {
-      for (int j = i + 1; j < r; ++j) w(i) -= L(j, i) * w(j);
-      w(i) /= L(i, i);
-    }
-  };
   auto x = act_x_.head(k);
   auto w = act_w_.head(std::max(r, 1));
   x.setZero();
   for (int i = 0; i < r; ++i) w(i) = -act_a0_(act_idx_(act_piv_(i)));
-  solveL1(w);
-  solveL1t(w);
+  pivotedForward(V, act_piv_, r, w);
+  pivotedBackward(V, act_piv_, r, w);
   for (int i = 0; i < r; ++i) x(act_piv_(i)) = w(i);
   int dn = 0;
   constexpr double kDone = -std::numeric_limits<double>::infinity();  // pivotedCholeskyLeft's mark
@@ -236,7 +222,7 @@ int ContactStage::factorActive(int k, double rcond) {
     z.setZero();
     z(b) = 1.0;
     for (int j = 0; j < r; ++j) w(j) = -V(b, j);
-    solveL1t(w);
+    pivotedBackward(V, act_piv_, r, w);
     for (int i = 0; i < r; ++i) z(act_piv_(i)) = w(i);
   }
   return r;

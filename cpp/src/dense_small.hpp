@@ -213,6 +213,24 @@ int pivotedCholeskyLeft(const MA& A, const VI& idx, int k, MV& V, VD& diag, VP& 
   return k;
 }
 
+// With pivotedCholeskyLeft's V and piv of rank r, L1(i, j) = V(piv(i), j) (r x r, lower
+// triangular): w <- L1^-1 w and w <- L1^-T w in place (w: r entries), for the particular solution
+// of S x = b on the pivots (both in turn) and S's null directions (the second alone).
+template <typename MV, typename VP, typename VW>
+void pivotedForward(const MV& V, const VP& piv, int r, VW&& w) {
+  for (int i = 0; i < r; ++i) {
+    for (int j = 0; j < i; ++j) w(i) -= V(piv(i), j) * w(j);
+    w(i) /= V(piv(i), i);
+  }
+}
+template <typename MV, typename VP, typename VW>
+void pivotedBackward(const MV& V, const VP& piv, int r, VW&& w) {
+  for (int i = r - 1; i >= 0; --i) {
+    for (int j = i + 1; j < r; ++j) w(i) -= V(piv(j), i) * w(j);
+    w(i) /= V(piv(i), i);
+  }
+}
+
 // Eigenvalues (into d, unsorted) of the symmetric tridiagonal matrix with diagonal d and
 // off-diagonal e (e(i) couples i and i + 1; overwritten): implicit QR steps with the Wilkinson
 // shift, each chasing its bulge down the unreduced block by Givens rotations, until every

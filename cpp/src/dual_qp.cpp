@@ -25,7 +25,7 @@ void DualActiveSetQp::reserve(int p, int k) {
   if (norm_.size() < k) norm_.resize(k), s_.resize(k), is_active_.resize(k);
 }
 
-bool DualActiveSetQp::direction(const Eigen::Ref<const Eigen::MatrixXd>& A, int row, double& zn) {
+void DualActiveSetQp::direction(const Eigen::Ref<const Eigen::MatrixXd>& A, int row, double& zn) {
   const int p = p_, a = na_;
   const double* Lp = l_.data();
   const Eigen::Index ls = l_.outerStride();
@@ -62,7 +62,6 @@ bool DualActiveSetQp::direction(const Eigen::Ref<const Eigen::MatrixXd>& A, int 
     for (int c = i + 1; c < p; ++c) v -= Lp[c + i * ls] * z[c];
     z[i] = v / Lp[i + i * ls];
   }
-  return true;
 }
 
 // Column j of J and T from B's column j and J's first j columns (modified Gram-Schmidt, twice).
@@ -135,10 +134,7 @@ DualActiveSetQp::Result DualActiveSetQp::solve(const Eigen::Ref<const Eigen::Mat
       continue;
     }
     double zn = 0.0;
-    if (na_ >= p || !direction(A, i, zn)) {  // as many active rows as unknowns: a dependent row
-      if (std::abs(slack(i)) > met(i)) return kInfeasible;
-      continue;
-    }
+    direction(A, i, zn);
     if (zn == 0.0) {  // implied by the earlier equalities: consistent, or no point at all
       if (std::abs(slack(i)) > met(i)) return kInfeasible;
       continue;
@@ -173,7 +169,7 @@ DualActiveSetQp::Result DualActiveSetQp::solve(const Eigen::Ref<const Eigen::Mat
     while (true) {  // steps for the row `add` until it is met
       if (++steps > max_steps) return kStepLimit;
       double zn = 0.0;
-      (void)direction(A, add, zn);
+      direction(A, add, zn);
       // The partial step: the first inequality multiplier to reach zero.
       int drop = -1;
       double t1 = std::numeric_limits<double>::infinity();

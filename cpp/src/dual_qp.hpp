@@ -10,8 +10,7 @@
 // linearly independent. The active normals in H^-1's metric, B = L^-1 N (H = L L^T), are kept as
 // B = J T (orthonormal J, upper triangular T), extended by one Gram-Schmidt column when a row
 // enters and refactored from the dropped column on when one leaves: meant for p and k of a few
-// dozen. Workspace by reserve(p, k);
-// solve() allocates nothing within it.
+// dozen. Workspace by reserve(p, k); solve() allocates nothing within it.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,9 +36,9 @@ class DualActiveSetQp {
  private:
   // The step for the row `row` (its normal n = A_row^T) with the active rows: primal direction
   // z = H^-1 n projected off the active normals in H^-1's metric, dual direction r (the active
-  // multipliers' change per unit of the new one). Returns z^T n (0 when n depends on the active
-  // normals); false when the active Gram matrix is not safely positive definite.
-  bool direction(const Eigen::Ref<const Eigen::MatrixXd>& A, int row, double& zn);
+  // multipliers' change per unit of the new one). zn: z^T n (0 when n depends on the active
+  // normals).
+  void direction(const Eigen::Ref<const Eigen::MatrixXd>& A, int row, double& zn);
   void orthogonalize(int j);
   void addActive(int row, double u);
   void dropActive(int j);

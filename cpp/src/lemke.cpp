@@ -195,14 +195,16 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
                                      int eq) {
   const int p = static_cast<int>(C.cols()), k = static_cast<int>(r.size());
   auto Q = q_.topLeftCorner(p, p);
-  Q.noalias() = C.transpose().lazyProduct(C);
+  Q.noalias() = C.transpose() * C;
   auto c = c_.head(p);
   c.noalias() = C.transpose() * t;
   const int limit = 100 + 40 * (2 * p + k);
   by_active_set_ = false;
-  if (C.rows() > 0) {
-    if ((by_active_set_ = activeSetSolve(P, pv, R, r, x, eq))) return Lemke::kSolved;
-    if (infeasible_ && eq == 0) return Lemke::kRay;  // (with E's pairs, their slack may matter)
+  if (C.rows() > 0 && eq == 0) {
+    const ActiveSet as = activeSetSolve(P, pv, R, r, x);
+    by_active_set_ = as == ActiveSet::kAnswered;
+    if (by_active_set_) return Lemke::kSolved;
+    if (as == ActiveSet::kInfeasible) return Lemke::kRay;
   }
   if (C.rows() == 0) {  // no first objective: x1 = 0 (the caller's point, feasible), Z spans everything
     x.setZero();
@@ -232,6 +234,15 @@ bool LexicographicQp::secondOnNull(const Eigen::Ref<const Eigen::MatrixXd>& P,
                                    const Eigen::Ref<const Eigen::MatrixXd>& Rs,
                                    const Eigen::Ref<const Eigen::VectorXd>& rs,
                                    const Eigen::Ref<const Eigen::VectorXd>& x, int d) {
+  secondData(P, pv, Rs, rs, x, d);
+  return secondPivoting(d, static_cast<int>(rs.size()));
+}
+
+void LexicographicQp::secondData(const Eigen::Ref<const Eigen::MatrixXd>& P,
+                                 const Eigen::Ref<const Eigen::VectorXd>& pv,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& Rs,
+                                 const Eigen::Ref<const Eigen::VectorXd>& rs,
+                                 const Eigen::Ref<const Eigen::VectorXd>& x, int d) {
   const int p = static_cast<int>(x.size()), k = static_cast<int>(rs.size());
   const auto Z = z_.topLeftCorner(p, d);
   auto PZ = v_.topLeftCorner(p, d);  // V is no longer needed
@@ -248,6 +259,13 @@ bool LexicographicQp::secondOnNull(const Eigen::Ref<const Eigen::MatrixXd>& P,
   auto r2 = r2_.head(k);
   r2 = rs;
   r2.noalias() -= Rs * x;
+}
+
+bool LexicographicQp::secondPivoting(int d, int k) {
+  const auto Q2 = q2_.topLeftCorner(d, d);
+  const auto c2 = c2_.head(d);
+  const auto RZ = rz_.topLeftCorner(k, d);
+  auto r2 = r2_.head(k);
   // x1 meets every row in exact arithmetic (the first programme's answer, or the caller's feasible
   // point); a row it misses by round-off would make w = 0 infeasible and the pivoting end on a
   // ray. Such a row asks only that w not make it worse.

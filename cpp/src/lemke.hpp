@@ -73,10 +73,10 @@ class ConvexQp {
 // primal's pivoting stalls on the degenerate pairs), it runs once more on the null space of
 // [C; E] with the other rows only (secondOnEqualities); when C has no rows that form runs first
 // (the doubled primal over all p unknowns only if it fails: the same minimiser in exact
-// arithmetic, E x = 0 kept exactly instead of within the pairs' slack). All of that is the fallback:
-// when C has rows, both programmes are first tried by the dual active-set method with a certificate
-// (lexicographic_active.cpp), which returns kRay itself when it proves the rows admit no point (without
-// E). Workspace by reserve(p, k) (p unknowns, k rows); solve() allocates nothing within it.
+// arithmetic, E x = 0 kept exactly instead of within the pairs' slack). Without E (eq = 0) and when C
+// has rows, all of that is the fallback: both programmes are first tried by the dual active-set
+// method with a certificate (lexicographic_active.cpp), which returns kRay itself when it proves the
+// rows admit no point. Workspace by reserve(p, k) (p unknowns, k rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:
   void reserve(int p, int k);
@@ -95,20 +95,28 @@ class LexicographicQp {
   bool secondOnNull(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
                     const Eigen::Ref<const Eigen::MatrixXd>& Rs, const Eigen::Ref<const Eigen::VectorXd>& rs,
                     const Eigen::Ref<const Eigen::VectorXd>& x, int d);
+  // secondOnNull's two halves: the programme in w into q2_, c2_, rz_, r2_ (activeSetSolve builds
+  // the same with coefficient-wise products); then its pivoting, which reads them.
+  void secondData(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
+                  const Eigen::Ref<const Eigen::MatrixXd>& Rs, const Eigen::Ref<const Eigen::VectorXd>& rs,
+                  const Eigen::Ref<const Eigen::VectorXd>& x, int d);
+  bool secondPivoting(int d, int k);
   bool strictSecond(const Eigen::Ref<const Eigen::MatrixXd>& Q2, const Eigen::Ref<const Eigen::VectorXd>& c2,
                     const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
                     Eigen::Ref<Eigen::VectorXd> w);
   int nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q);
-  // The first try by the dual active-set method, certified (lexicographic_active.cpp): true when x
-  // holds the answer; false leaves the pivoting to find it.
-  bool activeSetSolve(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
-                      const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
-                      Eigen::Ref<Eigen::VectorXd> x, int eq);
+  // The first try by the dual active-set method without equality pairs (eq = 0), certified
+  // (lexicographic_active.cpp): kAnswered
+  // when x holds the answer, kInfeasible when the rows admit no point, else kUnknown (the pivoting
+  // then finds it).
+  enum class ActiveSet { kAnswered, kInfeasible, kUnknown };
+  ActiveSet activeSetSolve(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
+                           const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
+                           Eigen::Ref<Eigen::VectorXd> x);
   bool firstOnActive(int p);
-  bool certified(const Eigen::Ref<const Eigen::VectorXd>& x, int eq, int rows);
+  bool certified(const Eigen::Ref<const Eigen::VectorXd>& x, int rows);
   void reserveActiveSet(int p, int k);
   DualActiveSetQp gi_, gi2_;  // the first programme's active rows; the second programme
-  bool infeasible_ = false;   // activeSetSolve: the rows admit no point
   bool by_active_set_ = false;
   Eigen::MatrixXd as_h_, as_pw_, as_s_, as_v_, as_rw_, as_gw_, as_lw_, as_a_;
   Eigen::VectorXd as_g_, as_x_, as_y_, as_t_, as_diag_, as_l_, as_b_;

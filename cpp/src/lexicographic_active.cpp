@@ -1,16 +1,17 @@
 // LexicographicQp's first try (lemke.hpp): the two programmes by the dual active-set method
 // (dual_qp.hpp) instead of Lemke's pivoting on the doubled primal, with a certificate; when any
 // part does not hold, solve() goes on with the pivoting, which does not depend on this.
+// Only without the equality pairs (eq = 0: the all-active guess and the whole-body solve): with
+// them (the least-effort stage) the pivoting runs as before.
 //   1. The active rows W of the strictly convex programme min 1/2 ||t + C x||^2 + eps (1/2 x^T P x
-//      + p^T x) (eps = 1e-7 of the two Hessians' scale ratio; over E x = 0, E^T E added with the
-//      first Hessian's scale, zero on the feasible set): for small eps its minimiser is near the
-//      lexicographic one and its active rows are the lexicographic answer's.
+//      + p^T x) (eps = 1e-7 of the two Hessians' scale ratio): for small eps its minimiser is near
+//      the lexicographic one and its active rows are the lexicographic answer's.
 //   2. The first programme on W's rows held as equalities, exactly: x1 = y + P_W v with y on the
 //      rows (R_W y = r_W, the least change of step 1's x) and P_W = I - R_W^T (R_W R_W^T)^-1 R_W
 //      the projector onto their null space, v from P_W Q P_W v = -P_W (c + Q y) (Q = C^T C,
 //      c = C^T t; a consistent positive semi-definite system, a pivoted Cholesky factor's
 //      particular solution).
-//   3. The second programme on C's null space from x1 (x = x1 + Z w; with E, on [C; E]'s), by the
+//   3. The second programme on C's null space from x1 (x = x1 + Z w), by the
 //      dual active-set method: it needs no feasible start, so x1 need not meet the other rows.
 //   4. The certificate: every row met to round-off (1e-9 of its terms), and x optimal for the first
 //      programme: its gradient C^T (t + C x) = R_W^T l with l >= 0 on the inequalities, every row
@@ -18,7 +19,6 @@
 //      over the first's optimal set {R x >= r, C x = C x1}).
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "dense_small.hpp"
 #include "lemke.hpp"
@@ -84,14 +84,8 @@ bool LexicographicQp::firstOnActive(int p) {
   const int r = pivotedCholeskyLeft(S, as_idx_, p, V, as_diag_, as_piv_, 1e-12 * top);
   auto w = as_l_.head(std::max(r, 1));
   for (int i = 0; i < r; ++i) w(i) = rhs(as_piv_(i));
-  for (int i = 0; i < r; ++i) {  // L1 L1^T w = rhs(piv), L1(i, j) = V(piv(i), j)
-    for (int j = 0; j < i; ++j) w(i) -= V(as_piv_(i), j) * w(j);
-    w(i) /= V(as_piv_(i), i);
-  }
-  for (int i = r - 1; i >= 0; --i) {
-    for (int j = i + 1; j < r; ++j) w(i) -= V(as_piv_(j), i) * w(j);
-    w(i) /= V(as_piv_(i), i);
-  }
+  pivotedForward(V, as_piv_, r, w);  // L1 L1^T w = rhs(piv)
+  pivotedBackward(V, as_piv_, r, w);
   auto v = as_x_.head(p);  // (step 1's x is no longer needed)
   v.setZero();
   for (int i = 0; i < r; ++i) v(as_piv_(i)) = w(i);
@@ -99,8 +93,8 @@ bool LexicographicQp::firstOnActive(int p) {
   return true;
 }
 
-// Step 4 at x: every row met, the equalities held, the first programme's multipliers on W.
-bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int eq, int rows) {
+// Step 4 at x: every row met, the first programme's multipliers on W.
+bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int rows) {
   const int p = static_cast<int>(x.size()), a = gi_.activeCount();
   const double xs = std::max(1.0, x.cwiseAbs().maxCoeff());
   const auto row_tol = [&](int i) {
@@ -108,7 +102,7 @@ bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int 
   };
   for (int i = 0; i < rows; ++i) {
     const double s = as_a_.row(i).head(p).dot(x) - as_b_(i);
-    if (i < eq ? std::abs(s) > row_tol(i) : s < -row_tol(i)) return false;
+    if (s < -row_tol(i)) return false;
   }
   const auto Q = q_.topLeftCorner(p, p);
   auto grad = as_g_.head(p);
@@ -126,7 +120,6 @@ bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int 
   if (res.cwiseAbs().maxCoeff() > 1e-9 * gs) return false;
   for (int j = 0; j < a; ++j) {
     const int i = gi_.active(j);
-    if (i < eq) continue;
     // A multiplier's scale: the gradient's over the row's length.
     const double ls = 1e-9 * gs / std::max(1e-300, as_a_.row(i).head(p).norm());
     if (l(j) < -ls) return false;
@@ -135,86 +128,68 @@ bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int 
   return true;
 }
 
-bool LexicographicQp::activeSetSolve(const Eigen::Ref<const Eigen::MatrixXd>& P,
-                                     const Eigen::Ref<const Eigen::VectorXd>& pv,
-                                     const Eigen::Ref<const Eigen::MatrixXd>& R,
-                                     const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::Ref<Eigen::VectorXd> x,
-                                     int eq) {
-  const int p = static_cast<int>(x.size()), k = static_cast<int>(r.size()) - 2 * eq, rows = eq + k;
-  infeasible_ = false;
+LexicographicQp::ActiveSet LexicographicQp::activeSetSolve(const Eigen::Ref<const Eigen::MatrixXd>& P,
+                                                           const Eigen::Ref<const Eigen::VectorXd>& pv,
+                                                           const Eigen::Ref<const Eigen::MatrixXd>& R,
+                                                           const Eigen::Ref<const Eigen::VectorXd>& r,
+                                                           Eigen::Ref<Eigen::VectorXd> x) {
+  const int p = static_cast<int>(x.size()), k = static_cast<int>(r.size());
   const auto Q = q_.topLeftCorner(p, p);
   const double sq = Q.diagonal().maxCoeff(), sp = P.diagonal().maxCoeff();
-  if (!(sq > 0.0) || !(sp > 0.0)) return false;
-  // The rows: E x = 0 (R's first eq rows; the pairs' second halves left out), then the others.
-  auto A = as_a_.topLeftCorner(rows, p);
-  auto b = as_b_.head(rows);
-  A.topRows(eq) = R.topRows(eq);
-  b.head(eq).setZero();
-  A.bottomRows(k) = R.bottomRows(k);
-  b.tail(k) = r.tail(k);
+  if (!(sq > 0.0) || !(sp > 0.0)) return ActiveSet::kUnknown;
+  auto A = as_a_.topLeftCorner(k, p);
+  auto b = as_b_.head(k);
+  A = R;
+  b = r;
   // Step 1.
   const double eps = 1e-7 * sq / sp;
   auto H = as_h_.topLeftCorner(p, p);
   H = Q + eps * P;
-  if (eq > 0) {
-    const double se = std::max(1e-300, A.topRows(eq).cwiseAbs2().rowwise().sum().maxCoeff());
-    H.noalias() += (sq / se) * A.topRows(eq).transpose().lazyProduct(A.topRows(eq));
-  }
   auto g = as_g_.head(p);
   g = c_.head(p) + eps * pv;
-  const int limit = 5 * (p + rows) + 20;
-  if (const DualActiveSetQp::Result res = gi_.solve(H, g, A, b, eq, as_x_.head(p), limit);
-      res != DualActiveSetQp::kSolved) {
-    // No point meets the rows (a violated row that active ones imply with non-negative weights,
-    // beyond round-off): both programmes have no answer.
-    if (res == DualActiveSetQp::kInfeasible) infeasible_ = true;
-    return false;
+  switch (gi_.solve(H, g, A, b, 0, as_x_.head(p), 5 * (p + k) + 20)) {
+    case DualActiveSetQp::kSolved:
+      break;
+    case DualActiveSetQp::kInfeasible:  // a violated row that active ones imply, beyond round-off
+      return ActiveSet::kInfeasible;
+    default:
+      return ActiveSet::kUnknown;
   }
   // Step 2.
-  if (!firstOnActive(p)) return false;
-  auto x1 = as_y_.head(p);
-  // Step 3: the second programme on the null space of C (and E).
-  int d = 0;
-  if (eq == 0) {
-    d = nullBasis(Q);
-  } else {
-    auto Qe = q2_.topLeftCorner(p, p);
-    Qe.noalias() = A.topRows(eq).transpose().lazyProduct(A.topRows(eq));
-    Qe /= std::max(1e-300, Qe.diagonal().maxCoeff());
-    Qe += Q / sq;
-    d = nullBasis(Qe);
-  }
+  if (!firstOnActive(p)) return ActiveSet::kUnknown;
+  const auto x1 = as_y_.head(p);
+  // Step 3: the second programme on the null space of C.
+  const int d = nullBasis(Q);
   x = x1;
   if (d > 0) {
+    // secondData's programme, its products coefficient by coefficient (this path's sizes are a
+    // few dozen at most; Eigen's blocked product dominated them), into the same members.
     const auto Z = z_.topLeftCorner(p, d);
     auto PZ = v_.topLeftCorner(p, d);
     PZ.noalias() = P.lazyProduct(Z);
-    auto Q2 = q2_.topLeftCorner(d, d);
-    Q2.noalias() = Z.transpose().lazyProduct(PZ);
+    q2_.topLeftCorner(d, d).noalias() = Z.transpose().lazyProduct(PZ);
     auto grad = w_.head(p);
     grad.noalias() = P * x1;
     grad += pv;
-    auto c2 = c2_.head(d);
-    c2.noalias() = Z.transpose() * grad;
-    auto RZ = rz_.topLeftCorner(k, d);
-    RZ.noalias() = A.bottomRows(k).lazyProduct(Z);
-    auto r2 = r2_.head(k);
-    r2 = b.tail(k);
-    r2.noalias() -= A.bottomRows(k) * x1;
+    c2_.head(d).noalias() = Z.transpose() * grad;
+    rz_.topLeftCorner(k, d).noalias() = A.lazyProduct(Z);
+    r2_.head(k) = b;
+    r2_.head(k).noalias() -= A * x1;
     auto w = as_t_.head(d);
     // (a second solver: the certificate reads step 1's active rows from gi_)
-    if (gi2_.solve(Q2, c2, RZ, r2, 0, w, 5 * (d + k) + 20) == DualActiveSetQp::kSolved) {
+    if (gi2_.solve(q2_.topLeftCorner(d, d), c2_.head(d), rz_.topLeftCorner(k, d), r2_.head(k), 0, w,
+                   5 * (d + k) + 20) == DualActiveSetQp::kSolved) {
       x.noalias() += Z * w;
     } else {
       // A degenerate vertex (more rows active than null directions, their multipliers huge) can
       // stall the method on round-off: the second programme by the pivoting of its dual, from x1
       // when x1 meets every row.
-      if (r2.maxCoeff() > 1e-9 * std::max(1.0, b.tail(k).cwiseAbs().maxCoeff())) return false;
-      if (!secondOnNull(P, pv, A.bottomRows(k), b.tail(k), x1, d)) return false;
+      if (r2_.head(k).maxCoeff() > 1e-9 * std::max(1.0, b.cwiseAbs().maxCoeff())) return ActiveSet::kUnknown;
+      if (!secondPivoting(d, k)) return ActiveSet::kUnknown;
       x.noalias() += Z * w_.head(d);
     }
   }
-  return certified(x, eq, rows);
+  return certified(x, k) ? ActiveSet::kAnswered : ActiveSet::kUnknown;
 }
 
 }  // namespace detail
