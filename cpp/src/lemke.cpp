@@ -195,16 +195,16 @@ Lemke::Result LexicographicQp::solve(const Eigen::Ref<const Eigen::MatrixXd>& C,
                                      int eq) {
   const int p = static_cast<int>(C.cols()), k = static_cast<int>(r.size());
   auto Q = q_.topLeftCorner(p, p);
-  Q.noalias() = C.transpose() * C;
+  Q.noalias() = C.transpose().lazyProduct(C);
   auto c = c_.head(p);
   c.noalias() = C.transpose() * t;
   const int limit = 100 + 40 * (2 * p + k);
   by_active_set_ = false;
-  if (C.rows() > 0 && eq == 0) {
-    const ActiveSet as = activeSetSolve(P, pv, R, r, x);
+  if (C.rows() > 0) {
+    const ActiveSet as = activeSetSolve(P, pv, R, r, x, eq);
     by_active_set_ = as == ActiveSet::kAnswered;
     if (by_active_set_) return Lemke::kSolved;
-    if (as == ActiveSet::kInfeasible) return Lemke::kRay;
+    if (as == ActiveSet::kInfeasible && eq == 0) return Lemke::kRay;  // (with E, the pairs' slack may matter)
   }
   if (C.rows() == 0) {  // no first objective: x1 = 0 (the caller's point, feasible), Z spans everything
     x.setZero();

@@ -73,10 +73,11 @@ class ConvexQp {
 // primal's pivoting stalls on the degenerate pairs), it runs once more on the null space of
 // [C; E] with the other rows only (secondOnEqualities); when C has no rows that form runs first
 // (the doubled primal over all p unknowns only if it fails: the same minimiser in exact
-// arithmetic, E x = 0 kept exactly instead of within the pairs' slack). Without E (eq = 0) and when C
-// has rows, all of that is the fallback: both programmes are first tried by the dual active-set
-// method with a certificate (lexicographic_active.cpp), which returns kRay itself when it proves the
-// rows admit no point. Workspace by reserve(p, k) (p unknowns, k rows); solve() allocates nothing within it.
+// arithmetic, E x = 0 kept exactly instead of within the pairs' slack). When C has rows, all of that
+// is the fallback: both programmes are first tried by the dual active-set method with a certificate
+// (lexicographic_active.cpp; E x = 0 as an equality there), which returns kRay itself when it proves
+// the rows admit no point (without E: with it the pairs' slack might). Workspace by reserve(p, k)
+// (p unknowns, k rows); solve() allocates nothing within it.
 class LexicographicQp {
  public:
   void reserve(int p, int k);
@@ -105,16 +106,15 @@ class LexicographicQp {
                     const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
                     Eigen::Ref<Eigen::VectorXd> w);
   int nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q);
-  // The first try by the dual active-set method without equality pairs (eq = 0), certified
-  // (lexicographic_active.cpp): kAnswered
+  // The first try by the dual active-set method, certified (lexicographic_active.cpp): kAnswered
   // when x holds the answer, kInfeasible when the rows admit no point, else kUnknown (the pivoting
   // then finds it).
   enum class ActiveSet { kAnswered, kInfeasible, kUnknown };
   ActiveSet activeSetSolve(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& pv,
                            const Eigen::Ref<const Eigen::MatrixXd>& R, const Eigen::Ref<const Eigen::VectorXd>& r,
-                           Eigen::Ref<Eigen::VectorXd> x);
+                           Eigen::Ref<Eigen::VectorXd> x, int eq);
   bool firstOnActive(int p);
-  bool certified(const Eigen::Ref<const Eigen::VectorXd>& x, int rows);
+  bool certified(const Eigen::Ref<const Eigen::VectorXd>& x, int eq, int rows);
   void reserveActiveSet(int p, int k);
   DualActiveSetQp gi_, gi2_;  // the first programme's active rows; the second programme
   bool by_active_set_ = false;

@@ -1,19 +1,20 @@
 // LexicographicQp's first try (lemke.hpp): the two programmes by the dual active-set method
 // (dual_qp.hpp) instead of Lemke's pivoting on the doubled primal, with a certificate; when any
 // part does not hold, solve() goes on with the pivoting, which does not depend on this.
-// Only without the equality pairs (eq = 0: the all-active guess and the whole-body solve): with
-// them (the least-effort stage) the pivoting runs as before.
 //   1. The active rows W of the strictly convex programme min 1/2 ||t + C x||^2 + eps (1/2 x^T P x
 //      + p^T x) (eps = 1e-7 of the two Hessians' scale ratio): for small eps its minimiser is near
-//      the lexicographic one and its active rows are the lexicographic answer's.
+//      the lexicographic one and its active rows are the lexicographic answer's. With the equality
+//      E x = 0 (R's first eq rows, written there as pairs within a round-off slack; here one
+//      equality row each, the pairs' second halves left out) E^T E is added at the first Hessian's
+//      scale, zero on the feasible set.
 //   2. The first programme on W's rows held as equalities, exactly: x1 = y + P_W v with y on the
 //      rows (R_W y = r_W, the least change of step 1's x) and P_W = I - R_W^T (R_W R_W^T)^-1 R_W
 //      the projector onto their null space, v from P_W Q P_W v = -P_W (c + Q y) (Q = C^T C,
 //      c = C^T t; a consistent positive semi-definite system, a pivoted Cholesky factor's
 //      particular solution).
-//   3. The second programme on C's null space from x1 (x = x1 + Z w), by the
+//   3. The second programme on C's null space (with E: on [C; E]'s) from x1 (x = x1 + Z w), by the
 //      dual active-set method: it needs no feasible start, so x1 need not meet the other rows.
-//   4. The certificate: every row met to round-off (1e-9 of its terms), and x optimal for the first
+//   4. The certificate: every row met to round-off (1e-9 of its terms; E x = 0 too), and x optimal for the first
 //      programme: its gradient C^T (t + C x) = R_W^T l with l >= 0 on the inequalities, every row
 //      with l > 0 active at x. Then x is the lexicographic answer (the second programme's optimum
 //      over the first's optimal set {R x >= r, C x = C x1}).
@@ -94,7 +95,7 @@ bool LexicographicQp::firstOnActive(int p) {
 }
 
 // Step 4 at x: every row met, the first programme's multipliers on W.
-bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int rows) {
+bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int eq, int rows) {
   const int p = static_cast<int>(x.size()), a = gi_.activeCount();
   const double xs = std::max(1.0, x.cwiseAbs().maxCoeff());
   const auto row_tol = [&](int i) {
@@ -102,7 +103,7 @@ bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int 
   };
   for (int i = 0; i < rows; ++i) {
     const double s = as_a_.row(i).head(p).dot(x) - as_b_(i);
-    if (s < -row_tol(i)) return false;
+    if (i < eq ? std::abs(s) > row_tol(i) : s < -row_tol(i)) return false;
   }
   const auto Q = q_.topLeftCorner(p, p);
   auto grad = as_g_.head(p);
@@ -120,6 +121,7 @@ bool LexicographicQp::certified(const Eigen::Ref<const Eigen::VectorXd>& x, int 
   if (res.cwiseAbs().maxCoeff() > 1e-9 * gs) return false;
   for (int j = 0; j < a; ++j) {
     const int i = gi_.active(j);
+    if (i < eq) continue;  // an equality's multiplier has no sign
     // A multiplier's scale: the gradient's over the row's length.
     const double ls = 1e-9 * gs / std::max(1e-300, as_a_.row(i).head(p).norm());
     if (l(j) < -ls) return false;
@@ -132,22 +134,29 @@ LexicographicQp::ActiveSet LexicographicQp::activeSetSolve(const Eigen::Ref<cons
                                                            const Eigen::Ref<const Eigen::VectorXd>& pv,
                                                            const Eigen::Ref<const Eigen::MatrixXd>& R,
                                                            const Eigen::Ref<const Eigen::VectorXd>& r,
-                                                           Eigen::Ref<Eigen::VectorXd> x) {
-  const int p = static_cast<int>(x.size()), k = static_cast<int>(r.size());
+                                                           Eigen::Ref<Eigen::VectorXd> x, int eq) {
+  const int p = static_cast<int>(x.size()), k = static_cast<int>(r.size()) - 2 * eq, rows = eq + k;
   const auto Q = q_.topLeftCorner(p, p);
   const double sq = Q.diagonal().maxCoeff(), sp = P.diagonal().maxCoeff();
   if (!(sq > 0.0) || !(sp > 0.0)) return ActiveSet::kUnknown;
-  auto A = as_a_.topLeftCorner(k, p);
-  auto b = as_b_.head(k);
-  A = R;
-  b = r;
-  // Step 1.
+  // The rows: E x = 0 (R's first eq rows; the pairs' second halves left out), then the others.
+  auto A = as_a_.topLeftCorner(rows, p);
+  auto b = as_b_.head(rows);
+  A.topRows(eq) = R.topRows(eq);
+  b.head(eq).setZero();
+  A.bottomRows(k) = R.bottomRows(k);
+  b.tail(k) = r.tail(k);
+  // Step 1 (with E: E^T E at the first Hessian's scale added, zero on the feasible set).
   const double eps = 1e-7 * sq / sp;
   auto H = as_h_.topLeftCorner(p, p);
   H = Q + eps * P;
+  if (eq > 0) {
+    const double se = std::max(1e-300, A.topRows(eq).cwiseAbs2().rowwise().sum().maxCoeff());
+    H.noalias() += (sq / se) * A.topRows(eq).transpose().lazyProduct(A.topRows(eq));
+  }
   auto g = as_g_.head(p);
   g = c_.head(p) + eps * pv;
-  switch (gi_.solve(H, g, A, b, 0, as_x_.head(p), 5 * (p + k) + 20)) {
+  switch (gi_.solve(H, g, A, b, eq, as_x_.head(p), 5 * (p + rows) + 20)) {
     case DualActiveSetQp::kSolved:
       break;
     case DualActiveSetQp::kInfeasible:  // a violated row that active ones imply, beyond round-off
@@ -158,8 +167,17 @@ LexicographicQp::ActiveSet LexicographicQp::activeSetSolve(const Eigen::Ref<cons
   // Step 2.
   if (!firstOnActive(p)) return ActiveSet::kUnknown;
   const auto x1 = as_y_.head(p);
-  // Step 3: the second programme on the null space of C.
-  const int d = nullBasis(Q);
+  // Step 3: the second programme on the null space of C (with E: of [C; E]).
+  int d = 0;
+  if (eq == 0) {
+    d = nullBasis(Q);
+  } else {
+    auto Qe = q2_.topLeftCorner(p, p);
+    Qe.noalias() = A.topRows(eq).transpose().lazyProduct(A.topRows(eq));
+    Qe /= std::max(1e-300, Qe.diagonal().maxCoeff());
+    Qe += Q / sq;
+    d = nullBasis(Qe);
+  }
   x = x1;
   if (d > 0) {
     // secondData's programme, its products coefficient by coefficient (this path's sizes are a
@@ -172,9 +190,9 @@ LexicographicQp::ActiveSet LexicographicQp::activeSetSolve(const Eigen::Ref<cons
     grad.noalias() = P * x1;
     grad += pv;
     c2_.head(d).noalias() = Z.transpose() * grad;
-    rz_.topLeftCorner(k, d).noalias() = A.lazyProduct(Z);
-    r2_.head(k) = b;
-    r2_.head(k).noalias() -= A * x1;
+    rz_.topLeftCorner(k, d).noalias() = A.bottomRows(k).lazyProduct(Z);
+    r2_.head(k) = b.tail(k);
+    r2_.head(k).noalias() -= A.bottomRows(k) * x1;
     auto w = as_t_.head(d);
     // (a second solver: the certificate reads step 1's active rows from gi_)
     if (gi2_.solve(q2_.topLeftCorner(d, d), c2_.head(d), rz_.topLeftCorner(k, d), r2_.head(k), 0, w,
@@ -184,12 +202,12 @@ LexicographicQp::ActiveSet LexicographicQp::activeSetSolve(const Eigen::Ref<cons
       // A degenerate vertex (more rows active than null directions, their multipliers huge) can
       // stall the method on round-off: the second programme by the pivoting of its dual, from x1
       // when x1 meets every row.
-      if (r2_.head(k).maxCoeff() > 1e-9 * std::max(1.0, b.cwiseAbs().maxCoeff())) return ActiveSet::kUnknown;
+      if (r2_.head(k).maxCoeff() > 1e-9 * std::max(1.0, b.tail(k).cwiseAbs().maxCoeff())) return ActiveSet::kUnknown;
       if (!secondPivoting(d, k)) return ActiveSet::kUnknown;
       x.noalias() += Z * w_.head(d);
     }
   }
-  return certified(x, k) ? ActiveSet::kAnswered : ActiveSet::kUnknown;
+  return certified(x, eq, rows) ? ActiveSet::kAnswered : ActiveSet::kUnknown;
 }
 
 }  // namespace detail

@@ -180,7 +180,8 @@ TEST_CASE("LexicographicQp: least first objective, then least second, against an
     ++checked;
   }
   CHECK(checked == 300);
-  MESSAGE("answered by the active-set method: ", fast, " of the 240 without the equality pair");
-  CHECK(fast >= 192);   // the pivoting only where the method stalls (degenerate vertices)
-  CHECK(fast_eq == 0);  // with the pair, the pivoting alone
+  MESSAGE("answered by the active-set method: ", fast, " of the 240 without the equality pair, ", fast_eq,
+          " of the 60 with it");
+  CHECK(fast >= 192);    // the pivoting only where the method stalls (degenerate vertices)
+  CHECK(fast_eq >= 48);  // with the pair as well (E x = 0 held as an equality)
 }

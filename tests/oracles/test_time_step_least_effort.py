@@ -134,11 +134,17 @@ def _oracle(prob, A, qdd):
     T[:, :m] = A.T
     x1 = _qp(T.T @ T, E, e, lo, hi)
     tau_cmd = T @ x1
-    # Then the least contact forces with the motors' torques kept.
-    F = np.zeros((3 * len(gens), E.shape[1]))
+    # Then the least contact forces with the motors' torques kept: tau_command = A^T nu is unique,
+    # so the second programme is over the other unknowns y (force weights, sticking joints'
+    # torques) with A^T nu moved to the right-hand side: E_y y = e - tau_command. (Held instead to
+    # T x = tau_command beside E x = e over all unknowns, a feasible set that is a single point or a
+    # thin face of the bounds left ProxQP's second solve reporting primal infeasibility.)
+    F = np.zeros((3 * len(gens), E.shape[1] - m))
     for i, G in enumerate(gens):
-        F[3 * i : 3 * i + 3, sizes[i + 1] : sizes[i + 2]] = G
-    x2 = _qp(F.T @ F, np.vstack([E, T]), np.concatenate([e, tau_cmd]), lo, hi)
+        F[3 * i : 3 * i + 3, sizes[i + 1] - m : sizes[i + 2] - m] = G
+    y = _qp(F.T @ F, E[:, m:], e - tau_cmd, lo[m:], hi[m:]) if E.shape[1] > m else np.zeros(0)
+    x2 = np.concatenate([x1[:m], y])
+    F = np.hstack([np.zeros((F.shape[0], m)), F])
     forces = (F @ x2).reshape(-1, 3)
     joint = rhs - A.T @ x2[:m] - sum((c.J.T @ f for c, f in zip(prob.contacts, forces)), np.zeros(n))
     return T @ x2, forces, joint
