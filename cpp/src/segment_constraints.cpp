@@ -214,7 +214,9 @@ void HdCore::moveColumnsToParent(int i, int lo, int w) {
 }
 
 // K = kg (M x M): certified Cholesky (truncation policy, every eigenvalue provably above the
-// threshold) else a Jacobi eigen-decomposition with the policy's multipliers. The Cholesky factor
+// threshold) else an eigen-decomposition with the policy's multipliers (symmetricEigen(): Householder
+// tridiagonalisation and implicit QR, about a third of cyclic Jacobi's work at M = 7; jacobiEigen()
+// only if the QR steps do not converge). The Cholesky factor
 // is built block by block (choleskyBlocks()): its entries off the blocks are exact zeros anyway,
 // and L^-1 is block-diagonal too, so ||L^-1||_F^2 is the sum over the blocks.
 void HdCore::factorizeCouplingGeneral() {
@@ -231,9 +233,16 @@ void HdCore::factorizeCouplingGeneral() {
   }
   auto W = g.work_g.topLeftCorner(m, m);
   auto V = g.vg.topLeftCorner(m, m);
-  W.setZero();  // the exact zeros between the blocks, which kg does not hold
-  forEachCouplingBlock([&](int lo, int w) { W.block(lo, lo, w, w) = g.kg.block(lo, lo, w, w); });
-  detail::jacobiEigen(W, V);
+  const auto fill = [&] {
+    W.setZero();  // the exact zeros between the blocks, which kg does not hold
+    forEachCouplingBlock([&](int lo, int w) { W.block(lo, lo, w, w) = g.kg.block(lo, lo, w, w); });
+  };
+  fill();
+  auto scratch = g.work_v.topLeftCorner(m, 4);
+  if (!detail::symmetricEigen(W, V, scratch)) {  // (the QR steps did not converge: rotations instead)
+    fill();
+    detail::jacobiEigen(W, V);
+  }
   const auto lam = W.diagonal();
   const double cut = options.rcond * std::max(std::max(lam.maxCoeff(), 0.0), ws.kappa);
   res.sigma_min = std::max(lam.minCoeff(), 0.0);
