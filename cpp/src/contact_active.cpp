@@ -2,8 +2,9 @@
 // support held along its normal and every resting point with friction held tangentially. When the
 // forces that hold them are unique and admissible (a support pushes, a sticking force lies inside
 // its polygon), the guess meets every contact condition and is the answer the full problem would
-// give (a resting point with friction sticks whenever every such point can): the final sweep
-// follows, the complementarity problem and the least-effort programme are not needed. Otherwise
+// give (a resting point with friction sticks whenever every such point can): the results follow
+// (finishHeld: linear in the forces from the base solve and the responses, or a final sweep), the
+// complementarity problem is not needed. Otherwise
 // the stage goes on with the general method. A support sliding with friction (its force not along
 // the direction it holds) or the damped policy skips the guess.
 //
@@ -291,9 +292,57 @@ int ContactStage::redundantGuess(DataImpl& d, const SolveInput& in, int k, int d
   const int admissible = activeForces(in, x);
   act_edge_tol_ = 0.0;
   if (admissible != -1) return 0;
-  if (int rc = solveWithForces(d, in)) return rc;
+  if (int rc = finishHeld(d, in)) return rc;
   reportStatus(in, true);
   return 1;
+}
+
+// The results of the held forces (`forces`, the active directions of activeDirections()). On a
+// fixed base with supports only and no pass-through they are linear in the forces from the base
+// solve and the held directions' responses (heldResponse): qdd, nu and the motors' torques move by
+// each direction's response times the force's component along it (a contact's held directions
+// are orthonormal: n, t1, t2), the segments' accelerations follow from qdd (accelerationsOf). The
+// final sweep would give the same to round-off: the forces enter as wrenches, linearly, and its
+// constraints and articulated inertias are the base solve's. Else (set-points: their columns
+// become known forces; a floating base; pass-through) that sweep runs (solveWithForces).
+int ContactStage::finishHeld(DataImpl& d, const SolveInput& in) {
+  HdCore& c = d.core;
+  bool linear = !c.model.floating && c.res.solved && !d.weights.f_any && !d.weights.t_any;
+  for (std::size_t k = 0; k < points_.size() && linear; ++k) linear = in.contacts[k].isSupport();
+  if (!linear) return solveWithForces(d, in);
+  const int m = c.res.m;
+  // Each force's components along its held directions, at their positions (act_w_: free now).
+  auto coef = act_w_.head(act_idx_.size());
+  coef.setZero();
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& p = points_[k];
+    const Vector3 f = forces.col(k);
+    if (p.normal_col >= 0) coef(p.normal_col) = p.n.dot(f);
+    if (p.stick_col >= 0) coef(p.stick_col) = p.t1.dot(f), coef(p.stick_col + 1) = p.t2.dot(f);
+  }
+  // The update's round-off, sum_i |coef_i| |dqdd_i| eps per term, must be negligible against the
+  // accelerations (ill-conditioned held directions give forces far above the problem's scale,
+  // whose responses cancel): else the sweep, which carries the forces through the dynamics.
+  double terms = 0.0;
+  for (int i = 0; i < coef.size(); ++i)
+    if (coef(i) != 0.0) terms += std::abs(coef(i)) * act_dqdd_.col(act_idx_(i)).head(nv_).cwiseAbs().maxCoeff();
+  const double scale = std::max(1.0, c.res.qdd.head(nv_).cwiseAbs().maxCoeff());
+  if (!(terms * std::numeric_limits<double>::epsilon() * static_cast<double>(coef.size()) <= 1e-12 * scale))
+    return solveWithForces(d, in);
+  auto qdd = c.res.qdd.head(nv_);
+  auto tau = c.res.tau_cmd.head(nv_);
+  double* nu = c.res.general ? c.res.nu_user.data() : c.res.nu.data();
+  for (int i = 0; i < coef.size(); ++i) {
+    const double value = coef(i);
+    if (value == 0.0) continue;
+    const int h = act_idx_(i);
+    qdd.noalias() += value * act_dqdd_.col(h).head(nv_);
+    tau.noalias() += value * act_cmd_.col(h).head(nv_);
+    for (int j = 0; j < m; ++j) nu[j] += value * act_dnu_(j, h);
+  }
+  if (!qdd.allFinite() || !tau.allFinite()) return solveWithForces(d, in);
+  c.accelerationsOf(qdd);
+  return 0;
 }
 
 void ContactStage::reserveActive(int directions, int rows) {
@@ -353,7 +402,7 @@ int ContactStage::tryAllActive(DataImpl& d, const SolveInput& in) {
     if (round > 0 && !droppedSeparate(x, k)) return 0;
     for (std::size_t c = 0; c < points_.size(); ++c)
       if (points_[c].dropped) forces.col(c).setZero();
-    if (int rc = solveWithForces(d, in)) return rc;
+    if (int rc = finishHeld(d, in)) return rc;
     reportStatus(in, true);
     return 1;
   }

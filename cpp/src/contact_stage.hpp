@@ -1,8 +1,9 @@
 // The contact stage of solve() (input.contacts, contact.hpp), built in a Data at its first solve
 // with contacts. Per solve:
 //   0. the all-active guess (contact_active.cpp): when every touching support held and every
-//      resting point with friction stuck is consistent and its forces are unique, that is the
-//      answer (one solve with the contacts as constraint columns, then step 4);
+//      resting point with friction stuck is consistent and its forces are admissible (the
+//      least-effort ones where they are not unique), that is the answer (one solve, the held
+//      directions' responses, then the results linear in the forces, or step 4: finishHeld);
 //   1. the contact points' kinematics at (q, qd) (KinematicsData): each contact is separating,
 //      touching at rest, or sliding; a force set-point becomes a constraint column (zero normal
 //      acceleration, held by the motors) plus its normal force as a known wrench;
@@ -273,6 +274,7 @@ class ContactStage {
   bool droppedSeparate(const Eigen::Ref<const Eigen::VectorXd>& x, int k);
   bool heldRowsStill(const Eigen::Ref<const Eigen::VectorXd>& x, int k);
   int redundantGuess(DataImpl& d, const SolveInput& in, int k, int dn);
+  int finishHeld(DataImpl& d, const SolveInput& in);  // the results of `forces`: linear update or final sweep
   Eigen::VectorXi act_seg_, act_idx_, act_piv_, act_normal_, act_tangent_;
   Matrix3X act_dirs_;
   Matrix6X act_wrench_;

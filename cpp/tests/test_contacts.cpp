@@ -239,6 +239,62 @@ TEST_CASE("sticking points with friction equal bilateral point constraints") {
   MESSAGE("worst relative error " << worst << " over " << sticking << " sticking points");
 }
 
+TEST_CASE("a contact solve's outputs are those of the plain solve with its forces as wrenches") {
+  // Supports (frictionless, and with friction at rest: sticking where they hold) with a task on
+  // the last segment or on another one: the contact stage's results, however it reaches them
+  // (the held forces' linear update or a final sweep), must equal a plain solve of the same input
+  // with each reported contact force as a frame wrench at its point, including nu, the command
+  // torques and the segments' accelerations (linkAccelerations).
+  RandomGen g(71);
+  double worst = 0.0;
+  int compared = 0, degenerate = 0;
+  for (int trial = 0; trial < 120; ++trial) {
+    const Model model = randomModel(g, trial % 2 == 1, g.integer(4, 9));
+    const int n = static_cast<int>(model.nrOfJoints()), ns = static_cast<int>(model.nrOfSegments());
+    const int k = g.integer(1, 3);
+    SolveInput in = restingInput(g, model, k, trial % 3 == 0 ? 0.0 : 1.5, std::numeric_limits<double>::quiet_NaN());
+    ConstraintBlock task;
+    task.segment = trial % 4 == 0 ? g.integer(0, ns - 1) : ns - 1;
+    task.columns = std::min(2, n - 1);
+    for (int c = 0; c < task.columns; ++c) task.alfa(3 + c, c) = 1.0;  // angular rows: the points keep moving
+    task.beta.setZero();
+    in.constraints.push_back(task);
+    Data data(model);
+    if (!solve(model, data, in)) continue;
+    // Held directions the motion hardly affects need forces far above the problem's scale (up to
+    // 1e18 N here); both answers then carry round-off of |f| eps in the accelerations, and the
+    // plain solve is no reference: such trials are counted, not compared.
+    if (data.contactForces().cwiseAbs().maxCoeff() > 1e6) {
+      ++degenerate;
+      continue;
+    }
+    SolveInput plain = in;
+    plain.contacts.clear();
+    for (int c = 0; c < k; ++c) {
+      FrameWrench w;
+      w.segment = in.contacts[c].segment;
+      w.point = in.contacts[c].point;
+      w.wrench.head<3>() = data.contactForces().col(c);
+      plain.wrenches.push_back(w);
+    }
+    Data ref(model);
+    REQUIRE(solve(model, ref, plain));
+    const auto rel = [](const auto& a, const auto& b) {
+      return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+    };
+    const double err = std::max({rel(data.qdd(), ref.qdd()), rel(data.commandTorques(), ref.commandTorques()),
+                                 rel(Eigen::VectorXd(data.nu()), Eigen::VectorXd(ref.nu())),
+                                 rel(data.linkAccelerations(), ref.linkAccelerations())});
+    CHECK_MESSAGE(err <= 1e-9, "trial " << trial << ": relative difference " << err);
+    worst = std::max(worst, err);
+    ++compared;
+  }
+  CHECK(compared > 80);
+  CHECK(degenerate <= 5);
+  MESSAGE("worst relative difference " << worst << " over " << compared << " solves (" << degenerate
+                                       << " with forces above 1e6 N left out)");
+}
+
 TEST_CASE("a frictionless force set-point holds the normal and pushes with its force") {
   RandomGen g(59);
   double worst = 0.0;
