@@ -24,6 +24,7 @@
 #include "data_impl.hpp"
 #include "dense_small.hpp"
 #include "hd_core.hpp"
+#include "model_validation.hpp"
 
 namespace vereshchagin {
 namespace detail {
@@ -340,7 +341,9 @@ int ContactStage::finishHeld(DataImpl& d, const SolveInput& in) {
     tau.noalias() += value * act_cmd_.col(h).head(nv_);
     for (int j = 0; j < m; ++j) nu[j] += value * act_dnu_(j, h);
   }
-  if (!qdd.allFinite() || !tau.allFinite()) return solveWithForces(d, in);
+  // (beyond the sweep's bounds: the sweep, which reports it)
+  if (!bounded(qdd) || !bounded(tau) || !bounded(Eigen::Map<const Eigen::VectorXd>(nu, m)))
+    return solveWithForces(d, in);
   c.accelerationsOf(qdd);
   return 0;
 }
