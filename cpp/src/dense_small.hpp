@@ -1,7 +1,8 @@
 // Small dense symmetric linear algebra on preallocated storage (no heap allocation): Cholesky
 // with a pivot threshold and its multi-column solve, rank-revealing L D L^T and pivoted Cholesky
 // for the positive semi-definite matrices of the friction optimisation (dimension <= joints),
-// a Jacobi eigen-decomposition, and the smallest eigenvalue of a symmetric matrix.
+// eigen-decompositions (Householder tridiagonalisation and implicit QR; cyclic Jacobi), and the
+// smallest eigenvalue of a symmetric matrix.
 #pragma once
 
 #include <algorithm>
@@ -237,7 +238,7 @@ void pivotedBackward(const MV& V, const VP& piv, int r, VW&& w) {
 // off-diagonal entry is negligible against its neighbours on the diagonal. Returns false if
 // 30 k steps did not suffice (the diagonal is then still a backward-stable approximation).
 // rotated(i, c, s) is told each rotation R = [c s; -s c] on rows and columns i, i + 1 (T <- R T
-// R^T), for eigenvectors (tridiagonalEigen); the arithmetic on d and e does not depend on it.
+// R^T), for eigenvectors (symmetricEigen); the arithmetic on d and e does not depend on it.
 template <typename VD, typename F>
 bool tridiagonalQr(VD& d, VD& e, int k, F&& rotated) {
   const double eps = std::numeric_limits<double>::epsilon();

@@ -287,13 +287,8 @@ bool LexicographicQp::secondOnEqualities(const Eigen::Ref<const Eigen::MatrixXd>
                                          int eq) {
   const int p = static_cast<int>(x.size()), k = static_cast<int>(r.size()) - 2 * eq;
   const auto Q = q_.topLeftCorner(p, p);
-  const auto E = R.topRows(eq);
-  auto Qe = q2_.topLeftCorner(p, p);
-  Qe.noalias() = E.transpose() * E;
-  const double qs = std::max(1e-300, Q.diagonal().maxCoeff()), es = std::max(1e-300, Qe.diagonal().maxCoeff());
-  Qe /= es;
-  Qe += Q / qs;
-  const int d = nullBasis(Qe);
+  const double qs = std::max(1e-300, Q.diagonal().maxCoeff());
+  const int d = nullBasisWithEqualities(R.topRows(eq));
   if (d == 0) return false;
   if (!secondOnNull(P, pv, R.bottomRows(k), r.tail(k), x, d)) return false;
   auto u = c_.head(p);  // the step Z w, checked before it is taken
@@ -326,13 +321,25 @@ int LexicographicQp::nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q) {
     auto z = z_.col(d++).head(p);
     z.setZero();
     z(b) = 1.0;
-    for (int i = r - 1; i >= 0; --i) {  // L1^T c = -V(b, :)^T, back substitution
-      double v = -V(b, i);
-      for (int j = i + 1; j < r; ++j) v -= V(piv_(j), i) * z(piv_(j));
-      z(piv_(i)) = v / V(piv_(i), i);
-    }
+    auto c = w_.head(std::max(r, 1));  // L1^T c = -V(b, :)^T (w_: free until the second programme)
+    for (int i = 0; i < r; ++i) c(i) = -V(b, i);
+    pivotedBackward(V, piv_, r, c);
+    for (int i = 0; i < r; ++i) z(piv_(i)) = c(i);
   }
   return d;
+}
+
+// nullBasis() of C^T C / |C^T C| + E^T E / |E^T E| (q_ holds C^T C; built in q2_): the directions
+// that keep both C x and E x.
+int LexicographicQp::nullBasisWithEqualities(const Eigen::Ref<const Eigen::MatrixXd>& E) {
+  const int p = static_cast<int>(E.cols());
+  const auto Q = q_.topLeftCorner(p, p);
+  auto Qe = q2_.topLeftCorner(p, p);
+  Qe.noalias() = E.transpose().lazyProduct(E);
+  const double qs = std::max(1e-300, Q.diagonal().maxCoeff()), es = std::max(1e-300, Qe.diagonal().maxCoeff());
+  Qe /= es;
+  Qe += Q / qs;
+  return nullBasis(Qe);
 }
 
 // The second programme has a positive definite Q2 (P is, on Z's span): its dual is an LCP in the

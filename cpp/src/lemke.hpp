@@ -106,6 +106,7 @@ class LexicographicQp {
                     const Eigen::Ref<const Eigen::MatrixXd>& RZ, const Eigen::Ref<const Eigen::VectorXd>& r2,
                     Eigen::Ref<Eigen::VectorXd> w);
   int nullBasis(const Eigen::Ref<const Eigen::MatrixXd>& Q);
+  int nullBasisWithEqualities(const Eigen::Ref<const Eigen::MatrixXd>& E);
   // The first try by the dual active-set method, certified (lexicographic_active.cpp): kAnswered
   // when x holds the answer, kInfeasible when the rows admit no point, else kUnknown (the pivoting
   // then finds it).

@@ -168,16 +168,7 @@ LexicographicQp::ActiveSet LexicographicQp::activeSetSolve(const Eigen::Ref<cons
   if (!firstOnActive(p)) return ActiveSet::kUnknown;
   const auto x1 = as_y_.head(p);
   // Step 3: the second programme on the null space of C (with E: of [C; E]).
-  int d = 0;
-  if (eq == 0) {
-    d = nullBasis(Q);
-  } else {
-    auto Qe = q2_.topLeftCorner(p, p);
-    Qe.noalias() = A.topRows(eq).transpose().lazyProduct(A.topRows(eq));
-    Qe /= std::max(1e-300, Qe.diagonal().maxCoeff());
-    Qe += Q / sq;
-    d = nullBasis(Qe);
-  }
+  const int d = eq == 0 ? nullBasis(Q) : nullBasisWithEqualities(A.topRows(eq));
   x = x1;
   if (d > 0) {
     // secondData's programme, its products coefficient by coefficient (this path's sizes are a
